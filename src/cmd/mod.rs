@@ -1,0 +1,3 @@
+//! One module per subcommand; each starts with what it reads and writes.
+
+pub mod simulate;

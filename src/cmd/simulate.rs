@@ -1,0 +1,261 @@
+//! `slidestack simulate`: one case, one ground motion.
+//!
+//! Reads a record (`--record`, a PEER `.AT2` or two-column time/acceleration file in g; the
+//! built-in Northridge record when absent) and the case from flags or a YAML file (`--config`,
+//! keys as the long flags with `_` for `-`; flags override it). Prints the peaks, slips, switch
+//! count and energy terms as a table or, with `--json`, one JSON object on stdout. Writes the full
+//! time history when `--history OUT.h5|OUT.csv` is given.
+
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use serde::{Deserialize, Serialize};
+use slidestack::dynamics::{
+    self, ExactOptions, G, Ground, Response, System, SystemSpec, simulate_exact, simulate_rk4,
+};
+use slidestack::motion::{self, Record};
+use slidestack::store::write_history;
+use std::path::PathBuf;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Integrator {
+    /// Event-driven closed-form integrator (exact for piecewise-linear ground motion).
+    Exact,
+    /// The paper's fixed-step RK4 with its top-down cluster rule.
+    Rk4,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// YAML file with the case (keys: record, period, alpha, mu, mu_static, damping, scale,
+    /// integrator, rk4_substeps, history); flags given on the command line override it.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Ground-motion record: PEER .AT2 or two-column time/acceleration text, values in g.
+    #[arg(long)]
+    record: Option<PathBuf>,
+    /// Period of the bare structure T_p, s [default: 1.0].
+    #[arg(long)]
+    period: Option<f64>,
+    /// Block mass ratios α_i = m_i/m_p, bottom block first [default: 0.5,0.5].
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
+    alpha: Option<Vec<f64>>,
+    /// Kinetic friction coefficients μ_i, interface 1 (structure–block 1) first [default: 0.2,0.1].
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
+    mu: Option<Vec<f64>>,
+    /// Static friction coefficients (≥ kinetic) [default: equal to --mu].
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
+    mu_static: Option<Vec<f64>>,
+    /// Damping ratio of the bare structure [default: 0.05].
+    #[arg(long)]
+    damping: Option<f64>,
+    /// Factor applied to the record [default: 1.0].
+    #[arg(long)]
+    scale: Option<f64>,
+    /// Integrator [default: exact].
+    #[arg(long, value_enum)]
+    integrator: Option<Integrator>,
+    /// RK4 sub-steps per record interval [default: 10].
+    #[arg(long)]
+    rk4_substeps: Option<usize>,
+    /// Write the time history to this .h5 or .csv file.
+    #[arg(long)]
+    history: Option<PathBuf>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The case as a YAML file states it; every key optional, unknown keys refused.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CaseFile {
+    record: Option<PathBuf>,
+    period: Option<f64>,
+    alpha: Option<Vec<f64>>,
+    mu: Option<Vec<f64>>,
+    mu_static: Option<Vec<f64>>,
+    damping: Option<f64>,
+    scale: Option<f64>,
+    integrator: Option<Integrator>,
+    rk4_substeps: Option<usize>,
+    history: Option<PathBuf>,
+}
+
+#[derive(Debug, Serialize)]
+struct EnergyJson {
+    input: f64,
+    kinetic: f64,
+    strain: f64,
+    damping: f64,
+    friction: f64,
+    friction_per_interface: Vec<f64>,
+}
+
+/// The `--json` contract (README): field names are relied on by users and checks.
+#[derive(Debug, Serialize)]
+struct Output {
+    record: String,
+    dt_s: f64,
+    npts: usize,
+    scale: f64,
+    period_s: f64,
+    period_rigid_s: f64,
+    damping: f64,
+    alpha: Vec<f64>,
+    mu: Vec<f64>,
+    mu_static: Vec<f64>,
+    integrator: Integrator,
+    rk4_substeps: Option<usize>,
+    peak_displacement_m: f64,
+    peak_displacement_time_s: f64,
+    peak_abs_accel_g: Vec<f64>,
+    peak_slip_m: Vec<f64>,
+    residual_slip_m: Vec<f64>,
+    slip_time_s: Vec<f64>,
+    switches: u64,
+    energy: EnergyJson,
+    energy_balance_error: f64,
+    energy_balance_error_max: f64,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let file = match &args.config {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read case file {}", path.display()))?;
+            serde_yaml::from_str::<CaseFile>(&text)
+                .with_context(|| format!("invalid case file {}", path.display()))?
+        }
+        None => CaseFile::default(),
+    };
+    let spec = SystemSpec {
+        period_s: args.period.or(file.period).unwrap_or(1.0),
+        damping_ratio: args.damping.or(file.damping).unwrap_or(0.05),
+        mass_kg: 1.0,
+        alpha: args.alpha.or(file.alpha).unwrap_or_else(|| vec![0.5, 0.5]),
+        mu: args.mu.or(file.mu).unwrap_or_else(|| vec![0.2, 0.1]),
+        mu_static: args.mu_static.or(file.mu_static),
+    };
+    let scale = args.scale.or(file.scale).unwrap_or(1.0);
+    if !(scale.is_finite() && scale > 0.0) {
+        bail!("scale must be finite and > 0, got {scale}");
+    }
+    let integrator = args.integrator.or(file.integrator).unwrap_or(Integrator::Exact);
+    let substeps = args.rk4_substeps.or(file.rk4_substeps).unwrap_or(10);
+    let history_path = args.history.or(file.history);
+    if let Some(p) = &history_path {
+        slidestack::store::HistoryFormat::from_path(p)?;
+    }
+    let system = System::new(&spec).context("invalid case")?;
+    let record: Record = match args.record.or(file.record) {
+        Some(path) => motion::read_record(&path)?,
+        None => motion::builtin(),
+    };
+    let accel = record.accel_mps2(scale);
+    let ground = Ground {
+        dt_s: record.dt_s,
+        accel_mps2: &accel,
+    };
+    let want_history = history_path.is_some();
+    let response = match integrator {
+        Integrator::Exact => simulate_exact(
+            &system,
+            &ground,
+            &ExactOptions {
+                history: want_history,
+                ..ExactOptions::default()
+            },
+        ),
+        Integrator::Rk4 => simulate_rk4(&system, &ground, substeps, want_history),
+    }
+    .with_context(|| format!("simulation of {} failed", record.name))?;
+    if let (Some(path), Some(h)) = (&history_path, &response.history) {
+        write_history(path, h)?;
+    }
+    let out = output(&record, scale, &system, integrator, substeps, &response);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        print_table(&out);
+        if let Some(p) = &history_path {
+            println!("history written to {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+fn output(
+    record: &Record,
+    scale: f64,
+    sys: &System,
+    integrator: Integrator,
+    substeps: usize,
+    r: &Response,
+) -> Output {
+    let e = &r.energy;
+    Output {
+        record: record.name.clone(),
+        dt_s: record.dt_s,
+        npts: record.accel_g.len(),
+        scale,
+        period_s: sys.period_s(),
+        period_rigid_s: sys.period_rigid_s(),
+        damping: sys.damping_ratio(),
+        alpha: sys.masses()[1..].iter().map(|m| m / sys.mass_kg()).collect(),
+        mu: sys.mu_kinetic().to_vec(),
+        mu_static: sys.mu_static().to_vec(),
+        integrator,
+        rk4_substeps: (integrator == Integrator::Rk4).then_some(substeps),
+        peak_displacement_m: r.peak_displacement_m,
+        peak_displacement_time_s: r.peak_displacement_time_s,
+        peak_abs_accel_g: r.peak_abs_accel_mps2.iter().map(|a| a / G).collect(),
+        peak_slip_m: r.peak_slip_m.clone(),
+        residual_slip_m: r.residual_slip_m.clone(),
+        slip_time_s: r.slip_time_s.clone(),
+        switches: r.switches,
+        energy: EnergyJson {
+            input: e.input,
+            kinetic: e.kinetic,
+            strain: e.strain,
+            damping: e.damping,
+            friction: e.friction,
+            friction_per_interface: e.friction_per_interface.clone(),
+        },
+        energy_balance_error: e.balance_error(),
+        energy_balance_error_max: r.energy_balance_error_max,
+    }
+}
+
+fn print_table(o: &Output) {
+    let list = |v: &[f64], prec: usize| {
+        v.iter().map(|x| format!("{x:.prec$}")).collect::<Vec<_>>().join(", ")
+    };
+    println!("record            {} ({} samples, dt {} s, scale {})", o.record, o.npts, o.dt_s, o.scale);
+    println!(
+        "structure         T_p {} s, damping {}, T_rigid {:.4} s",
+        o.period_s, o.damping, o.period_rigid_s
+    );
+    println!("stack             alpha [{}], mu [{}], mu_static [{}]", list(&o.alpha, 3), list(&o.mu, 3), list(&o.mu_static, 3));
+    let integ = match o.rk4_substeps {
+        Some(n) => format!("rk4, {n} sub-steps"),
+        None => "exact".to_string(),
+    };
+    println!("integrator        {integ}");
+    println!(
+        "peak displacement {:.6} m at {:.4} s",
+        o.peak_displacement_m, o.peak_displacement_time_s
+    );
+    println!("peak abs accel    [{}] g (structure, blocks bottom-up)", list(&o.peak_abs_accel_g, 4));
+    println!("peak slip         [{}] m", list(&o.peak_slip_m, 5));
+    println!("residual slip     [{}] m", list(&o.residual_slip_m, 5));
+    println!("slipping time     [{}] s", list(&o.slip_time_s, 3));
+    println!("switches          {}", o.switches);
+    let e = &o.energy;
+    println!(
+        "energy (J/kg)     input {:.6}, kinetic {:.6}, strain {:.6}, damping {:.6}, friction {:.6}",
+        e.input, e.kinetic, e.strain, e.damping, e.friction
+    );
+    println!("energy balance    |residual|/input = {:.2e}", o.energy_balance_error);
+    let _ = dynamics::G;
+}

@@ -1,0 +1,230 @@
+//! Closed-form motion within one stick/slip mode over a piece of a sample interval.
+//!
+//! Within a mode the friction forces are constant and the ground acceleration is linear in the
+//! local time `τ`, so every quantity of interest (a cluster's displacement or velocity, a relative
+//! velocity, a required friction force) has the form
+//! `g(τ) = p₀ + p₁τ + p₂τ² + p₃τ³ + e^{−aτ}·(c·cos ωτ + d·sin ωτ)`,
+//! where `a`, `ω` are the decay rate and damped frequency of the cluster that holds the structure
+//! (the Nigam–Jennings solution of a linear SDOF under linearly varying load). [`Wave`] is that
+//! form; [`Basis`] caches `e^{−aτ}`, `cos ωτ`, `sin ωτ` at one `τ` so many waves share them.
+
+/// Decay rate `a = ζ_e·ω_n` (1/s) and damped circular frequency `ω = ω_n·sqrt(1−ζ_e²)` (rad/s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Osc {
+    pub decay: f64,
+    pub omega: f64,
+}
+
+/// `e^{−aτ}`, `cos ωτ`, `sin ωτ` at one `τ`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Basis {
+    pub tau: f64,
+    pub exp: f64,
+    pub cos: f64,
+    pub sin: f64,
+}
+
+impl Basis {
+    pub fn at(osc: Osc, tau: f64) -> Self {
+        let (sin, cos) = (osc.omega * tau).sin_cos();
+        Self {
+            tau,
+            exp: (-osc.decay * tau).exp(),
+            cos,
+            sin,
+        }
+    }
+}
+
+/// `p₀ + p₁τ + p₂τ² + p₃τ³ + e^{−aτ}·(c·cos ωτ + d·sin ωτ)`; see the module doc.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Wave {
+    pub p: [f64; 4],
+    pub c: f64,
+    pub d: f64,
+}
+
+impl Wave {
+    pub const ZERO: Wave = Wave {
+        p: [0.0; 4],
+        c: 0.0,
+        d: 0.0,
+    };
+
+    pub fn constant(v: f64) -> Self {
+        Wave {
+            p: [v, 0.0, 0.0, 0.0],
+            ..Wave::ZERO
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, b: &Basis) -> f64 {
+        let t = b.tau;
+        let poly = self.p[0] + t * (self.p[1] + t * (self.p[2] + t * self.p[3]));
+        poly + b.exp * (self.c * b.cos + self.d * b.sin)
+    }
+
+    /// `dg/dτ`.
+    pub fn deriv(&self, osc: Osc) -> Wave {
+        Wave {
+            p: [self.p[1], 2.0 * self.p[2], 3.0 * self.p[3], 0.0],
+            c: -osc.decay * self.c + osc.omega * self.d,
+            d: -osc.decay * self.d - osc.omega * self.c,
+        }
+    }
+
+    /// `self·s + other·t`.
+    #[inline]
+    pub fn combine(&self, s: f64, other: &Wave, t: f64) -> Wave {
+        Wave {
+            p: [
+                self.p[0] * s + other.p[0] * t,
+                self.p[1] * s + other.p[1] * t,
+                self.p[2] * s + other.p[2] * t,
+                self.p[3] * s + other.p[3] * t,
+            ],
+            c: self.c * s + other.c * t,
+            d: self.d * s + other.d * t,
+        }
+    }
+
+    pub fn scale(&self, s: f64) -> Wave {
+        self.combine(s, &Wave::ZERO, 0.0)
+    }
+
+    pub fn plus_constant(mut self, v: f64) -> Wave {
+        self.p[0] += v;
+        self
+    }
+
+    /// Upper bound of `|g(τ)|` over `[t0, t1]` (`0 ≤ t0 ≤ t1`): the polynomial part bounded
+    /// term by term, the oscillation by its amplitude times `e^{−a·t0}`.
+    pub fn abs_bound(&self, osc: Osc, t0: f64, t1: f64) -> f64 {
+        let tm = t1.max(t0.abs());
+        let poly = self.p[0].abs() + tm * (self.p[1].abs() + tm * (self.p[2].abs() + tm * self.p[3].abs()));
+        poly + self.c.hypot(self.d) * (-osc.decay * t0).exp()
+    }
+
+    /// `∫₀^τ g(t) dt` at the basis point.
+    pub fn integral(&self, osc: Osc, b: &Basis) -> f64 {
+        let t = b.tau;
+        let poly = t * (self.p[0] + t * (self.p[1] / 2.0 + t * (self.p[2] / 3.0 + t * self.p[3] / 4.0)));
+        // Antiderivative of e^{−aτ}(c cos + d sin) is e^{−aτ}(c' cos + d' sin).
+        let (a, w) = (osc.decay, osc.omega);
+        let den = a * a + w * w;
+        if den == 0.0 {
+            return poly + self.c * t;
+        }
+        let c1 = (-a * self.c - w * self.d) / den;
+        let d1 = (w * self.c - a * self.d) / den;
+        poly + b.exp * (c1 * b.cos + d1 * b.sin) - c1
+    }
+}
+
+/// Complex number, just what the integrals below need.
+#[derive(Debug, Clone, Copy)]
+struct Cx(f64, f64);
+
+impl Cx {
+    fn mul(self, o: Cx) -> Cx {
+        Cx(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
+    }
+    fn div(self, o: Cx) -> Cx {
+        let den = o.0 * o.0 + o.1 * o.1;
+        Cx(
+            (self.0 * o.0 + self.1 * o.1) / den,
+            (self.1 * o.0 - self.0 * o.1) / den,
+        )
+    }
+}
+
+/// `φ₁(x) = (eˣ − 1)/x` for complex `x`, accurate also near 0.
+fn phi1(x: Cx) -> Cx {
+    let mag = x.0.hypot(x.1);
+    if mag < 0.5 {
+        let mut term = Cx(1.0, 0.0);
+        let mut sum = Cx(1.0, 0.0);
+        for k in 2..=24 {
+            term = term.mul(x).div(Cx(k as f64, 0.0));
+            sum = Cx(sum.0 + term.0, sum.1 + term.1);
+        }
+        sum
+    } else {
+        let e = x.0.exp();
+        let (s, c) = x.1.sin_cos();
+        Cx(e * c - 1.0, e * s).div(x)
+    }
+}
+
+/// `∫₀^h (B + e^{−aτ}(c·cos ωτ + d·sin ωτ))² dτ` for a velocity wave whose polynomial part is the
+/// constant `B` (the structure's velocity within a mode). Used for the damping energy `∫c·u̇²`.
+pub fn integral_of_square(v: &Wave, osc: Osc, b: &Basis) -> f64 {
+    debug_assert!(v.p[1] == 0.0 && v.p[2] == 0.0 && v.p[3] == 0.0);
+    let h = b.tau;
+    let big_b = v.p[0];
+    let (a, w) = (osc.decay, osc.omega);
+    let osc_only = Wave {
+        p: [0.0; 4],
+        c: v.c,
+        d: v.d,
+    };
+    let cross = 2.0 * big_b * osc_only.integral(osc, b);
+    // (c cos + d sin)² = (c²+d²)/2 + (c²−d²)/2·cos 2ωτ + c·d·sin 2ωτ
+    let mean = 0.5 * (v.c * v.c + v.d * v.d);
+    let i_exp = h * phi1(Cx(-2.0 * a * h, 0.0)).0;
+    let z = phi1(Cx(-2.0 * a * h, 2.0 * w * h));
+    let (i_cos, i_sin) = (h * z.0, h * z.1);
+    big_b * big_b * h + cross + mean * i_exp + 0.5 * (v.c * v.c - v.d * v.d) * i_cos + v.c * v.d * i_sin
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(f: impl Fn(f64) -> f64, h: f64) -> f64 {
+        // Composite Simpson with many panels: an independent numerical check.
+        let n = 20_000;
+        let dx = h / n as f64;
+        let mut s = f(0.0) + f(h);
+        for i in 1..n {
+            s += f(i as f64 * dx) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        s * dx / 3.0
+    }
+
+    #[test]
+    fn derivative_and_integrals_match_numerics() {
+        let osc = Osc { decay: 0.7, omega: 9.0 };
+        let g = Wave { p: [0.3, -1.2, 0.5, 0.25], c: 0.8, d: -0.4 };
+        let h = 0.37;
+        let f = |t: f64| g.eval(&Basis::at(osc, t));
+        let dg = g.deriv(osc);
+        let eps = 1e-6;
+        let num = (f(0.2 + eps) - f(0.2 - eps)) / (2.0 * eps);
+        assert!((dg.eval(&Basis::at(osc, 0.2)) - num).abs() < 1e-7);
+        let exact = g.integral(osc, &Basis::at(osc, h));
+        assert!((exact - quad(f, h)).abs() < 1e-12, "{exact}");
+        let v = Wave { p: [0.6, 0.0, 0.0, 0.0], c: -0.3, d: 1.1 };
+        let fv = |t: f64| v.eval(&Basis::at(osc, t)).powi(2);
+        let sq = integral_of_square(&v, osc, &Basis::at(osc, h));
+        assert!((sq - quad(fv, h)).abs() < 1e-12, "{sq}");
+        // Tiny pieces and zero damping take the series branch.
+        let osc0 = Osc { decay: 0.0, omega: 3.0 };
+        let hs = 1e-4;
+        let sq0 = integral_of_square(&v, osc0, &Basis::at(osc0, hs));
+        let fv0 = |t: f64| v.eval(&Basis::at(osc0, t)).powi(2);
+        assert!(((sq0 - quad(fv0, hs)) / sq0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn abs_bound_bounds() {
+        let osc = Osc { decay: 0.2, omega: 30.0 };
+        let g = Wave { p: [0.1, -2.0, 3.0, -1.0], c: 0.5, d: 0.9 };
+        let b = g.abs_bound(osc, 0.1, 0.6);
+        for i in 0..=1000 {
+            let t = 0.1 + 0.5 * i as f64 / 1000.0;
+            assert!(g.eval(&Basis::at(osc, t)).abs() <= b);
+        }
+    }
+}

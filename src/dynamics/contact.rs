@@ -1,0 +1,342 @@
+//! Coulomb-consistent choice of the stick/slip pattern at an instant (NOTES.md, "The physical
+//! system").
+//!
+//! At an instant where some interfaces have zero relative velocity, their friction forces `f_i`
+//! are unknown. With static friction equal to kinetic, the consistent forces are the unique
+//! minimiser of the dual of "kinetic-energy distance to the free motion plus friction
+//! dissipation": over the box `|f_i| ≤ μ_s,i·N_i`, minimise
+//! `Φ(f) = ½·Σ_j (E_j + f_j − f_{j+1})² / m_j`,
+//! where `E_j` is every other force on body `j`. `∂Φ/∂f_i` is the relative acceleration `ṡ_i`, so
+//! the KKT conditions are exactly Coulomb's law: an interior `f_i` sticks (`ṡ_i = 0`), a force at
+//! its bound slips away from it. The Hessian is tridiagonal and positive definite; a primal
+//! active-set method with a Thomas solve finds the minimiser in a finite number of steps.
+//!
+//! With `μ_s > μ_k` several patterns can be consistent. The rule used here, **progressive
+//! release**: solve with the static bounds; every interface whose force is pinned at its static
+//! bound with a nonzero relative acceleration is released to slip with its kinetic force, and the
+//! rest is solved again, until nothing more is released. Interfaces stick wherever static friction
+//! can hold them given the ones that must slip. With `μ_s = μ_k` it returns the unique pattern.
+
+use thiserror::Error;
+
+/// State of one interface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Contact {
+    /// No relative motion; the friction force is whatever keeps it so, within the static limit.
+    Stick,
+    /// Relative velocity `s_i = v_i − v_{i−1}` has sign `dir` (±1); force `−μ_k·N·dir`.
+    Slip(i8),
+    /// `μ_s = 0`: no friction can ever act; the bodies move independently.
+    Free,
+}
+
+impl Contact {
+    /// Small integer code used in histories: 0 stick, 1 slip forward, −1 slip backward, 2 free.
+    pub fn code(self) -> i8 {
+        match self {
+            Contact::Stick => 0,
+            Contact::Slip(d) => d,
+            Contact::Free => 2,
+        }
+    }
+}
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ContactError {
+    #[error("contact selection did not converge at interfaces {first}..{last} (non-finite forces?)")]
+    NoConvergence { first: usize, last: usize },
+}
+
+/// Reusable workspace for [`ContactSelector::select`]; allocation happens once, in `new`.
+#[derive(Debug, Clone)]
+pub struct ContactSelector {
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    f: Vec<f64>,
+    grad: Vec<f64>,
+    dir: Vec<f64>,
+    active: Vec<i8>,
+    diag: Vec<f64>,
+    off: Vec<f64>,
+    rhs: Vec<f64>,
+    released: Vec<bool>,
+}
+
+impl ContactSelector {
+    pub fn new(blocks: usize) -> Self {
+        let z = vec![0.0; blocks];
+        Self {
+            lo: z.clone(),
+            hi: z.clone(),
+            f: z.clone(),
+            grad: z.clone(),
+            dir: z.clone(),
+            active: vec![0; blocks],
+            diag: z.clone(),
+            off: z.clone(),
+            rhs: z,
+            released: vec![false; blocks],
+        }
+    }
+
+    /// Chooses the contact state and friction force of every interface.
+    ///
+    /// * `masses`: `[m_p, m_1, …, m_n]`, kg.
+    /// * `external`: force on each body from everything but interface friction, N.
+    /// * `limit_static`, `limit_kinetic`: `μ_s,i·N_i`, `μ_k,i·N_i` per interface, N.
+    /// * `contacts`: on entry, `Slip(d)` for interfaces whose relative velocity is nonzero with
+    ///   sign `d`, `Free` where `μ_s = 0`, anything else (`Stick`) where the relative velocity is
+    ///   zero. On return, the chosen state of every interface.
+    /// * `force`: on return `f_i`, the force body `i−1` exerts on body `i`, N.
+    pub fn select(
+        &mut self,
+        masses: &[f64],
+        external: &[f64],
+        limit_static: &[f64],
+        limit_kinetic: &[f64],
+        contacts: &mut [Contact],
+        force: &mut [f64],
+    ) -> Result<(), ContactError> {
+        let n = contacts.len();
+        for i in 0..n {
+            force[i] = match contacts[i] {
+                Contact::Slip(d) => -limit_kinetic[i] * f64::from(d),
+                _ => 0.0,
+            };
+        }
+        // Segments: maximal runs of zero-velocity interfaces i0..i1 (0-based interface indices,
+        // interface index i sits between bodies i and i+1).
+        let mut i = 0;
+        while i < n {
+            if contacts[i] != Contact::Stick {
+                i += 1;
+                continue;
+            }
+            let i0 = i;
+            while i < n && contacts[i] == Contact::Stick {
+                i += 1;
+            }
+            self.solve_segment(
+                masses,
+                external,
+                limit_static,
+                limit_kinetic,
+                i0,
+                i,
+                contacts,
+                force,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Interfaces `i0..i1` (0-based) are all at zero relative velocity; bodies `i0..=i1` form the
+    /// segment. Forces of the interfaces bounding the segment are already in `force`.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_segment(
+        &mut self,
+        masses: &[f64],
+        external: &[f64],
+        limit_static: &[f64],
+        limit_kinetic: &[f64],
+        i0: usize,
+        i1: usize,
+        contacts: &mut [Contact],
+        force: &mut [f64],
+    ) -> Result<(), ContactError> {
+        let p = i1 - i0;
+        // Known force on body j of the segment: external plus bounding kinetic friction.
+        let known = |j: usize, force: &[f64]| -> f64 {
+            let mut e = external[j];
+            if j == i0 && j > 0 {
+                e += force[j - 1];
+            }
+            if j == i1 && j < force.len() {
+                e -= force[j];
+            }
+            e
+        };
+        let mut scale = 0.0f64;
+        for j in i0..=i1 {
+            scale = scale.max(known(j, force).abs());
+        }
+        for k in 0..p {
+            self.released[k] = false;
+            self.lo[k] = -limit_static[i0 + k];
+            self.hi[k] = limit_static[i0 + k];
+            scale = scale.max(limit_static[i0 + k]);
+        }
+        loop {
+            self.active_set(masses, i0, p, |j| known(j, force), scale)
+                .ok_or(ContactError::NoConvergence {
+                    first: i0 + 1,
+                    last: i1,
+                })?;
+            // Release every force pinned at a static bound while its relative acceleration
+            // pushes beyond it (progressive release; see the module doc).
+            let mut more = false;
+            for k in 0..p {
+                if self.released[k] || self.active[k] == 0 {
+                    continue;
+                }
+                let m_lo = masses[i0 + k];
+                let m_hi = masses[i0 + k + 1];
+                let tol = 1e-13 * scale * (1.0 / m_lo + 1.0 / m_hi);
+                let pushing = f64::from(self.active[k]) * self.grad[k] < -tol;
+                if pushing {
+                    let sign = f64::from(self.active[k]);
+                    let fk = sign * limit_kinetic[i0 + k];
+                    self.lo[k] = fk;
+                    self.hi[k] = fk;
+                    self.released[k] = true;
+                    more = true;
+                }
+            }
+            if !more {
+                break;
+            }
+        }
+        for k in 0..p {
+            let i = i0 + k;
+            force[i] = self.f[k];
+            contacts[i] = if self.released[k] {
+                // Force +μ_k·N (lower body drags the upper forward) means the upper body lags:
+                // relative velocity becomes negative.
+                Contact::Slip(if self.f[k] > 0.0 { -1 } else { 1 })
+            } else {
+                Contact::Stick
+            };
+        }
+        Ok(())
+    }
+
+    /// Relative accelerations `ṡ_k = ∂Φ/∂f_k` of the segment at the current forces.
+    fn gradient(&mut self, masses: &[f64], i0: usize, p: usize, known: &impl Fn(usize) -> f64) {
+        let accel = |j: usize, f: &[f64]| -> f64 {
+            // body j = i0 + jj; interfaces below/above are k = jj-1 and k = jj.
+            let jj = j - i0;
+            let below = if jj > 0 { f[jj - 1] } else { 0.0 };
+            let above = if jj < p { f[jj] } else { 0.0 };
+            (known(j) + below - above) / masses[j]
+        };
+        let mut prev = accel(i0, &self.f);
+        for k in 0..p {
+            let next = accel(i0 + k + 1, &self.f);
+            self.grad[k] = next - prev;
+            prev = next;
+        }
+    }
+
+    /// Primal active-set method for the box-constrained QP of one segment. Leaves the optimum in
+    /// `self.f`, the bound each force is pinned at in `self.active` (−1, 0, +1) and the relative
+    /// accelerations in `self.grad`. `None` if it fails to terminate (non-finite input).
+    fn active_set(
+        &mut self,
+        masses: &[f64],
+        i0: usize,
+        p: usize,
+        known: impl Fn(usize) -> f64,
+        scale: f64,
+    ) -> Option<()> {
+        for k in 0..p {
+            self.f[k] = 0.0f64.clamp(self.lo[k], self.hi[k]);
+            self.active[k] = if self.lo[k] == self.hi[k] {
+                if self.lo[k] > 0.0 { 1 } else { -1 }
+            } else {
+                0
+            };
+        }
+        let max_iter = 50 * (p + 2);
+        for _ in 0..max_iter {
+            self.gradient(masses, i0, p, &known);
+            // Newton direction on the free variables: H_FF·d_F = −grad_F, d_W = 0.
+            for k in 0..p {
+                let m_lo = masses[i0 + k];
+                let m_hi = masses[i0 + k + 1];
+                if self.active[k] != 0 {
+                    self.diag[k] = 1.0;
+                    self.rhs[k] = 0.0;
+                } else {
+                    self.diag[k] = 1.0 / m_lo + 1.0 / m_hi;
+                    self.rhs[k] = -self.grad[k];
+                }
+                // Coupling between k and k+1 is −1/m of the body between them.
+                self.off[k] = if k + 1 < p && self.active[k] == 0 && self.active[k + 1] == 0 {
+                    -1.0 / m_hi
+                } else {
+                    0.0
+                };
+            }
+            thomas(&mut self.diag[..p], &self.off[..p], &mut self.rhs[..p], &mut self.dir[..p]);
+            let mut step = 1.0;
+            let mut block = None;
+            for k in 0..p {
+                if self.active[k] != 0 {
+                    continue;
+                }
+                let d = self.dir[k];
+                let room = if d > 0.0 {
+                    (self.hi[k] - self.f[k]) / d
+                } else if d < 0.0 {
+                    (self.lo[k] - self.f[k]) / d
+                } else {
+                    f64::INFINITY
+                };
+                if room < step {
+                    step = room;
+                    block = Some(k);
+                }
+            }
+            if !step.is_finite() {
+                return None;
+            }
+            for k in 0..p {
+                if self.active[k] == 0 {
+                    self.f[k] += step * self.dir[k];
+                }
+            }
+            if let Some(k) = block {
+                let upper = self.dir[k] > 0.0;
+                self.f[k] = if upper { self.hi[k] } else { self.lo[k] };
+                self.active[k] = if upper { 1 } else { -1 };
+                continue;
+            }
+            // Subspace optimum: check the multipliers of the pinned forces.
+            self.gradient(masses, i0, p, &known);
+            let mut worst = None;
+            let mut worst_val = 0.0;
+            for k in 0..p {
+                if self.active[k] == 0 || self.lo[k] == self.hi[k] {
+                    continue;
+                }
+                // At the upper bound optimality needs grad ≤ 0, at the lower grad ≥ 0.
+                let wrong = f64::from(self.active[k]) * self.grad[k];
+                let tol = 1e-15 * scale * (1.0 / masses[i0 + k] + 1.0 / masses[i0 + k + 1]);
+                if wrong > tol && wrong > worst_val {
+                    worst_val = wrong;
+                    worst = Some(k);
+                }
+            }
+            match worst {
+                None => return Some(()),
+                Some(k) => self.active[k] = 0,
+            }
+        }
+        None
+    }
+}
+
+/// Solves a symmetric tridiagonal system in place: `diag` on the diagonal, `off[k]` coupling
+/// `k` and `k+1`; the solution goes to `x`. `diag` and `rhs` are overwritten.
+fn thomas(diag: &mut [f64], off: &[f64], rhs: &mut [f64], x: &mut [f64]) {
+    let p = diag.len();
+    for k in 1..p {
+        let w = off[k - 1] / diag[k - 1];
+        diag[k] -= w * off[k - 1];
+        rhs[k] -= w * rhs[k - 1];
+    }
+    for k in (0..p).rev() {
+        let upper = if k + 1 < p { off[k] * x[k + 1] } else { 0.0 };
+        x[k] = (rhs[k] - upper) / diag[k];
+    }
+}

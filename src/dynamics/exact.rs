@@ -1,0 +1,741 @@
+//! The exact event-driven integrator (default).
+//!
+//! Within a stick/slip mode the bodies form clusters (runs of stuck interfaces). The cluster that
+//! holds the structure is a linear SDOF of its total mass under `−M·a_g(t)` plus the constant
+//! friction of the interface above it; every other cluster is a free mass under `−M·a_g(t)` plus
+//! constant friction. With `a_g` linear over a sample interval both have closed forms
+//! ([`closed_form::Wave`]), so a sample interval is crossed in one evaluation unless a switch
+//! occurs inside it:
+//! * a slipping interface's relative velocity reaches zero;
+//! * a stuck interface inside the structure's cluster needs more than its static friction
+//!   (stuck interfaces in free clusters carry constant forces and cannot switch within a mode).
+//!
+//! Each switching function is located by a certified search (a bound on its second derivative
+//! rules out roots between evaluations, so no zero crossing is missed however short) and refined
+//! by bracketed root finding to a few ulps of time. At a switch the new mode comes from
+//! [`ContactSelector`]. The peaks of the structure's displacement and absolute acceleration are
+//! found by the same kind of bound-and-refine search, so they are exact, not sampled. Energy terms
+//! are integrated in closed form piece by piece.
+//!
+//! A friction force counts as exceeding its static limit only beyond `1e-10` of that limit, so a
+//! demand that sits exactly at the limit (ground acceleration equal to `μ·g`) sticks instead of
+//! chattering. More than `max_switches_per_step` switches within one sample interval stop the run
+//! with [`SimError::Zeno`].
+
+use super::closed_form::{Basis, Osc, Wave, integral_of_square};
+use super::contact::{Contact, ContactSelector};
+use super::model::System;
+use super::response::{Energy, History, Response};
+use super::{Ground, SimError};
+
+/// Relative tolerance on the static friction limit before a stuck interface breaks away.
+pub const BREAK_TOLERANCE: f64 = 1e-10;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExactOptions {
+    /// Keep the full time history (one row per record sample).
+    pub history: bool,
+    /// Switches allowed within one sample interval before the run is refused as Zeno.
+    pub max_switches_per_step: usize,
+}
+
+impl Default for ExactOptions {
+    fn default() -> Self {
+        Self {
+            history: false,
+            max_switches_per_step: 1000,
+        }
+    }
+}
+
+/// Runs the exact integrator over the whole record.
+pub fn simulate_exact(
+    sys: &System,
+    ground: &Ground,
+    opts: &ExactOptions,
+) -> Result<Response, SimError> {
+    ground.validate()?;
+    Exact::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)
+}
+
+/// Coefficients of the structure's cluster when its top body is `e0`.
+#[derive(Debug, Clone, Copy)]
+struct Cluster0 {
+    mass: f64,
+    osc: Osc,
+    omega2: f64,
+    basis_dt: Basis,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum EventKind {
+    /// Slipping interface (0-based) whose relative velocity reaches zero.
+    SlipStop(usize),
+    /// Stuck interface (0-based) whose required force leaves the static limit.
+    Break(usize),
+}
+
+/// A switching function `g ≥ 0` while the mode holds, with its first three derivatives.
+#[derive(Debug, Clone, Copy)]
+struct Event {
+    kind: EventKind,
+    g: Wave,
+    d1: Wave,
+    d2: Wave,
+    d3: Wave,
+}
+
+/// A quantity whose peak |value| is tracked, with its first three derivatives.
+#[derive(Debug, Clone, Copy)]
+struct Peaked {
+    f: Wave,
+    d1: Wave,
+    d2: Wave,
+    d3: Wave,
+}
+
+impl Peaked {
+    fn new(f: Wave, osc: Osc) -> Self {
+        let d1 = f.deriv(osc);
+        let d2 = d1.deriv(osc);
+        let d3 = d2.deriv(osc);
+        Self { f, d1, d2, d3 }
+    }
+}
+
+struct Exact<'s> {
+    sys: &'s System,
+    dt: f64,
+    opts: ExactOptions,
+    n: usize,
+    cluster0: Vec<Cluster0>,
+    /// `mass_prefix[j] = Σ_{i<j} m_i`.
+    mass_prefix: Vec<f64>,
+    lim_s: Vec<f64>,
+    lim_k: Vec<f64>,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    contacts: Vec<Contact>,
+    before: Vec<Contact>,
+    force: Vec<f64>,
+    external: Vec<f64>,
+    selector: ContactSelector,
+    cluster_of: Vec<usize>,
+    bottom: Vec<usize>,
+    top: Vec<usize>,
+    disp: Vec<Wave>,
+    vel: Vec<Wave>,
+    /// Constant absolute acceleration of each free cluster, m/s².
+    accel_free: Vec<f64>,
+    events: Vec<Event>,
+    slip_start: Vec<f64>,
+    out: Response,
+    energy: Energy,
+}
+
+impl<'s> Exact<'s> {
+    fn new(sys: &'s System, dt: f64, opts: ExactOptions) -> Self {
+        let n = sys.blocks();
+        let m = sys.masses();
+        let mut mass_prefix = vec![0.0; n + 2];
+        for j in 0..=n {
+            mass_prefix[j + 1] = mass_prefix[j] + m[j];
+        }
+        let k = sys.stiffness();
+        let c = sys.damping();
+        let cluster0 = (0..=n)
+            .map(|e0| {
+                let mass = mass_prefix[e0 + 1];
+                let omega2 = k / mass;
+                let decay = c / (2.0 * mass);
+                let osc = Osc {
+                    decay,
+                    omega: (omega2 - decay * decay).sqrt(),
+                };
+                Cluster0 {
+                    mass,
+                    osc,
+                    omega2,
+                    basis_dt: Basis::at(osc, dt),
+                }
+            })
+            .collect();
+        let lim_s = (1..=n).map(|i| sys.static_limit(i)).collect();
+        let lim_k = (1..=n).map(|i| sys.kinetic_limit(i)).collect();
+        let contacts: Vec<Contact> = sys
+            .mu_static()
+            .iter()
+            .map(|&mu| if mu == 0.0 { Contact::Free } else { Contact::Stick })
+            .collect();
+        let out = Response {
+            peak_abs_accel_mps2: vec![0.0; n + 1],
+            peak_slip_m: vec![0.0; n],
+            residual_slip_m: vec![0.0; n],
+            slip_time_s: vec![0.0; n],
+            ..Response::default()
+        };
+        Self {
+            sys,
+            dt,
+            opts,
+            n,
+            cluster0,
+            mass_prefix,
+            lim_s,
+            lim_k,
+            x: vec![0.0; n + 1],
+            v: vec![0.0; n + 1],
+            before: contacts.clone(),
+            contacts,
+            force: vec![0.0; n],
+            external: vec![0.0; n + 1],
+            selector: ContactSelector::new(n),
+            cluster_of: vec![0; n + 1],
+            bottom: vec![0; n + 1],
+            top: vec![0; n + 1],
+            disp: vec![Wave::ZERO; n + 1],
+            vel: vec![Wave::ZERO; n + 1],
+            accel_free: vec![0.0; n + 1],
+            events: Vec::with_capacity(2 * n),
+            slip_start: vec![0.0; n],
+            out,
+            energy: Energy {
+                friction_per_interface: vec![0.0; n],
+                ..Energy::default()
+            },
+        }
+    }
+
+    fn run(mut self, accel: &[f64]) -> Result<Response, SimError> {
+        let steps = accel.len() - 1;
+        let mut history = self
+            .opts
+            .history
+            .then(|| History::with_capacity(steps + 1, self.n + 1));
+        self.select(accel[0])?;
+        self.build(accel[0], (accel[1] - accel[0]) / self.dt);
+        if let Some(h) = history.as_mut() {
+            self.record(h, 0.0, accel[0]);
+        }
+        for k in 0..steps {
+            let t0 = k as f64 * self.dt;
+            let slope = (accel[k + 1] - accel[k]) / self.dt;
+            let mut tau = 0.0;
+            let mut switches_here = 0;
+            loop {
+                let ga = accel[k] + slope * tau;
+                self.build(ga, slope);
+                let h = self.dt - tau;
+                let osc = self.osc();
+                let basis_h = if tau == 0.0 {
+                    self.cluster0[self.top[0]].basis_dt
+                } else {
+                    Basis::at(osc, h)
+                };
+                let mut first: Option<(f64, usize)> = None;
+                for (e, ev) in self.events.iter().enumerate() {
+                    let limit = first.map_or(h, |f| f.0);
+                    let g_end = if limit == h {
+                        ev.g.eval(&basis_h)
+                    } else {
+                        ev.g.eval(&Basis::at(osc, limit))
+                    };
+                    if let Some(t) = first_violation(ev, osc, limit, g_end, self.dt) {
+                        if first.is_none_or(|f| t < f.0) {
+                            first = Some((t, e));
+                        }
+                    }
+                }
+                let end = first.map_or(h, |f| f.0);
+                let basis_end = if first.is_none() { basis_h } else { Basis::at(osc, end) };
+                self.advance(t0 + tau, ga, slope, &basis_end);
+                if let Some((_, e)) = first {
+                    tau += end;
+                    let kind = self.events[e].kind;
+                    self.switch(kind, accel[k] + slope * tau)?;
+                    switches_here += 1;
+                    if switches_here > self.opts.max_switches_per_step {
+                        return Err(SimError::Zeno {
+                            time_s: t0,
+                            limit: self.opts.max_switches_per_step,
+                        });
+                    }
+                } else {
+                    break;
+                }
+            }
+            let t1 = (k + 1) as f64 * self.dt;
+            let err = self.balance_error();
+            self.out.energy_balance_error_max = self.out.energy_balance_error_max.max(err);
+            if let Some(h) = history.as_mut() {
+                let slope_next = if k + 2 <= steps {
+                    (accel[k + 2] - accel[k + 1]) / self.dt
+                } else {
+                    0.0
+                };
+                self.build(accel[k + 1], slope_next);
+                self.record(h, t1, accel[k + 1]);
+            }
+        }
+        self.finish(history)
+    }
+
+    fn osc(&self) -> Osc {
+        self.cluster0[self.top[0]].osc
+    }
+
+    /// External forces at the current state and the Coulomb-consistent mode.
+    fn select(&mut self, ga: f64) -> Result<(), SimError> {
+        let m = self.sys.masses();
+        for j in 0..=self.n {
+            self.external[j] = -m[j] * ga;
+        }
+        self.external[0] -= self.sys.damping() * self.v[0] + self.sys.stiffness() * self.x[0];
+        for i in 0..self.n {
+            if let Contact::Slip(_) = self.contacts[i] {
+                // A slip whose relative velocity is exactly zero is a stick candidate.
+                if self.v[i + 1] == self.v[i] {
+                    self.contacts[i] = Contact::Stick;
+                }
+            }
+        }
+        self.selector.select(
+            m,
+            &self.external,
+            &self.lim_s,
+            &self.lim_k,
+            &mut self.contacts,
+            &mut self.force,
+        )?;
+        Ok(())
+    }
+
+    /// Clusters, their closed-form motion from the current state, and the switching functions.
+    fn build(&mut self, ga: f64, slope: f64) {
+        let n = self.n;
+        let mut nc = 0;
+        for j in 0..=n {
+            if j == 0 || self.contacts[j - 1] != Contact::Stick {
+                self.bottom[nc] = j;
+                nc += 1;
+            }
+            self.cluster_of[j] = nc - 1;
+            self.top[nc - 1] = j;
+        }
+        let e0 = self.top[0];
+        let cl = self.cluster0[e0];
+        let f_top0 = if e0 < n { self.force[e0] } else { 0.0 };
+        // Structure cluster: ü + 2aü + ω²u = p0 + p1·τ (Nigam–Jennings, constant friction added).
+        let p0 = -f_top0 / cl.mass - ga;
+        let p1 = -slope;
+        let b = p1 / cl.omega2;
+        let a = (p0 - 2.0 * cl.osc.decay * b) / cl.omega2;
+        let c = self.x[0] - a;
+        let d = (self.v[0] - b + cl.osc.decay * c) / cl.osc.omega;
+        let osc = cl.osc;
+        self.disp[0] = Wave { p: [a, b, 0.0, 0.0], c, d };
+        self.vel[0] = self.disp[0].deriv(osc);
+        for cidx in 1..nc {
+            let (bj, ej) = (self.bottom[cidx], self.top[cidx]);
+            let mass = self.mass_prefix[ej + 1] - self.mass_prefix[bj];
+            let above = if ej < n { self.force[ej] } else { 0.0 };
+            let acc_abs = (self.force[bj - 1] - above) / mass;
+            self.accel_free[cidx] = acc_abs;
+            self.disp[cidx] = Wave {
+                p: [self.x[bj], self.v[bj], 0.5 * (acc_abs - ga), -slope / 6.0],
+                c: 0.0,
+                d: 0.0,
+            };
+            self.vel[cidx] = self.disp[cidx].deriv(osc);
+        }
+        self.events.clear();
+        let accel0 = self.accel0_wave();
+        for i in 0..n {
+            match self.contacts[i] {
+                Contact::Slip(dir) => {
+                    let sgn = f64::from(dir);
+                    let lower = self.cluster_of[i];
+                    let upper = self.cluster_of[i + 1];
+                    let mut g = self.vel[upper].combine(sgn, &self.vel[lower], -sgn);
+                    // Anchor the value at τ = 0 to the state (exactly 0 for a fresh slip).
+                    let g0_state = sgn * (self.v[i + 1] - self.v[i]);
+                    g.p[0] += g0_state - (g.p[0] + g.c);
+                    self.push_event(EventKind::SlipStop(i), g, osc);
+                }
+                Contact::Stick if i < e0 => {
+                    let m_above = self.mass_prefix[e0 + 1] - self.mass_prefix[i + 1];
+                    let f = accel0.scale(m_above).plus_constant(f_top0);
+                    let room = self.lim_s[i] * (1.0 + BREAK_TOLERANCE);
+                    self.push_event(EventKind::Break(i), f.scale(-1.0).plus_constant(room), osc);
+                    self.push_event(EventKind::Break(i), f.plus_constant(room), osc);
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn push_event(&mut self, kind: EventKind, g: Wave, osc: Osc) {
+        let d1 = g.deriv(osc);
+        let d2 = d1.deriv(osc);
+        let d3 = d2.deriv(osc);
+        self.events.push(Event { kind, g, d1, d2, d3 });
+    }
+
+    /// Absolute acceleration of the structure's cluster: `(F − c·u̇ − k·u)/M`.
+    fn accel0_wave(&self) -> Wave {
+        let e0 = self.top[0];
+        let mass = self.cluster0[e0].mass;
+        let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
+        self.vel[0]
+            .combine(-self.sys.damping() / mass, &self.disp[0], -self.sys.stiffness() / mass)
+            .plus_constant(-f_top0 / mass)
+    }
+
+    /// Moves the state to the end of the current piece, accumulating peaks and energy over it.
+    fn advance(&mut self, t_start: f64, ga: f64, slope: f64, b: &Basis) {
+        let osc = self.osc();
+        let e0 = self.top[0];
+        let end = b.tau;
+        let b0 = Basis::at(osc, 0.0);
+        // Peaks of the structure's displacement and its cluster's absolute acceleration.
+        let u = Peaked::new(self.disp[0], osc);
+        let (best, at) = peak_abs(&u, osc, &b0, b, self.out.peak_displacement_m, self.dt);
+        if best > self.out.peak_displacement_m {
+            self.out.peak_displacement_m = best;
+            self.out.peak_displacement_time_s = t_start + at;
+        }
+        let acc = Peaked::new(self.accel0_wave(), osc);
+        // Bodies of the structure's cluster share its acceleration: search above the smallest
+        // of their peaks; a result above it is this piece's maximum.
+        let floor = self.out.peak_abs_accel_mps2[..=e0].iter().copied().fold(f64::INFINITY, f64::min);
+        let (best_acc, _) = peak_abs(&acc, osc, &b0, b, floor, self.dt);
+        if best_acc > floor {
+            for p in &mut self.out.peak_abs_accel_mps2[..=e0] {
+                *p = p.max(best_acc);
+            }
+        }
+        for j in e0 + 1..=self.n {
+            let a = self.accel_free[self.cluster_of[j]].abs();
+            let p = &mut self.out.peak_abs_accel_mps2[j];
+            *p = p.max(a);
+        }
+        // Energy: input −Σ M_c∫a_g·v_c, damping ∫c·u̇².
+        let nc = self.cluster_of[self.n] + 1;
+        let mut input = 0.0;
+        for cidx in 0..nc {
+            let mass = self.mass_prefix[self.top[cidx] + 1] - self.mass_prefix[self.bottom[cidx]];
+            let w = &self.disp[cidx];
+            let x0 = w.p[0] + w.c;
+            let x1 = w.eval(b);
+            let int_av = ga * (x1 - x0) + slope * (end * x1 - w.integral(osc, b));
+            input -= mass * int_av;
+        }
+        self.energy.input += input;
+        self.energy.damping += self.sys.damping() * integral_of_square(&self.vel[0], osc, b);
+        // New state of every body; offsets within a cluster are constant.
+        for i in 0..self.n {
+            self.slip_start[i] = self.x[i + 1] - self.x[i];
+        }
+        for cidx in 0..nc {
+            let bj = self.bottom[cidx];
+            let xb = self.disp[cidx].eval(b);
+            let shift = xb - self.x[bj];
+            let vb = self.vel[cidx].eval(b);
+            for j in bj..=self.top[cidx] {
+                self.x[j] = if j == bj { xb } else { self.x[j] + shift };
+                self.v[j] = vb;
+            }
+        }
+        for i in 0..self.n {
+            let slip = self.x[i + 1] - self.x[i];
+            if let Contact::Slip(_) = self.contacts[i] {
+                self.out.slip_time_s[i] += end;
+                // The relative velocity keeps its sign within a mode: work is μ_k·N·|Δslip|.
+                let w = self.lim_k[i] * (slip - self.slip_start[i]).abs();
+                self.energy.friction_per_interface[i] += w;
+                self.energy.friction += w;
+            }
+            let p = &mut self.out.peak_slip_m[i];
+            *p = p.max(slip.abs());
+        }
+    }
+
+    /// Applies a switch at the current state and chooses the next mode.
+    fn switch(&mut self, kind: EventKind, ga: f64) -> Result<(), SimError> {
+        self.before.copy_from_slice(&self.contacts);
+        // Every slipping interface whose relative velocity has reached or crossed zero sticks
+        // momentarily; each group of bodies so joined takes its momentum-weighted velocity.
+        let mut stopped = false;
+        for i in 0..self.n {
+            let Contact::Slip(dir) = self.contacts[i] else { continue };
+            let s = f64::from(dir) * (self.v[i + 1] - self.v[i]);
+            if s <= 0.0 || kind == EventKind::SlipStop(i) {
+                self.contacts[i] = Contact::Stick;
+                stopped = true;
+            }
+        }
+        if stopped {
+            self.merge_stopped();
+        }
+        self.select(ga)?;
+        let changed = self.contacts.iter().zip(&self.before).filter(|(a, b)| a != b).count();
+        self.out.switches += changed as u64;
+        Ok(())
+    }
+
+    /// Gives every run of bodies joined by stuck interfaces one momentum-weighted velocity; the
+    /// kinetic energy this removes (round-off small after an exact root) is friction work of the
+    /// lowest interface that just stopped in the run.
+    fn merge_stopped(&mut self) {
+        let m = self.sys.masses();
+        let mut j0 = 0;
+        while j0 <= self.n {
+            let mut j1 = j0;
+            while j1 < self.n && self.contacts[j1] == Contact::Stick {
+                j1 += 1;
+            }
+            let first_stopped =
+                (j0..j1).find(|&i| self.before[i] != Contact::Stick);
+            if let Some(i) = first_stopped {
+                let mass = self.mass_prefix[j1 + 1] - self.mass_prefix[j0];
+                let momentum: f64 = (j0..=j1).map(|j| m[j] * self.v[j]).sum();
+                let vm = momentum / mass;
+                let loss: f64 =
+                    (j0..=j1).map(|j| 0.5 * m[j] * (self.v[j] - vm) * (self.v[j] - vm)).sum();
+                self.energy.friction_per_interface[i] += loss;
+                self.energy.friction += loss;
+                for j in j0..=j1 {
+                    self.v[j] = vm;
+                }
+            }
+            j0 = j1 + 1;
+        }
+    }
+
+    fn balance_error(&self) -> f64 {
+        let mut e = self.energy.clone();
+        self.fill_state_energy(&mut e);
+        e.balance_error()
+    }
+
+    fn fill_state_energy(&self, e: &mut Energy) {
+        let m = self.sys.masses();
+        e.kinetic = 0.5 * m.iter().zip(&self.v).map(|(m, v)| m * v * v).sum::<f64>();
+        e.strain = 0.5 * self.sys.stiffness() * self.x[0] * self.x[0];
+    }
+
+    /// Appends the current state as a history row (mode of the piece ending here).
+    fn record(&self, h: &mut History, t: f64, ga: f64) {
+        h.time_s.push(t);
+        h.ground_accel_mps2.push(ga);
+        h.displacement_m.extend_from_slice(&self.x);
+        h.velocity_mps.extend_from_slice(&self.v);
+        let e0 = self.top[0];
+        let mass = self.cluster0[e0].mass;
+        let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
+        let a0 = (-f_top0 - self.sys.damping() * self.v[0] - self.sys.stiffness() * self.x[0]) / mass;
+        for j in 0..=self.n {
+            h.abs_accel_mps2
+                .push(if j <= e0 { a0 } else { self.accel_free[self.cluster_of[j]] });
+        }
+        h.contact.extend(self.contacts.iter().map(|c| c.code()));
+    }
+
+    fn finish(mut self, history: Option<History>) -> Result<Response, SimError> {
+        let mut e = std::mem::take(&mut self.energy);
+        self.fill_state_energy(&mut e);
+        let per_kg = 1.0 / self.sys.mass_kg();
+        for val in [
+            &mut e.input,
+            &mut e.kinetic,
+            &mut e.strain,
+            &mut e.damping,
+            &mut e.friction,
+        ] {
+            *val *= per_kg;
+        }
+        for val in &mut e.friction_per_interface {
+            *val *= per_kg;
+        }
+        for i in 0..self.n {
+            self.out.residual_slip_m[i] = self.x[i + 1] - self.x[i];
+        }
+        self.out.energy = e;
+        self.out.history = history;
+        Ok(self.out)
+    }
+}
+
+/// Earliest `τ ∈ (0, h]` where the switching function goes negative, refined to a few ulps of
+/// the sample interval `dt`; `None` if it stays non-negative. `g_h` is `g(h)`.
+fn first_violation(ev: &Event, osc: Osc, h: f64, g_h: f64, dt: f64) -> Option<f64> {
+    let g0 = ev.g.p[0] + ev.g.c;
+    if g0 < 0.0 {
+        return Some(0.0);
+    }
+    let mut lo = 0.0;
+    if g0 == 0.0 {
+        // Starts on the boundary (a fresh slip): certify an initial stretch from the Taylor
+        // bound g(τ) ≥ g'(0)τ + g''(0)τ²/2 − G₃τ³/6.
+        let g1 = ev.d1.p[0] + ev.d1.c;
+        let g2 = ev.d2.p[0] + ev.d2.c;
+        let g3 = ev.d3.abs_bound(osc, 0.0, h);
+        let tc = taylor_clearance(g1, g2, g3);
+        if tc <= 0.0 {
+            return Some(0.0);
+        }
+        lo = (0.999 * tc).min(h);
+        if lo >= h {
+            return None;
+        }
+    }
+    let glo = ev.g.eval(&Basis::at(osc, lo));
+    let min_width = 4.0 * f64::EPSILON * dt;
+    let (a, b) = search(ev, osc, lo, h, glo, g_h, min_width, 0)?;
+    Some(refine(|t| ev.g.eval(&Basis::at(osc, t)), a, b, min_width))
+}
+
+/// Largest `τ_c` with `g₁τ + g₂τ²/2 − g₃τ³/6 > 0` on `(0, τ_c)`; 0 if there is none.
+fn taylor_clearance(g1: f64, g2: f64, g3: f64) -> f64 {
+    if g1 < 0.0 || (g1 == 0.0 && g2 <= 0.0) {
+        return 0.0;
+    }
+    // Positive root of −(g₃/6)τ² + (g₂/2)τ + g₁ = 0.
+    let (qa, qb, qc) = (g3 / 6.0, g2 / 2.0, g1);
+    if qa == 0.0 {
+        return if qb >= 0.0 { f64::INFINITY } else { -qc / qb };
+    }
+    (qb + (qb * qb + 4.0 * qa * qc).sqrt()) / (2.0 * qa)
+}
+
+/// Bracket `(a, b)` with `g(a) ≥ 0 > g(b)` around the earliest sign change in `[lo, hi]`.
+#[allow(clippy::too_many_arguments)]
+fn search(
+    ev: &Event,
+    osc: Osc,
+    lo: f64,
+    hi: f64,
+    glo: f64,
+    ghi: f64,
+    min_width: f64,
+    depth: u32,
+) -> Option<(f64, f64)> {
+    let width = hi - lo;
+    let curv = ev.d2.abs_bound(osc, lo, hi);
+    if glo.min(ghi) - curv * width * width / 8.0 >= 0.0 {
+        return None;
+    }
+    if ghi < 0.0 {
+        // Monotone on [lo, hi] if g' cannot change sign there: a single root, the earliest.
+        let slope = ev.d1.eval(&Basis::at(osc, lo));
+        if slope < 0.0 && -slope > curv * width {
+            return Some((lo, hi));
+        }
+    }
+    if width <= min_width || depth > 80 {
+        return (ghi < 0.0).then_some((lo, hi));
+    }
+    let mid = lo + 0.5 * width;
+    let gm = ev.g.eval(&Basis::at(osc, mid));
+    search(ev, osc, lo, mid, glo, gm, min_width, depth + 1)
+        .or_else(|| search(ev, osc, mid, hi, gm, ghi, min_width, depth + 1))
+}
+
+/// Shrinks a bracket `g(a) ≥ 0 > g(b)` (Illinois regula falsi with bisection safeguard) and
+/// returns its right end: the first representable time at which the function is negative.
+fn refine(g: impl Fn(f64) -> f64, mut a: f64, mut b: f64, min_width: f64) -> f64 {
+    let mut ga = g(a);
+    let mut gb = g(b);
+    if gb >= 0.0 {
+        return b;
+    }
+    let mut side = 0;
+    for _ in 0..200 {
+        if b - a <= min_width {
+            break;
+        }
+        let mut t = (a * gb - b * ga) / (gb - ga);
+        if !(t > a && t < b) {
+            t = 0.5 * (a + b);
+        }
+        let gt = g(t);
+        if gt < 0.0 {
+            b = t;
+            gb = gt;
+            if side == -1 {
+                ga *= 0.5;
+            }
+            side = -1;
+        } else {
+            a = t;
+            ga = gt;
+            if side == 1 {
+                gb *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    b
+}
+
+/// Peak `|f|` over `[b0.tau, b1.tau]` if it exceeds `best`, with its time; else `(best, _)`.
+/// Branch and bound: a sub-interval is dropped when `max(|f(lo)|,|f(hi)|) + G₂·w²/8 ≤ best`;
+/// where `f'` changes sign once (certified by the bound on `f'''`), the extremum is refined.
+fn peak_abs(p: &Peaked, osc: Osc, b0: &Basis, b1: &Basis, best: f64, dt: f64) -> (f64, f64) {
+    let mut best = (best, 0.0);
+    for b in [b0, b1] {
+        let v = p.f.eval(b).abs();
+        if v > best.0 {
+            best = (v, b.tau);
+        }
+    }
+    let min_width = 4.0 * f64::EPSILON * dt;
+    peak_rec(p, osc, b0.tau, b1.tau, p.f.eval(b0), p.f.eval(b1), &mut best, min_width, 0);
+    best
+}
+
+#[allow(clippy::too_many_arguments)]
+fn peak_rec(
+    p: &Peaked,
+    osc: Osc,
+    lo: f64,
+    hi: f64,
+    flo: f64,
+    fhi: f64,
+    best: &mut (f64, f64),
+    min_width: f64,
+    depth: u32,
+) {
+    let width = hi - lo;
+    let curv = p.d2.abs_bound(osc, lo, hi);
+    if flo.abs().max(fhi.abs()) + curv * width * width / 8.0 <= best.0 {
+        return;
+    }
+    let blo = Basis::at(osc, lo);
+    let bhi = Basis::at(osc, hi);
+    let (slo, shi) = (p.d1.eval(&blo), p.d1.eval(&bhi));
+    if slo * shi < 0.0 {
+        let jerk_bound = p.d3.abs_bound(osc, lo, hi);
+        let c_lo = p.d2.eval(&blo);
+        if c_lo.abs() > jerk_bound * width {
+            // f' is monotone here: its single zero is the only interior extremum.
+            let g = |t: f64| p.d1.eval(&Basis::at(osc, t)) * slo.signum();
+            let t = refine(g, lo, hi, min_width);
+            let v = p.f.eval(&Basis::at(osc, t)).abs();
+            if v > best.0 {
+                *best = (v, t);
+            }
+            return;
+        }
+    }
+    if width <= min_width || depth > 60 {
+        return;
+    }
+    let mid = lo + 0.5 * width;
+    let fm = p.f.eval(&Basis::at(osc, mid));
+    if fm.abs() > best.0 {
+        *best = (fm.abs(), mid);
+    }
+    peak_rec(p, osc, lo, mid, flo, fm, best, min_width, depth + 1);
+    peak_rec(p, osc, mid, hi, fm, fhi, best, min_width, depth + 1);
+}

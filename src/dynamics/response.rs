@@ -1,0 +1,91 @@
+//! What a simulation returns: peaks, slips, switch counts, energy terms and, on request, the
+//! full time history.
+
+use serde::Serialize;
+
+/// Energy terms per kg of structure mass, J/kg, in the relative-motion formulation: the input
+/// energy is the work of the effective earthquake forces `−m_j·a_g` on the relative velocities.
+/// `input = kinetic + strain + damping + friction` up to `residual`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Energy {
+    pub input: f64,
+    pub kinetic: f64,
+    pub strain: f64,
+    pub damping: f64,
+    pub friction: f64,
+    /// Friction dissipation per interface, interface 1 first.
+    pub friction_per_interface: Vec<f64>,
+}
+
+impl Energy {
+    /// `input − (kinetic + strain + damping + friction)`.
+    pub fn residual(&self) -> f64 {
+        self.input - (self.kinetic + self.strain + self.damping + self.friction)
+    }
+
+    /// `|residual| / input` (0 when no energy entered).
+    pub fn balance_error(&self) -> f64 {
+        let scale = self.input.abs().max(self.kinetic + self.strain + self.damping + self.friction);
+        if scale == 0.0 { 0.0 } else { self.residual().abs() / scale }
+    }
+}
+
+/// Time history sampled at every record sample (and, for the RK4 integrator, every sample).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct History {
+    /// Time of each row, s.
+    pub time_s: Vec<f64>,
+    /// Ground acceleration, m/s².
+    pub ground_accel_mps2: Vec<f64>,
+    /// Displacement relative to the ground, m: row-major `[time][body]`, structure first.
+    pub displacement_m: Vec<f64>,
+    /// Velocity relative to the ground, m/s, same layout.
+    pub velocity_mps: Vec<f64>,
+    /// Absolute acceleration, m/s², same layout.
+    pub abs_accel_mps2: Vec<f64>,
+    /// Interface state ([`crate::dynamics::Contact::code`]): row-major `[time][interface]`.
+    pub contact: Vec<i8>,
+    /// Number of bodies (structure plus blocks).
+    pub bodies: usize,
+}
+
+impl History {
+    pub fn with_capacity(rows: usize, bodies: usize) -> Self {
+        Self {
+            time_s: Vec::with_capacity(rows),
+            ground_accel_mps2: Vec::with_capacity(rows),
+            displacement_m: Vec::with_capacity(rows * bodies),
+            velocity_mps: Vec::with_capacity(rows * bodies),
+            abs_accel_mps2: Vec::with_capacity(rows * bodies),
+            contact: Vec::with_capacity(rows * bodies.saturating_sub(1)),
+            bodies,
+        }
+    }
+
+    pub fn rows(&self) -> usize {
+        self.time_s.len()
+    }
+}
+
+/// Result of one simulation.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Response {
+    /// Peak |structure displacement| relative to the ground, m, and when it occurs, s.
+    pub peak_displacement_m: f64,
+    pub peak_displacement_time_s: f64,
+    /// Peak |absolute acceleration| of every body, m/s², structure first then blocks bottom-up.
+    pub peak_abs_accel_mps2: Vec<f64>,
+    /// Peak |relative displacement| across each interface, m, interface 1 first.
+    pub peak_slip_m: Vec<f64>,
+    /// Relative displacement across each interface at the end of the record, m.
+    pub residual_slip_m: Vec<f64>,
+    /// Total time each interface spent slipping, s.
+    pub slip_time_s: Vec<f64>,
+    /// Number of interface state changes.
+    pub switches: u64,
+    /// Energy terms at the end of the record, J per kg of structure mass.
+    pub energy: Energy,
+    /// Largest `|residual| / input` seen at any record sample.
+    pub energy_balance_error_max: f64,
+    pub history: Option<History>,
+}

@@ -1,0 +1,329 @@
+//! The paper's integrator (its Section 3, Eqs. 1–3): fixed-step classical RK4 on the cluster
+//! equations, with the stick/slip pattern decided once per sub-step by the top-down cluster rule.
+//! Kept as a reference and for the accuracy-versus-time comparison; the default is
+//! [`super::exact`].
+//!
+//! Per sub-step `h = dt/substeps`:
+//! 1. An interface is *at rest* if it was stuck in the previous sub-step or its relative velocity
+//!    changed sign during it (the paper's `sign()` would otherwise chatter). Runs of bodies joined
+//!    by at-rest interfaces take their momentum-weighted velocity (the kinetic energy removed is
+//!    booked as friction work).
+//! 2. Top-down cluster rule (paper Eq. 1): with every at-rest interface assumed stuck, each
+//!    cluster's acceleration follows from Eqs. 2–3. Going down from the top, an at-rest
+//!    interface whose required force exceeds `μ_s·N` slips with kinetic force in the direction of
+//!    that force; its cluster splits and the accelerations below are recomputed.
+//! 3. RK4 integrates the cluster equations with that pattern and the slip directions frozen,
+//!    together with the energy rates (input, damping, friction).
+//!
+//! Switches are resolved only to within a sub-step, so the method converges at first order in
+//! `h` on records that slide, whatever RK4's order on smooth pieces.
+
+use super::contact::Contact;
+use super::model::System;
+use super::response::{Energy, History, Response};
+use super::{Ground, SimError};
+
+/// Runs the paper's RK4 with `substeps` sub-steps per record interval.
+pub fn simulate_rk4(
+    sys: &System,
+    ground: &Ground,
+    substeps: usize,
+    history: bool,
+) -> Result<Response, SimError> {
+    ground.validate()?;
+    if substeps == 0 {
+        return Err(SimError::Substeps(substeps));
+    }
+    Ok(Rk4::new(sys).run(ground, substeps, history))
+}
+
+struct Rk4<'s> {
+    sys: &'s System,
+    n: usize,
+    masses: Vec<f64>,
+    lim_s: Vec<f64>,
+    lim_k: Vec<f64>,
+    contacts: Vec<Contact>,
+    /// Friction force of each interface for the current sub-step (slipping ones), N.
+    force: Vec<f64>,
+    /// Cluster index of each body and each cluster's absolute acceleration.
+    cluster_of: Vec<usize>,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    energy: Energy,
+}
+
+impl<'s> Rk4<'s> {
+    fn new(sys: &'s System) -> Self {
+        let n = sys.blocks();
+        Self {
+            sys,
+            n,
+            masses: sys.masses().to_vec(),
+            lim_s: (1..=n).map(|i| sys.static_limit(i)).collect(),
+            lim_k: (1..=n).map(|i| sys.kinetic_limit(i)).collect(),
+            contacts: sys
+                .mu_static()
+                .iter()
+                .map(|&m| if m == 0.0 { Contact::Free } else { Contact::Stick })
+                .collect(),
+            force: vec![0.0; n],
+            cluster_of: vec![0; n + 1],
+            x: vec![0.0; n + 1],
+            v: vec![0.0; n + 1],
+            energy: Energy {
+                friction_per_interface: vec![0.0; n],
+                ..Energy::default()
+            },
+        }
+    }
+
+    /// Mass of bodies `lo..=hi`.
+    fn mass(&self, lo: usize, hi: usize) -> f64 {
+        self.masses[lo..=hi].iter().sum()
+    }
+
+    /// Absolute acceleration of the cluster `lo..=hi` for the given state and current forces.
+    fn cluster_accel(&self, lo: usize, hi: usize, x0: f64, v0: f64) -> f64 {
+        let below = if lo > 0 { self.force[lo - 1] } else { 0.0 };
+        let above = if hi < self.n { self.force[hi] } else { 0.0 };
+        let mut f = below - above;
+        if lo == 0 {
+            f -= self.sys.damping() * v0 + self.sys.stiffness() * x0;
+        }
+        f / self.mass(lo, hi)
+    }
+
+    /// Step 1 and 2 of the module doc: velocities of at-rest runs merged, pattern chosen top-down.
+    fn choose_pattern(&mut self) {
+        let n = self.n;
+        // Merge at-rest runs.
+        let mut j0 = 0;
+        while j0 <= n {
+            let mut j1 = j0;
+            while j1 < n && self.contacts[j1] == Contact::Stick {
+                j1 += 1;
+            }
+            if j1 > j0 {
+                let mass = self.mass(j0, j1);
+                let vm = (j0..=j1).map(|j| self.masses[j] * self.v[j]).sum::<f64>() / mass;
+                let loss: f64 = (j0..=j1)
+                    .map(|j| 0.5 * self.masses[j] * (self.v[j] - vm).powi(2))
+                    .sum();
+                self.energy.friction_per_interface[j0] += loss;
+                self.energy.friction += loss;
+                for j in j0..=j1 {
+                    self.v[j] = vm;
+                }
+            }
+            j0 = j1 + 1;
+        }
+        for i in 0..n {
+            self.force[i] = match self.contacts[i] {
+                Contact::Slip(d) => -self.lim_k[i] * f64::from(d),
+                _ => 0.0,
+            };
+        }
+        // Top-down: check each stuck interface against its cluster's acceleration.
+        let mut top = n;
+        let mut i = n;
+        while i > 0 {
+            let iface = i - 1; // between bodies i-1 and i
+            if self.contacts[iface] != Contact::Stick {
+                top = i - 1;
+                i -= 1;
+                continue;
+            }
+            let mut lo = i - 1;
+            while lo > 0 && self.contacts[lo - 1] == Contact::Stick {
+                lo -= 1;
+            }
+            let acc = self.cluster_accel(lo, top, self.x[0], self.v[0]);
+            let above = if top < n { self.force[top] } else { 0.0 };
+            let required = self.mass(i, top) * acc + above;
+            if required.abs() > self.lim_s[iface] {
+                let dir: i8 = if required > 0.0 { -1 } else { 1 };
+                self.contacts[iface] = Contact::Slip(dir);
+                self.force[iface] = -self.lim_k[iface] * f64::from(dir);
+                top = i - 1;
+            }
+            i -= 1;
+        }
+        let mut c = 0;
+        for j in 0..=n {
+            if j > 0 && self.contacts[j - 1] != Contact::Stick {
+                c += 1;
+            }
+            self.cluster_of[j] = c;
+        }
+    }
+
+    /// Relative accelerations of all bodies (bodies of a cluster share one) into `acc`,
+    /// absolute accelerations into `abs`.
+    fn accelerations(&self, x: &[f64], v: &[f64], ag: f64, acc: &mut [f64], abs: &mut [f64]) {
+        let n = self.n;
+        let mut lo = 0;
+        while lo <= n {
+            let mut hi = lo;
+            while hi < n && self.contacts[hi] == Contact::Stick {
+                hi += 1;
+            }
+            let a = self.cluster_accel(lo, hi, x[0], v[0]);
+            for j in lo..=hi {
+                abs[j] = a;
+                acc[j] = a - ag;
+            }
+            lo = hi + 1;
+        }
+    }
+
+    /// Energy rates `[input, damping, friction_1..n]` at a state.
+    fn rates(&self, v: &[f64], ag: f64, out: &mut [f64]) {
+        out[0] = -ag * self.masses.iter().zip(v).map(|(m, v)| m * v).sum::<f64>();
+        out[1] = self.sys.damping() * v[0] * v[0];
+        for i in 0..self.n {
+            out[2 + i] = -self.force[i] * (v[i + 1] - v[i]);
+        }
+    }
+
+    fn run(mut self, ground: &Ground, substeps: usize, want_history: bool) -> Response {
+        let n = self.n;
+        let nb = n + 1;
+        let acc_g = ground.accel_mps2;
+        let dt = ground.dt_s;
+        let h = dt / substeps as f64;
+        let steps = acc_g.len() - 1;
+        let mut out = Response {
+            peak_abs_accel_mps2: vec![0.0; nb],
+            peak_slip_m: vec![0.0; n],
+            residual_slip_m: vec![0.0; n],
+            slip_time_s: vec![0.0; n],
+            ..Response::default()
+        };
+        let mut history = want_history.then(|| History::with_capacity(steps + 1, nb));
+        let nr = 2 + n;
+        let mut kx = vec![vec![0.0; nb]; 4];
+        let mut kv = vec![vec![0.0; nb]; 4];
+        let mut ke = vec![vec![0.0; nr]; 4];
+        let mut xs = vec![0.0; nb];
+        let mut vs = vec![0.0; nb];
+        let mut abs = vec![0.0; nb];
+        let mut s_before = vec![0.0; n];
+        let mut switches = 0u64;
+        let mut prev = self.contacts.clone();
+        let ag_at = |t_index: usize, frac: f64| -> f64 {
+            let a0 = acc_g[t_index];
+            let a1 = acc_g[(t_index + 1).min(steps)];
+            a0 + (a1 - a0) * frac
+        };
+        for k in 0..steps {
+            for sub in 0..substeps {
+                let frac0 = sub as f64 / substeps as f64;
+                let t = k as f64 * dt + sub as f64 * h;
+                self.choose_pattern();
+                switches += self.contacts.iter().zip(&prev).filter(|(a, b)| a != b).count() as u64;
+                prev.copy_from_slice(&self.contacts);
+                if k == 0 && sub == 0 {
+                    if let Some(hist) = history.as_mut() {
+                        self.accelerations(&self.x, &self.v, acc_g[0], &mut kv[0], &mut abs);
+                        record(hist, 0.0, acc_g[0], &self.x, &self.v, &abs, &self.contacts);
+                    }
+                }
+                for i in 0..n {
+                    s_before[i] = self.v[i + 1] - self.v[i];
+                }
+                // Classical RK4 over [t, t+h].
+                let stage_frac = [0.0, 0.5, 0.5, 1.0];
+                for st in 0..4 {
+                    let ag = ag_at(k, frac0 + stage_frac[st] / substeps as f64);
+                    if st == 0 {
+                        xs.copy_from_slice(&self.x);
+                        vs.copy_from_slice(&self.v);
+                    } else {
+                        let w = stage_frac[st] * h;
+                        for j in 0..nb {
+                            xs[j] = self.x[j] + w * kx[st - 1][j];
+                            vs[j] = self.v[j] + w * kv[st - 1][j];
+                        }
+                    }
+                    kx[st].copy_from_slice(&vs);
+                    let (kv_st, abs_ref) = (&mut kv[st], &mut abs);
+                    self.accelerations(&xs, &vs, ag, kv_st, abs_ref);
+                    if st == 0 {
+                        for j in 0..nb {
+                            out.peak_abs_accel_mps2[j] = out.peak_abs_accel_mps2[j].max(abs[j].abs());
+                        }
+                        let _ = t;
+                    }
+                    self.rates(&vs, ag, &mut ke[st]);
+                }
+                for j in 0..nb {
+                    self.x[j] += h / 6.0 * (kx[0][j] + 2.0 * kx[1][j] + 2.0 * kx[2][j] + kx[3][j]);
+                    self.v[j] += h / 6.0 * (kv[0][j] + 2.0 * kv[1][j] + 2.0 * kv[2][j] + kv[3][j]);
+                }
+                let de = |r: usize| h / 6.0 * (ke[0][r] + 2.0 * ke[1][r] + 2.0 * ke[2][r] + ke[3][r]);
+                self.energy.input += de(0);
+                self.energy.damping += de(1);
+                for i in 0..n {
+                    let w = de(2 + i);
+                    self.energy.friction_per_interface[i] += w;
+                    self.energy.friction += w;
+                }
+                // Interfaces whose relative velocity changed sign are at rest next sub-step.
+                for i in 0..n {
+                    if let Contact::Slip(d) = self.contacts[i] {
+                        out.slip_time_s[i] += h;
+                        let s = self.v[i + 1] - self.v[i];
+                        if f64::from(d) * s <= 0.0 || s_before[i] * s < 0.0 {
+                            self.contacts[i] = Contact::Stick;
+                        }
+                    }
+                    out.peak_slip_m[i] = out.peak_slip_m[i].max((self.x[i + 1] - self.x[i]).abs());
+                }
+                let u = self.x[0].abs();
+                if u > out.peak_displacement_m {
+                    out.peak_displacement_m = u;
+                    out.peak_displacement_time_s = t + h;
+                }
+            }
+            let mut e = self.energy.clone();
+            self.fill_state_energy(&mut e);
+            out.energy_balance_error_max = out.energy_balance_error_max.max(e.balance_error());
+            if let Some(hist) = history.as_mut() {
+                let t1 = (k + 1) as f64 * dt;
+                self.accelerations(&self.x, &self.v, acc_g[k + 1], &mut kv[0], &mut abs);
+                record(hist, t1, acc_g[k + 1], &self.x, &self.v, &abs, &self.contacts);
+            }
+        }
+        let mut e = std::mem::take(&mut self.energy);
+        self.fill_state_energy(&mut e);
+        let per_kg = 1.0 / self.sys.mass_kg();
+        for val in [&mut e.input, &mut e.kinetic, &mut e.strain, &mut e.damping, &mut e.friction] {
+            *val *= per_kg;
+        }
+        for val in &mut e.friction_per_interface {
+            *val *= per_kg;
+        }
+        for i in 0..n {
+            out.residual_slip_m[i] = self.x[i + 1] - self.x[i];
+        }
+        out.switches = switches;
+        out.energy = e;
+        out.history = history;
+        out
+    }
+
+    fn fill_state_energy(&self, e: &mut Energy) {
+        e.kinetic = 0.5 * self.masses.iter().zip(&self.v).map(|(m, v)| m * v * v).sum::<f64>();
+        e.strain = 0.5 * self.sys.stiffness() * self.x[0] * self.x[0];
+    }
+}
+
+fn record(h: &mut History, t: f64, ag: f64, x: &[f64], v: &[f64], abs: &[f64], c: &[Contact]) {
+    h.time_s.push(t);
+    h.ground_accel_mps2.push(ag);
+    h.displacement_m.extend_from_slice(x);
+    h.velocity_mps.extend_from_slice(v);
+    h.abs_accel_mps2.extend_from_slice(abs);
+    h.contact.extend(c.iter().map(|c| c.code()));
+}
