@@ -13,9 +13,12 @@
 //!
 //! With `μ_s > μ_k` several patterns can be consistent. The rule used here, **progressive
 //! release**: solve with the static bounds; every interface whose force is pinned at its static
-//! bound with a nonzero relative acceleration is released to slip with its kinetic force, and the
-//! rest is solved again, until nothing more is released. Interfaces stick wherever static friction
-//! can hold them given the ones that must slip. With `μ_s = μ_k` it returns the unique pattern.
+//! bound with a nonzero relative acceleration is released to slip with its kinetic force, a
+//! released interface whose relative acceleration the later releases have reversed is reopened,
+//! and the rest is solved again until nothing changes. Interfaces stick wherever static friction
+//! can hold them given the ones that must slip. Should release and reopening cycle (bounded at
+//! `4p + 4` rounds for `p` interfaces), the kinetic solution (all bounds at `μ_k·N`) is taken: it
+//! is always consistent. With `μ_s = μ_k` the first solve is final and the pattern unique.
 
 use thiserror::Error;
 
@@ -166,6 +169,7 @@ impl ContactSelector {
             self.hi[k] = limit_static[i0 + k];
             scale = scale.max(limit_static[i0 + k]);
         }
+        let mut rounds = 0;
         loop {
             self.active_set(masses, i0, p, |j| known(j, force), scale)
                 .ok_or(ContactError::NoConvergence {
@@ -173,26 +177,50 @@ impl ContactSelector {
                     last: i1,
                 })?;
             // Release every force pinned at a static bound while its relative acceleration
-            // pushes beyond it (progressive release; see the module doc).
-            let mut more = false;
+            // pushes beyond it; reopen a released one whose slip the others have reversed
+            // (progressive release; see the module doc).
+            let mut changed = false;
             for k in 0..p {
-                if self.released[k] || self.active[k] == 0 {
-                    continue;
-                }
                 let m_lo = masses[i0 + k];
                 let m_hi = masses[i0 + k + 1];
                 let tol = 1e-13 * scale * (1.0 / m_lo + 1.0 / m_hi);
-                let pushing = f64::from(self.active[k]) * self.grad[k] < -tol;
-                if pushing {
-                    let sign = f64::from(self.active[k]);
-                    let fk = sign * limit_kinetic[i0 + k];
+                let push = f64::from(self.active[k]) * self.grad[k];
+                if self.released[k] {
+                    if push > tol {
+                        self.lo[k] = -limit_static[i0 + k];
+                        self.hi[k] = limit_static[i0 + k];
+                        self.released[k] = false;
+                        changed = true;
+                    }
+                } else if self.active[k] != 0 && push < -tol {
+                    let fk = f64::from(self.active[k]) * limit_kinetic[i0 + k];
                     self.lo[k] = fk;
                     self.hi[k] = fk;
                     self.released[k] = true;
-                    more = true;
+                    changed = true;
                 }
             }
-            if !more {
+            if !changed {
+                break;
+            }
+            rounds += 1;
+            if rounds > 4 * p + 4 {
+                // Release and reopening cycle: fall back to the kinetic solution, which is
+                // always Coulomb-consistent (stuck forces within μ_k·N ≤ μ_s·N).
+                for k in 0..p {
+                    self.lo[k] = -limit_kinetic[i0 + k];
+                    self.hi[k] = limit_kinetic[i0 + k];
+                }
+                self.active_set(masses, i0, p, |j| known(j, force), scale)
+                    .ok_or(ContactError::NoConvergence {
+                        first: i0 + 1,
+                        last: i1,
+                    })?;
+                for k in 0..p {
+                    let tol = 1e-13 * scale * (1.0 / masses[i0 + k] + 1.0 / masses[i0 + k + 1]);
+                    self.released[k] =
+                        self.active[k] != 0 && f64::from(self.active[k]) * self.grad[k] < -tol;
+                }
                 break;
             }
         }

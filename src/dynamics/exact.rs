@@ -439,10 +439,9 @@ impl<'s> Exact<'s> {
         for cidx in 0..nc {
             let bj = self.bottom[cidx];
             let xb = self.disp[cidx].eval(b);
-            let shift = xb - self.x[bj];
             let vb = self.vel[cidx].eval(b);
-            for j in bj..=self.top[cidx] {
-                self.x[j] = if j == bj { xb } else { self.x[j] + shift };
+            for j in (bj..=self.top[cidx]).rev() {
+                self.x[j] = xb + (self.x[j] - self.x[bj]);
                 self.v[j] = vb;
             }
         }
