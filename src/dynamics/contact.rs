@@ -181,9 +181,7 @@ impl ContactSelector {
             // (progressive release; see the module doc).
             let mut changed = false;
             for k in 0..p {
-                let m_lo = masses[i0 + k];
-                let m_hi = masses[i0 + k + 1];
-                let tol = 1e-13 * scale * (1.0 / m_lo + 1.0 / m_hi);
+                let tol = release_tolerance(masses, external, limit_static, i0 + k);
                 let push = f64::from(self.active[k]) * self.grad[k];
                 if self.released[k] {
                     if push > tol {
@@ -217,7 +215,7 @@ impl ContactSelector {
                         last: i1,
                     })?;
                 for k in 0..p {
-                    let tol = 1e-13 * scale * (1.0 / masses[i0 + k] + 1.0 / masses[i0 + k + 1]);
+                    let tol = release_tolerance(masses, external, limit_static, i0 + k);
                     self.released[k] =
                         self.active[k] != 0 && f64::from(self.active[k]) * self.grad[k] < -tol;
                 }
@@ -352,6 +350,13 @@ impl ContactSelector {
         }
         None
     }
+}
+
+/// Relative acceleration below which interface `i` (0-based) pinned at its bound counts as not
+/// pushing: round-off of the forces acting on its two bodies.
+fn release_tolerance(masses: &[f64], external: &[f64], limit_static: &[f64], i: usize) -> f64 {
+    let force = limit_static[i] + external[i].abs() + external[i + 1].abs();
+    1e-13 * force * (1.0 / masses[i] + 1.0 / masses[i + 1])
 }
 
 /// Solves a symmetric tridiagonal system in place: `diag` on the diagonal, `off[k]` coupling

@@ -291,14 +291,6 @@ impl<'s> Exact<'s> {
             self.external[j] = -m[j] * ga;
         }
         self.external[0] -= self.sys.damping() * self.v[0] + self.sys.stiffness() * self.x[0];
-        for i in 0..self.n {
-            if let Contact::Slip(_) = self.contacts[i] {
-                // A slip whose relative velocity is exactly zero is a stick candidate.
-                if self.v[i + 1] == self.v[i] {
-                    self.contacts[i] = Contact::Stick;
-                }
-            }
-        }
         self.selector.select(
             m,
             &self.external,
@@ -477,6 +469,15 @@ impl<'s> Exact<'s> {
             self.merge_stopped();
         }
         self.select(ga)?;
+        if let EventKind::Break(i) = kind {
+            if self.contacts[i] == Contact::Stick {
+                // The event proved the demand exceeds the static limit; a selection that pins the
+                // force at the limit with a relative acceleration below round-off is resolved
+                // here: the interface slips against its force, with kinetic friction.
+                self.contacts[i] = Contact::Slip(if self.force[i] > 0.0 { -1 } else { 1 });
+                self.select(ga)?;
+            }
+        }
         let changed = self.contacts.iter().zip(&self.before).filter(|(a, b)| a != b).count();
         self.out.switches += changed as u64;
         Ok(())
