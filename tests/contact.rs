@@ -1,5 +1,7 @@
 //! The contact selector against brute-force enumeration of every stick/slip pattern.
 
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 
 use common::Rng;
@@ -41,7 +43,10 @@ fn evaluate(st: &State, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
             accel[j] = a;
         }
         for i in lo..hi {
-            force[i] = (i + 1..=hi).map(|j| st.masses[j] * a - st.external[j]).sum::<f64>() + above;
+            force[i] = (i + 1..=hi)
+                .map(|j| st.masses[j] * a - st.external[j])
+                .sum::<f64>()
+                + above;
         }
         lo = hi + 1;
     }
@@ -52,14 +57,17 @@ fn evaluate(st: &State, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
 /// Is the pattern Coulomb-consistent, with slack `tol` (relative)?
 fn consistent(st: &State, pattern: &[Contact], tol: f64) -> bool {
     let (force, rel) = evaluate(st, pattern);
-    pattern.iter().enumerate().all(|(i, c)| match (st.given[i], *c) {
-        (Contact::Stick, Contact::Stick) => force[i].abs() <= st.lim_s[i] * (1.0 + tol),
-        (Contact::Stick, Contact::Slip(d)) => {
-            let scale = st.lim_s[i] / st.masses[i].min(st.masses[i + 1]) + 1e-300;
-            f64::from(d) * rel[i] > -tol * scale
-        }
-        (g, c) => g == c,
-    })
+    pattern
+        .iter()
+        .enumerate()
+        .all(|(i, c)| match (st.given[i], *c) {
+            (Contact::Stick, Contact::Stick) => force[i].abs() <= st.lim_s[i] * (1.0 + tol),
+            (Contact::Stick, Contact::Slip(d)) => {
+                let scale = st.lim_s[i] / st.masses[i].min(st.masses[i + 1]) + 1e-300;
+                f64::from(d) * rel[i] > -tol * scale
+            }
+            (g, c) => g == c,
+        })
 }
 
 fn all_patterns(given: &[Contact]) -> Vec<Vec<Contact>> {
@@ -90,7 +98,11 @@ fn random_state(rng: &mut Rng, static_gap: bool) -> State {
     for i in 0..n {
         let normal: f64 = G * masses[i + 1..].iter().sum::<f64>();
         let mu_k = rng.range(0.02, 0.8);
-        let mu_s = if static_gap { mu_k * rng.range(1.0, 2.0) } else { mu_k };
+        let mu_s = if static_gap {
+            mu_k * rng.range(1.0, 2.0)
+        } else {
+            mu_k
+        };
         lim_k.push(mu_k * normal);
         lim_s.push(mu_s * normal);
         given.push(match rng.below(4) {
@@ -99,7 +111,13 @@ fn random_state(rng: &mut Rng, static_gap: bool) -> State {
         });
     }
     let external = masses.iter().map(|m| m * G * 0.6 * rng.normal()).collect();
-    State { masses, external, lim_s, lim_k, given }
+    State {
+        masses,
+        external,
+        lim_s,
+        lim_k,
+        given,
+    }
 }
 
 fn select(st: &State) -> Vec<Contact> {
@@ -107,13 +125,29 @@ fn select(st: &State) -> Vec<Contact> {
     let mut sel = ContactSelector::new(n);
     let mut contacts = st.given.clone();
     let mut force = vec![0.0; n];
-    sel.select(&st.masses, &st.external, &st.lim_s, &st.lim_k, &mut contacts, &mut force)
-        .unwrap();
+    sel.select(
+        &st.masses,
+        &st.external,
+        &st.lim_s,
+        &st.lim_k,
+        &mut contacts,
+        &mut force,
+    )
+    .unwrap();
     // The forces it returns are those of its pattern.
     let (f_ref, _) = evaluate(st, &contacts);
-    let scale = st.lim_s.iter().chain(st.external.iter()).fold(0.0f64, |m, x| m.max(x.abs()));
+    let scale = st
+        .lim_s
+        .iter()
+        .chain(st.external.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
     for i in 0..n {
-        assert!((force[i] - f_ref[i]).abs() <= 1e-9 * scale, "force {i}: {} vs {}", force[i], f_ref[i]);
+        assert!(
+            (force[i] - f_ref[i]).abs() <= 1e-9 * scale,
+            "force {i}: {} vs {}",
+            force[i],
+            f_ref[i]
+        );
     }
     contacts
 }
@@ -128,13 +162,26 @@ fn unique_consistent_pattern_is_chosen() {
     for _ in 0..3000 {
         let st = random_state(&mut rng, false);
         let patterns = all_patterns(&st.given);
-        let loose: Vec<_> = patterns.iter().filter(|p| consistent(&st, p, 1e-9)).collect();
-        let strict = patterns.iter().filter(|p| consistent(&st, p, -1e-12)).count();
+        let loose: Vec<_> = patterns
+            .iter()
+            .filter(|p| consistent(&st, p, 1e-9))
+            .collect();
+        let strict = patterns
+            .iter()
+            .filter(|p| consistent(&st, p, -1e-12))
+            .count();
         if loose.len() != 1 || strict != 1 {
             skipped += 1;
             continue;
         }
-        assert_eq!(&select(&st), loose[0], "masses {:?} ext {:?} given {:?}", st.masses, st.external, st.given);
+        assert_eq!(
+            &select(&st),
+            loose[0],
+            "masses {:?} ext {:?} given {:?}",
+            st.masses,
+            st.external,
+            st.given
+        );
         checked += 1;
     }
     assert!(skipped * 50 <= checked, "{skipped} near-ties of {checked}");
@@ -148,13 +195,23 @@ fn static_gap_choice_is_consistent() {
     for _ in 0..3000 {
         let st = random_state(&mut rng, true);
         let chosen = select(&st);
-        assert!(consistent(&st, &chosen, 1e-9), "chosen {chosen:?} inconsistent for {:?}", st.given);
-        let count = all_patterns(&st.given).iter().filter(|p| consistent(&st, p, 1e-9)).count();
+        assert!(
+            consistent(&st, &chosen, 1e-9),
+            "chosen {chosen:?} inconsistent for {:?}",
+            st.given
+        );
+        let count = all_patterns(&st.given)
+            .iter()
+            .filter(|p| consistent(&st, p, 1e-9))
+            .count();
         if count > 1 {
             several += 1;
         }
     }
-    assert!(several > 50, "the sample must contain ambiguous states, got {several}");
+    assert!(
+        several > 50,
+        "the sample must contain ambiguous states, got {several}"
+    );
 }
 
 /// The documented rule on the simplest ambiguous state: a block at rest whose demand lies between
@@ -172,7 +229,11 @@ fn progressive_release_sticks_when_static_friction_can_hold() {
             .select(&masses, &[push, 0.0], &lim_s, &lim_k, &mut c, &mut f)
             .unwrap();
         assert_eq!(c[0], expect);
-        let expected_force = if expect == Contact::Stick { push / 2.0 } else { lim_k[0] };
+        let expected_force = if expect == Contact::Stick {
+            push / 2.0
+        } else {
+            lim_k[0]
+        };
         assert!((f[0] - expected_force).abs() < 1e-12);
     }
 }

@@ -1,5 +1,7 @@
 //! Limit cases with closed-form or independent oracles (NOTES.md, "Stated special cases").
 
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 
 use common::{column, max_rel_diff, real_records, sdof_oracle};
@@ -17,8 +19,15 @@ const HIST: ExactOptions = ExactOptions {
 fn rigid_limit_equals_sdof_of_total_mass() {
     for rec in real_records() {
         let accel = rec.accel_mps2(1.0);
-        let ground = Ground { dt_s: rec.dt_s, accel_mps2: &accel };
-        for (tp, alpha) in [(0.5, vec![0.5, 0.5]), (1.2, vec![1.0]), (0.2, vec![0.1, 0.3, 0.2])] {
+        let ground = Ground {
+            dt_s: rec.dt_s,
+            accel_mps2: &accel,
+        };
+        for (tp, alpha) in [
+            (0.5, vec![0.5, 0.5]),
+            (1.2, vec![1.0]),
+            (0.2, vec![0.1, 0.3, 0.2]),
+        ] {
             let mu = vec![100.0; alpha.len()];
             let sys = System::new(&SystemSpec::new(tp, &alpha, &mu)).unwrap();
             let r = simulate_exact(&sys, &ground, &HIST).unwrap();
@@ -44,7 +53,10 @@ fn rigid_limit_equals_sdof_of_total_mass() {
 fn frictionless_stack_leaves_structure_alone() {
     for rec in real_records() {
         let accel = rec.accel_mps2(1.0);
-        let ground = Ground { dt_s: rec.dt_s, accel_mps2: &accel };
+        let ground = Ground {
+            dt_s: rec.dt_s,
+            accel_mps2: &accel,
+        };
         let sys = System::new(&SystemSpec::new(0.7, &[0.5, 2.0], &[0.0, 0.0])).unwrap();
         let r = simulate_exact(&sys, &ground, &HIST).unwrap();
         let omega = 2.0 * std::f64::consts::PI / 0.7;
@@ -77,7 +89,10 @@ fn frictionless_stack_leaves_structure_alone() {
 fn stack_with_upward_nondecreasing_friction_is_one_block() {
     for rec in real_records() {
         let accel = rec.accel_mps2(1.5);
-        let ground = Ground { dt_s: rec.dt_s, accel_mps2: &accel };
+        let ground = Ground {
+            dt_s: rec.dt_s,
+            accel_mps2: &accel,
+        };
         for (tp, a1, a2, m1, m2) in [
             (1.0, 0.5, 0.5, 0.1, 0.2),
             (0.5, 1.0, 0.1, 0.05, 0.05),
@@ -87,8 +102,19 @@ fn stack_with_upward_nondecreasing_friction_is_one_block() {
             let single = System::new(&SystemSpec::new(tp, &[a1 + a2], &[m1])).unwrap();
             let rs = simulate_exact(&stack, &ground, &HIST).unwrap();
             let r1 = simulate_exact(&single, &ground, &HIST).unwrap();
-            assert!(rs.peak_slip_m[0] > 1e-3, "{} T={tp}: must slide: {:?}", rec.name, rs.peak_slip_m);
-            assert!(rs.peak_slip_m[1] == 0.0, "top block never slips");
+            assert!(
+                rs.peak_slip_m[0] > 1e-3,
+                "{} T={tp}: must slide: {:?}",
+                rec.name,
+                rs.peak_slip_m
+            );
+            // The top block never slips: at most round-off (a release undone at once).
+            assert!(
+                rs.peak_slip_m[1] < 1e-12,
+                "{} T={tp}: top block slips: {:?}",
+                rec.name,
+                rs.peak_slip_m
+            );
             let peak = r1.peak_displacement_m;
             assert!((rs.peak_displacement_m - peak).abs() / peak < 1e-10);
             let (hs, h1) = (rs.history.unwrap(), r1.history.unwrap());
@@ -118,14 +144,18 @@ fn newmark_block_under_trapezoidal_pulse() {
             *a = amp;
         }
     }
-    let ground = Ground { dt_s: dt, accel_mps2: &accel };
+    let ground = Ground {
+        dt_s: dt,
+        accel_mps2: &accel,
+    };
     let mut spec = SystemSpec::new(1e-6, &[0.01], &[mu]);
     spec.damping_ratio = 0.9;
     let sys = System::new(&spec).unwrap();
     let res = simulate_exact(&sys, &ground, &ExactOptions::default()).unwrap();
     // Relative velocity w of block to base; slip = ∫w.
     let ts = r * e / amp;
-    let d1 = e * (r - ts).powi(2) / 2.0 - amp / (2.0 * r) * ((r.powi(3) - ts.powi(3)) / 3.0 - ts * ts * (r - ts));
+    let d1 = e * (r - ts).powi(2) / 2.0
+        - amp / (2.0 * r) * ((r.powi(3) - ts.powi(3)) / 3.0 - ts * ts * (r - ts));
     let w_r = e * (r - ts) - amp * (r * r - ts * ts) / (2.0 * r);
     let d2 = w_r * (t0 - r) + (e - amp) * (t0 - r).powi(2) / 2.0;
     let w_t0 = w_r + (e - amp) * (t0 - r);
@@ -134,9 +164,15 @@ fn newmark_block_under_trapezoidal_pulse() {
     let d4 = -w3 * w3 / (2.0 * e);
     let slip = d1 + d2 + d3 + d4;
     let newmark = -(amp * t0).powi(2) / (2.0 * e) * (1.0 - e / amp);
-    assert!((slip - newmark).abs() / newmark.abs() < 0.01, "closed form near Newmark's");
+    assert!(
+        (slip - newmark).abs() / newmark.abs() < 0.01,
+        "closed form near Newmark's"
+    );
     let got = res.residual_slip_m[0];
-    assert!((got - slip).abs() / slip.abs() < 1e-5, "slip {got} vs closed form {slip}");
+    assert!(
+        (got - slip).abs() / slip.abs() < 1e-5,
+        "slip {got} vs closed form {slip}"
+    );
     assert!((res.peak_slip_m[0] - slip.abs()).abs() / slip.abs() < 1e-5);
     assert_eq!(res.switches, 2, "one break-away and one stop");
 }

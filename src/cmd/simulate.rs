@@ -10,7 +10,7 @@ use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use serde::{Deserialize, Serialize};
 use slidestack::dynamics::{
-    self, ExactOptions, G, Ground, Response, System, SystemSpec, simulate_exact, simulate_rk4,
+    ExactOptions, G, Ground, Response, System, SystemSpec, simulate_exact, simulate_rk4,
 };
 use slidestack::motion::{self, Record};
 use slidestack::store::write_history;
@@ -141,7 +141,10 @@ pub fn run(args: Args) -> Result<()> {
     if !(scale.is_finite() && scale > 0.0) {
         bail!("scale must be finite and > 0, got {scale}");
     }
-    let integrator = args.integrator.or(file.integrator).unwrap_or(Integrator::Exact);
+    let integrator = args
+        .integrator
+        .or(file.integrator)
+        .unwrap_or(Integrator::Exact);
     let substeps = args.rk4_substeps.or(file.rk4_substeps).unwrap_or(10);
     let history_path = args.history.or(file.history);
     if let Some(p) = &history_path {
@@ -202,7 +205,10 @@ fn output(
         period_s: sys.period_s(),
         period_rigid_s: sys.period_rigid_s(),
         damping: sys.damping_ratio(),
-        alpha: sys.masses()[1..].iter().map(|m| m / sys.mass_kg()).collect(),
+        alpha: sys.masses()[1..]
+            .iter()
+            .map(|m| m / sys.mass_kg())
+            .collect(),
         mu: sys.mu_kinetic().to_vec(),
         mu_static: sys.mu_static().to_vec(),
         integrator,
@@ -229,14 +235,25 @@ fn output(
 
 fn print_table(o: &Output) {
     let list = |v: &[f64], prec: usize| {
-        v.iter().map(|x| format!("{x:.prec$}")).collect::<Vec<_>>().join(", ")
+        v.iter()
+            .map(|x| format!("{x:.prec$}"))
+            .collect::<Vec<_>>()
+            .join(", ")
     };
-    println!("record            {} ({} samples, dt {} s, scale {})", o.record, o.npts, o.dt_s, o.scale);
+    println!(
+        "record            {} ({} samples, dt {} s, scale {})",
+        o.record, o.npts, o.dt_s, o.scale
+    );
     println!(
         "structure         T_p {} s, damping {}, T_rigid {:.4} s",
         o.period_s, o.damping, o.period_rigid_s
     );
-    println!("stack             alpha [{}], mu [{}], mu_static [{}]", list(&o.alpha, 3), list(&o.mu, 3), list(&o.mu_static, 3));
+    println!(
+        "stack             alpha [{}], mu [{}], mu_static [{}]",
+        list(&o.alpha, 3),
+        list(&o.mu, 3),
+        list(&o.mu_static, 3)
+    );
     let integ = match o.rk4_substeps {
         Some(n) => format!("rk4, {n} sub-steps"),
         None => "exact".to_string(),
@@ -246,7 +263,10 @@ fn print_table(o: &Output) {
         "peak displacement {:.6} m at {:.4} s",
         o.peak_displacement_m, o.peak_displacement_time_s
     );
-    println!("peak abs accel    [{}] g (structure, blocks bottom-up)", list(&o.peak_abs_accel_g, 4));
+    println!(
+        "peak abs accel    [{}] g (structure, blocks bottom-up)",
+        list(&o.peak_abs_accel_g, 4)
+    );
     println!("peak slip         [{}] m", list(&o.peak_slip_m, 5));
     println!("residual slip     [{}] m", list(&o.residual_slip_m, 5));
     println!("slipping time     [{}] s", list(&o.slip_time_s, 3));
@@ -256,6 +276,8 @@ fn print_table(o: &Output) {
         "energy (J/kg)     input {:.6}, kinetic {:.6}, strain {:.6}, damping {:.6}, friction {:.6}",
         e.input, e.kinetic, e.strain, e.damping, e.friction
     );
-    println!("energy balance    |residual|/input = {:.2e}", o.energy_balance_error);
-    let _ = dynamics::G;
+    println!(
+        "energy balance    |residual|/input = {:.2e}",
+        o.energy_balance_error
+    );
 }

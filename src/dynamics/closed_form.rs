@@ -102,14 +102,16 @@ impl Wave {
     /// term by term, the oscillation by its amplitude times `e^{−a·t0}`.
     pub fn abs_bound(&self, osc: Osc, t0: f64, t1: f64) -> f64 {
         let tm = t1.max(t0.abs());
-        let poly = self.p[0].abs() + tm * (self.p[1].abs() + tm * (self.p[2].abs() + tm * self.p[3].abs()));
+        let poly = self.p[0].abs()
+            + tm * (self.p[1].abs() + tm * (self.p[2].abs() + tm * self.p[3].abs()));
         poly + self.c.hypot(self.d) * (-osc.decay * t0).exp()
     }
 
     /// `∫₀^τ g(t) dt` at the basis point.
     pub fn integral(&self, osc: Osc, b: &Basis) -> f64 {
         let t = b.tau;
-        let poly = t * (self.p[0] + t * (self.p[1] / 2.0 + t * (self.p[2] / 3.0 + t * self.p[3] / 4.0)));
+        let poly =
+            t * (self.p[0] + t * (self.p[1] / 2.0 + t * (self.p[2] / 3.0 + t * self.p[3] / 4.0)));
         // ∫₀^h e^{−aτ}(c cos ωτ + d sin ωτ) dτ = Re[(c − i·d)·(e^{zh} − 1)/z], z = −a + iω,
         // through φ₁ so that short pieces lose no digits to cancellation.
         let zh = Cx(-osc.decay * t, osc.omega * t);
@@ -177,7 +179,11 @@ pub fn integral_of_square(v: &Wave, osc: Osc, b: &Basis) -> f64 {
     let i_exp = h * phi1(Cx(-2.0 * a * h, 0.0)).0;
     let z = phi1(Cx(-2.0 * a * h, 2.0 * w * h));
     let (i_cos, i_sin) = (h * z.0, h * z.1);
-    big_b * big_b * h + cross + mean * i_exp + 0.5 * (v.c * v.c - v.d * v.d) * i_cos + v.c * v.d * i_sin
+    big_b * big_b * h
+        + cross
+        + mean * i_exp
+        + 0.5 * (v.c * v.c - v.d * v.d) * i_cos
+        + v.c * v.d * i_sin
 }
 
 #[cfg(test)]
@@ -197,8 +203,15 @@ mod tests {
 
     #[test]
     fn derivative_and_integrals_match_numerics() {
-        let osc = Osc { decay: 0.7, omega: 9.0 };
-        let g = Wave { p: [0.3, -1.2, 0.5, 0.25], c: 0.8, d: -0.4 };
+        let osc = Osc {
+            decay: 0.7,
+            omega: 9.0,
+        };
+        let g = Wave {
+            p: [0.3, -1.2, 0.5, 0.25],
+            c: 0.8,
+            d: -0.4,
+        };
         let h = 0.37;
         let f = |t: f64| g.eval(&Basis::at(osc, t));
         let dg = g.deriv(osc);
@@ -207,12 +220,19 @@ mod tests {
         assert!((dg.eval(&Basis::at(osc, 0.2)) - num).abs() < 1e-7);
         let exact = g.integral(osc, &Basis::at(osc, h));
         assert!((exact - quad(f, h)).abs() < 1e-12, "{exact}");
-        let v = Wave { p: [0.6, 0.0, 0.0, 0.0], c: -0.3, d: 1.1 };
+        let v = Wave {
+            p: [0.6, 0.0, 0.0, 0.0],
+            c: -0.3,
+            d: 1.1,
+        };
         let fv = |t: f64| v.eval(&Basis::at(osc, t)).powi(2);
         let sq = integral_of_square(&v, osc, &Basis::at(osc, h));
         assert!((sq - quad(fv, h)).abs() < 1e-12, "{sq}");
         // Tiny pieces and zero damping take the series branch.
-        let osc0 = Osc { decay: 0.0, omega: 3.0 };
+        let osc0 = Osc {
+            decay: 0.0,
+            omega: 3.0,
+        };
         let hs = 1e-4;
         let sq0 = integral_of_square(&v, osc0, &Basis::at(osc0, hs));
         let fv0 = |t: f64| v.eval(&Basis::at(osc0, t)).powi(2);
@@ -222,8 +242,15 @@ mod tests {
 
     #[test]
     fn abs_bound_bounds() {
-        let osc = Osc { decay: 0.2, omega: 30.0 };
-        let g = Wave { p: [0.1, -2.0, 3.0, -1.0], c: 0.5, d: 0.9 };
+        let osc = Osc {
+            decay: 0.2,
+            omega: 30.0,
+        };
+        let g = Wave {
+            p: [0.1, -2.0, 3.0, -1.0],
+            c: 0.5,
+            d: 0.9,
+        };
         let b = g.abs_bound(osc, 0.1, 0.6);
         for i in 0..=1000 {
             let t = 0.1 + 0.5 * i as f64 / 1000.0;

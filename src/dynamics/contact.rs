@@ -46,7 +46,9 @@ impl Contact {
 
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ContactError {
-    #[error("contact selection did not converge at interfaces {first}..{last} (non-finite forces?)")]
+    #[error(
+        "contact selection did not converge at interfaces {first}..{last} (non-finite forces?)"
+    )]
     NoConvergence { first: usize, last: usize },
 }
 
@@ -293,7 +295,12 @@ impl ContactSelector {
                     0.0
                 };
             }
-            thomas(&mut self.diag[..p], &self.off[..p], &mut self.rhs[..p], &mut self.dir[..p]);
+            thomas(
+                &mut self.diag[..p],
+                &self.off[..p],
+                &mut self.rhs[..p],
+                &mut self.dir[..p],
+            );
             let mut step = 1.0;
             let mut block = None;
             for k in 0..p {
@@ -356,7 +363,7 @@ impl ContactSelector {
 /// pushing: round-off of the forces acting on its two bodies.
 fn release_tolerance(masses: &[f64], external: &[f64], limit_static: &[f64], i: usize) -> f64 {
     let force = limit_static[i] + external[i].abs() + external[i + 1].abs();
-    1e-13 * force * (1.0 / masses[i] + 1.0 / masses[i + 1])
+    1e-11 * force * (1.0 / masses[i] + 1.0 / masses[i + 1])
 }
 
 /// Solves a symmetric tridiagonal system in place: `diag` on the diagonal, `off[k]` coupling

@@ -58,7 +58,12 @@ impl Ground<'_> {
         if self.accel_mps2.len() < 2 {
             return Err(SimError::TooShort(self.accel_mps2.len()));
         }
-        if let Some((index, &value)) = self.accel_mps2.iter().enumerate().find(|(_, a)| !a.is_finite()) {
+        if let Some((index, &value)) = self
+            .accel_mps2
+            .iter()
+            .enumerate()
+            .find(|(_, a)| !a.is_finite())
+        {
             return Err(SimError::NonFinite { index, value });
         }
         Ok(())

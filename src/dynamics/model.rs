@@ -20,11 +20,11 @@ pub enum ModelError {
     Mass(f64),
     #[error("alpha_{index} (mass ratio of block {index}) must be finite and > 0, got {value}")]
     Alpha { index: usize, value: f64 },
-    #[error("mu_{index} (kinetic friction of interface {index}) must be finite and >= 0, got {value}")]
-    MuKinetic { index: usize, value: f64 },
     #[error(
-        "mu_static_{index} must be finite and >= mu_{index} (kinetic, {kinetic}), got {value}"
+        "mu_{index} (kinetic friction of interface {index}) must be finite and >= 0, got {value}"
     )]
+    MuKinetic { index: usize, value: f64 },
+    #[error("mu_static_{index} must be finite and >= mu_{index} (kinetic, {kinetic}), got {value}")]
     MuStatic {
         index: usize,
         value: f64,
@@ -245,15 +245,60 @@ mod tests {
         let ok = SystemSpec::new(1.0, &[0.5, 0.5], &[0.2, 0.1]);
         assert!(System::new(&ok).is_ok());
         let cases: Vec<(SystemSpec, &str)> = vec![
-            (SystemSpec { period_s: 0.0, ..ok.clone() }, "period_s"),
-            (SystemSpec { damping_ratio: 1.0, ..ok.clone() }, "damping ratio"),
-            (SystemSpec { mass_kg: -1.0, ..ok.clone() }, "mass_kg"),
-            (SystemSpec { alpha: vec![0.5, -0.1], ..ok.clone() }, "alpha_2"),
-            (SystemSpec { mu: vec![-0.1, 0.1], ..ok.clone() }, "mu_1"),
-            (SystemSpec { mu: vec![0.1, f64::NAN], ..ok.clone() }, "mu_2"),
-            (SystemSpec { mu: vec![0.1], ..ok.clone() }, "mu lists 1"),
             (
-                SystemSpec { mu_static: Some(vec![0.1, 0.1]), ..ok.clone() },
+                SystemSpec {
+                    period_s: 0.0,
+                    ..ok.clone()
+                },
+                "period_s",
+            ),
+            (
+                SystemSpec {
+                    damping_ratio: 1.0,
+                    ..ok.clone()
+                },
+                "damping ratio",
+            ),
+            (
+                SystemSpec {
+                    mass_kg: -1.0,
+                    ..ok.clone()
+                },
+                "mass_kg",
+            ),
+            (
+                SystemSpec {
+                    alpha: vec![0.5, -0.1],
+                    ..ok.clone()
+                },
+                "alpha_2",
+            ),
+            (
+                SystemSpec {
+                    mu: vec![-0.1, 0.1],
+                    ..ok.clone()
+                },
+                "mu_1",
+            ),
+            (
+                SystemSpec {
+                    mu: vec![0.1, f64::NAN],
+                    ..ok.clone()
+                },
+                "mu_2",
+            ),
+            (
+                SystemSpec {
+                    mu: vec![0.1],
+                    ..ok.clone()
+                },
+                "mu lists 1",
+            ),
+            (
+                SystemSpec {
+                    mu_static: Some(vec![0.1, 0.1]),
+                    ..ok.clone()
+                },
                 "mu_static_1",
             ),
         ];

@@ -25,8 +25,15 @@ impl Energy {
 
     /// `|residual| / input` (0 when no energy entered).
     pub fn balance_error(&self) -> f64 {
-        let scale = self.input.abs().max(self.kinetic + self.strain + self.damping + self.friction);
-        if scale == 0.0 { 0.0 } else { self.residual().abs() / scale }
+        let scale = self
+            .input
+            .abs()
+            .max(self.kinetic + self.strain + self.damping + self.friction);
+        if scale == 0.0 {
+            0.0
+        } else {
+            self.residual().abs() / scale
+        }
     }
 }
 
@@ -85,7 +92,7 @@ pub struct Response {
     pub switches: u64,
     /// Energy terms at the end of the record, J per kg of structure mass.
     pub energy: Energy,
-    /// Largest `|residual| / input` seen at any record sample.
+    /// Largest `|residual(t)| / max_{s≤t} input(s)` over the record samples.
     pub energy_balance_error_max: f64,
     pub history: Option<History>,
 }

@@ -19,7 +19,10 @@ pub struct Record {
 impl Record {
     /// Acceleration in m/s², multiplied by `scale`.
     pub fn accel_mps2(&self, scale: f64) -> Vec<f64> {
-        self.accel_g.iter().map(|a| a * scale * crate::dynamics::G).collect()
+        self.accel_g
+            .iter()
+            .map(|a| a * scale * crate::dynamics::G)
+            .collect()
     }
 
     /// Peak ground acceleration, g.
@@ -45,9 +48,17 @@ pub enum RecordError {
     )]
     MissingHeader { file: String, line: usize },
     #[error("{file}:{line}: `{token}` is not a number")]
-    NotANumber { file: String, line: usize, token: String },
+    NotANumber {
+        file: String,
+        line: usize,
+        token: String,
+    },
     #[error("{file}:{line}: value {value} is not finite")]
-    NonFinite { file: String, line: usize, value: f64 },
+    NonFinite {
+        file: String,
+        line: usize,
+        value: f64,
+    },
     #[error("{file}:{line}: time step dt must be > 0, got {dt}")]
     TimeStep { file: String, line: usize, dt: f64 },
     #[error("{file}:{line}: header says NPTS = {expected} but the file has {found} values")]
@@ -58,8 +69,14 @@ pub enum RecordError {
         found: usize,
     },
     #[error("{file}:{line}: expected 2 columns (time, acceleration in g), found {found}")]
-    Columns { file: String, line: usize, found: usize },
-    #[error("{file}:{line}: time step {found} s differs from the first step {expected} s (non-uniform sampling)")]
+    Columns {
+        file: String,
+        line: usize,
+        found: usize,
+    },
+    #[error(
+        "{file}:{line}: time step {found} s differs from the first step {expected} s (non-uniform sampling)"
+    )]
     NonUniform {
         file: String,
         line: usize,
@@ -67,7 +84,11 @@ pub enum RecordError {
         found: f64,
     },
     #[error("{file}:{line}: a record needs at least 2 samples, found {found}")]
-    TooShort { file: String, line: usize, found: usize },
+    TooShort {
+        file: String,
+        line: usize,
+        found: usize,
+    },
 }
 
 /// Reads a `.AT2` file (detected by extension or a `PEER` first line) or a two-column
@@ -81,7 +102,10 @@ pub fn read_record(path: &Path) -> Result<Record, RecordError> {
     let is_at2 = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("at2"))
-        || text.lines().next().is_some_and(|l| l.to_ascii_uppercase().contains("PEER"));
+        || text
+            .lines()
+            .next()
+            .is_some_and(|l| l.to_ascii_uppercase().contains("PEER"));
     if is_at2 {
         parse_at2(&text, &file)
     } else {
@@ -208,7 +232,10 @@ pub fn parse_two_column(text: &str, file: &str) -> Result<Record, RecordError> {
     let mut last_line = 0;
     for (idx, raw) in text.lines().enumerate() {
         let line = raw.split('#').next().unwrap_or("");
-        let cols: Vec<&str> = line.split(|c: char| c.is_whitespace() || c == ',').filter(|t| !t.is_empty()).collect();
+        let cols: Vec<&str> = line
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|t| !t.is_empty())
+            .collect();
         if cols.is_empty() {
             continue;
         }
@@ -274,14 +301,23 @@ mod tests {
         parse_at2(text, "bad.AT2").unwrap_err().to_string()
     }
 
-    const HEAD: &str = "PEER NGA STRONG MOTION DATABASE RECORD\nx\nACCELERATION TIME SERIES IN UNITS OF G\n";
+    const HEAD: &str =
+        "PEER NGA STRONG MOTION DATABASE RECORD\nx\nACCELERATION TIME SERIES IN UNITS OF G\n";
 
     #[test]
     fn both_header_styles() {
-        let a = parse_at2(&format!("{HEAD}NPTS=  3, DT=   .0100 SEC\n 0.1 -0.2\n .3E-1\n"), "a").unwrap();
+        let a = parse_at2(
+            &format!("{HEAD}NPTS=  3, DT=   .0100 SEC\n 0.1 -0.2\n .3E-1\n"),
+            "a",
+        )
+        .unwrap();
         assert_eq!(a.accel_g, vec![0.1, -0.2, 0.03]);
         assert_eq!(a.dt_s, 0.01);
-        let b = parse_at2(&format!("{HEAD}    3    0.02000    NPTS, DT\n 0.1 -0.2 0.3\n"), "b").unwrap();
+        let b = parse_at2(
+            &format!("{HEAD}    3    0.02000    NPTS, DT\n 0.1 -0.2 0.3\n"),
+            "b",
+        )
+        .unwrap();
         assert_eq!(b.accel_g.len(), 3);
         assert_eq!(b.dt_s, 0.02);
     }
@@ -335,10 +371,16 @@ mod tests {
             "tc.txt:3: time step 0.019999999999999997 s differs from the first step 0.01 s (non-uniform sampling)"
         );
         let e = parse_two_column("0 0\n0.01 0.1 7\n", "tc.txt").unwrap_err();
-        assert_eq!(e.to_string(), "tc.txt:2: expected 2 columns (time, acceleration in g), found 3");
+        assert_eq!(
+            e.to_string(),
+            "tc.txt:2: expected 2 columns (time, acceleration in g), found 3"
+        );
         let e = parse_two_column("0 0\n0 0.1\n", "tc.txt").unwrap_err();
         assert_eq!(e.to_string(), "tc.txt:2: time step dt must be > 0, got 0");
         let e = parse_two_column("0 0\n", "tc.txt").unwrap_err();
-        assert_eq!(e.to_string(), "tc.txt:1: a record needs at least 2 samples, found 1");
+        assert_eq!(
+            e.to_string(),
+            "tc.txt:1: a record needs at least 2 samples, found 1"
+        );
     }
 }

@@ -1,11 +1,14 @@
 //! Shared test helpers: fixtures, a seeded generator and an independent linear-SDOF oracle.
 #![allow(dead_code)]
+#![allow(clippy::needless_range_loop)]
 
 use slidestack::motion::{Record, read_record};
 use std::path::PathBuf;
 
 pub fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/records").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/records")
+        .join(name)
 }
 
 /// The committed real records (PROVENANCE.md beside them).
@@ -69,7 +72,11 @@ fn mat_mul(a: &M4, b: &M4) -> M4 {
 
 /// `exp(A·t)` by scaling and squaring of a 30-term Taylor series.
 fn expm(a: &M4, t: f64) -> M4 {
-    let norm = a.iter().flatten().map(|x| (x * t).abs()).fold(0.0, f64::max);
+    let norm = a
+        .iter()
+        .flatten()
+        .map(|x| (x * t).abs())
+        .fold(0.0, f64::max);
     let mut s = 0;
     while norm / 2f64.powi(s) > 0.25 {
         s += 1;
@@ -150,13 +157,20 @@ pub fn sdof_oracle(omega: f64, zeta: f64, dt: f64, accel: &[f64]) -> SdofOracle 
         u.push(end[0]);
         y = end;
     }
-    SdofOracle { displacement: u, peak }
+    SdofOracle {
+        displacement: u,
+        peak,
+    }
 }
 
 /// Largest |a − b| over the two series divided by `scale`.
 pub fn max_rel_diff(a: &[f64], b: &[f64], scale: f64) -> f64 {
     assert_eq!(a.len(), b.len());
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+        / scale
 }
 
 /// Column `body` of a row-major `[time][body]` history array.
