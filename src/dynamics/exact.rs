@@ -561,9 +561,7 @@ impl<'s> Exact<'s> {
     }
 
     fn fill_state_energy(&self, e: &mut Energy) {
-        let m = self.sys.masses();
-        e.kinetic = 0.5 * m.iter().zip(&self.v).map(|(m, v)| m * v * v).sum::<f64>();
-        e.strain = 0.5 * self.sys.stiffness() * self.x[0] * self.x[0];
+        e.set_state(self.sys.masses(), &self.v, self.sys.stiffness(), self.x[0]);
     }
 
     /// Appends the current state as a history row (mode of the piece ending here).
@@ -590,19 +588,7 @@ impl<'s> Exact<'s> {
     fn finish(mut self, history: Option<History>) -> Result<Response, SimError> {
         let mut e = std::mem::take(&mut self.energy);
         self.fill_state_energy(&mut e);
-        let per_kg = 1.0 / self.sys.mass_kg();
-        for val in [
-            &mut e.input,
-            &mut e.kinetic,
-            &mut e.strain,
-            &mut e.damping,
-            &mut e.friction,
-        ] {
-            *val *= per_kg;
-        }
-        for val in &mut e.friction_per_interface {
-            *val *= per_kg;
-        }
+        let e = e.per_kg(self.sys.mass_kg());
         for i in 0..self.n {
             self.out.residual_slip_m[i] = self.x[i + 1] - self.x[i];
         }

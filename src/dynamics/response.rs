@@ -23,6 +23,36 @@ impl Energy {
         self.input - (self.kinetic + self.strain + self.damping + self.friction)
     }
 
+    /// Sets the kinetic (`½Σm_j·v_j²`) and strain (`½k·u₀²`) terms from a state: masses and
+    /// relative velocities of all bodies, stiffness and structure displacement.
+    pub fn set_state(&mut self, masses: &[f64], velocity: &[f64], stiffness: f64, u0: f64) {
+        self.kinetic = 0.5
+            * masses
+                .iter()
+                .zip(velocity)
+                .map(|(m, v)| m * v * v)
+                .sum::<f64>();
+        self.strain = 0.5 * stiffness * u0 * u0;
+    }
+
+    /// Every term divided by the structure mass, so in J per kg of it.
+    pub fn per_kg(mut self, mass_kg: f64) -> Self {
+        let s = 1.0 / mass_kg;
+        for val in [
+            &mut self.input,
+            &mut self.kinetic,
+            &mut self.strain,
+            &mut self.damping,
+            &mut self.friction,
+        ]
+        .into_iter()
+        .chain(self.friction_per_interface.iter_mut())
+        {
+            *val *= s;
+        }
+        self
+    }
+
     /// `|residual| / input` (0 when no energy entered).
     pub fn balance_error(&self) -> f64 {
         let scale = self

@@ -325,19 +325,7 @@ impl<'s> Rk4<'s> {
         }
         let mut e = std::mem::take(&mut self.energy);
         self.fill_state_energy(&mut e);
-        let per_kg = 1.0 / self.sys.mass_kg();
-        for val in [
-            &mut e.input,
-            &mut e.kinetic,
-            &mut e.strain,
-            &mut e.damping,
-            &mut e.friction,
-        ] {
-            *val *= per_kg;
-        }
-        for val in &mut e.friction_per_interface {
-            *val *= per_kg;
-        }
+        let e = e.per_kg(self.sys.mass_kg());
         for i in 0..n {
             out.residual_slip_m[i] = self.x[i + 1] - self.x[i];
         }
@@ -348,14 +336,7 @@ impl<'s> Rk4<'s> {
     }
 
     fn fill_state_energy(&self, e: &mut Energy) {
-        e.kinetic = 0.5
-            * self
-                .masses
-                .iter()
-                .zip(&self.v)
-                .map(|(m, v)| m * v * v)
-                .sum::<f64>();
-        e.strain = 0.5 * self.sys.stiffness() * self.x[0] * self.x[0];
+        e.set_state(self.sys.masses(), &self.v, self.sys.stiffness(), self.x[0]);
     }
 }
 
