@@ -2,10 +2,13 @@
 //!
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
 //! * [`motion`]: ground-motion records and their readers.
+//! * [`spectrum`]: response spectra and target spectra.
 //! * [`store`]: writing results (time histories) to HDF5 and CSV.
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
 
 pub mod dynamics;
 pub mod motion;
+mod numeric;
+pub mod spectrum;
 pub mod store;

@@ -8,6 +8,8 @@
 //! (the Nigam–Jennings solution of a linear SDOF under linearly varying load). [`Wave`] is that
 //! form; [`Basis`] caches `e^{−aτ}`, `cos ωτ`, `sin ωτ` at one `τ` so many waves share them.
 
+use crate::numeric::{Cx, phi1};
+
 /// Decay rate `a = ζ_e·ω_n` (1/s) and damped circular frequency `ω = ω_n·sqrt(1−ζ_e²)` (rad/s).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Osc {
@@ -123,41 +125,6 @@ impl Wave {
         };
         let osc_part = Cx(self.c, -self.d).mul(e_zh_minus_1_over_z).0;
         poly + osc_part
-    }
-}
-
-/// Complex number, just what the integrals below need.
-#[derive(Debug, Clone, Copy)]
-struct Cx(f64, f64);
-
-impl Cx {
-    fn mul(self, o: Cx) -> Cx {
-        Cx(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
-    }
-    fn div(self, o: Cx) -> Cx {
-        let den = o.0 * o.0 + o.1 * o.1;
-        Cx(
-            (self.0 * o.0 + self.1 * o.1) / den,
-            (self.1 * o.0 - self.0 * o.1) / den,
-        )
-    }
-}
-
-/// `φ₁(x) = (eˣ − 1)/x` for complex `x`, accurate also near 0.
-fn phi1(x: Cx) -> Cx {
-    let mag = x.0.hypot(x.1);
-    if mag < 0.5 {
-        let mut term = Cx(1.0, 0.0);
-        let mut sum = Cx(1.0, 0.0);
-        for k in 2..=24 {
-            term = term.mul(x).div(Cx(k as f64, 0.0));
-            sum = Cx(sum.0 + term.0, sum.1 + term.1);
-        }
-        sum
-    } else {
-        let e = x.0.exp();
-        let (s, c) = x.1.sin_cos();
-        Cx(e * c - 1.0, e * s).div(x)
     }
 }
 

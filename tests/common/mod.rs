@@ -23,6 +23,29 @@ pub fn real_records() -> Vec<Record> {
     .collect()
 }
 
+/// The eleven FEMA P695 components of the study's record seeds (`configs/fema-p695-11.yaml`).
+pub const ELEVEN: [&str; 11] = [
+    "RSN68_SFERN_PEL090.AT2",
+    "RSN725_SUPERST_B-POE270.AT2",
+    "RSN752_LOMAP_CAP000.AT2",
+    "RSN829_CAPEMEND_RIO360.AT2",
+    "RSN900_LANDERS_YER270.AT2",
+    "RSN960_NORTHR_LOS270.AT2",
+    "RSN1111_KOBE_NIS000.AT2",
+    "RSN1158_KOCAELI_DZC270.AT2",
+    "RSN1602_DUZCE_BOL090.AT2",
+    "RSN1633_MANJIL_ABBAR--L.AT2",
+    "RSN1787_HECTOR_HEC090.AT2",
+];
+
+/// The eleven records of [`ELEVEN`], read.
+pub fn eleven_records() -> Vec<Record> {
+    ELEVEN
+        .iter()
+        .map(|n| read_record(&fixture(n)).expect("fixture reads"))
+        .collect()
+}
+
 /// xorshift64*: small, seeded, reproducible.
 pub struct Rng(u64);
 
