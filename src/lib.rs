@@ -3,9 +3,11 @@
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
 //! * [`motion`]: ground-motion records and their readers.
 //! * [`store`]: writing results (time histories) to HDF5 and CSV.
+//! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
 
 pub mod dynamics;
 pub mod motion;
+pub mod spectrum;
 pub mod store;
