@@ -2,7 +2,7 @@
 //!
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
 //! * [`motion`]: ground-motion records and their readers.
-//! * [`spectrum`]: response spectra and target spectra.
+//! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
 //! * [`store`]: writing results (time histories) to HDF5 and CSV.
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
