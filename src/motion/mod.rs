@@ -1,8 +1,13 @@
-//! Ground-motion records: readers and the built-in default motion.
+//! Ground-motion records: readers and writer ([`record`]), processing ([`process`]) and the
+//! built-in default motion.
 
+pub mod process;
 pub mod record;
 
-pub use record::{Record, RecordError, read_record};
+pub use process::{BaselineCorrection, ProcessError};
+pub use record::{
+    ReadOptions, Record, RecordError, Units, format_at2, read_record, read_record_with, write_at2,
+};
 
 /// File name of the built-in record (a committed fixture, see `tests/fixtures/records/`).
 pub const BUILTIN_NAME: &str = "RSN960_NORTHR_LOS270.AT2";
