@@ -1,6 +1,7 @@
-//! Ground-motion records: readers and writer ([`record`]), processing ([`process`]) and the
-//! built-in default motion.
+//! Ground-motion records: readers and writer ([`record`]), processing ([`process`]), spectral
+//! matching ([`matching`]) and the built-in default motion.
 
+pub mod matching;
 pub mod process;
 pub mod record;
 

@@ -216,6 +216,152 @@ fn reach_per_interval(accel: &[f64], h: f64) -> Vec<f64> {
         .collect()
 }
 
+/// Four oscillators of one damping ratio, advanced together.
+struct Lanes {
+    omega: [f64; LANES],
+    w2: [f64; LANES],
+    inv_w2: [f64; LANES],
+    /// `2ζ/ω³`: the lag of the particular solution per unit load slope, s³.
+    lag: [f64; LANES],
+    /// `1/ω_d²`.
+    inv_wd2: [f64; LANES],
+    /// A quarter of the damped period, s.
+    quarter: [f64; LANES],
+    steps: [NjStep; LANES],
+    zeta: f64,
+    h: f64,
+}
+
+/// The ground acceleration over one interval: ends (m/s²), `p`'s slope `−(a_g1 − a_g0)/h`
+/// (m/s³) and `reach = h·max|a_g|` (m/s).
+struct IntervalLoad {
+    ag0: f64,
+    ag1: f64,
+    slope: f64,
+    reach: f64,
+}
+
+/// Relative slack on the bounds against round-off.
+const SLACK: f64 = 1.0 - 1e-10;
+
+impl Lanes {
+    /// Whether lane `l`, at `(u0, v0)` at the start of an interval with ground acceleration
+    /// `ag0 → ag1` and `reach = h·max|a_g|`, can exceed `peak` inside the interval. Two
+    /// rigorous bounds of `max|u|`, either of which may clear it:
+    /// * energy: `√E` grows by at most `reach`, and `ω|u| ≤ √E` (tight at long periods);
+    /// * split: `u = u_p + y` with `u_p` linear in time and `y` a free damped vibration whose
+    ///   amplitude `√(y² + ((ẏ + ζωy)/ω_d)²)` cannot grow (tight at short periods, where the
+    ///   oscillator follows the ground).
+    #[inline(always)]
+    fn may_raise(&self, l: usize, peak: f64, (u0, v0): (f64, f64), g: &IntervalLoad) -> bool {
+        let e = self.w2[l] * u0 * u0 + v0 * v0;
+        let room = self.omega[l] * peak - g.reach;
+        if room > 0.0 && e <= room * room * SLACK {
+            return false;
+        }
+        let lag = g.slope * self.lag[l];
+        let (up0, up1) = (-g.ag0 * self.inv_w2[l] - lag, -g.ag1 * self.inv_w2[l] - lag);
+        let y = u0 - up0;
+        let yd = v0 - g.slope * self.inv_w2[l] + self.zeta * self.omega[l] * y;
+        let amp2 = y * y + yd * yd * self.inv_wd2[l];
+        let room = peak - up0.abs().max(up1.abs());
+        !(room > 0.0 && amp2 <= room * room * SLACK)
+    }
+
+    /// The exact peaks: first the recurrence over the samples, storing the states and the
+    /// largest sampled `|u|`; then a sweep over the intervals in which only those whose bound
+    /// reaches the running peak are searched exactly. Starting the sweep from the sampled
+    /// peak (a lower bound of the true one, within `1 − cos(π·dt/T)`) keeps the exact search
+    /// to the few intervals around the largest excursions.
+    fn peaks(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
+        let n = accel.len();
+        let mut states = Vec::with_capacity(n);
+        let (mut u, mut v) = ([0.0f64; LANES], [0.0f64; LANES]);
+        let mut best = [(0.0f64, 0usize); LANES];
+        states.push((u, v));
+        for k in 0..n - 1 {
+            let (ag0, ag1) = (accel[k], accel[k + 1]);
+            for l in 0..LANES {
+                (u[l], v[l]) = self.steps[l].step(u[l], v[l], ag0, ag1);
+                if u[l].abs() > best[l].0 {
+                    best[l] = (u[l].abs(), k + 1);
+                }
+            }
+            states.push((u, v));
+        }
+        let inv_h = 1.0 / self.h;
+        let mut peaks = [Peak {
+            sd_m: 0.0,
+            u_m: 0.0,
+            time_s: 0.0,
+        }; LANES];
+        for l in 0..LANES {
+            let (sd, k) = best[l];
+            peaks[l] = Peak {
+                sd_m: sd,
+                u_m: states[k].0[l],
+                time_s: k as f64 * self.h,
+            };
+        }
+        for k in 0..n - 1 {
+            let (ag0, ag1) = (accel[k], accel[k + 1]);
+            let load = IntervalLoad {
+                ag0,
+                ag1,
+                slope: (ag0 - ag1) * inv_h,
+                reach: reach[k],
+            };
+            let ((u0, v0), (u1, v1)) = (states[k], states[k + 1]);
+            for l in 0..LANES {
+                if self.may_raise(l, peaks[l].sd_m, (u0[l], v0[l]), &load) {
+                    self.search(
+                        l,
+                        k,
+                        (u0[l], v0[l]),
+                        (u1[l], v1[l]),
+                        (ag0, ag1),
+                        &mut peaks[l],
+                    );
+                }
+            }
+        }
+        peaks
+    }
+
+    /// Exact search of interval `k` of lane `l` for a `|u|` above `peak`.
+    #[cold]
+    fn search(
+        &self,
+        l: usize,
+        k: usize,
+        (u0, v0): (f64, f64),
+        (u1, v1): (f64, f64),
+        (ag0, ag1): (f64, f64),
+        peak: &mut Peak,
+    ) {
+        // Short interval with no sign change of u̇ or of the relative acceleration at its
+        // ends: u̇ is monotone and nonzero inside, so the ends hold the largest |u| (and the
+        // samples were counted in the first pass).
+        let two_zw = 2.0 * self.zeta * self.omega[l];
+        let a0 = -ag0 - self.w2[l] * u0 - two_zw * v0;
+        let a1 = -ag1 - self.w2[l] * u1 - two_zw * v1;
+        if self.h <= self.quarter[l] && v0 * v1 > 0.0 && a0 * a1 > 0.0 {
+            return;
+        }
+        let interval = Interval {
+            t0_s: k as f64 * self.h,
+            h: self.h,
+            omega: self.omega[l],
+            zeta: self.zeta,
+            u0,
+            v0,
+            ag0,
+            ag1,
+        };
+        interval.raise_peak(u1, v1, peak);
+    }
+}
+
 fn peaks_in_lanes(
     accel: &[f64],
     reach: &[f64],
@@ -224,50 +370,18 @@ fn peaks_in_lanes(
     zeta: f64,
 ) -> [Peak; LANES] {
     let omega = periods_s.map(|t| std::f64::consts::TAU / t);
-    let w2 = omega.map(|w| w * w);
-    let steps = omega.map(|w| NjStep::new(w, zeta, h));
-    let mut u = [0.0f64; LANES];
-    let mut v = [0.0f64; LANES];
-    let mut peaks = [Peak {
-        sd_m: 0.0,
-        u_m: 0.0,
-        time_s: 0.0,
-    }; LANES];
-    // ω·peak per lane, the level √E must reach for an interval to matter.
-    let mut level = [0.0f64; LANES];
-    // Relative slack on the bound against round-off in E.
-    const SLACK: f64 = 1.0 - 1e-10;
-    for k in 0..accel.len() - 1 {
-        let (ag0, ag1, r) = (accel[k], accel[k + 1], reach[k]);
-        let mut examine = [false; LANES];
-        let u0 = u;
-        let v0 = v;
-        for l in 0..LANES {
-            let e = w2[l] * u[l] * u[l] + v[l] * v[l];
-            let room = level[l] - r;
-            examine[l] = !(room > 0.0 && e <= room * room * SLACK);
-            (u[l], v[l]) = steps[l].step(u[l], v[l], ag0, ag1);
-        }
-        if examine.iter().any(|&x| x) {
-            for l in 0..LANES {
-                if examine[l] {
-                    let interval = Interval {
-                        t0_s: k as f64 * h,
-                        h,
-                        omega: omega[l],
-                        zeta,
-                        u0: u0[l],
-                        v0: v0[l],
-                        ag0,
-                        ag1,
-                    };
-                    interval.raise_peak(u[l], &mut peaks[l]);
-                    level[l] = omega[l] * peaks[l].sd_m;
-                }
-            }
-        }
-    }
-    peaks
+    let lanes = Lanes {
+        omega,
+        w2: omega.map(|w| w * w),
+        inv_w2: omega.map(|w| 1.0 / (w * w)),
+        lag: omega.map(|w| 2.0 * zeta / (w * w * w)),
+        inv_wd2: omega.map(|w| 1.0 / (w * w * (1.0 - zeta * zeta))),
+        quarter: omega.map(|w| 0.25 * std::f64::consts::TAU / (w * (1.0 - zeta * zeta).sqrt())),
+        steps: omega.map(|w| NjStep::new(w, zeta, h)),
+        zeta,
+        h,
+    };
+    lanes.peaks(accel, reach)
 }
 
 /// One sample interval of one oscillator, for the exact search of `max |u|` inside it.
@@ -285,7 +399,7 @@ struct Interval {
 impl Interval {
     /// Raises `peak` to the largest `|u|` over the interval: the end sample `u1` (from the
     /// recurrence) and every interior zero of `u̇`.
-    fn raise_peak(&self, u1: f64, peak: &mut Peak) {
+    fn raise_peak(&self, u1: f64, v1: f64, peak: &mut Peak) {
         let mut offer = |u: f64, tau: f64| {
             if u.abs() > peak.sd_m {
                 *peak = Peak {
@@ -299,7 +413,19 @@ impl Interval {
         let (osc, disp) = self.closed_form();
         let vel = disp.deriv(osc);
         let acc = vel.deriv(osc);
+        // The relative acceleration is a damped sinusoid (the particular part of u is linear),
+        // so |u̇(τ) − u̇(0)| ≤ h·√(c² + d²) of its wave: when both ends are farther from zero
+        // than that, with the same sign, u̇ has no zero inside.
+        let reach_v = self.h * (acc.c * acc.c + acc.d * acc.d).sqrt();
+        if self.v0 * v1 > 0.0 && self.v0.abs().min(v1.abs()) > reach_v {
+            return;
+        }
         let at = |w: &Wave, tau: f64| w.eval(&Basis::at(osc, tau));
+        let jerk = acc.deriv(osc);
+        let with_slope = |w: &Wave, dw: &Wave, tau: f64| {
+            let b = Basis::at(osc, tau);
+            (w.eval(&b), dw.eval(&b))
+        };
         // Pieces of at most a quarter damped period: the relative acceleration (a damped
         // sinusoid, the particular part being linear in u) changes sign at most once in each.
         let quarter = 0.25 * std::f64::consts::TAU / osc.omega;
@@ -315,13 +441,13 @@ impl Interval {
             let (v_hi, a_hi) = (at(&vel, hi), at(&acc, hi));
             let mut parts = [(lo, v_lo, hi, v_hi), (hi, v_hi, hi, v_hi)];
             if a_lo * a_hi < 0.0 {
-                let tc = bracketed_root(|t| at(&acc, t), |t| at(&acc.deriv(osc), t), lo, hi);
+                let tc = bracketed_root(|t| with_slope(&acc, &jerk, t), lo, hi, a_lo, a_hi);
                 let vc = at(&vel, tc);
                 parts = [(lo, v_lo, tc, vc), (tc, vc, hi, v_hi)];
             }
             for &(a, va, b, vb) in &parts {
                 if b > a && va * vb <= 0.0 {
-                    let tz = bracketed_root(|t| at(&vel, t), |t| at(&acc, t), a, b);
+                    let tz = bracketed_root(|t| with_slope(&vel, &acc, t), a, b, va, vb);
                     offer(at(&disp, tz), tz);
                 }
             }
