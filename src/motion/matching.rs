@@ -506,8 +506,9 @@ mod tests {
 
     #[test]
     fn wavelet_leaves_no_drift() {
-        // ∫f dt and ∫∫f dt² of the improved tapered cosine vanish to e^{−(ωγ/2)²} ≈ 1e-6 of
-        // ∫|f| dt: the design property of Al Atik & Abrahamson's wavelet.
+        // ∫f dt and ∫∫f dt² of the improved tapered cosine nearly vanish: the design property of
+        // Al Atik & Abrahamson's wavelet. ∫f dt = γ√π·e^{−(ωγ/2)²}·cos(…), largest at long
+        // periods (e^{−(ωγ/2)²} ≈ 7e-6 at T = 4 s, 2e-5 of ∫|f| measured): bound 5e-5.
         for &t in &[0.05, 0.3, 1.0, 4.0] {
             let dt = 0.005;
             let (first, w) = wavelet(t, 0.05, 40.0, dt, 20_000);
@@ -519,8 +520,8 @@ mod tests {
             }
             let dur = (w.len() - 1) as f64 * dt;
             assert!(first > 0);
-            assert!(v.abs() < 1e-5 * mag, "T={t}: v {v} vs {mag}");
-            assert!(d.abs() < 1e-5 * mag * dur, "T={t}: d {d}");
+            assert!(v.abs() < 5e-5 * mag, "T={t}: v {v} vs {mag}");
+            assert!(d.abs() < 5e-5 * mag * dur, "T={t}: d {d}");
         }
     }
 
@@ -543,8 +544,10 @@ mod tests {
                 (u, v) = step.step(u, v, s[0], s[1]);
             }
             let rest = at - k as f64 * dt;
-            let a1 = rec[k] + (rec[k + 1] - rec[k]) * rest / dt;
-            (u, _) = NjStep::new(omega, 0.05, rest).step(u, v, rec[k], a1);
+            if rest > 0.0 {
+                let a1 = rec[k] + (rec[k + 1] - rec[k]) * rest / dt;
+                (u, _) = NjStep::new(omega, 0.05, rest).step(u, v, rec[k], a1);
+            }
             let want = omega * omega * u;
             assert!(
                 (got - want).abs() < 1e-12 * want.abs().max(1e-3),
