@@ -1,7 +1,7 @@
 //! slidestack: seismic response of a linear structure carrying stacks of sliding rigid blocks.
 //!
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
-//! * [`motion`]: ground-motion records and their readers.
+//! * [`motion`]: ground-motion records, their readers, and stochastic synthetic motions.
 //! * [`store`]: writing results (time histories) to HDF5 and CSV.
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.

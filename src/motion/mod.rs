@@ -1,8 +1,11 @@
-//! Ground-motion records: readers and the built-in default motion.
+//! Ground-motion records: readers, the built-in default motion, and built-in stochastic motions
+//! ([`stochastic`]).
 
 pub mod record;
+pub mod stochastic;
 
 pub use record::{Record, RecordError, read_record};
+pub use stochastic::{Envelope, ParameterScatter, StochasticError, StochasticModel};
 
 /// File name of the built-in record (a committed fixture, see `tests/fixtures/records/`).
 pub const BUILTIN_NAME: &str = "RSN960_NORTHR_LOS270.AT2";
