@@ -1,7 +1,7 @@
 //! slidestack: seismic response of a linear structure carrying stacks of sliding rigid blocks.
 //!
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
-//! * [`motion`]: ground-motion records and their readers.
+//! * [`motion`]: ground-motion records, processing, spectral matching, stochastic motions.
 //! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
 //! * [`store`]: writing results (time histories) to HDF5 and CSV.
 //!

@@ -1,14 +1,17 @@
 //! Ground-motion records: readers and writer ([`record`]), processing ([`process`]), spectral
-//! matching ([`matching`]) and the built-in default motion.
+//! matching ([`matching`]), built-in stochastic motions ([`stochastic`]) and the built-in default
+//! motion.
 
 pub mod matching;
 pub mod process;
 pub mod record;
+pub mod stochastic;
 
 pub use process::{BaselineCorrection, ProcessError};
 pub use record::{
     ReadOptions, Record, RecordError, Units, format_at2, read_record, read_record_with, write_at2,
 };
+pub use stochastic::{Envelope, ParameterScatter, StochasticError, StochasticModel};
 
 /// File name of the built-in record (a committed fixture, see `tests/fixtures/records/`).
 pub const BUILTIN_NAME: &str = "RSN960_NORTHR_LOS270.AT2";
