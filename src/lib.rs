@@ -3,7 +3,8 @@
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
 //! * [`motion`]: ground-motion records, processing, spectral matching, stochastic motions.
 //! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
-//! * [`store`]: writing results (time histories) to HDF5 and CSV.
+//! * [`study`]: the study configuration and its stages.
+//! * [`store`]: result files (time histories, stage files) and input fingerprints.
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
 
@@ -12,3 +13,4 @@ pub mod motion;
 mod numeric;
 pub mod spectrum;
 pub mod store;
+pub mod study;

@@ -16,12 +16,21 @@ struct Cli {
 enum Command {
     /// Simulate one case: a structure and its stack under one ground motion.
     Simulate(cmd::simulate::Args),
+    /// Response spectra (Sd, PSV, PSA) of records, exact between samples.
+    Spectrum(cmd::spectrum::Args),
+    /// Match records to a target spectrum (wavelet adjustment) and write them as .AT2 files.
+    Match(cmd::matching::Args),
+    /// Study stage 1: seed motions matched to every zone's target → motions.h5.
+    Motions(cmd::motions::Args),
 }
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(args) => cmd::simulate::run(args),
+        Command::Spectrum(args) => cmd::spectrum::run(args),
+        Command::Match(args) => cmd::matching::run(args),
+        Command::Motions(args) => cmd::motions::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

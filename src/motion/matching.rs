@@ -17,6 +17,7 @@
 //!
 //! Units: accelerations and spectral values in g. Nothing here reads files.
 
+use super::process::{BaselineCorrection, ProcessError};
 use crate::spectrum::response::{NjStep, response_spectrum, validate_record};
 use crate::spectrum::{SpectrumError, TargetError, TargetSpectrum};
 use serde::{Deserialize, Serialize};
@@ -51,6 +52,30 @@ pub struct MatchSettings {
     /// Scale the record first so that its spectrum's geometric mean over the check range equals
     /// the target's.
     pub prescale: bool,
+    /// Baseline correction applied to every trial motion (`none`, `poly:N`, `highpass:F[:N]`):
+    /// wavelets cut by the ends of a record leave velocity and displacement drift, and correcting
+    /// each trial lets the iterations match the corrected motion itself.
+    #[serde(with = "as_text")]
+    pub baseline: BaselineCorrection,
+    /// After the baseline correction, subtract the linear acceleration `α + β·t` that brings the
+    /// ground exactly to rest at the end (zero final velocity and displacement).
+    pub end_at_rest: bool,
+}
+
+/// Serde through the text form of [`BaselineCorrection`].
+mod as_text {
+    use super::BaselineCorrection;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(b: &BaselineCorrection, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&b.to_string())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<BaselineCorrection, D::Error> {
+        String::deserialize(d)?
+            .parse()
+            .map_err(serde::de::Error::custom)
+    }
 }
 
 impl Default for MatchSettings {
@@ -67,6 +92,8 @@ impl Default for MatchSettings {
             gain: 1.0,
             regularisation: 1e-3,
             prescale: true,
+            baseline: BaselineCorrection::Polynomial { order: 3 },
+            end_at_rest: true,
         }
     }
 }
@@ -83,6 +110,8 @@ pub enum MatchError {
     Target(#[from] TargetError),
     #[error(transparent)]
     Spectrum(#[from] SpectrumError),
+    #[error("baseline correction: {0}")]
+    Baseline(#[from] ProcessError),
 }
 
 impl MatchSettings {
@@ -260,6 +289,27 @@ fn response_at(
         (u, _) = NjStep::new(omega, damping, rest).step(u, v, a0, a1);
     }
     omega * omega * u
+}
+
+/// Subtracts from `accel` (any units) the linear acceleration `α + β·t` whose removal leaves the
+/// final velocity and displacement exactly zero: with `T` the duration, `v_T` and `d_T` the final
+/// velocity and displacement (exact for a piecewise-linear record), `α·T + β·T²/2 = v_T` and
+/// `α·T²/2 + β·T³/6 = d_T`. A correction of the record's own length barely touches periods up to a
+/// few seconds.
+pub fn bring_to_rest(accel: &mut [f64], dt_s: f64) {
+    let (mut v, mut d) = (0.0, 0.0);
+    for w in accel.windows(2) {
+        d += v * dt_s + dt_s * dt_s * (2.0 * w[0] + w[1]) / 6.0;
+        v += 0.5 * dt_s * (w[0] + w[1]);
+    }
+    let t = (accel.len() - 1) as f64 * dt_s;
+    // [T, T²/2; T²/2, T³/6]·(α, β) = (v, d); determinant −T⁴/12.
+    let det = -t.powi(4) / 12.0;
+    let alpha = (v * t.powi(3) / 6.0 - d * t * t / 2.0) / det;
+    let beta = (t * d - t * t / 2.0 * v) / det;
+    for (k, a) in accel.iter_mut().enumerate() {
+        *a -= alpha + beta * k as f64 * dt_s;
+    }
 }
 
 /// Solves `(CᵀC + μI)·b = Cᵀ·d` by Cholesky (`c` row-major `n×n`).
@@ -443,6 +493,10 @@ pub fn match_record(
                         *a += gain * bj * w;
                     }
                 }
+                let mut trial = settings.baseline.apply(&trial, dt_s)?;
+                if settings.end_at_rest {
+                    bring_to_rest(&mut trial, dt_s);
+                }
                 let eval = evaluate(&trial, dt_s, &grid, &q, zeta)?;
                 if eval.sum_sq < now.sum_sq {
                     if eval.worst < best.1.worst {
@@ -502,6 +556,23 @@ mod tests {
         for k in 0..3 {
             assert!((b[k] - x[k]).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn bring_to_rest_zeroes_the_final_velocity_and_displacement() {
+        // A record with an offset and a trend ends at rest after the correction, to round-off
+        // of the sums (1e-12 of the uncorrected values).
+        let dt = 0.01;
+        let mut a: Vec<f64> = (0..3000)
+            .map(|k| 0.3 * (0.05 * k as f64).sin() + 0.01 + 2e-6 * k as f64)
+            .collect();
+        let (v0, d0) = crate::motion::process::drift(&a, dt);
+        bring_to_rest(&mut a, dt);
+        let (v, d) = crate::motion::process::drift(&a, dt);
+        assert!(
+            v.abs() < 1e-12 * v0.abs() && d.abs() < 1e-12 * d0.abs(),
+            "{v} {d}"
+        );
     }
 
     #[test]

@@ -275,19 +275,15 @@ impl Lanes {
     /// to the few intervals around the largest excursions.
     fn peaks(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
         let n = accel.len();
-        let mut states = Vec::with_capacity(n);
-        let (mut u, mut v) = ([0.0f64; LANES], [0.0f64; LANES]);
+        let states = self.sample_states(accel);
+        // The sampled peak of each lane and its first sample.
         let mut best = [(0.0f64, 0usize); LANES];
-        states.push((u, v));
-        for k in 0..n - 1 {
-            let (ag0, ag1) = (accel[k], accel[k + 1]);
-            for l in 0..LANES {
-                (u[l], v[l]) = self.steps[l].step(u[l], v[l], ag0, ag1);
-                if u[l].abs() > best[l].0 {
-                    best[l] = (u[l].abs(), k + 1);
+        for (l, b) in best.iter_mut().enumerate() {
+            for (k, (u, _)) in states.iter().enumerate() {
+                if u[l].abs() > b.0 {
+                    *b = (u[l].abs(), k);
                 }
             }
-            states.push((u, v));
         }
         let inv_h = 1.0 / self.h;
         let mut peaks = [Peak {
@@ -326,6 +322,28 @@ impl Lanes {
             }
         }
         peaks
+    }
+
+    /// `(u, v)` of every lane at every sample: the recurrence, with the coefficients laid out
+    /// lane by lane so the four updates run side by side.
+    #[inline(never)]
+    fn sample_states(&self, accel: &[f64]) -> Vec<([f64; LANES], [f64; LANES])> {
+        let c = |f: fn(&NjStep) -> f64| self.steps.map(|s| f(&s));
+        let (uu, uv, ug0, ug1) = (c(|s| s.uu), c(|s| s.uv), c(|s| s.ug0), c(|s| s.ug1));
+        let (vu, vv, vg0, vg1) = (c(|s| s.vu), c(|s| s.vv), c(|s| s.vg0), c(|s| s.vg1));
+        let mut states = Vec::with_capacity(accel.len());
+        let (mut u, mut v) = ([0.0f64; LANES], [0.0f64; LANES]);
+        states.push((u, v));
+        for w in accel.windows(2) {
+            let (ag0, ag1) = (w[0], w[1]);
+            for l in 0..LANES {
+                let (u0, v0) = (u[l], v[l]);
+                u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * ag0 + ug1[l] * ag1;
+                v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * ag0 + vg1[l] * ag1;
+            }
+            states.push((u, v));
+        }
+        states
     }
 
     /// Exact search of interval `k` of lane `l` for a `|u|` above `peak`.

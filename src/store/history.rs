@@ -1,8 +1,8 @@
 //! A simulation's time history as HDF5 (one dataset per quantity, `[time, body]` or
 //! `[time, interface]`, with `units` and `long_name` attributes) or CSV (one row per sample).
 
+use super::h5::attr_str as attr;
 use crate::dynamics::History;
-use hdf5::types::VarLenUnicode;
 use std::io::Write;
 use std::path::Path;
 use thiserror::Error;
@@ -89,15 +89,6 @@ fn write_csv(path: &Path, h: &History) -> std::io::Result<()> {
         writeln!(w)?;
     }
     w.flush()
-}
-
-fn attr(obj: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
-    let v: VarLenUnicode = value
-        .parse()
-        .map_err(|e| hdf5::Error::from(format!("{e:?}")))?;
-    obj.new_attr::<VarLenUnicode>()
-        .create(name)?
-        .write_scalar(&v)
 }
 
 fn write_hdf5(path: &Path, h: &History) -> hdf5::Result<()> {

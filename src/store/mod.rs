@@ -1,5 +1,14 @@
-//! Writing results to files: time histories as HDF5 or CSV.
+//! Writing and reading result files: time histories (HDF5 or CSV), the stage files, input
+//! fingerprints.
+//!
+//! * [`history`]: one simulation's time history.
+//! * [`motions`]: `motions.h5`, the ground-motion stage.
+//! * [`fingerprint`]: SHA-256 of inputs, for up-to-date checks.
+//! * [`h5`]: small HDF5 helpers.
 
+pub mod fingerprint;
+pub mod h5;
 pub mod history;
+pub mod motions;
 
 pub use history::{HistoryFormat, StoreError, write_history};

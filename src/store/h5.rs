@@ -1,0 +1,92 @@
+//! Small HDF5 helpers shared by the stage files: string attributes, 1-D and 2-D `f64` datasets
+//! with `units` and `long_name`, string datasets.
+
+use hdf5::types::VarLenUnicode;
+
+/// Writes (or replaces) the string attribute `name`.
+pub fn attr_str(obj: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
+    let v: VarLenUnicode = value
+        .parse()
+        .map_err(|e| hdf5::Error::from(format!("{e:?}")))?;
+    if obj.attr(name).is_ok() {
+        obj.delete_attr(name)?;
+    }
+    obj.new_attr::<VarLenUnicode>()
+        .create(name)?
+        .write_scalar(&v)
+}
+
+/// Reads the string attribute `name`, if present.
+pub fn read_attr_str(obj: &hdf5::Location, name: &str) -> Option<String> {
+    let a = obj.attr(name).ok()?;
+    a.read_scalar::<VarLenUnicode>().ok().map(|v| v.to_string())
+}
+
+/// Writes a scalar `f64` attribute.
+pub fn attr_f64(obj: &hdf5::Location, name: &str, value: f64) -> hdf5::Result<()> {
+    obj.new_attr::<f64>().create(name)?.write_scalar(&value)
+}
+
+pub fn read_attr_f64(obj: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
+    obj.attr(name)?.read_scalar::<f64>()
+}
+
+/// A 1-D `f64` dataset with its units and description.
+pub fn write_1d(
+    g: &hdf5::Group,
+    name: &str,
+    data: &[f64],
+    units: &str,
+    long_name: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = g.new_dataset::<f64>().shape(data.len()).create(name)?;
+    ds.write_raw(data)?;
+    attr_str(&ds, "units", units)?;
+    attr_str(&ds, "long_name", long_name)?;
+    Ok(ds)
+}
+
+/// A row-major 2-D `f64` dataset `[rows][cols]`.
+pub fn write_2d(
+    g: &hdf5::Group,
+    name: &str,
+    data: &[f64],
+    shape: (usize, usize),
+    units: &str,
+    long_name: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = g.new_dataset::<f64>().shape(shape).create(name)?;
+    ds.write_raw(data)?;
+    attr_str(&ds, "units", units)?;
+    attr_str(&ds, "long_name", long_name)?;
+    Ok(ds)
+}
+
+/// A 1-D dataset of strings.
+pub fn write_strings(
+    g: &hdf5::Group,
+    name: &str,
+    values: &[String],
+    long_name: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let v = values
+        .iter()
+        .map(|s| s.parse::<VarLenUnicode>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| hdf5::Error::from(format!("{e:?}")))?;
+    let ds = g
+        .new_dataset::<VarLenUnicode>()
+        .shape(v.len())
+        .create(name)?;
+    ds.write_raw(&v)?;
+    attr_str(&ds, "long_name", long_name)?;
+    Ok(ds)
+}
+
+pub fn read_strings(g: &hdf5::Group, name: &str) -> hdf5::Result<Vec<String>> {
+    Ok(g.dataset(name)?
+        .read_raw::<VarLenUnicode>()?
+        .into_iter()
+        .map(|s| s.to_string())
+        .collect())
+}

@@ -1,0 +1,240 @@
+//! `motions.h5`, the ground-motion stage's file.
+//!
+//! ```text
+//! /                      attrs: contents, slidestack_version, fingerprint, config_sha256, inputs
+//! /seeds/seed_NN         seed motion NN (g); attrs name, dt_s, units, long_name
+//! /zone_<name>/          attrs: target (SPEC), target_label, fingerprint, set_scale,
+//!                               mean_ratio_min, set_mean_min, set_mean_ok, asce7_ok,
+//!                               all_within_band
+//!     period             check grid, s                                  [period]
+//!     target_psa_g, mean_psa_g                                          [period]
+//!     motion             names of the kept (matched and accepted) motions [motion]
+//!     psa_g              5 %-damped PSA of each kept motion, g          [motion, period]
+//!     seed               names of all seeds                             [seed]
+//!     converged, iterations, worst_misfit, scale, pga_before_g, pga_after_g,
+//!     final_velocity_mps, final_displacement_m, arias_ratio             [seed]
+//!     accel/motion_NN    kept motion NN (g); attrs name, dt_s, units
+//! ```
+
+use super::h5::{
+    attr_f64, attr_str, read_attr_f64, read_attr_str, read_strings, write_1d, write_2d,
+    write_strings,
+};
+use crate::motion::Record;
+use crate::motion::matching::MatchReport;
+use crate::study::motions::ZoneMotions;
+use std::path::Path;
+
+/// Provenance written on the file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StageMeta {
+    pub fingerprint: String,
+    pub config_sha256: String,
+    /// JSON list of the input files and their SHA-256.
+    pub inputs: String,
+}
+
+fn write_record(g: &hdf5::Group, key: &str, r: &Record, long: &str) -> hdf5::Result<()> {
+    let ds = write_1d(g, key, &r.accel_g, "g", long)?;
+    attr_str(&ds, "name", &r.name)?;
+    attr_f64(&ds, "dt_s", r.dt_s)
+}
+
+fn read_record(g: &hdf5::Group, key: &str) -> hdf5::Result<Record> {
+    let ds = g.dataset(key)?;
+    Ok(Record {
+        name: read_attr_str(&ds, "name").unwrap_or_else(|| key.to_string()),
+        dt_s: read_attr_f64(&ds, "dt_s")?,
+        accel_g: ds.read_raw::<f64>()?,
+    })
+}
+
+/// Writes `motions.h5` at `path` (through a temporary file renamed at the end, so a reader
+/// never sees a half-written file).
+pub fn write_motions(
+    path: &Path,
+    meta: &StageMeta,
+    seeds: &[Record],
+    zones: &[(ZoneMotions, String)],
+) -> hdf5::Result<()> {
+    let tmp = path.with_extension("h5.tmp");
+    {
+        let f = hdf5::File::create(&tmp)?;
+        attr_str(
+            &f,
+            "contents",
+            "slidestack motions stage: seed motions, motions matched per zone, their spectra",
+        )?;
+        attr_str(&f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
+        attr_str(&f, "fingerprint", &meta.fingerprint)?;
+        attr_str(&f, "config_sha256", &meta.config_sha256)?;
+        attr_str(&f, "inputs", &meta.inputs)?;
+        let g = f.create_group("seeds")?;
+        for (i, s) in seeds.iter().enumerate() {
+            write_record(&g, &format!("seed_{i:02}"), s, "seed ground acceleration")?;
+        }
+        for (z, fp) in zones {
+            write_zone(&f, z, fp)?;
+        }
+    }
+    std::fs::rename(&tmp, path).map_err(|e| hdf5::Error::from(e.to_string()))
+}
+
+fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Result<()> {
+    let g = f.create_group(&format!("zone_{}", z.name))?;
+    attr_str(&g, "target", &z.target.to_string())?;
+    attr_str(&g, "target_label", &z.target.label())?;
+    attr_str(&g, "fingerprint", fingerprint)?;
+    attr_f64(&g, "set_scale", z.set_scale)?;
+    attr_f64(&g, "mean_ratio_min", z.mean_ratio_min)?;
+    for (k, v) in [
+        ("set_mean_ok", z.set_mean_ok),
+        ("asce7_ok", z.asce7_ok),
+        ("all_within_band", z.all_within_band),
+    ] {
+        attr_f64(&g, k, if v { 1.0 } else { 0.0 })?;
+    }
+    write_1d(&g, "period", &z.periods_s, "s", "oscillator period")?;
+    write_1d(
+        &g,
+        "target_psa_g",
+        &z.target_psa_g,
+        "g",
+        "target pseudo-spectral acceleration",
+    )?;
+    write_1d(
+        &g,
+        "mean_psa_g",
+        &z.mean_psa_g,
+        "g",
+        "mean PSA of the kept motions (5 % damping)",
+    )?;
+    let names: Vec<String> = z.motions.iter().map(|m| m.name.clone()).collect();
+    write_strings(&g, "motion", &names, "kept (matched and accepted) motions")?;
+    let flat: Vec<f64> = z.psa_g.iter().flatten().copied().collect();
+    let ds = write_2d(
+        &g,
+        "psa_g",
+        &flat,
+        (z.psa_g.len(), z.periods_s.len()),
+        "g",
+        "pseudo-spectral acceleration of each kept motion (5 % damping)",
+    )?;
+    attr_str(&ds, "dims", "motion, period")?;
+    write_strings(&g, "seed", &z.seeds, "all seed motions")?;
+    let col = |f: &dyn Fn(&MatchReport) -> f64| z.reports.iter().map(f).collect::<Vec<f64>>();
+    let report: [(&str, Vec<f64>, &str, &str); 9] = [
+        (
+            "converged",
+            col(&|r| f64::from(u8::from(r.converged))),
+            "1",
+            "1 when every check period is within the band",
+        ),
+        (
+            "iterations",
+            col(&|r| r.iterations as f64),
+            "1",
+            "matching iterations",
+        ),
+        (
+            "worst_misfit",
+            col(&|r| r.worst_misfit),
+            "1",
+            "largest |PSA/target − 1| on the check grid",
+        ),
+        (
+            "scale",
+            col(&|r| r.scale),
+            "1",
+            "pre-scale factor before matching",
+        ),
+        (
+            "pga_before_g",
+            col(&|r| r.pga_before_g),
+            "g",
+            "peak ground acceleration of the seed",
+        ),
+        (
+            "pga_after_g",
+            col(&|r| r.pga_after_g),
+            "g",
+            "peak ground acceleration after matching",
+        ),
+        (
+            "final_velocity_mps",
+            col(&|r| r.final_velocity_mps),
+            "m/s",
+            "ground velocity at the end (drift)",
+        ),
+        (
+            "final_displacement_m",
+            col(&|r| r.final_displacement_m),
+            "m",
+            "ground displacement at the end (drift)",
+        ),
+        (
+            "arias_ratio",
+            col(&|r| r.arias_ratio),
+            "1",
+            "Arias intensity after / before matching",
+        ),
+    ];
+    for (name, data, units, long) in &report {
+        let ds = write_1d(&g, name, data, units, long)?;
+        attr_str(&ds, "dims", "seed")?;
+    }
+    let acc = g.create_group("accel")?;
+    for (i, m) in z.motions.iter().enumerate() {
+        write_record(
+            &acc,
+            &format!("motion_{i:02}"),
+            m,
+            "matched ground acceleration",
+        )?;
+    }
+    Ok(())
+}
+
+/// The stage fingerprint stored in an existing file, if it can be read.
+pub fn read_fingerprint(path: &Path) -> Option<String> {
+    let f = hdf5::File::open(path).ok()?;
+    read_attr_str(&f, "fingerprint")
+}
+
+/// The zone names of a motions file, in file order.
+pub fn zone_names(path: &Path) -> hdf5::Result<Vec<String>> {
+    let f = hdf5::File::open(path)?;
+    Ok(f.member_names()?
+        .into_iter()
+        .filter_map(|n| n.strip_prefix("zone_").map(str::to_string))
+        .collect())
+}
+
+/// The kept motions of one zone, in order.
+pub fn read_zone_motions(path: &Path, zone: &str) -> hdf5::Result<Vec<Record>> {
+    let f = hdf5::File::open(path)?;
+    let acc = f.group(&format!("zone_{zone}/accel"))?;
+    let mut names = acc.member_names()?;
+    names.sort();
+    names.iter().map(|k| read_record(&acc, k)).collect()
+}
+
+/// `(period_s, target_psa_g, mean_psa_g)` of one zone.
+pub fn read_zone_spectra(path: &Path, zone: &str) -> hdf5::Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+    let f = hdf5::File::open(path)?;
+    let g = f.group(&format!("zone_{zone}"))?;
+    let read = |n: &str| g.dataset(n)?.read_raw::<f64>();
+    Ok((read("period")?, read("target_psa_g")?, read("mean_psa_g")?))
+}
+
+/// The seed names of one zone's report and whether each was kept.
+pub fn read_zone_report(path: &Path, zone: &str) -> hdf5::Result<Vec<(String, bool)>> {
+    let f = hdf5::File::open(path)?;
+    let g = f.group(&format!("zone_{zone}"))?;
+    let names = read_strings(&g, "seed")?;
+    let conv = g.dataset("converged")?.read_raw::<f64>()?;
+    Ok(names
+        .into_iter()
+        .zip(conv.into_iter().map(|c| c == 1.0))
+        .collect())
+}
