@@ -7,7 +7,7 @@ use common::{ELEVEN, eleven_records, fixture};
 use slidestack::motion::matching::MatchSettings;
 use slidestack::motion::process::drift;
 use slidestack::motion::read_record;
-use slidestack::study::config::{MotionsConfig, SeedsConfig};
+use slidestack::study::config::{MotionsConfig, RecordSeeds, SeedsConfig};
 use slidestack::study::motions::match_zone;
 use std::process::Command;
 
@@ -30,7 +30,11 @@ fn eleven_real_records_match_both_zones() {
     let cfg = MotionsConfig {
         seeds: SeedsConfig {
             stochastic: None,
-            records: None,
+            records: Some(RecordSeeds {
+                files: Vec::new(),
+                units: None,
+                dt_s: None,
+            }),
         },
         matching: MatchSettings::default(),
         set_mean_min: 1.0,
@@ -281,4 +285,68 @@ fn motions_stage_refuses_bad_configs_naming_the_key() {
         "{}",
         stderr(&out)
     );
+}
+
+#[test]
+fn motions_file_does_not_depend_on_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("s.yaml");
+    std::fs::write(
+        &cfg,
+        "output_dir: unused\nzones: [{ name: V, target: \"is1893:zone=V,soil=I\" }]\n\
+         motions: { seeds: { stochastic: { count: 2, seed: 7, spare: 1 } } }\n",
+    )
+    .unwrap();
+    let mut read = Vec::new();
+    for threads in ["1", "2"] {
+        let out_dir = dir.path().join(threads);
+        let out = Command::new(env!("CARGO_BIN_EXE_slidestack"))
+            .args([
+                "motions",
+                cfg.to_str().unwrap(),
+                "--out",
+                out_dir.to_str().unwrap(),
+            ])
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", stderr(&out));
+        let path = out_dir.join("motions.h5");
+        read.push((
+            slidestack::store::motions::read_zone_motions(&path, "V").unwrap(),
+            slidestack::store::motions::read_zone_spectra(&path, "V").unwrap(),
+        ));
+    }
+    assert_eq!(read[0], read[1]);
+}
+
+#[test]
+fn stochastic_mean_spectrum_peaks_near_the_filter_frequency() {
+    // The model's spectral intent: a filter of frequency f_mid (5.87 Hz at t_mid, falling by
+    // 0.089 Hz/s) shapes the motion, so the mean 5 %-damped PSA of 100 draws peaks near
+    // T = 1/f_mid = 0.17 s. Bound: within a factor 1.5 either side (the filter's damping of 0.21
+    // and its drift over the strong phase spread the peak); the peak is also well above the
+    // long-period end (ratio > 5 at 2 s).
+    let model = slidestack::motion::StochasticModel::default();
+    let motions = model.simulate_set(99, 100, "s").unwrap();
+    let periods = slidestack::motion::matching::log_space(0.03, 2.0, 120);
+    let mut mean = vec![0.0; periods.len()];
+    for m in &motions {
+        let s = slidestack::spectrum::response_spectrum(&m.accel_mps2(1.0), m.dt_s, &periods, 0.05)
+            .unwrap()
+            .psa_g();
+        for (a, b) in mean.iter_mut().zip(s) {
+            *a += b / 100.0;
+        }
+    }
+    let i = (0..periods.len())
+        .max_by(|&a, &b| mean[a].total_cmp(&mean[b]))
+        .unwrap();
+    let t_peak = periods[i];
+    let t_filter = 1.0 / model.f_mid_hz;
+    assert!(
+        t_peak > t_filter / 1.5 && t_peak < t_filter * 1.5,
+        "peak of the mean PSA at {t_peak} s, filter period {t_filter} s"
+    );
+    assert!(mean[i] / mean[periods.len() - 1] > 5.0);
 }

@@ -11,7 +11,7 @@
 //!     motion             names of the kept (matched and accepted) motions [motion]
 //!     psa_g              5 %-damped PSA of each kept motion, g          [motion, period]
 //!     seed               names of all seeds                             [seed]
-//!     converged, iterations, worst_misfit, scale, pga_before_g, pga_after_g,
+//!     kept, converged, iterations, worst_misfit, scale, pga_before_g, pga_after_g,
 //!     final_velocity_mps, final_displacement_m, arias_ratio             [seed]
 //!     accel/motion_NN    kept motion NN (g); attrs name, dt_s, units
 //! ```
@@ -123,7 +123,16 @@ fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Resul
     attr_str(&ds, "dims", "motion, period")?;
     write_strings(&g, "seed", &z.seeds, "all seed motions")?;
     let col = |f: &dyn Fn(&MatchReport) -> f64| z.reports.iter().map(f).collect::<Vec<f64>>();
-    let report: [(&str, Vec<f64>, &str, &str); 9] = [
+    let kept: Vec<f64> = (0..z.seeds.len())
+        .map(|i| f64::from(u8::from(z.kept.contains(&i))))
+        .collect();
+    let report: [(&str, Vec<f64>, &str, &str); 10] = [
+        (
+            "kept",
+            kept,
+            "1",
+            "1 when the motion is one of the zone's motions",
+        ),
         (
             "converged",
             col(&|r| f64::from(u8::from(r.converged))),

@@ -55,6 +55,10 @@ fn one() -> f64 {
     1.0
 }
 
+fn three() -> usize {
+    3
+}
+
 /// Where the motions come from: exactly one of `stochastic` and `records`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -86,8 +90,13 @@ impl SeedsConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StochasticSeeds {
+    /// Motions wanted per zone.
     pub count: usize,
     pub seed: u64,
+    /// Extra seeds drawn so that `count` motions remain when some fail the matching
+    /// acceptance; the first `count` accepted (in seed order) are kept.
+    #[serde(default = "three")]
+    pub spare: usize,
     #[serde(default)]
     pub model: StochasticModel,
 }

@@ -25,7 +25,10 @@ pub enum SeedError {
 /// The seed motions of a study, in configuration order.
 pub fn seed_records(cfg: &MotionsConfig) -> Result<Vec<Record>, SeedError> {
     match cfg.seeds.kind() {
-        Seeds::Stochastic(s) => Ok(s.model.simulate_set(s.seed, s.count, "stochastic")?),
+        Seeds::Stochastic(s) => {
+            Ok(s.model
+                .simulate_set(s.seed, s.count + s.spare, "stochastic")?)
+        }
         Seeds::Records(r) => {
             let opts = StudyConfig::read_options(r);
             r.files
@@ -80,8 +83,13 @@ pub fn match_zone(
         .par_iter()
         .map(|s| match_record(&s.accel_g, s.dt_s, target, settings))
         .collect::<Result<Vec<_>, _>>()?;
+    let wanted = match cfg.seeds.kind() {
+        Seeds::Stochastic(s) => s.count,
+        Seeds::Records(_) => seeds.len(),
+    };
     let kept: Vec<usize> = (0..seeds.len())
         .filter(|&i| matched[i].report.converged)
+        .take(wanted)
         .collect();
     let n = periods_s.len();
     let mean = |psa: &[Vec<f64>]| -> Vec<f64> {
