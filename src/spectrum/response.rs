@@ -299,27 +299,51 @@ impl Lanes {
                 time_s: k as f64 * self.h,
             };
         }
+        // An interval can hold a larger |u| than its ends only if u̇ vanishes inside, which
+        // needs a sign change of u̇, or of the relative acceleration (u̇ then has an extremum and
+        // may cross zero twice), at its ends; unless it is longer than a quarter period, when
+        // those end tests say nothing. Those candidates then face the bounds of `may_raise`.
+        let two_zw = self.omega.map(|w| 2.0 * self.zeta * w);
+        let long = self.quarter.map(|q| self.h > q);
+        let rel_acc = |k: usize, l: usize| {
+            let (u, v) = (states[k].0[l], states[k].1[l]);
+            -accel[k] - self.w2[l] * u - two_zw[l] * v
+        };
+        let mut a0 = [0.0f64; LANES];
+        for (l, a) in a0.iter_mut().enumerate() {
+            *a = rel_acc(0, l);
+        }
         for k in 0..n - 1 {
-            let (ag0, ag1) = (accel[k], accel[k + 1]);
-            let load = IntervalLoad {
-                ag0,
-                ag1,
-                slope: (ag0 - ag1) * inv_h,
-                reach: reach[k],
-            };
             let ((u0, v0), (u1, v1)) = (states[k], states[k + 1]);
+            let mut a1 = [0.0f64; LANES];
+            let mut candidate = false;
             for l in 0..LANES {
-                if self.may_raise(l, peaks[l].sd_m, (u0[l], v0[l]), &load) {
-                    self.search(
-                        l,
-                        k,
-                        (u0[l], v0[l]),
-                        (u1[l], v1[l]),
-                        (ag0, ag1),
-                        &mut peaks[l],
-                    );
+                a1[l] = -accel[k + 1] - self.w2[l] * u1[l] - two_zw[l] * v1[l];
+                candidate |= long[l] || v0[l] * v1[l] <= 0.0 || a0[l] * a1[l] <= 0.0;
+            }
+            if candidate {
+                let (ag0, ag1) = (accel[k], accel[k + 1]);
+                let load = IntervalLoad {
+                    ag0,
+                    ag1,
+                    slope: (ag0 - ag1) * inv_h,
+                    reach: reach[k],
+                };
+                for l in 0..LANES {
+                    let sign_change = long[l] || v0[l] * v1[l] <= 0.0 || a0[l] * a1[l] <= 0.0;
+                    if sign_change && self.may_raise(l, peaks[l].sd_m, (u0[l], v0[l]), &load) {
+                        self.search(
+                            l,
+                            k,
+                            (u0[l], v0[l]),
+                            (u1[l], v1[l]),
+                            (ag0, ag1),
+                            &mut peaks[l],
+                        );
+                    }
                 }
             }
+            a0 = a1;
         }
         peaks
     }
