@@ -18,6 +18,7 @@
 
 use crate::dynamics::closed_form::{Basis, Osc, Wave};
 use crate::numeric::{Cx, bracketed_root, phi1, phi2};
+use rayon::prelude::*;
 use thiserror::Error;
 
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -170,13 +171,17 @@ pub fn response_spectrum(
         validate_oscillator(t, damping)?;
     }
     let reach = reach_per_interval(accel_mps2, dt_s);
-    let mut peaks = Vec::with_capacity(periods_s.len());
-    for chunk in periods_s.chunks(LANES) {
-        let mut lanes = [periods_s[0]; LANES];
-        lanes[..chunk.len()].copy_from_slice(chunk);
-        let found = peaks_in_lanes(accel_mps2, &reach, dt_s, &lanes, damping);
-        peaks.extend_from_slice(&found[..chunk.len()]);
-    }
+    // Groups of four periods are independent: in parallel, the result does not depend on the
+    // thread count.
+    let groups: Vec<Vec<Peak>> = periods_s
+        .par_chunks(LANES)
+        .map(|chunk| {
+            let mut lanes = [periods_s[0]; LANES];
+            lanes[..chunk.len()].copy_from_slice(chunk);
+            peaks_in_lanes(accel_mps2, &reach, dt_s, &lanes, damping)[..chunk.len()].to_vec()
+        })
+        .collect();
+    let peaks: Vec<Peak> = groups.into_iter().flatten().collect();
     Ok(ResponseSpectrum {
         damping,
         periods_s: periods_s.to_vec(),
