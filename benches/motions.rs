@@ -14,28 +14,11 @@ use slidestack::motion::read_record;
 use slidestack::spectrum::TargetSpectrum;
 use slidestack::spectrum::response::{response_spectrum, sampled_peak};
 use std::hint::black_box;
-use std::path::PathBuf;
 use std::time::Instant;
 
-const ELEVEN: [&str; 11] = [
-    "RSN68_SFERN_PEL090.AT2",
-    "RSN725_SUPERST_B-POE270.AT2",
-    "RSN752_LOMAP_CAP000.AT2",
-    "RSN829_CAPEMEND_RIO360.AT2",
-    "RSN900_LANDERS_YER270.AT2",
-    "RSN960_NORTHR_LOS270.AT2",
-    "RSN1111_KOBE_NIS000.AT2",
-    "RSN1158_KOCAELI_DZC270.AT2",
-    "RSN1602_DUZCE_BOL090.AT2",
-    "RSN1633_MANJIL_ABBAR--L.AT2",
-    "RSN1787_HECTOR_HEC090.AT2",
-];
-
-fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/records")
-        .join(name)
-}
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::{ELEVEN, fixture};
 
 /// Median wall time of `reps` runs of `f`, s.
 fn time(reps: usize, mut f: impl FnMut()) -> f64 {
