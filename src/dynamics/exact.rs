@@ -4,7 +4,7 @@
 //! holds the structure is a linear SDOF of its total mass under `−M·a_g(t)` plus the constant
 //! friction of the interface above it; every other cluster is a free mass under `−M·a_g(t)` plus
 //! constant friction. With `a_g` linear over a sample interval both have closed forms
-//! ([`closed_form::Wave`]), so a sample interval is crossed in one evaluation unless a switch
+//! ([`super::closed_form::Wave`]), so a sample interval is crossed in one evaluation unless a switch
 //! occurs inside it:
 //! * a slipping interface's relative velocity reaches zero;
 //! * a stuck interface inside the structure's cluster needs more than its static friction
