@@ -8,13 +8,16 @@
 //! digit at long periods where the textbook formulas cancel (`2ζ/(ωh)` against `1`).
 //!
 //! The peak `max_t |u(t)|` is exact too, not only over the samples: sampling alone can be low by
-//! up to `1 − cos(π·dt/T)`. An energy bound decides which intervals can hold a new peak:
-//! with `E = u̇² + ω²u²`, `d√E/dt ≤ |a_g|`, so over an interval `ω|u| ≤ √E₀ + h·max|a_g|`. Only
-//! intervals whose bound reaches the running peak are examined, and in those the zeros of `u̇`
-//! are found on the closed form (pieces of at most a quarter damped period, where `u̇` has at most
-//! one extremum, so no pair of zeros is missed).
+//! up to `1 − cos(π·dt/T)`. A first pass runs the recurrence and takes the sampled peak; a second
+//! visits only the intervals that can exceed it: `u̇` or the relative acceleration changes sign
+//! at their ends (or they are longer than a quarter period), and a rigorous bound of `max|u|` over
+//! them reaches the peak (an energy bound, tight at long periods, or a particular-plus-free split,
+//! tight at short ones; `Lanes::may_raise`). In those the zeros of `u̇` are found on the closed
+//! form (pieces of at most a quarter damped period, where `u̇` has at most one extremum, so no
+//! pair of zeros is missed).
 //!
-//! Four oscillators advance together in lanes so the recurrences overlap in the pipeline.
+//! Four oscillators advance together in lanes so the recurrences overlap in the pipeline, and
+//! groups of four run in parallel.
 
 use crate::dynamics::closed_form::{Basis, Osc, Wave};
 use crate::numeric::{Cx, bracketed_root, phi1, phi2};
@@ -386,15 +389,6 @@ impl Lanes {
         (ag0, ag1): (f64, f64),
         peak: &mut Peak,
     ) {
-        // Short interval with no sign change of u̇ or of the relative acceleration at its
-        // ends: u̇ is monotone and nonzero inside, so the ends hold the largest |u| (and the
-        // samples were counted in the first pass).
-        let two_zw = 2.0 * self.zeta * self.omega[l];
-        let a0 = -ag0 - self.w2[l] * u0 - two_zw * v0;
-        let a1 = -ag1 - self.w2[l] * u1 - two_zw * v1;
-        if self.h <= self.quarter[l] && v0 * v1 > 0.0 && a0 * a1 > 0.0 {
-            return;
-        }
         let interval = Interval {
             t0_s: k as f64 * self.h,
             h: self.h,
