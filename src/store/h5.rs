@@ -90,3 +90,30 @@ pub fn read_strings(g: &hdf5::Group, name: &str) -> hdf5::Result<Vec<String>> {
         .map(|s| s.to_string())
         .collect())
 }
+
+unsafe extern "C" {
+    fn H5DSset_scale(dsid: i64, dimname: *const std::ffi::c_char) -> i32;
+    fn H5DSattach_scale(did: i64, dsid: i64, idx: std::ffi::c_uint) -> i32;
+}
+
+/// Makes `scale` a dimension scale named `name` (HDF5 high-level library, `H5DSset_scale`).
+pub fn set_scale(scale: &hdf5::Dataset, name: &str) -> hdf5::Result<()> {
+    let c = std::ffi::CString::new(name).map_err(|e| hdf5::Error::from(e.to_string()))?;
+    // SAFETY: both ids are valid open dataset handles owned by `scale`; the string outlives the
+    // call.
+    let rc = hdf5::sync::sync(|| unsafe { H5DSset_scale(scale.id(), c.as_ptr()) });
+    if rc < 0 {
+        return Err(hdf5::Error::from(format!("H5DSset_scale({name}) failed")));
+    }
+    Ok(())
+}
+
+/// Attaches dimension scale `scale` to dimension `idx` of `data` (`H5DSattach_scale`).
+pub fn attach_scale(data: &hdf5::Dataset, scale: &hdf5::Dataset, idx: usize) -> hdf5::Result<()> {
+    // SAFETY: as in `set_scale`.
+    let rc = hdf5::sync::sync(|| unsafe { H5DSattach_scale(data.id(), scale.id(), idx as u32) });
+    if rc < 0 {
+        return Err(hdf5::Error::from("H5DSattach_scale failed".to_string()));
+    }
+    Ok(())
+}

@@ -29,6 +29,70 @@ pub struct StudyConfig {
     pub output_dir: PathBuf,
     pub zones: Vec<ZoneConfig>,
     pub motions: MotionsConfig,
+    /// The parameter grid of the sweep; required by `sweep` and later stages.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<GridConfig>,
+}
+
+/// A list of values, or an inclusive range `{ from, to, step }`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Values {
+    List(Vec<f64>),
+    Range(Range),
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Range {
+    pub from: f64,
+    pub to: f64,
+    pub step: f64,
+}
+
+impl Values {
+    /// The values in order; a range is `from + k·step` up to `to` (within 1e-9 of a step), each
+    /// rounded to 12 significant digits so that `0.1 + 2·0.1` reads back as `0.3`.
+    pub fn values(&self) -> Vec<f64> {
+        match self {
+            Values::List(v) => v.clone(),
+            Values::Range(r) => {
+                if !(r.step > 0.0 && r.to >= r.from) || !r.step.is_finite() {
+                    return Vec::new();
+                }
+                let n = ((r.to - r.from) / r.step + 1e-9).floor() as usize;
+                (0..=n)
+                    .map(|k| {
+                        let v = r.from + r.step * k as f64;
+                        format!("{v:.12e}").parse().unwrap_or(v)
+                    })
+                    .collect()
+            }
+        }
+    }
+}
+
+/// The sweep's grid (paper Section 7.3): structure periods, block mass ratios per block (bottom
+/// first) and kinetic friction coefficients per interface (interface 1 first).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridConfig {
+    /// Periods `T_p` of the bare structure, s.
+    pub period_s: Values,
+    /// `α_i = m_i/m_p` per block.
+    pub alpha: Vec<Values>,
+    /// Kinetic `μ_i` per interface.
+    pub mu: Vec<Values>,
+    /// Static coefficients are `mu_static_ratio·μ_i` (≥ 1; 1: static equals kinetic, the paper).
+    #[serde(default = "one")]
+    pub mu_static_ratio: f64,
+    /// Damping ratio of the bare structure.
+    #[serde(default = "five_percent")]
+    pub damping: f64,
+}
+
+fn five_percent() -> f64 {
+    0.05
 }
 
 /// One hazard level: its name (the group `zone_<name>`) and its target spectrum (SPEC string).
@@ -203,6 +267,9 @@ impl StudyConfig {
                 format!("{m} must be in (0, matching.upper]"),
             );
         }
+        if let Some(g) = &self.grid {
+            validate_grid(g)?;
+        }
         let seeds = &self.motions.seeds;
         if seeds.stochastic.is_some() == seeds.records.is_some() {
             return err(
@@ -248,6 +315,15 @@ impl StudyConfig {
         Ok(())
     }
 
+    /// The grid, or an error naming the missing section.
+    pub fn grid(&self) -> Result<&GridConfig, ConfigError> {
+        self.grid.as_ref().ok_or_else(|| ConfigError::Invalid {
+            file: "study".into(),
+            key: "grid".into(),
+            why: "this stage needs a `grid` section".into(),
+        })
+    }
+
     /// The target spectrum of zone `i`.
     pub fn target(&self, i: usize) -> Result<TargetSpectrum, TargetError> {
         self.zones[i].target.parse()
@@ -260,4 +336,63 @@ impl StudyConfig {
             dt_s: r.dt_s,
         }
     }
+}
+
+fn validate_grid(g: &GridConfig) -> Result<(), (String, String)> {
+    let check = |key: String, v: &Values, lo: f64, lo_open: bool| -> Result<(), (String, String)> {
+        let vals = v.values();
+        if vals.is_empty() {
+            return Err((
+                key,
+                "needs at least one value (a range needs step > 0, to ≥ from)".into(),
+            ));
+        }
+        for x in &vals {
+            let ok = x.is_finite() && if lo_open { *x > lo } else { *x >= lo };
+            if !ok {
+                let rel = if lo_open { ">" } else { "≥" };
+                return Err((key, format!("value {x} must be finite and {rel} {lo}")));
+            }
+        }
+        if vals.windows(2).any(|w| w[1] <= w[0]) {
+            return Err((key, "values must be strictly increasing".into()));
+        }
+        Ok(())
+    };
+    check("grid.period_s".into(), &g.period_s, 0.0, true)?;
+    if g.alpha.is_empty() {
+        return Err((
+            "grid.alpha".into(),
+            "needs one list per block (at least one block)".into(),
+        ));
+    }
+    if g.mu.len() != g.alpha.len() {
+        return Err((
+            "grid.mu".into(),
+            format!(
+                "needs one list per interface: {} blocks, {} lists",
+                g.alpha.len(),
+                g.mu.len()
+            ),
+        ));
+    }
+    for (i, a) in g.alpha.iter().enumerate() {
+        check(format!("grid.alpha[{i}]"), a, 0.0, true)?;
+    }
+    for (i, m) in g.mu.iter().enumerate() {
+        check(format!("grid.mu[{i}]"), m, 0.0, false)?;
+    }
+    if !(g.mu_static_ratio.is_finite() && g.mu_static_ratio >= 1.0) {
+        return Err((
+            "grid.mu_static_ratio".into(),
+            format!("{} must be ≥ 1", g.mu_static_ratio),
+        ));
+    }
+    if !(g.damping.is_finite() && (0.0..1.0).contains(&g.damping)) {
+        return Err((
+            "grid.damping".into(),
+            format!("{} must be in [0, 1)", g.damping),
+        ));
+    }
+    Ok(())
 }

@@ -2,6 +2,8 @@
 //!
 //! * [`config`]: the study file (YAML), validated before any work.
 //! * [`motions`]: the first stage: seeds, spectral matching per zone, the set checks.
+//! * [`sweep`]: the grid of cases, the skip rules, one work unit.
 
 pub mod config;
 pub mod motions;
+pub mod sweep;

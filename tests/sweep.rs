@@ -1,0 +1,74 @@
+//! The sweep's skip rules against brute force: every system of every case simulated.
+
+mod common;
+
+use common::real_records;
+use slidestack::dynamics::Ground;
+use slidestack::study::config::{GridConfig, Values};
+use slidestack::study::sweep::{Grid, UnitOptions, run_unit};
+
+fn grid(ratio: f64) -> Grid {
+    Grid::from_config(&GridConfig {
+        period_s: Values::List(vec![0.3, 1.0]),
+        alpha: vec![Values::List(vec![0.1, 1.0]), Values::List(vec![0.5, 1.0])],
+        // From "never slips" (0.9) to sliding (0.05), with increasing and decreasing pairs.
+        mu: vec![
+            Values::List(vec![0.05, 0.2, 0.9]),
+            Values::List(vec![0.05, 0.1, 0.3, 0.9]),
+        ],
+        mu_static_ratio: ratio,
+        damping: 0.05,
+    })
+}
+
+#[test]
+fn skip_rules_equal_brute_force() {
+    // Tolerances: NoSlip compares the rigid SDOF with the stack simulated with every interface
+    // stuck (two exact solutions, 1e-9 relative); SingleBlock compares the single block with
+    // the stack whose upper interfaces never slip (1e-9, the limit tests' bound is 1e-10).
+    let mut counts = [0usize; 3];
+    for ratio in [1.0, 1.5] {
+        let g = grid(ratio);
+        for rec in &real_records()[..2] {
+            let accel = rec.accel_mps2(1.0);
+            let ground = Ground {
+                dt_s: rec.dt_s,
+                accel_mps2: &accel,
+            };
+            for p in 0..g.periods_s.len() {
+                let fast = run_unit(&g, &ground, p, UnitOptions { skip: true }).unwrap();
+                let slow = run_unit(&g, &ground, p, UnitOptions { skip: false }).unwrap();
+                assert!(slow.skip_rule.iter().all(|&r| r == 0));
+                for c in 0..g.cases_per_unit() {
+                    counts[fast.skip_rule[c] as usize] += 1;
+                    let close = |a: f64, b: f64, what: &str| {
+                        let scale = a.abs().max(b.abs()).max(1e-12);
+                        assert!(
+                            (a - b).abs() <= 1e-9 * scale,
+                            "{} T={} case {c} ({:?}) rule {}: {what} {a} vs {b}",
+                            rec.name,
+                            g.periods_s[p],
+                            g.case(c),
+                            fast.skip_rule[c]
+                        );
+                    };
+                    close(fast.u_stack[c], slow.u_stack[c], "u_stack");
+                    close(fast.u_single[c], slow.u_single[c], "u_single");
+                    close(fast.u_rigid[c], slow.u_rigid[c], "u_rigid");
+                    close(fast.a_stack[c], slow.a_stack[c], "a_stack");
+                    for i in 0..g.blocks() {
+                        let k = c * g.blocks() + i;
+                        assert!((fast.slip_peak[k] - slow.slip_peak[k]).abs() < 1e-9);
+                    }
+                    let fe = (fast.friction_energy[c] - slow.friction_energy[c]).abs();
+                    assert!(
+                        fe <= 1e-9 * slow.friction_energy[c].max(1e-9),
+                        "friction {fe}"
+                    );
+                }
+            }
+        }
+    }
+    // Every rule was exercised.
+    assert!(counts.iter().all(|&n| n > 0), "{counts:?}");
+}
