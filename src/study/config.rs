@@ -57,7 +57,7 @@ impl Values {
         match self {
             Values::List(v) => v.clone(),
             Values::Range(r) => {
-                if !(r.step > 0.0 && r.to >= r.from) || !r.step.is_finite() {
+                if !(r.step > 0.0 && r.to >= r.from && r.step.is_finite()) {
                     return Vec::new();
                 }
                 let n = ((r.to - r.from) / r.step + 1e-9).floor() as usize;
