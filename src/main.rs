@@ -22,6 +22,10 @@ enum Command {
     Match(cmd::matching::Args),
     /// Study stage 1: seed motions matched to every zone's target → motions.h5.
     Motions(cmd::motions::Args),
+    /// Study stage 2: every case of the grid under every motion → sweep.h5 (resumable, shards).
+    Sweep(cmd::sweep::Args),
+    /// Join the units of a sharded sweep into sweep.h5.
+    Merge(cmd::sweep::MergeArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -31,6 +35,8 @@ fn main() -> std::process::ExitCode {
         Command::Spectrum(args) => cmd::spectrum::run(args),
         Command::Match(args) => cmd::matching::run(args),
         Command::Motions(args) => cmd::motions::run(args),
+        Command::Sweep(args) => cmd::sweep::run(args),
+        Command::Merge(args) => cmd::sweep::merge(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

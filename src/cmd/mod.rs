@@ -4,6 +4,7 @@ pub mod matching;
 pub mod motions;
 pub mod simulate;
 pub mod spectrum;
+pub mod sweep;
 
 use anyhow::{Context, Result, bail};
 use slidestack::motion::{ReadOptions, Record, Units, read_record_with};

@@ -72,11 +72,11 @@ pub fn run(args: Args) -> Result<()> {
         let zm = match_zone(&z.name, &target, &seeds, &cfg.motions)
             .with_context(|| format!("zone {}: matching failed", z.name))?;
         println!(
-            "motions: zone {}: {} motions kept of {} seeds matched to {} in {:.1} s; set scale {:.4}, \
+            "motions: zone {}: {} motions kept of {} seeds tried, matched to {} in {:.1} s; set scale {:.4}, \
              mean/target ≥ {:.3} (set_mean_min {}: {}; ASCE 7 90 %: {})",
             z.name,
             zm.kept.len(),
-            seeds.len(),
+            zm.seeds.len(),
             target,
             start.elapsed().as_secs_f64(),
             zm.set_scale,

@@ -77,6 +77,7 @@ pub fn write_strings(
     let ds = g
         .new_dataset::<VarLenUnicode>()
         .shape(v.len())
+        .obj_track_times(false)
         .create(name)?;
     ds.write_raw(&v)?;
     attr_str(&ds, "long_name", long_name)?;

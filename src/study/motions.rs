@@ -47,7 +47,8 @@ pub struct ZoneMotions {
     /// The check grid, s.
     pub periods_s: Vec<f64>,
     pub target_psa_g: Vec<f64>,
-    /// Names of all seeds, and what matching did to each.
+    /// Names of the seeds tried (spares that were not needed are not), and what matching did to
+    /// each.
     pub seeds: Vec<String>,
     pub reports: Vec<MatchReport>,
     /// Indices (into `seeds`) of the motions kept.
@@ -79,14 +80,30 @@ pub fn match_zone(
     let settings = &cfg.matching;
     let periods_s = settings.check_grid_s();
     let target_psa_g: Vec<f64> = periods_s.iter().map(|&t| target.sa_g(t)).collect();
-    let matched = seeds
-        .par_iter()
-        .map(|s| match_record(&s.accel_g, s.dt_s, target, settings))
-        .collect::<Result<Vec<_>, _>>()?;
     let wanted = match cfg.seeds.kind() {
         Seeds::Stochastic(s) => s.count,
         Seeds::Records(_) => seeds.len(),
     };
+    // Seeds are matched in order, a batch at a time, until `wanted` are accepted: spares are
+    // only matched when needed, and which seeds are tried does not depend on the thread count.
+    let mut matched = Vec::new();
+    loop {
+        let accepted = matched
+            .iter()
+            .filter(|m: &&crate::motion::matching::Matched| m.report.converged)
+            .count();
+        if accepted >= wanted || matched.len() == seeds.len() {
+            break;
+        }
+        let from = matched.len();
+        let to = (from + wanted - accepted).min(seeds.len());
+        let batch = seeds[from..to]
+            .par_iter()
+            .map(|s| match_record(&s.accel_g, s.dt_s, target, settings))
+            .collect::<Result<Vec<_>, _>>()?;
+        matched.extend(batch);
+    }
+    let seeds = &seeds[..matched.len()];
     let kept: Vec<usize> = (0..seeds.len())
         .filter(|&i| matched[i].report.converged)
         .take(wanted)
