@@ -1,23 +1,35 @@
 #!/usr/bin/env bash
-# Installs what slidestack needs to build on Debian/Ubuntu: libhdf5-dev and pkg-config (for the
-# hdf5-metno crate). Needs a Rust toolchain (cargo) already on PATH. Without apt-get or root it
-# stops and says what to install.
+# Installs what slidestack needs on Debian/Ubuntu: libhdf5-dev and pkg-config (for the
+# hdf5-metno crate and the HDF5 high-level library). Needs a Rust toolchain (cargo) on PATH.
+# Without apt-get or root it stops and says what to install.
+#
+# With --test it also makes .venv-test/, a Python environment with h5py, xarray and h5netcdf
+# from PyPI, in which the tests check that xarray reads the stage files.
 set -euo pipefail
+cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
   echo "slidestack needs a Rust toolchain (cargo >= 1.85): install it from https://rustup.rs" >&2
   exit 1
 fi
-if pkg-config --exists hdf5 2>/dev/null || [ -e /usr/include/hdf5/serial/hdf5.h ]; then
-  exit 0
+if ! { pkg-config --exists hdf5 2>/dev/null || [ -e /usr/include/hdf5/serial/hdf5.h ]; }; then
+  if command -v apt-get >/dev/null 2>&1; then
+    SUDO=""
+    [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libhdf5-dev pkg-config >/dev/null
+  else
+    echo "slidestack needs the HDF5 C library and headers (1.10 or newer, with the high-level" >&2
+    echo "library libhdf5_hl) and pkg-config:" >&2
+    echo "  Debian/Ubuntu: apt-get install libhdf5-dev pkg-config" >&2
+    echo "  Fedora: dnf install hdf5-devel pkgconf;  macOS: brew install hdf5 pkg-config" >&2
+    exit 1
+  fi
 fi
-if command -v apt-get >/dev/null 2>&1; then
-  SUDO=""
-  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libhdf5-dev pkg-config >/dev/null
-else
-  echo "slidestack needs the HDF5 C library and headers (1.10 or newer) and pkg-config:" >&2
-  echo "  Debian/Ubuntu: apt-get install libhdf5-dev pkg-config" >&2
-  echo "  Fedora: dnf install hdf5-devel pkgconf;  macOS: brew install hdf5 pkg-config" >&2
-  exit 1
+if [ "${1:-}" = "--test" ] && ! .venv-test/bin/python -c "import h5py, xarray, h5netcdf" 2>/dev/null; then
+  if ! command -v python3 >/dev/null 2>&1; then
+    echo "the tests need Python 3 (>= 3.9) with venv and pip: apt-get install python3-venv" >&2
+    exit 1
+  fi
+  python3 -m venv .venv-test
+  .venv-test/bin/pip install -q --disable-pip-version-check h5py xarray h5netcdf
 fi
