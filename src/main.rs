@@ -26,6 +26,8 @@ enum Command {
     Sweep(cmd::sweep::Args),
     /// Join the units of a sharded sweep into sweep.h5.
     Merge(cmd::sweep::MergeArgs),
+    /// Study stage 3: T_new and the displacement response ratios → tnew.h5.
+    Tnew(cmd::tnew::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -37,6 +39,7 @@ fn main() -> std::process::ExitCode {
         Command::Motions(args) => cmd::motions::run(args),
         Command::Sweep(args) => cmd::sweep::run(args),
         Command::Merge(args) => cmd::sweep::merge(args),
+        Command::Tnew(args) => cmd::tnew::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

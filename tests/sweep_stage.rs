@@ -126,6 +126,11 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
     let o = ok(slidestack(&["sweep", cfg_s, "--out", s], "2"));
     assert!(String::from_utf8_lossy(&o.stdout).contains("is up to date"));
 
+    // tnew: no slip gives T_new = T_rigid; DRR_1 = 1 there.
+    ok(slidestack(&["tnew", cfg_s, "--out", s], "2"));
+    let o = ok(slidestack(&["tnew", cfg_s, "--out", s], "2"));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("is up to date"));
+
     // xarray opens the group with its named dimensions (Python environment made by
     // scripts/install-deps.sh).
     let python = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-test/bin/python");
@@ -138,9 +143,19 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
         ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_III')\n\
         print(list(ds['u_stack'].dims), list(ds['slip_peak'].dims))\n\
         print(ds['T_p'].attrs['units'], ds['u_stack'].attrs['units'], float(ds['mu_1'][1]))\n\
-        print(int(ds['u_stack'].isnull().sum()))\n";
+        print(int(ds['u_stack'].isnull().sum()))\n\
+        t = xr.open_dataset(sys.argv[2], engine='h5netcdf', group='zone_III')\n\
+        print(list(t['T_new'].dims))\n\
+        ns = t['T_new_flag'] == 3\n\
+        print(bool(ns.any()), bool((t['T_new'] == t['T_rigid']).where(ns, True).all()),\n\
+              bool((t['DRR_1'] == 1).where(ns, True).all()))\n";
     let o = Command::new(python)
-        .args(["-c", script, sharded.join("sweep.h5").to_str().unwrap()])
+        .args([
+            "-c",
+            script,
+            sharded.join("sweep.h5").to_str().unwrap(),
+            sharded.join("tnew.h5").to_str().unwrap(),
+        ])
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&o.stdout);
@@ -148,7 +163,8 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
     assert_eq!(
         text,
         "['motion', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2'] \
-         ['motion', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2', 'interface']\ns m 0.3\n0\n"
+         ['motion', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2', 'interface']\ns m 0.3\n0\n\
+         ['T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2']\nTrue True True\n"
     );
 }
 

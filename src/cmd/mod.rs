@@ -5,6 +5,7 @@ pub mod motions;
 pub mod simulate;
 pub mod spectrum;
 pub mod sweep;
+pub mod tnew;
 
 use anyhow::{Context, Result, bail};
 use slidestack::motion::{ReadOptions, Record, Units, read_record_with};

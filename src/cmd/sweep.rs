@@ -63,17 +63,19 @@ fn parse_shard(s: &str) -> Result<(usize, usize), String> {
 }
 
 /// Everything the stage needs, checked before any work.
-struct Stage {
-    cfg: StudyConfig,
-    grid: Grid,
-    out: PathBuf,
+pub struct Stage {
+    pub cfg: StudyConfig,
+    pub grid: Grid,
+    pub out: PathBuf,
     units_dir: PathBuf,
-    fingerprint: String,
+    /// The fingerprint `sweep.h5` must carry to be up to date.
+    pub fingerprint: String,
     motions_fingerprint: String,
     config_sha256: String,
 }
 
-fn prepare(config: &Path, out: Option<PathBuf>) -> Result<Stage> {
+/// Loads the config and checks that `motions.h5` is up to date with it.
+pub fn prepare(config: &Path, out: Option<PathBuf>) -> Result<Stage> {
     let cfg = StudyConfig::load(config)?;
     let grid = Grid::from_config(cfg.grid()?);
     let out = out.unwrap_or_else(|| cfg.output_dir.clone());
@@ -119,7 +121,7 @@ fn all_units(
     v
 }
 
-fn load_motions(stage: &Stage) -> Result<Vec<Vec<slidestack::motion::Record>>> {
+pub fn load_motions(stage: &Stage) -> Result<Vec<Vec<slidestack::motion::Record>>> {
     let path = stage.out.join("motions.h5");
     stage
         .cfg

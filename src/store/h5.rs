@@ -118,3 +118,48 @@ pub fn attach_scale(data: &hdf5::Dataset, scale: &hdf5::Dataset, idx: usize) -> 
     }
     Ok(())
 }
+
+/// A chunked, deflate+shuffle compressed `f64` variable with NaN fill.
+pub fn scalar_var(
+    g: &hdf5::Group,
+    name: &str,
+    shape: &[usize],
+    chunk: &[usize],
+    data: &[f64],
+    units: &str,
+    long: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = g
+        .new_dataset::<f64>()
+        .shape(shape.to_vec())
+        .chunk(chunk.to_vec())
+        .shuffle()
+        .deflate(4)
+        .fill_value(f64::NAN)
+        .obj_track_times(false)
+        .create(name)?;
+    ds.write_raw(data)?;
+    attr_str(&ds, "units", units)?;
+    attr_str(&ds, "long_name", long)?;
+    Ok(ds)
+}
+
+/// A 1-D coordinate, made a dimension scale named after itself.
+pub fn coordinate(
+    g: &hdf5::Group,
+    name: &str,
+    values: &[f64],
+    units: &str,
+    long: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = g
+        .new_dataset::<f64>()
+        .shape(values.len())
+        .obj_track_times(false)
+        .create(name)?;
+    ds.write_raw(values)?;
+    attr_str(&ds, "units", units)?;
+    attr_str(&ds, "long_name", long)?;
+    set_scale(&ds, name)?;
+    Ok(ds)
+}

@@ -18,7 +18,7 @@
 //! Variables are chunked by work unit (one motion, one `T_p`), deflate+shuffle compressed, with
 //! NaN (255 for the rule codes) as fill value.
 
-use super::h5::{attach_scale, attr_str, set_scale, write_strings};
+use super::h5::{attach_scale, attr_str, coordinate, scalar_var, set_scale, write_strings};
 use crate::study::sweep::{Grid, SKIP_RULE_CODES, UnitResult};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -124,30 +124,6 @@ pub struct ZoneUnits<'a> {
     pub units: Vec<Vec<UnitResult>>,
 }
 
-fn scalar_var(
-    g: &hdf5::Group,
-    name: &str,
-    shape: &[usize],
-    chunk: &[usize],
-    data: &[f64],
-    units: &str,
-    long: &str,
-) -> hdf5::Result<hdf5::Dataset> {
-    let ds = g
-        .new_dataset::<f64>()
-        .shape(shape.to_vec())
-        .chunk(chunk.to_vec())
-        .shuffle()
-        .deflate(4)
-        .fill_value(f64::NAN)
-        .obj_track_times(false)
-        .create(name)?;
-    ds.write_raw(data)?;
-    attr_str(&ds, "units", units)?;
-    attr_str(&ds, "long_name", long)?;
-    Ok(ds)
-}
-
 fn code_var(
     g: &hdf5::Group,
     name: &str,
@@ -167,25 +143,6 @@ fn code_var(
         .create(name)?;
     ds.write_raw(data)?;
     attr_str(&ds, "long_name", long)?;
-    Ok(ds)
-}
-
-fn coordinate(
-    g: &hdf5::Group,
-    name: &str,
-    values: &[f64],
-    units: &str,
-    long: &str,
-) -> hdf5::Result<hdf5::Dataset> {
-    let ds = g
-        .new_dataset::<f64>()
-        .shape(values.len())
-        .obj_track_times(false)
-        .create(name)?;
-    ds.write_raw(values)?;
-    attr_str(&ds, "units", units)?;
-    attr_str(&ds, "long_name", long)?;
-    set_scale(&ds, name)?;
     Ok(ds)
 }
 
@@ -363,4 +320,44 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneUnits) -> hdf5::Result<()> {
 pub fn read_fingerprint(path: &Path) -> Option<String> {
     let f = hdf5::File::open(path).ok()?;
     super::h5::read_attr_str(&f, "fingerprint")
+}
+
+/// One zone of `sweep.h5`, read back: the coordinates and the variables `tnew` needs, flat in
+/// the file's order (`[motion][T_p][alpha…][mu…]`, `slip_peak` with a trailing interface).
+#[derive(Debug, Clone)]
+pub struct ZoneSweep {
+    pub motions: Vec<String>,
+    pub grid: Grid,
+    pub u_stack: Vec<f64>,
+    pub u_single: Vec<f64>,
+    pub u_rigid: Vec<f64>,
+    pub slip_peak: Vec<f64>,
+}
+
+/// Reads zone `zone` of `sweep.h5`; the grid's static ratio and damping come from `grid`
+/// (they are not coordinates).
+pub fn read_zone_sweep(path: &Path, zone: &str, like: &Grid) -> hdf5::Result<ZoneSweep> {
+    let f = hdf5::File::open(path)?;
+    let g = f.group(&format!("zone_{zone}"))?;
+    let read = |n: &str| g.dataset(n)?.read_raw::<f64>();
+    let n = like.blocks();
+    let grid = Grid {
+        periods_s: read("T_p")?,
+        alpha: (1..=n)
+            .map(|i| read(&format!("alpha_{i}")))
+            .collect::<hdf5::Result<_>>()?,
+        mu: (1..=n)
+            .map(|i| read(&format!("mu_{i}")))
+            .collect::<hdf5::Result<_>>()?,
+        mu_static_ratio: like.mu_static_ratio,
+        damping: like.damping,
+    };
+    Ok(ZoneSweep {
+        motions: super::h5::read_strings(&g, "motion")?,
+        grid,
+        u_stack: read("u_stack")?,
+        u_single: read("u_single")?,
+        u_rigid: read("u_rigid")?,
+        slip_peak: read("slip_peak")?,
+    })
 }

@@ -1,0 +1,107 @@
+//! `T_new` and the displacement response ratios (paper Section 7.1, Eqs. 7–8; NOTES.md "Derived
+//! quantities").
+//!
+//! For one case and one zone: the mean over the motions of the peak structure displacement with
+//! the stack, `ū`, is read off the mean 5 %-damped displacement spectrum `S̄d(T)` of the same
+//! motions: `T_new` is the period where `S̄d(T) = ū`, by linear interpolation between the
+//! spectrum's periods. When no motion makes any interface slip, `T_new = T_rigid` (step 1 of
+//! Section 7.1). `DRR_1 = ū_stack/ū_rigid`, `DRR_2 = ū_single/ū_rigid` (ratios of the means).
+//!
+//! Several crossings: the spectrum need not be monotone. The rule: take the crossing nearest
+//! to `T_rigid` (in log period); the stack can only soften the structure up to the rigidly
+//! attached mass, and the crossing near `T_rigid` is the one that continues the `μ → ∞` limit.
+//! The flag says which case applied.
+
+/// How `T_new` was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum TnewFlag {
+    /// One crossing.
+    Unique = 0,
+    /// Several crossings: the one nearest `T_rigid` (log period) was taken.
+    Several = 1,
+    /// `ū` lies outside the spectrum's range on its period grid: `T_new` is NaN.
+    OutsideRange = 2,
+    /// Nothing slid: `T_new = T_rigid`.
+    NoSlip = 3,
+}
+
+/// Meaning of the `T_new_flag` codes, for the file attribute.
+pub const TNEW_FLAG_CODES: &str = "0 one crossing of the mean displacement spectrum; 1 several \
+     crossings, the one nearest T_rigid (log period) taken; 2 the mean displacement lies outside \
+     the spectrum's range (T_new NaN); 3 nothing slid, T_new = T_rigid";
+
+/// The period at which the piecewise-linear curve `(periods_s, sd_m)` equals `u_m`, by the rule
+/// of the module doc; `periods_s` increasing.
+pub fn period_at_displacement(
+    periods_s: &[f64],
+    sd_m: &[f64],
+    u_m: f64,
+    t_rigid_s: f64,
+) -> (f64, TnewFlag) {
+    let mut crossings = Vec::new();
+    for i in 0..periods_s.len().saturating_sub(1) {
+        let (a, b) = (sd_m[i] - u_m, sd_m[i + 1] - u_m);
+        if a == 0.0 {
+            crossings.push(periods_s[i]);
+        } else if a * b < 0.0 {
+            let f = a / (a - b);
+            crossings.push(periods_s[i] + f * (periods_s[i + 1] - periods_s[i]));
+        }
+    }
+    if let (Some(&last_t), Some(&last_s)) = (periods_s.last(), sd_m.last())
+        && last_s == u_m
+    {
+        crossings.push(last_t);
+    }
+    match crossings.len() {
+        0 => (f64::NAN, TnewFlag::OutsideRange),
+        1 => (crossings[0], TnewFlag::Unique),
+        _ => {
+            let best = crossings
+                .iter()
+                .copied()
+                .min_by(|x, y| {
+                    (x / t_rigid_s)
+                        .ln()
+                        .abs()
+                        .total_cmp(&(y / t_rigid_s).ln().abs())
+                })
+                .expect("non-empty");
+            (best, TnewFlag::Several)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hand_cases() {
+        // Sd = 0.1·T on [0.5, 2]: ū = 0.138 m lies at T = 1.38 s (NOTES.md's Section 7.1 number
+        // in the 1/T branch, Sd ∝ T), exactly on the straight segment.
+        let t = [0.5, 1.0, 1.5, 2.0];
+        let sd = [0.05, 0.1, 0.15, 0.2];
+        let (tn, f) = period_at_displacement(&t, &sd, 0.138, 1.7);
+        assert!((tn - 1.38).abs() < 1e-12 && f == TnewFlag::Unique, "{tn}");
+        // On a grid point.
+        assert_eq!(
+            period_at_displacement(&t, &sd, 0.1, 1.7),
+            (1.0, TnewFlag::Unique)
+        );
+        assert_eq!(
+            period_at_displacement(&t, &sd, 0.2, 1.7),
+            (2.0, TnewFlag::Unique)
+        );
+        // Outside the range.
+        let (tn, f) = period_at_displacement(&t, &sd, 0.3, 1.7);
+        assert!(tn.is_nan() && f == TnewFlag::OutsideRange);
+        // Three crossings, at 0.75, 1.25 and 1.75: nearest T_rigid = 1.6 is 1.75; to 0.7, 0.75.
+        let sd2 = [0.05, 0.15, 0.05, 0.15];
+        let (tn, f) = period_at_displacement(&t, &sd2, 0.1, 1.6);
+        assert!((tn - 1.75).abs() < 1e-12 && f == TnewFlag::Several, "{tn}");
+        let (tn, _) = period_at_displacement(&t, &sd2, 0.1, 0.7);
+        assert!((tn - 0.75).abs() < 1e-12, "{tn}");
+    }
+}
