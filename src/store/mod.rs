@@ -4,7 +4,7 @@
 //! * [`history`]: one simulation's time history.
 //! * [`motions`]: `motions.h5`, the ground-motion stage.
 //! * [`sweep`]: the sweep's unit files and `sweep.h5`.
-//! * [`tnew`]: `tnew.h5`.
+//! * [`tnew`]: the T_new stage file, `tnew.h5`.
 //! * [`fingerprint`]: SHA-256 of inputs, for up-to-date checks.
 //! * [`h5`]: small HDF5 helpers.
 
