@@ -3,12 +3,14 @@
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
 //! * [`motion`]: ground-motion records, processing, spectral matching, stochastic motions.
 //! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
+//! * [`fit`]: the design equation for T_new: forms, argmin problems, metrics.
 //! * [`study`]: the study configuration and its stages.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
 
 pub mod dynamics;
+pub mod fit;
 pub mod motion;
 mod numeric;
 pub mod spectrum;
