@@ -28,6 +28,8 @@ enum Command {
     Merge(cmd::sweep::MergeArgs),
     /// Study stage 3: T_new and the displacement response ratios → tnew.h5.
     Tnew(cmd::tnew::Args),
+    /// Study stage 4: fit the design equation for T_new (argmin) → fit.h5, fit.yaml.
+    Fit(cmd::fit::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -40,6 +42,7 @@ fn main() -> std::process::ExitCode {
         Command::Sweep(args) => cmd::sweep::run(args),
         Command::Merge(args) => cmd::sweep::merge(args),
         Command::Tnew(args) => cmd::tnew::run(args),
+        Command::Fit(args) => cmd::fit::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -179,3 +179,33 @@ pub fn read_fingerprint(path: &Path) -> Option<String> {
     let f = hdf5::File::open(path).ok()?;
     super::h5::read_attr_str(&f, "fingerprint")
 }
+
+/// What the fit stage reads from one zone of `tnew.h5`: the case coordinates and, flat over
+/// `[T_p][alpha…][mu…]`, `T_rigid`, `T_new` and its flag.
+#[derive(Debug, Clone)]
+pub struct ZoneTnewRead {
+    pub periods_s: Vec<f64>,
+    pub alpha: Vec<Vec<f64>>,
+    pub mu: Vec<Vec<f64>>,
+    pub t_rigid: Vec<f64>,
+    pub t_new: Vec<f64>,
+    pub flag: Vec<f64>,
+}
+
+pub fn read_zone_tnew(path: &Path, zone: &str, blocks: usize) -> hdf5::Result<ZoneTnewRead> {
+    let f = hdf5::File::open(path)?;
+    let g = f.group(&format!("zone_{zone}"))?;
+    let read = |n: &str| g.dataset(n)?.read_raw::<f64>();
+    Ok(ZoneTnewRead {
+        periods_s: read("T_p")?,
+        alpha: (1..=blocks)
+            .map(|i| read(&format!("alpha_{i}")))
+            .collect::<hdf5::Result<_>>()?,
+        mu: (1..=blocks)
+            .map(|i| read(&format!("mu_{i}")))
+            .collect::<hdf5::Result<_>>()?,
+        t_rigid: read("T_rigid")?,
+        t_new: read("T_new")?,
+        flag: read("T_new_flag")?,
+    })
+}
