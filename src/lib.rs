@@ -4,6 +4,7 @@
 //! * [`motion`]: ground-motion records, processing, spectral matching, stochastic motions.
 //! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
 //! * [`fit`]: the design equation for T_new: forms, argmin problems, metrics.
+//! * [`report`]: SVG figures and the HTML report.
 //! * [`study`]: the study configuration and its stages.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
 //!
@@ -13,6 +14,7 @@ pub mod dynamics;
 pub mod fit;
 pub mod motion;
 mod numeric;
+pub mod report;
 pub mod spectrum;
 pub mod store;
 pub mod study;

@@ -30,6 +30,8 @@ enum Command {
     Tnew(cmd::tnew::Args),
     /// Study stage 4: fit the design equation for T_new (argmin) → fit.h5, fit.yaml.
     Fit(cmd::fit::Args),
+    /// Study stage 5: figures and tables → report/index.html.
+    Report(cmd::report::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -43,6 +45,7 @@ fn main() -> std::process::ExitCode {
         Command::Merge(args) => cmd::sweep::merge(args),
         Command::Tnew(args) => cmd::tnew::run(args),
         Command::Fit(args) => cmd::fit::run(args),
+        Command::Report(args) => cmd::report::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

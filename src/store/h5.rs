@@ -163,3 +163,17 @@ pub fn coordinate(
     set_scale(&ds, name)?;
     Ok(ds)
 }
+
+/// A whole `f64` dataset `group/name` of the file at `path`, flat.
+pub fn read_f64(path: &std::path::Path, group: &str, name: &str) -> hdf5::Result<Vec<f64>> {
+    hdf5::File::open(path)?
+        .group(group)?
+        .dataset(name)?
+        .read_raw::<f64>()
+}
+
+/// A scalar `f64` attribute of `group` in the file at `path`.
+pub fn read_group_attr(path: &std::path::Path, group: &str, name: &str) -> hdf5::Result<f64> {
+    let g = hdf5::File::open(path)?.group(group)?;
+    read_attr_f64(&g, name)
+}
