@@ -15,6 +15,7 @@
 
 use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::neldermead::NelderMead;
+use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
@@ -183,6 +184,9 @@ impl Fitted {
     }
 }
 
+/// Nelder–Mead iterations at most.
+pub const MAX_ITERATIONS: u64 = 5_000;
+
 /// Fits `form` to `data` by least squares.
 pub fn fit(form: Form, data: &[Sample]) -> Result<Fitted, FitError> {
     let k = data.first().map_or(0, |s| s.x.len());
@@ -202,11 +206,17 @@ pub fn fit(form: Form, data: &[Sample]) -> Result<Fitted, FitError> {
         v[i] = 0.5;
         simplex.push(v);
     }
-    let solver = NelderMead::new(simplex)
-        .with_sd_tolerance(1e-12)
+    let problem = LeastSquares { form, data };
+    // Stop when the simplex's costs agree to 1e-12 of the starting cost (the sum of squared
+    // errors; a relative bound, so large data sets stop as early as small ones).
+    let start_cost = problem
+        .cost(&start)
         .map_err(|e| FitError::Solver(e.to_string()))?;
-    let result = Executor::new(LeastSquares { form, data }, solver)
-        .configure(|s| s.max_iters(20_000))
+    let solver = NelderMead::new(simplex)
+        .with_sd_tolerance(1e-12 * start_cost.max(f64::MIN_POSITIVE))
+        .map_err(|e| FitError::Solver(e.to_string()))?;
+    let result = Executor::new(problem, solver)
+        .configure(|s| s.max_iters(MAX_ITERATIONS))
         .run()
         .map_err(|e| FitError::Solver(e.to_string()))?;
     let best = result
@@ -265,19 +275,24 @@ pub fn metrics(observed: &[f64], predicted: &[f64]) -> Metrics {
 /// `k`-fold cross-validated metrics: case `i` is in fold `i mod k`; each fold is predicted by
 /// the form fitted to the others.
 pub fn cross_validate(form: Form, data: &[Sample], k: usize) -> Result<Metrics, FitError> {
-    let mut predicted = vec![0.0; data.len()];
-    for fold in 0..k {
-        let train: Vec<Sample> = data
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| i % k != fold)
-            .map(|(_, s)| s.clone())
-            .collect();
-        let f = fit(form, &train)?;
-        for (i, s) in data.iter().enumerate().filter(|(i, _)| i % k == fold) {
-            predicted[i] = f.predict(s);
-        }
-    }
+    // Folds are independent fits: in parallel, the result does not depend on the thread count.
+    let fitted = (0..k)
+        .into_par_iter()
+        .map(|fold| {
+            let train: Vec<Sample> = data
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| i % k != fold)
+                .map(|(_, s)| s.clone())
+                .collect();
+            fit(form, &train)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let predicted: Vec<f64> = data
+        .iter()
+        .enumerate()
+        .map(|(i, s)| fitted[i % k].predict(s))
+        .collect();
     let observed: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
     Ok(metrics(&observed, &predicted))
 }
