@@ -32,6 +32,8 @@ enum Command {
     Fit(cmd::fit::Args),
     /// Study stage 5: figures and tables → report/index.html.
     Report(cmd::report::Args),
+    /// The whole study: motions, sweep, tnew, fit, report (each skipped when up to date).
+    Run(cmd::run::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -46,6 +48,7 @@ fn main() -> std::process::ExitCode {
         Command::Tnew(args) => cmd::tnew::run(args),
         Command::Fit(args) => cmd::fit::run(args),
         Command::Report(args) => cmd::report::run(args),
+        Command::Run(args) => cmd::run::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -22,10 +22,10 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Study file (YAML).
-    config: PathBuf,
+    pub config: PathBuf,
     /// Output directory [default: the config's output_dir].
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
 }
 
 const FOLDS: usize = 5;

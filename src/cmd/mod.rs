@@ -4,6 +4,7 @@ pub mod fit;
 pub mod matching;
 pub mod motions;
 pub mod report;
+pub mod run;
 pub mod simulate;
 pub mod spectrum;
 pub mod sweep;

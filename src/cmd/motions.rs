@@ -17,13 +17,13 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Study file (YAML).
-    config: PathBuf,
+    pub config: PathBuf,
     /// Output directory [default: the config's output_dir].
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
     /// Rebuild even when the stored fingerprint says the file is up to date.
     #[arg(long)]
-    force: bool,
+    pub force: bool,
 }
 
 /// The fingerprint of the motions stage for `cfg` and the JSON list of its input files.

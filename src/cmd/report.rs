@@ -19,10 +19,10 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Study file (YAML).
-    config: PathBuf,
+    pub config: PathBuf,
     /// Output directory [default: the config's output_dir].
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
 }
 
 /// The paper's Table 3 (fit quality of Eqs. 16–17): R², R, RMSE, MSE, MAE.

@@ -28,22 +28,22 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Study file (YAML).
-    config: PathBuf,
+    pub config: PathBuf,
     /// Output directory [default: the config's output_dir].
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
     /// Compute only shard K of N (1 ≤ K ≤ N) and leave the assembly to `merge`.
     #[arg(long, value_parser = parse_shard)]
-    shard: Option<(usize, usize)>,
+    pub shard: Option<(usize, usize)>,
 }
 
 #[derive(Debug, clap::Args)]
 pub struct MergeArgs {
     /// Study file (YAML).
-    config: PathBuf,
+    pub config: PathBuf,
     /// Output directory [default: the config's output_dir].
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
 }
 
 fn parse_shard(s: &str) -> Result<(usize, usize), String> {
@@ -177,6 +177,7 @@ pub fn run(args: Args) -> Result<()> {
         ProgressBar::hidden()
     };
     let start = std::time::Instant::now();
+    let sims = std::sync::atomic::AtomicUsize::new(0);
     todo.par_iter().try_for_each(|u| -> Result<()> {
         let (z, m, p) = *u;
         let rec = &motions[z][m];
@@ -187,6 +188,7 @@ pub fn run(args: Args) -> Result<()> {
         };
         let r = run_unit(&stage.grid, &ground, p, UnitOptions { skip: true })
             .with_context(|| format!("zone {}, motion {}", stage.cfg.zones[z].name, rec.name))?;
+        sims.fetch_add(r.simulations, std::sync::atomic::Ordering::Relaxed);
         let path = path_of(u);
         write_unit(&path, &stage.fingerprint, &r)
             .with_context(|| format!("cannot write {}", path.display()))?;
@@ -196,11 +198,16 @@ pub fn run(args: Args) -> Result<()> {
     bar.finish_and_clear();
     let secs = start.elapsed().as_secs_f64();
     if !todo.is_empty() {
+        let sims = sims.into_inner();
         println!(
-            "sweep: {} cases in {:.1} s ({:.0} cases/s)",
+            "sweep: {} cases in {:.1} s ({:.0} cases/s); {} simulations ({:.0}/s; the skip rules \
+             saved {:.0} %)",
             cases,
             secs,
-            cases as f64 / secs.max(1e-9)
+            cases as f64 / secs.max(1e-9),
+            sims,
+            sims as f64 / secs.max(1e-9),
+            100.0 * (1.0 - sims as f64 / (3 * cases) as f64)
         );
     }
     if let Some((k, n)) = args.shard {

@@ -125,6 +125,8 @@ pub struct UnitResult {
     pub skip_rule: Vec<u8>,
     /// 0: single block simulated; 1: it cannot slip, equal to the rigid system.
     pub single_rule: Vec<u8>,
+    /// Simulations run for this unit (not stored; for rates).
+    pub simulations: usize,
 }
 
 /// Options for [`run_unit`].
@@ -189,6 +191,7 @@ pub fn run_unit(
                 mu_static: None,
             };
             rigid.insert(key, simulate(&spec, ground, case)?);
+            out.simulations += 1;
         }
         let r = &rigid[&key];
         let a_rigid = r.peak_abs_accel_mps2[0];
@@ -203,6 +206,7 @@ pub fn run_unit(
             spec.damping_ratio = zeta;
             spec.mu_static = Some(vec![mu_s[0]]);
             single.insert(skey, simulate(&spec, ground, case)?);
+            out.simulations += 1;
         }
         let u_single = if single_holds {
             r.peak_displacement_m
@@ -220,6 +224,7 @@ pub fn run_unit(
             let mut spec = SystemSpec::new(tp, &alpha, &mu);
             spec.damping_ratio = zeta;
             spec.mu_static = Some(mu_s.clone());
+            out.simulations += 1;
             (SkipRule::Simulated, Some(simulate(&spec, ground, case)?))
         };
         out.u_rigid.push(r.peak_displacement_m);
