@@ -1,0 +1,61 @@
+//! The study end to end: `slidestack run` on a config (default `configs/paper.yaml`, the paper's
+//! full grid, both zones) into a fresh directory, printing the time of each stage, cases per
+//! second and simulations per second.
+//!
+//! `cargo bench --bench study` (several minutes on 2 cores); `SLIDESTACK_BENCH_CONFIG=configs/quick.yaml`
+//! for a short run.
+
+use std::process::Command;
+
+fn main() {
+    let config =
+        std::env::var("SLIDESTACK_BENCH_CONFIG").unwrap_or_else(|_| "configs/paper.yaml".into());
+    let dir = std::env::temp_dir().join(format!("slidestack-bench-{}", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .args([
+            "run",
+            &config,
+            "--out",
+            dir.to_str().expect("utf-8 temp dir"),
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("runs slidestack");
+    let text = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() {
+        eprintln!("{text}{}", String::from_utf8_lossy(&out.stderr));
+        std::process::exit(1);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|c| {
+            c.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_default();
+    println!(
+        "\nStudy benchmark: `slidestack run {config}` ({cpu}, {} threads)",
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    );
+    println!("| stage | time (s) |\n|---|---|");
+    if let Some(line) = text.lines().find(|l| l.starts_with("run: ")) {
+        let (stages, total) = line
+            .trim_start_matches("run: ")
+            .split_once(" (total ")
+            .unwrap_or((line, ""));
+        for part in stages.split(", ") {
+            if let Some((name, t)) = part.split_once(' ') {
+                println!("| {name} | {} |", t.trim_end_matches(" s"));
+            }
+        }
+        println!("| total | {} |", total.trim_end_matches(" s)"));
+    }
+    if let Some(line) = text
+        .lines()
+        .find(|l| l.starts_with("sweep: ") && l.contains("cases/s"))
+    {
+        println!("\n{line}");
+    }
+}
