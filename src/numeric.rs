@@ -98,6 +98,35 @@ pub(crate) fn bracketed_root(
     x
 }
 
+/// Solves `A·x = rhs` for a symmetric positive definite `n×n` matrix `a` (row-major; only the
+/// lower triangle is read, and `a` is overwritten by its Cholesky factor), in place of `rhs`.
+/// Pivots are floored at `min_pivot` (> 0) against round-off in nearly singular systems.
+pub(crate) fn cholesky_solve(a: &mut [f64], rhs: &mut [f64], n: usize, min_pivot: f64) {
+    for j in 0..n {
+        let mut s = a[j * n + j];
+        for k in 0..j {
+            s -= a[j * n + k] * a[j * n + k];
+        }
+        let ljj = s.max(min_pivot).sqrt();
+        a[j * n + j] = ljj;
+        for i in j + 1..n {
+            let mut s = a[i * n + j];
+            for k in 0..j {
+                s -= a[i * n + k] * a[j * n + k];
+            }
+            a[i * n + j] = s / ljj;
+        }
+    }
+    for i in 0..n {
+        let s = rhs[i] - (0..i).map(|k| a[i * n + k] * rhs[k]).sum::<f64>();
+        rhs[i] = s / a[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let s = rhs[i] - (i + 1..n).map(|k| a[k * n + i] * rhs[k]).sum::<f64>();
+        rhs[i] = s / a[i * n + i];
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -96,34 +96,8 @@ fn least_squares(a: &[f64], y: &[f64], cols: usize) -> Vec<f64> {
     let scale = (0..cols).map(|p| m[p * cols + p]).fold(0.0, f64::max);
     for p in 0..cols {
         m[p * cols + p] += 1e-12 * scale + f64::MIN_POSITIVE;
-        for q in 0..p {
-            m[q * cols + p] = m[p * cols + q];
-        }
     }
-    // Cholesky in place, then two triangular solves.
-    for j in 0..cols {
-        let mut s = m[j * cols + j];
-        for k in 0..j {
-            s -= m[j * cols + k] * m[j * cols + k];
-        }
-        let d = s.max(f64::MIN_POSITIVE).sqrt();
-        m[j * cols + j] = d;
-        for i in j + 1..cols {
-            let mut s = m[i * cols + j];
-            for k in 0..j {
-                s -= m[i * cols + k] * m[j * cols + k];
-            }
-            m[i * cols + j] = s / d;
-        }
-    }
-    for i in 0..cols {
-        let s = r[i] - (0..i).map(|k| m[i * cols + k] * r[k]).sum::<f64>();
-        r[i] = s / m[i * cols + i];
-    }
-    for i in (0..cols).rev() {
-        let s = r[i] - (i + 1..cols).map(|k| m[k * cols + i] * r[k]).sum::<f64>();
-        r[i] = s / m[i * cols + i];
-    }
+    crate::numeric::cholesky_solve(&mut m, &mut r, cols, f64::MIN_POSITIVE);
     r
 }
 

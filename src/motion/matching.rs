@@ -330,36 +330,7 @@ fn regularised_solve(c: &[f64], d: &[f64], reg: f64) -> Vec<f64> {
     for i in 0..n {
         a[i * n + i] += mu;
     }
-    // Cholesky A = L·Lᵀ in place (lower triangle).
-    for j in 0..n {
-        let mut s = a[j * n + j];
-        for k in 0..j {
-            s -= a[j * n + k] * a[j * n + k];
-        }
-        let ljj = s.max(mu).sqrt();
-        a[j * n + j] = ljj;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / ljj;
-        }
-    }
-    for i in 0..n {
-        let mut s = rhs[i];
-        for k in 0..i {
-            s -= a[i * n + k] * rhs[k];
-        }
-        rhs[i] = s / a[i * n + i];
-    }
-    for i in (0..n).rev() {
-        let mut s = rhs[i];
-        for k in i + 1..n {
-            s -= a[k * n + i] * rhs[k];
-        }
-        rhs[i] = s / a[i * n + i];
-    }
+    crate::numeric::cholesky_solve(&mut a, &mut rhs, n, mu);
     rhs
 }
 
