@@ -196,3 +196,42 @@ fn sweep_refuses_what_it_cannot_do() {
         String::from_utf8_lossy(&o.stderr)
     );
 }
+
+#[test]
+fn run_does_the_whole_quick_study_and_ends_with_the_report_path() {
+    // The README's first command, into a temporary directory.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
+    let out = dir.path().join("quick");
+    let o = ok(slidestack(
+        &["run", cfg.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        "2",
+    ));
+    let text = String::from_utf8_lossy(&o.stdout);
+    let last = text.lines().last().unwrap();
+    assert_eq!(Path::new(last), out.join("report/index.html"));
+    let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    for part in [
+        "spectra_III.svg",
+        "history_V.svg",
+        "tnew_III.svg",
+        "fit_V.svg",
+        "Table 3-like",
+    ] {
+        assert!(html.contains(part), "{part}");
+    }
+    let fit = std::fs::read_to_string(out.join("fit.yaml")).unwrap();
+    assert!(fit.contains("cross_validated") && fit.contains("form: bounded"));
+    // A second run finds every stage up to date.
+    let o = ok(slidestack(
+        &["run", cfg.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        "2",
+    ));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for stage in ["motions", "sweep", "tnew", "fit"] {
+        let up = text
+            .lines()
+            .any(|l| l.starts_with(&format!("{stage}: ")) && l.ends_with("is up to date"));
+        assert!(up, "{stage}: {text}");
+    }
+}
