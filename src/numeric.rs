@@ -21,14 +21,21 @@ impl Cx {
     }
 }
 
-/// Taylor series `Σ_{k≥0} x^k/(k+j)!` of `φ_j`, used where the closed forms cancel.
+/// Taylor series `Σ_{k≥0} x^k/(k+j)!` of `φ_j`, used where the closed forms cancel (`|x| < 1`),
+/// summed until a term no longer changes the sum (at most 30 terms).
 fn phi_series(x: Cx, j: u32) -> Cx {
     let first = (1..=j).fold(1.0, |f, k| f * k as f64);
     let mut term = Cx(1.0 / first, 0.0);
     let mut sum = term;
     for k in 1..=30 {
-        term = term.mul(x).div(Cx((k + j) as f64, 0.0));
-        sum = sum.add(term);
+        let t = term.mul(x);
+        let inv = 1.0 / (k + j) as f64;
+        term = Cx(t.0 * inv, t.1 * inv);
+        let next = sum.add(term);
+        if next == sum {
+            break;
+        }
+        sum = next;
     }
     sum
 }
