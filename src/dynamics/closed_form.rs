@@ -106,7 +106,7 @@ impl Wave {
         let tm = t1.max(t0.abs());
         let poly = self.p[0].abs()
             + tm * (self.p[1].abs() + tm * (self.p[2].abs() + tm * self.p[3].abs()));
-        poly + self.c.hypot(self.d) * (-osc.decay * t0).exp()
+        poly + (self.c * self.c + self.d * self.d).sqrt() * (-osc.decay * t0).exp()
     }
 
     /// `∫₀^τ g(t) dt` at the basis point.
@@ -117,7 +117,7 @@ impl Wave {
         // ∫₀^h e^{−aτ}(c cos ωτ + d sin ωτ) dτ = Re[(c − i·d)·(e^{zh} − 1)/z], z = −a + iω,
         // through φ₁ so that short pieces lose no digits to cancellation.
         let zh = Cx(-osc.decay * t, osc.omega * t);
-        let e_zh_minus_1_over_z = if zh.0.hypot(zh.1) < 0.5 {
+        let e_zh_minus_1_over_z = if zh.norm_sqr() < 0.25 {
             let p = phi1(zh);
             Cx(p.0 * t, p.1 * t)
         } else {
