@@ -13,6 +13,7 @@ use slidestack::dynamics::{
 const HIST: ExactOptions = ExactOptions {
     history: true,
     max_switches_per_step: 1000,
+    energy_balance: true,
 };
 
 /// Exact integrator on real records: input = kinetic + strain + damping + friction to 1e-9 of
@@ -199,9 +200,40 @@ fn switch_guard_gives_clear_error() {
     let opts = ExactOptions {
         history: false,
         max_switches_per_step: 0,
+        energy_balance: true,
     };
     let msg = simulate_exact(&sys, &ground, &opts)
         .unwrap_err()
         .to_string();
     assert!(msg.contains("Zeno") && msg.contains("t = "), "{msg}");
+}
+
+#[test]
+fn switching_off_the_balance_changes_nothing_else() {
+    // The sweep runs without the input and damping integrals: every other output is
+    // bit-identical, and the skipped terms are NaN rather than a misleading zero.
+    let rec = &real_records()[0];
+    let accel = rec.accel_mps2(1.0);
+    let ground = Ground {
+        dt_s: rec.dt_s,
+        accel_mps2: &accel,
+    };
+    let sys = System::new(&SystemSpec::new(1.0, &[0.5, 0.5], &[0.2, 0.1])).unwrap();
+    let on = simulate_exact(&sys, &ground, &ExactOptions::default()).unwrap();
+    let off = simulate_exact(
+        &sys,
+        &ground,
+        &ExactOptions {
+            energy_balance: false,
+            ..ExactOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(on.peak_displacement_m, off.peak_displacement_m);
+    assert_eq!(on.peak_abs_accel_mps2, off.peak_abs_accel_mps2);
+    assert_eq!(on.peak_slip_m, off.peak_slip_m);
+    assert_eq!(on.energy.friction, off.energy.friction);
+    assert_eq!(on.switches, off.switches);
+    assert!(off.energy.input.is_nan() && off.energy.damping.is_nan());
+    assert!(off.energy_balance_error_max.is_nan());
 }

@@ -10,6 +10,7 @@ use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, simulate_ex
 const HIST: ExactOptions = ExactOptions {
     history: true,
     max_switches_per_step: 1000,
+    energy_balance: true,
 };
 
 /// μ large: the stack never slides and the structure is a linear SDOF of mass m_p(1+α) with the
