@@ -738,10 +738,8 @@ fn peak_abs(p: &Peaked, osc: Osc, b0: &Basis, b1: &Basis, best: f64, dt: f64) ->
     peak_rec(
         p,
         osc,
-        b0.tau,
-        b1.tau,
-        p.f.eval(b0),
-        p.f.eval(b1),
+        (b0, p.f.eval(b0)),
+        (b1, p.f.eval(b1)),
         &mut best,
         min_width,
         0,
@@ -749,29 +747,27 @@ fn peak_abs(p: &Peaked, osc: Osc, b0: &Basis, b1: &Basis, best: f64, dt: f64) ->
     best
 }
 
-#[allow(clippy::too_many_arguments)]
+/// One node of the branch and bound: the interval between two bases (with `f` there), so that
+/// each split evaluates the exponential and trigonometric functions once, at the midpoint.
 fn peak_rec(
     p: &Peaked,
     osc: Osc,
-    lo: f64,
-    hi: f64,
-    flo: f64,
-    fhi: f64,
+    (blo, flo): (&Basis, f64),
+    (bhi, fhi): (&Basis, f64),
     best: &mut (f64, f64),
     min_width: f64,
     depth: u32,
 ) {
+    let (lo, hi) = (blo.tau, bhi.tau);
     let width = hi - lo;
     let curv = p.d2.abs_bound(osc, lo, hi);
     if flo.abs().max(fhi.abs()) + curv * width * width / 8.0 <= best.0 {
         return;
     }
-    let blo = Basis::at(osc, lo);
-    let bhi = Basis::at(osc, hi);
-    let (slo, shi) = (p.d1.eval(&blo), p.d1.eval(&bhi));
+    let (slo, shi) = (p.d1.eval(blo), p.d1.eval(bhi));
     if slo * shi < 0.0 {
         let jerk_bound = p.d3.abs_bound(osc, lo, hi);
-        let c_lo = p.d2.eval(&blo);
+        let c_lo = p.d2.eval(blo);
         if c_lo.abs() > jerk_bound * width {
             // f' is monotone here: its single zero is the only interior extremum.
             let g = |t: f64| p.d1.eval(&Basis::at(osc, t)) * slo.signum();
@@ -786,11 +782,11 @@ fn peak_rec(
     if width <= min_width || depth > 60 {
         return;
     }
-    let mid = lo + 0.5 * width;
-    let fm = p.f.eval(&Basis::at(osc, mid));
+    let bm = Basis::at(osc, lo + 0.5 * width);
+    let fm = p.f.eval(&bm);
     if fm.abs() > best.0 {
-        *best = (fm.abs(), mid);
+        *best = (fm.abs(), bm.tau);
     }
-    peak_rec(p, osc, lo, mid, flo, fm, best, min_width, depth + 1);
-    peak_rec(p, osc, mid, hi, fm, fhi, best, min_width, depth + 1);
+    peak_rec(p, osc, (blo, flo), (&bm, fm), best, min_width, depth + 1);
+    peak_rec(p, osc, (&bm, fm), (bhi, fhi), best, min_width, depth + 1);
 }
