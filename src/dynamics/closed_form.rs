@@ -103,10 +103,21 @@ impl Wave {
     /// Upper bound of `|g(τ)|` over `[t0, t1]` (`0 ≤ t0 ≤ t1`): the polynomial part bounded
     /// term by term, the oscillation by its amplitude times `e^{−a·t0}`.
     pub fn abs_bound(&self, osc: Osc, t0: f64, t1: f64) -> f64 {
+        self.bound_with(t0, t1, (-osc.decay * t0).exp())
+    }
+
+    /// [`Wave::abs_bound`] over `[b0.tau, t1]`, reusing the exponential already in `b0`.
+    #[inline]
+    pub fn abs_bound_from(&self, b0: &Basis, t1: f64) -> f64 {
+        self.bound_with(b0.tau, t1, b0.exp)
+    }
+
+    #[inline]
+    fn bound_with(&self, t0: f64, t1: f64, exp_t0: f64) -> f64 {
         let tm = t1.max(t0.abs());
         let poly = self.p[0].abs()
             + tm * (self.p[1].abs() + tm * (self.p[2].abs() + tm * self.p[3].abs()));
-        poly + (self.c * self.c + self.d * self.d).sqrt() * (-osc.decay * t0).exp()
+        poly + (self.c * self.c + self.d * self.d).sqrt() * exp_t0
     }
 
     /// `∫₀^τ g(t) dt` at the basis point.

@@ -760,13 +760,13 @@ fn peak_rec(
 ) {
     let (lo, hi) = (blo.tau, bhi.tau);
     let width = hi - lo;
-    let curv = p.d2.abs_bound(osc, lo, hi);
+    let curv = p.d2.abs_bound_from(blo, hi);
     if flo.abs().max(fhi.abs()) + curv * width * width / 8.0 <= best.0 {
         return;
     }
     let (slo, shi) = (p.d1.eval(blo), p.d1.eval(bhi));
     if slo * shi < 0.0 {
-        let jerk_bound = p.d3.abs_bound(osc, lo, hi);
+        let jerk_bound = p.d3.abs_bound_from(blo, hi);
         let c_lo = p.d2.eval(blo);
         if c_lo.abs() > jerk_bound * width {
             // f' is monotone here: its single zero is the only interior extremum.
