@@ -15,7 +15,7 @@ use slidestack::fit::{
     Fitted, Form, Metrics, Sample, cross_validate, fit, metrics, paper_equation,
 };
 use slidestack::store::fingerprint::fingerprint;
-use slidestack::store::h5::{attr_f64, attr_str, read_attr_str, write_1d};
+use slidestack::store::h5::{attr_f64, attr_str, read_attr_str, write_1d, write_stage_file};
 use slidestack::store::tnew::{read_fingerprint as read_tnew_fp, read_zone_tnew};
 use std::path::{Path, PathBuf};
 
@@ -202,42 +202,38 @@ fn write_metrics(g: &hdf5::Location, prefix: &str, m: &Metrics) -> hdf5::Result<
 }
 
 fn write_fit(path: &Path, r: &FitYaml) -> hdf5::Result<()> {
-    let tmp = path.with_extension("h5.tmp");
-    {
-        let f = hdf5::File::create(&tmp)?;
-        attr_str(
-            &f,
-            "contents",
-            "slidestack fit stage: design equations for T_new (see fit.yaml)",
-        )?;
-        attr_str(&f, "slidestack_version", &r.slidestack_version)?;
-        attr_str(&f, "fingerprint", &r.fingerprint)?;
-        attr_str(&f, "features", &r.features.join(", "))?;
-        for z in &r.zones {
-            let g = f.create_group(&format!("zone_{}", z.zone))?;
-            for fr in &z.forms {
-                let sub = g.create_group(match fr.form {
-                    Form::Paper => "paper",
-                    Form::Bounded => "bounded",
-                })?;
-                let values: Vec<f64> = fr.coefficients.iter().map(|c| c.1).collect();
-                let names: Vec<String> = fr.coefficients.iter().map(|c| c.0.clone()).collect();
-                let ds = write_1d(
-                    &sub,
-                    "coefficients",
-                    &values,
-                    "mixed (s, s per unit feature)",
-                    "fitted coefficients",
-                )?;
-                attr_str(&ds, "names", &names.join(", "))?;
-                write_metrics(&sub, "", &fr.all_cases)?;
-                write_metrics(&sub, "cv_", &fr.cross_validated)?;
+    write_stage_file(
+        path,
+        "slidestack fit stage: design equations for T_new (see fit.yaml)",
+        &r.fingerprint,
+        |f| {
+            attr_str(f, "features", &r.features.join(", "))?;
+            for z in &r.zones {
+                let g = f.create_group(&format!("zone_{}", z.zone))?;
+                for fr in &z.forms {
+                    let sub = g.create_group(match fr.form {
+                        Form::Paper => "paper",
+                        Form::Bounded => "bounded",
+                    })?;
+                    let values: Vec<f64> = fr.coefficients.iter().map(|c| c.1).collect();
+                    let names: Vec<String> = fr.coefficients.iter().map(|c| c.0.clone()).collect();
+                    let ds = write_1d(
+                        &sub,
+                        "coefficients",
+                        &values,
+                        "mixed (s, s per unit feature)",
+                        "fitted coefficients",
+                    )?;
+                    attr_str(&ds, "names", &names.join(", "))?;
+                    write_metrics(&sub, "", &fr.all_cases)?;
+                    write_metrics(&sub, "cv_", &fr.cross_validated)?;
+                }
+                if let Some(m) = &z.published {
+                    let sub = g.create_group("published")?;
+                    write_metrics(&sub, "", m)?;
+                }
             }
-            if let Some(m) = &z.published {
-                let sub = g.create_group("published")?;
-                write_metrics(&sub, "", m)?;
-            }
-        }
-    }
-    std::fs::rename(&tmp, path).map_err(|e| hdf5::Error::from(e.to_string()))
+            Ok(())
+        },
+    )
 }

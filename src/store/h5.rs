@@ -177,3 +177,26 @@ pub fn read_group_attr(path: &std::path::Path, group: &str, name: &str) -> hdf5:
     let g = hdf5::File::open(path)?.group(group)?;
     read_attr_f64(&g, name)
 }
+
+/// Writes a stage file at `path` atomically: `fill` writes into a new file `path.h5.tmp` (object
+/// times not tracked, so equal contents give equal bytes) that already carries the `contents`,
+/// `slidestack_version` and `fingerprint` attributes; the file is then renamed to `path`, so a
+/// reader never sees a half-written stage file.
+pub fn write_stage_file(
+    path: &std::path::Path,
+    contents: &str,
+    fingerprint: &str,
+    fill: impl FnOnce(&hdf5::File) -> hdf5::Result<()>,
+) -> hdf5::Result<()> {
+    let tmp = path.with_extension("h5.tmp");
+    {
+        let f = hdf5::File::with_options()
+            .with_fcpl(|p| p.obj_track_times(false))
+            .create(&tmp)?;
+        attr_str(&f, "contents", contents)?;
+        attr_str(&f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
+        attr_str(&f, "fingerprint", fingerprint)?;
+        fill(&f)?;
+    }
+    std::fs::rename(&tmp, path).map_err(|e| hdf5::Error::from(e.to_string()))
+}

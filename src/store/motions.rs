@@ -18,7 +18,7 @@
 
 use super::h5::{
     attr_f64, attr_str, read_attr_f64, read_attr_str, read_strings, write_1d, write_2d,
-    write_strings,
+    write_stage_file, write_strings,
 };
 use crate::motion::Record;
 use crate::motion::matching::MatchReport;
@@ -57,27 +57,23 @@ pub fn write_motions(
     seeds: &[Record],
     zones: &[(ZoneMotions, String)],
 ) -> hdf5::Result<()> {
-    let tmp = path.with_extension("h5.tmp");
-    {
-        let f = hdf5::File::create(&tmp)?;
-        attr_str(
-            &f,
-            "contents",
-            "slidestack motions stage: seed motions, motions matched per zone, their spectra",
-        )?;
-        attr_str(&f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
-        attr_str(&f, "fingerprint", &meta.fingerprint)?;
-        attr_str(&f, "config_sha256", &meta.config_sha256)?;
-        attr_str(&f, "inputs", &meta.inputs)?;
-        let g = f.create_group("seeds")?;
-        for (i, s) in seeds.iter().enumerate() {
-            write_record(&g, &format!("seed_{i:02}"), s, "seed ground acceleration")?;
-        }
-        for (z, fp) in zones {
-            write_zone(&f, z, fp)?;
-        }
-    }
-    std::fs::rename(&tmp, path).map_err(|e| hdf5::Error::from(e.to_string()))
+    write_stage_file(
+        path,
+        "slidestack motions stage: seed motions, motions matched per zone, their spectra",
+        &meta.fingerprint,
+        |f| {
+            attr_str(f, "config_sha256", &meta.config_sha256)?;
+            attr_str(f, "inputs", &meta.inputs)?;
+            let g = f.create_group("seeds")?;
+            for (i, s) in seeds.iter().enumerate() {
+                write_record(&g, &format!("seed_{i:02}"), s, "seed ground acceleration")?;
+            }
+            for (z, fp) in zones {
+                write_zone(f, z, fp)?;
+            }
+            Ok(())
+        },
+    )
 }
 
 fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Result<()> {

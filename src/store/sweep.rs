@@ -18,7 +18,9 @@
 //! Variables are chunked by work unit (one motion, one `T_p`), deflate+shuffle compressed, with
 //! NaN (255 for the rule codes) as fill value.
 
-use super::h5::{attach_scale, attr_str, coordinate, scalar_var, set_scale, write_strings};
+use super::h5::{
+    attach_scale, attr_str, coordinate, scalar_var, set_scale, write_stage_file, write_strings,
+};
 use crate::study::sweep::{Grid, SKIP_RULE_CODES, UnitResult};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -153,26 +155,20 @@ pub fn write_sweep(
     grid: &Grid,
     zones: &[ZoneUnits],
 ) -> hdf5::Result<()> {
-    let tmp = path.with_extension("h5.tmp");
-    {
-        let f = hdf5::File::with_options()
-            .with_fcpl(|p| p.obj_track_times(false))
-            .create(&tmp)?;
-        attr_str(
-            &f,
-            "contents",
-            "slidestack sweep stage: peak responses over the grid, per zone",
-        )?;
-        attr_str(&f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
-        attr_str(&f, "fingerprint", &meta.fingerprint)?;
-        attr_str(&f, "config_sha256", &meta.config_sha256)?;
-        attr_str(&f, "motions_fingerprint", &meta.motions_fingerprint)?;
-        attr_str(&f, "skip_rule_codes", SKIP_RULE_CODES)?;
-        for z in zones {
-            write_zone(&f, grid, z)?;
-        }
-    }
-    std::fs::rename(&tmp, path).map_err(|e| hdf5::Error::from(e.to_string()))
+    write_stage_file(
+        path,
+        "slidestack sweep stage: peak responses over the grid, per zone",
+        &meta.fingerprint,
+        |f| {
+            attr_str(f, "config_sha256", &meta.config_sha256)?;
+            attr_str(f, "motions_fingerprint", &meta.motions_fingerprint)?;
+            attr_str(f, "skip_rule_codes", SKIP_RULE_CODES)?;
+            for z in zones {
+                write_zone(f, grid, z)?;
+            }
+            Ok(())
+        },
+    )
 }
 
 fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneUnits) -> hdf5::Result<()> {

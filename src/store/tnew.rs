@@ -10,7 +10,7 @@
 //!     period_sd (s), sd_mean (m): the zone's mean 5 %-damped displacement spectrum
 //! ```
 
-use super::h5::{attach_scale, attr_str, coordinate, scalar_var};
+use super::h5::{attach_scale, attr_str, coordinate, scalar_var, write_stage_file};
 use crate::study::sweep::Grid;
 use crate::study::tnew::TNEW_FLAG_CODES;
 use std::path::Path;
@@ -41,137 +41,131 @@ pub fn write_tnew(
     grid: &Grid,
     zones: &[ZoneTnew],
 ) -> hdf5::Result<()> {
-    let tmp = path.with_extension("h5.tmp");
-    {
-        let f = hdf5::File::with_options()
-            .with_fcpl(|p| p.obj_track_times(false))
-            .create(&tmp)?;
-        attr_str(
-            &f,
-            "contents",
-            "slidestack tnew stage: T_new and displacement response ratios",
-        )?;
-        attr_str(&f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
-        attr_str(&f, "fingerprint", fingerprint)?;
-        attr_str(&f, "sweep_fingerprint", sweep_fingerprint)?;
-        attr_str(&f, "T_new_flag_codes", TNEW_FLAG_CODES)?;
-        for z in zones {
-            let g = f.create_group(&format!("zone_{}", z.name))?;
-            attr_str(&g, "target", &z.target)?;
-            let mut scales = vec![coordinate(
-                &g,
-                "T_p",
-                &grid.periods_s,
-                "s",
-                "period of the bare structure",
-            )?];
-            for (i, a) in grid.alpha.iter().enumerate() {
-                scales.push(coordinate(
+    write_stage_file(
+        path,
+        "slidestack tnew stage: T_new and displacement response ratios",
+        fingerprint,
+        |f| {
+            attr_str(&f, "sweep_fingerprint", sweep_fingerprint)?;
+            attr_str(&f, "T_new_flag_codes", TNEW_FLAG_CODES)?;
+            for z in zones {
+                let g = f.create_group(&format!("zone_{}", z.name))?;
+                attr_str(&g, "target", &z.target)?;
+                let mut scales = vec![coordinate(
                     &g,
-                    &format!("alpha_{}", i + 1),
-                    a,
-                    "1",
-                    &format!("mass ratio of block {}", i + 1),
-                )?);
-            }
-            for (i, m) in grid.mu.iter().enumerate() {
-                scales.push(coordinate(
-                    &g,
-                    &format!("mu_{}", i + 1),
-                    m,
-                    "1",
-                    &format!("kinetic friction coefficient of interface {}", i + 1),
-                )?);
-            }
-            let mut shape = vec![grid.periods_s.len()];
-            shape.extend(grid.case_shape());
-            let mut chunk = vec![1];
-            chunk.extend(grid.case_shape());
-            let vars: [(&str, &Vec<f64>, &str, &str); 9] = [
-                (
-                    "u_stack_mean",
-                    &z.u_stack_mean,
-                    "m",
-                    "mean over the motions of the peak structure displacement with the sliding stack",
-                ),
-                (
-                    "u_single_mean",
-                    &z.u_single_mean,
-                    "m",
-                    "mean peak structure displacement with the stack as one block",
-                ),
-                (
-                    "u_rigid_mean",
-                    &z.u_rigid_mean,
-                    "m",
-                    "mean peak structure displacement with the stack rigidly attached",
-                ),
-                (
-                    "T_rigid",
-                    &z.t_rigid,
+                    "T_p",
+                    &grid.periods_s,
                     "s",
-                    "period with the stack rigidly attached, T_p·sqrt(1+α)",
-                ),
-                (
-                    "T_new",
-                    &z.t_new,
-                    "s",
-                    "period whose mean 5 %-damped spectral displacement equals u_stack_mean (Section 7.1)",
-                ),
-                (
-                    "DRR_1",
-                    &z.drr_1,
-                    "1",
-                    "u_stack_mean / u_rigid_mean (Eq. 7)",
-                ),
-                (
-                    "DRR_2",
-                    &z.drr_2,
-                    "1",
-                    "u_single_mean / u_rigid_mean (Eq. 8)",
-                ),
-                (
-                    "slides",
-                    &z.slides,
-                    "1",
-                    "1 when some interface slips under some motion",
-                ),
-                (
-                    "T_new_flag",
-                    &z.flag,
-                    "1",
-                    "how T_new was found (file attribute T_new_flag_codes)",
-                ),
-            ];
-            for (name, data, units, long) in vars {
-                let ds = scalar_var(&g, name, &shape, &chunk, data, units, long)?;
-                for (d, s) in scales.iter().enumerate() {
-                    attach_scale(&ds, s, d)?;
+                    "period of the bare structure",
+                )?];
+                for (i, a) in grid.alpha.iter().enumerate() {
+                    scales.push(coordinate(
+                        &g,
+                        &format!("alpha_{}", i + 1),
+                        a,
+                        "1",
+                        &format!("mass ratio of block {}", i + 1),
+                    )?);
                 }
+                for (i, m) in grid.mu.iter().enumerate() {
+                    scales.push(coordinate(
+                        &g,
+                        &format!("mu_{}", i + 1),
+                        m,
+                        "1",
+                        &format!("kinetic friction coefficient of interface {}", i + 1),
+                    )?);
+                }
+                let mut shape = vec![grid.periods_s.len()];
+                shape.extend(grid.case_shape());
+                let mut chunk = vec![1];
+                chunk.extend(grid.case_shape());
+                let vars: [(&str, &Vec<f64>, &str, &str); 9] = [
+                    (
+                        "u_stack_mean",
+                        &z.u_stack_mean,
+                        "m",
+                        "mean over the motions of the peak structure displacement with the sliding stack",
+                    ),
+                    (
+                        "u_single_mean",
+                        &z.u_single_mean,
+                        "m",
+                        "mean peak structure displacement with the stack as one block",
+                    ),
+                    (
+                        "u_rigid_mean",
+                        &z.u_rigid_mean,
+                        "m",
+                        "mean peak structure displacement with the stack rigidly attached",
+                    ),
+                    (
+                        "T_rigid",
+                        &z.t_rigid,
+                        "s",
+                        "period with the stack rigidly attached, T_p·sqrt(1+α)",
+                    ),
+                    (
+                        "T_new",
+                        &z.t_new,
+                        "s",
+                        "period whose mean 5 %-damped spectral displacement equals u_stack_mean (Section 7.1)",
+                    ),
+                    (
+                        "DRR_1",
+                        &z.drr_1,
+                        "1",
+                        "u_stack_mean / u_rigid_mean (Eq. 7)",
+                    ),
+                    (
+                        "DRR_2",
+                        &z.drr_2,
+                        "1",
+                        "u_single_mean / u_rigid_mean (Eq. 8)",
+                    ),
+                    (
+                        "slides",
+                        &z.slides,
+                        "1",
+                        "1 when some interface slips under some motion",
+                    ),
+                    (
+                        "T_new_flag",
+                        &z.flag,
+                        "1",
+                        "how T_new was found (file attribute T_new_flag_codes)",
+                    ),
+                ];
+                for (name, data, units, long) in vars {
+                    let ds = scalar_var(&g, name, &shape, &chunk, data, units, long)?;
+                    for (d, s) in scales.iter().enumerate() {
+                        attach_scale(&ds, s, d)?;
+                    }
+                }
+                let p = coordinate(
+                    &g,
+                    "period_sd",
+                    &z.period_sd_s,
+                    "s",
+                    "period of the mean displacement spectrum",
+                )?;
+                let ds = g
+                    .new_dataset::<f64>()
+                    .shape(z.sd_mean_m.len())
+                    .obj_track_times(false)
+                    .create("sd_mean")?;
+                ds.write_raw(&z.sd_mean_m)?;
+                attr_str(&ds, "units", "m")?;
+                attr_str(
+                    &ds,
+                    "long_name",
+                    "mean 5 %-damped displacement spectrum of the zone's motions",
+                )?;
+                attach_scale(&ds, &p, 0)?;
             }
-            let p = coordinate(
-                &g,
-                "period_sd",
-                &z.period_sd_s,
-                "s",
-                "period of the mean displacement spectrum",
-            )?;
-            let ds = g
-                .new_dataset::<f64>()
-                .shape(z.sd_mean_m.len())
-                .obj_track_times(false)
-                .create("sd_mean")?;
-            ds.write_raw(&z.sd_mean_m)?;
-            attr_str(&ds, "units", "m")?;
-            attr_str(
-                &ds,
-                "long_name",
-                "mean 5 %-damped displacement spectrum of the zone's motions",
-            )?;
-            attach_scale(&ds, &p, 0)?;
-        }
-    }
-    std::fs::rename(&tmp, path).map_err(|e| hdf5::Error::from(e.to_string()))
+            Ok(())
+        },
+    )
 }
 
 /// The stage fingerprint stored in an existing `tnew.h5`.
