@@ -46,8 +46,8 @@ pub fn write_tnew(
         "slidestack tnew stage: T_new and displacement response ratios",
         fingerprint,
         |f| {
-            attr_str(&f, "sweep_fingerprint", sweep_fingerprint)?;
-            attr_str(&f, "T_new_flag_codes", TNEW_FLAG_CODES)?;
+            attr_str(f, "sweep_fingerprint", sweep_fingerprint)?;
+            attr_str(f, "T_new_flag_codes", TNEW_FLAG_CODES)?;
             for z in zones {
                 let g = f.create_group(&format!("zone_{}", z.name))?;
                 attr_str(&g, "target", &z.target)?;
