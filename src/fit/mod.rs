@@ -347,31 +347,18 @@ mod tests {
     fn fits_recover_known_coefficients() {
         // Noise-free data made by each form: the fit reproduces the data to 1e-6 s RMSE and the
         // coefficients to 1e-3 (Nelder–Mead stops on the simplex spread, 1e-12 of the cost).
-        let bounded = [0.8, 2.0, 1.5, -0.4, -0.3, -1.0];
-        let data = synthetic(Form::Bounded, &bounded);
-        let f = fit(Form::Bounded, &data).unwrap();
-        let pred: Vec<f64> = data.iter().map(|s| f.predict(s)).collect();
-        let obs: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
-        assert!(
-            metrics(&obs, &pred).rmse < 1e-6,
-            "{:?}",
-            metrics(&obs, &pred)
-        );
-        for (p, t) in f.params.iter().zip(&bounded) {
-            assert!((p - t).abs() < 1e-3, "{:?}", f.params);
-        }
-        let paper = [0.5, 0.2, 0.1, 0.3, 0.2, 0.4, 0.3, -0.2, 0.1, 0.2, 0.7, -0.5];
-        let data = synthetic(Form::Paper, &paper);
-        let f = fit(Form::Paper, &data).unwrap();
-        let pred: Vec<f64> = data.iter().map(|s| f.predict(s)).collect();
-        let obs: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
-        assert!(
-            metrics(&obs, &pred).rmse < 1e-6,
-            "{:?}",
-            metrics(&obs, &pred)
-        );
-        for (p, t) in f.params.iter().zip(&paper) {
-            assert!((p - t).abs() < 1e-3, "{:?}", f.params);
+        let bounded = vec![0.8, 2.0, 1.5, -0.4, -0.3, -1.0];
+        let paper = vec![0.5, 0.2, 0.1, 0.3, 0.2, 0.4, 0.3, -0.2, 0.1, 0.2, 0.7, -0.5];
+        for (form, truth) in [(Form::Bounded, bounded), (Form::Paper, paper)] {
+            let data = synthetic(form, &truth);
+            let f = fit(form, &data).unwrap();
+            let pred: Vec<f64> = data.iter().map(|s| f.predict(s)).collect();
+            let obs: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
+            let m = metrics(&obs, &pred);
+            assert!(m.rmse < 1e-6, "{form:?}: {m:?}");
+            for (p, t) in f.params.iter().zip(&truth) {
+                assert!((p - t).abs() < 1e-3, "{form:?}: {:?}", f.params);
+            }
         }
     }
 }
