@@ -37,6 +37,13 @@ enum Command {
 }
 
 fn main() -> std::process::ExitCode {
+    // Piped into `head` and the like, stop quietly when the reader goes away, as shell tools do,
+    // instead of panicking on the failed write.
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(args) => cmd::simulate::run(args),
