@@ -11,12 +11,11 @@
 use super::sweep::prepare;
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
-use slidestack::fit::{
-    Fitted, Form, Metrics, Sample, cross_validate, fit, metrics, paper_equation,
-};
+use slidestack::fit::{Fitted, Form, Metrics, cross_validate, fit, metrics, paper_equation};
 use slidestack::store::fingerprint::fingerprint;
 use slidestack::store::h5::{attr_f64, attr_str, read_attr_str, write_1d, write_stage_file};
 use slidestack::store::tnew::{read_fingerprint as read_tnew_fp, read_zone_tnew};
+use slidestack::study::tnew::samples;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
@@ -107,21 +106,7 @@ pub fn run(args: Args) -> Result<()> {
     for zc in &stage.cfg.zones {
         let t = read_zone_tnew(&tnew_path, &zc.name, n)
             .with_context(|| format!("cannot read zone {} of {}", zc.name, tnew_path.display()))?;
-        let per_period = stage.grid.cases_per_unit();
-        let data: Vec<Sample> = (0..t.t_new.len())
-            .filter(|&c| t.t_new[c].is_finite())
-            .map(|c| {
-                let (alpha, mu) = stage.grid.case(c % per_period);
-                let mut x = vec![t.periods_s[c / per_period]];
-                x.extend(mu);
-                x.extend(alpha);
-                Sample {
-                    x,
-                    t_rigid_s: t.t_rigid[c],
-                    t_new_s: t.t_new[c],
-                }
-            })
-            .collect();
+        let data = samples(&stage.grid, &t.t_rigid, &t.t_new);
         let observed: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
         let mut forms = Vec::new();
         for form in [Form::Paper, Form::Bounded] {

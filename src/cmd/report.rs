@@ -10,10 +10,12 @@
 use super::sweep::{load_motions, prepare};
 use anyhow::{Context, Result};
 use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, simulate_exact};
-use slidestack::fit::{Fitted, Form, Sample};
+use slidestack::fit::{Fitted, Form};
 use slidestack::report::{Series, chart, page, table};
 use slidestack::store::h5::{read_f64, read_group_attr};
 use slidestack::store::motions::read_zone_spectra;
+use slidestack::study::sweep::rigid_spec;
+use slidestack::study::tnew::samples;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -42,12 +44,20 @@ fn peak_case(
     mu: &[f64],
     history: bool,
 ) -> Result<slidestack::dynamics::Response> {
+    simulate_spec(rec, &SystemSpec::new(period_s, alpha, mu), history)
+}
+
+fn simulate_spec(
+    rec: &slidestack::motion::Record,
+    spec: &SystemSpec,
+    history: bool,
+) -> Result<slidestack::dynamics::Response> {
     let accel = rec.accel_mps2(1.0);
     let ground = Ground {
         dt_s: rec.dt_s,
         accel_mps2: &accel,
     };
-    let sys = System::new(&SystemSpec::new(period_s, alpha, mu))?;
+    let sys = System::new(spec)?;
     Ok(simulate_exact(
         &sys,
         &ground,
@@ -116,20 +126,7 @@ pub fn run(args: Args) -> Result<()> {
         let total: f64 = case_alpha.iter().sum();
         let stack = peak_case(rec, 1.0, &case_alpha, &case_mu, true)?;
         let single = peak_case(rec, 1.0, &[total], &case_mu[..1], true)?;
-        let mut rigid_spec = SystemSpec::new((1.0 + total).sqrt(), &[], &[]);
-        rigid_spec.damping_ratio = 0.05 / (1.0 + total).sqrt();
-        let accel = rec.accel_mps2(1.0);
-        let rigid = simulate_exact(
-            &System::new(&rigid_spec)?,
-            &Ground {
-                dt_s: rec.dt_s,
-                accel_mps2: &accel,
-            },
-            &ExactOptions {
-                history: true,
-                ..ExactOptions::default()
-            },
-        )?;
+        let rigid = simulate_spec(rec, &rigid_spec(1.0, total, 0.05), true)?;
         let hist = |r: &slidestack::dynamics::Response, label: &str| {
             let h = r.history.as_ref().expect("history requested");
             let u: Vec<f64> = h
@@ -159,16 +156,17 @@ pub fn run(args: Args) -> Result<()> {
 
         // Table 2-like: T_p 0.5 s, α 0.5/0.5, μ 0.3/0.1 (two blocks), every motion.
         if n == 2 {
-            let (mut s_sum, mut k_sum) = (0.0, 0.0);
+            let mut single_stack = Vec::new();
             for rec in &motions[z] {
-                s_sum += peak_case(rec, 0.5, &[1.0], &[0.3], false)?.peak_displacement_m;
-                k_sum += peak_case(rec, 0.5, &[0.5, 0.5], &[0.3, 0.1], false)?.peak_displacement_m;
+                single_stack.push((
+                    peak_case(rec, 0.5, &[1.0], &[0.3], false)?.peak_displacement_m,
+                    peak_case(rec, 0.5, &[0.5, 0.5], &[0.3, 0.1], false)?.peak_displacement_m,
+                ));
             }
-            let m = motions[z].len() as f64;
-            let first_s =
-                peak_case(&motions[z][0], 0.5, &[1.0], &[0.3], false)?.peak_displacement_m;
-            let first_k = peak_case(&motions[z][0], 0.5, &[0.5, 0.5], &[0.3, 0.1], false)?
-                .peak_displacement_m;
+            let m = single_stack.len() as f64;
+            let (first_s, first_k) = single_stack[0];
+            let s_sum: f64 = single_stack.iter().map(|p| p.0).sum();
+            let k_sum: f64 = single_stack.iter().map(|p| p.1).sum();
             let paper = PAPER_TABLE_2.iter().find(|p| p.0 == zc.name);
             table2.push(vec![
                 zc.name.clone(),
@@ -264,20 +262,8 @@ pub fn run(args: Args) -> Result<()> {
             let params = read_f64(&fh5, &format!("{group}/{name}"), "coefficients")?;
             let f = Fitted { form, params };
             let (mut xs, mut ys) = (Vec::new(), Vec::new());
-            for c in 0..t_new.len() {
-                if !t_new[c].is_finite() {
-                    continue;
-                }
-                let (alpha, mu) = grid.case(c % per);
-                let mut x = vec![grid.periods_s[c / per]];
-                x.extend(mu);
-                x.extend(alpha);
-                let s = Sample {
-                    x,
-                    t_rigid_s: t_rigid[c],
-                    t_new_s: t_new[c],
-                };
-                xs.push(t_new[c]);
+            for s in samples(grid, &t_rigid, &t_new) {
+                xs.push(s.t_new_s);
                 ys.push(f.predict(&s));
             }
             fit_series.push(Series::points(format!("{name} form"), xs, ys));

@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use slidestack::store::fingerprint::fingerprint;
 use slidestack::store::sweep::{read_fingerprint as read_sweep_fp, read_zone_sweep};
 use slidestack::store::tnew::{ZoneTnew, read_fingerprint, write_tnew};
+use slidestack::study::sweep::rigid_spec;
 use slidestack::study::tnew::{TnewFlag, period_at_displacement};
 use std::path::PathBuf;
 
@@ -92,9 +93,8 @@ pub fn run(args: Args) -> Result<()> {
                 mean(&sw.u_single, c),
                 mean(&sw.u_rigid, c),
             );
-            let (alpha, _) = grid.case(c % grid.cases_per_unit());
-            let tp = grid.periods_s[c / grid.cases_per_unit()];
-            let t_rigid = tp * (1.0 + alpha.iter().sum::<f64>()).sqrt();
+            let (tp, alpha, _) = grid.point(c);
+            let t_rigid = rigid_spec(tp, alpha.iter().sum(), grid.damping).period_s;
             let slides = (0..m).any(|k| {
                 sw.slip_peak[(k * cases + c) * n..(k * cases + c + 1) * n]
                     .iter()

@@ -148,6 +148,31 @@ fn code_var(
     Ok(ds)
 }
 
+/// The coordinates of the case dimensions `T_p, alpha_1 … alpha_n, mu_1 … mu_n` of `grid` in
+/// group `g`, as dimension scales in that order (shared by `sweep.h5` and `tnew.h5`).
+pub fn case_coordinates(g: &hdf5::Group, grid: &Grid) -> hdf5::Result<Vec<hdf5::Dataset>> {
+    let mut scales = vec![coordinate(
+        g,
+        "T_p",
+        &grid.periods_s,
+        "s",
+        "period of the bare structure",
+    )?];
+    for (i, a) in grid.alpha.iter().enumerate() {
+        let long = format!("mass ratio m_{}/m_p of block {} (bottom = 1)", i + 1, i + 1);
+        scales.push(coordinate(g, &format!("alpha_{}", i + 1), a, "1", &long)?);
+    }
+    for (i, mu) in grid.mu.iter().enumerate() {
+        let long = format!(
+            "kinetic friction coefficient of interface {} (static = {} × kinetic)",
+            i + 1,
+            grid.mu_static_ratio
+        );
+        scales.push(coordinate(g, &format!("mu_{}", i + 1), mu, "1", &long)?);
+    }
+    Ok(scales)
+}
+
 /// Assembles `sweep.h5` at `path` (through a temporary file renamed at the end).
 pub fn write_sweep(
     path: &Path,
@@ -184,25 +209,7 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneUnits) -> hdf5::Result<()> {
     )?;
     set_scale(&m, "motion")?;
     scales.push(m);
-    scales.push(coordinate(
-        &g,
-        "T_p",
-        &grid.periods_s,
-        "s",
-        "period of the bare structure",
-    )?);
-    for (i, a) in grid.alpha.iter().enumerate() {
-        let long = format!("mass ratio m_{}/m_p of block {} (bottom = 1)", i + 1, i + 1);
-        scales.push(coordinate(&g, &format!("alpha_{}", i + 1), a, "1", &long)?);
-    }
-    for (i, mu) in grid.mu.iter().enumerate() {
-        let long = format!(
-            "kinetic friction coefficient of interface {} (static = {} × kinetic)",
-            i + 1,
-            grid.mu_static_ratio
-        );
-        scales.push(coordinate(&g, &format!("mu_{}", i + 1), mu, "1", &long)?);
-    }
+    scales.extend(case_coordinates(&g, grid)?);
     let iface: Vec<f64> = (1..=n).map(|i| i as f64).collect();
     let iface = coordinate(
         &g,

@@ -51,31 +51,7 @@ pub fn write_tnew(
             for z in zones {
                 let g = f.create_group(&format!("zone_{}", z.name))?;
                 attr_str(&g, "target", &z.target)?;
-                let mut scales = vec![coordinate(
-                    &g,
-                    "T_p",
-                    &grid.periods_s,
-                    "s",
-                    "period of the bare structure",
-                )?];
-                for (i, a) in grid.alpha.iter().enumerate() {
-                    scales.push(coordinate(
-                        &g,
-                        &format!("alpha_{}", i + 1),
-                        a,
-                        "1",
-                        &format!("mass ratio of block {}", i + 1),
-                    )?);
-                }
-                for (i, m) in grid.mu.iter().enumerate() {
-                    scales.push(coordinate(
-                        &g,
-                        &format!("mu_{}", i + 1),
-                        m,
-                        "1",
-                        &format!("kinetic friction coefficient of interface {}", i + 1),
-                    )?);
-                }
+                let scales = super::sweep::case_coordinates(&g, grid)?;
                 let mut shape = vec![grid.periods_s.len()];
                 shape.extend(grid.case_shape());
                 let mut chunk = vec![1];

@@ -94,6 +94,14 @@ impl Grid {
         self.case_shape().iter().product()
     }
 
+    /// `(T_p, α, μ)` at `index` over `[T_p][case]`, the order of the case variables of
+    /// `tnew.h5` (and of `sweep.h5` within one motion).
+    pub fn point(&self, index: usize) -> (f64, Vec<f64>, Vec<f64>) {
+        let per = self.cases_per_unit();
+        let (alpha, mu) = self.case(index % per);
+        (self.periods_s[index / per], alpha, mu)
+    }
+
     /// `(α, μ)` of case `index` (row-major over `case_shape`, the last `μ` fastest).
     pub fn case(&self, mut index: usize) -> (Vec<f64>, Vec<f64>) {
         let shape = self.case_shape();
@@ -134,6 +142,20 @@ pub struct UnitResult {
 pub struct UnitOptions {
     /// Apply the skip rules (off: simulate every system of every case, for checking them).
     pub skip: bool,
+}
+
+/// The stack rigidly attached: the bare structure's `k` and `c` on the mass `m_p(1+α)`, so
+/// `T_rigid = T_p·sqrt(1+α)` and damping `ζ/sqrt(1+α)` (paper Eqs. 10–13).
+pub fn rigid_spec(period_s: f64, alpha_total: f64, zeta: f64) -> SystemSpec {
+    let root = (1.0 + alpha_total).sqrt();
+    SystemSpec {
+        period_s: period_s * root,
+        damping_ratio: zeta / root,
+        mass_kg: 1.0,
+        alpha: Vec::new(),
+        mu: Vec::new(),
+        mu_static: None,
+    }
 }
 
 fn simulate(
@@ -183,17 +205,7 @@ pub fn run_unit(
         let key = total.to_bits();
         let case = (tp, alpha.as_slice(), mu.as_slice());
         if !rigid.contains_key(&key) || !opts.skip {
-            // Same k and c as the bare structure on the mass m_p(1+α): T_p·sqrt(1+α) and
-            // ζ/sqrt(1+α).
-            let spec = SystemSpec {
-                period_s: tp * (1.0 + total).sqrt(),
-                damping_ratio: zeta / (1.0 + total).sqrt(),
-                mass_kg: 1.0,
-                alpha: Vec::new(),
-                mu: Vec::new(),
-                mu_static: None,
-            };
-            rigid.insert(key, simulate(&spec, ground, case)?);
+            rigid.insert(key, simulate(&rigid_spec(tp, total, zeta), ground, case)?);
             out.simulations += 1;
         }
         let r = &rigid[&key];

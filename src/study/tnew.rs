@@ -12,6 +12,28 @@
 //! attached mass, and the crossing near `T_rigid` is the one that continues the `μ → ∞` limit.
 //! The flag says which case applied.
 
+use super::sweep::Grid;
+use crate::fit::Sample;
+
+/// The fit's samples: every case of `grid` (flat over `[T_p][case]`) with a finite `T_new`,
+/// features `(T_p, μ_1 … μ_n, α_1 … α_n)`.
+pub fn samples(grid: &Grid, t_rigid_s: &[f64], t_new_s: &[f64]) -> Vec<Sample> {
+    (0..t_new_s.len())
+        .filter(|&c| t_new_s[c].is_finite())
+        .map(|c| {
+            let (tp, alpha, mu) = grid.point(c);
+            let mut x = vec![tp];
+            x.extend(mu);
+            x.extend(alpha);
+            Sample {
+                x,
+                t_rigid_s: t_rigid_s[c],
+                t_new_s: t_new_s[c],
+            }
+        })
+        .collect()
+}
+
 /// How `T_new` was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u8)]
