@@ -17,6 +17,25 @@ pub struct Osc {
     pub omega: f64,
 }
 
+impl Osc {
+    /// Undamped circular frequency `ω_n = √(a² + ω²)`, rad/s: each `τ`-derivative of
+    /// `e^{−aτ}(c·cos ωτ + d·sin ωτ)` is again of that form with its amplitude `√(c² + d²)`
+    /// multiplied by `ω_n`.
+    pub fn natural(&self) -> f64 {
+        (self.decay * self.decay + self.omega * self.omega).sqrt()
+    }
+
+    /// `[A, A·ω_n, …, A·ω_n⁴]`: the oscillation amplitude of a wave with amplitude `A` and of its
+    /// first four derivatives (see [`Osc::natural`]).
+    pub fn amplitudes(natural: f64, amplitude: f64) -> [f64; 5] {
+        let mut out = [amplitude; 5];
+        for k in 1..5 {
+            out[k] = out[k - 1] * natural;
+        }
+        out
+    }
+}
+
 /// `e^{−aτ}`, `cos ωτ`, `sin ωτ` at one `τ`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Basis {
@@ -27,7 +46,19 @@ pub struct Basis {
 }
 
 impl Basis {
+    /// The basis at `τ = 0`, equal bit for bit to `Basis::at(osc, 0.0)` for any `osc`.
+    pub const ZERO: Basis = Basis {
+        tau: 0.0,
+        exp: 1.0,
+        cos: 1.0,
+        sin: 0.0,
+    };
+
+    #[inline]
     pub fn at(osc: Osc, tau: f64) -> Self {
+        if tau == 0.0 {
+            return Self::ZERO;
+        }
         let (sin, cos) = (osc.omega * tau).sin_cos();
         Self {
             tau,
@@ -103,7 +134,12 @@ impl Wave {
     /// Upper bound of `|g(τ)|` over `[t0, t1]` (`0 ≤ t0 ≤ t1`): the polynomial part bounded
     /// term by term, the oscillation by its amplitude times `e^{−a·t0}`.
     pub fn abs_bound(&self, osc: Osc, t0: f64, t1: f64) -> f64 {
-        self.bound_with(t0, t1, (-osc.decay * t0).exp())
+        let exp_t0 = if t0 == 0.0 {
+            1.0
+        } else {
+            (-osc.decay * t0).exp()
+        };
+        self.bound_with(t0, t1, exp_t0)
     }
 
     /// [`Wave::abs_bound`] over `[b0.tau, t1]`, reusing the exponential already in `b0`.
@@ -118,6 +154,28 @@ impl Wave {
         let poly = self.p[0].abs()
             + tm * (self.p[1].abs() + tm * (self.p[2].abs() + tm * self.p[3].abs()));
         poly + (self.c * self.c + self.d * self.d).sqrt() * exp_t0
+    }
+
+    /// `√(c² + d²)`: the amplitude of the oscillation at `τ = 0`.
+    pub fn amplitude(&self) -> f64 {
+        (self.c * self.c + self.d * self.d).sqrt()
+    }
+
+    /// Upper bound of `|dᵏg/dτᵏ|` (`k ≤ 4`) over `[t0, t1]`, `0 ≤ t0 ≤ t1`: the polynomial part's
+    /// k-th derivative bounded term by term at `t1`, plus `amp_k·e^{−a·t0}` where `amp_k` is the
+    /// k-th entry of [`Osc::amplitudes`] for this wave and `exp_t0 = e^{−a·t0}`. The same bound
+    /// as [`Wave::abs_bound`] of the k-th derivative wave, without building it.
+    #[inline]
+    pub fn deriv_abs_bound(&self, k: usize, t1: f64, exp_t0: f64, amp_k: f64) -> f64 {
+        let (p1, p2, p3) = (self.p[1].abs(), self.p[2].abs(), self.p[3].abs());
+        let poly = match k {
+            0 => self.p[0].abs() + t1 * (p1 + t1 * (p2 + t1 * p3)),
+            1 => p1 + t1 * (2.0 * p2 + 3.0 * t1 * p3),
+            2 => 2.0 * p2 + 6.0 * t1 * p3,
+            3 => 6.0 * p3,
+            _ => 0.0,
+        };
+        poly + amp_k * exp_t0
     }
 
     /// `∫₀^τ g(t) dt` at the basis point.
@@ -137,6 +195,42 @@ impl Wave {
         let osc_part = Cx(self.c, -self.d).mul(e_zh_minus_1_over_z).0;
         poly + osc_part
     }
+}
+
+/// Smallest and largest value over `s ∈ [0, 1]` of the cubic Hermite interpolant with end values
+/// `f0`, `f1` and end slopes `m0`, `m1` (derivatives with respect to `s`). For a function `g` on
+/// an interval of width `w`, `|g − H| ≤ max|g⁗|·w⁴/384` there, so the range of `H` widened by that
+/// bounds the range of `g` far more tightly than the end values and a curvature bound alone.
+pub fn hermite_range(f0: f64, f1: f64, m0: f64, m1: f64) -> (f64, f64) {
+    // H(s) = f0 + a1·s + a2·s² + a3·s³.
+    let a1 = m0;
+    let a2 = 3.0 * (f1 - f0) - 2.0 * m0 - m1;
+    let a3 = 2.0 * (f0 - f1) + m0 + m1;
+    let (mut lo, mut hi) = (f0.min(f1), f0.max(f1));
+    let mut take = |s: f64| {
+        if s > 0.0 && s < 1.0 {
+            let v = f0 + s * (a1 + s * (a2 + s * a3));
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    };
+    // H'(s) = a1 + 2·a2·s + 3·a3·s²: its real roots, by the cancellation-free quadratic formula.
+    let (qa, qb, qc) = (3.0 * a3, 2.0 * a2, a1);
+    if qa == 0.0 {
+        if qb != 0.0 {
+            take(-qc / qb);
+        }
+    } else {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc >= 0.0 {
+            let q = -0.5 * (qb + qb.signum() * disc.sqrt());
+            take(q / qa);
+            if q != 0.0 {
+                take(qc / q);
+            }
+        }
+    }
+    (lo, hi)
 }
 
 /// `∫₀^h (B + e^{−aτ}(c·cos ωτ + d·sin ωτ))² dτ` for a velocity wave whose polynomial part is the
@@ -216,6 +310,62 @@ mod tests {
         let fv0 = |t: f64| v.eval(&Basis::at(osc0, t)).powi(2);
         let rel = ((sq0 - quad(fv0, hs)) / sq0).abs();
         assert!(rel < 1e-12, "{rel:e}");
+    }
+
+    #[test]
+    fn derivative_bounds_match_the_derivative_waves() {
+        let osc = Osc {
+            decay: 0.3,
+            omega: 12.0,
+        };
+        let g = Wave {
+            p: [0.1, -2.0, 3.0, -1.0],
+            c: 0.5,
+            d: 0.9,
+        };
+        let amps = Osc::amplitudes(osc.natural(), g.amplitude());
+        let (t0, t1) = (0.05, 0.4);
+        let exp_t0 = (-osc.decay * t0).exp();
+        let mut dk = g;
+        for (k, amp) in amps.iter().enumerate() {
+            let direct = dk.abs_bound(osc, t0, t1);
+            let ours = g.deriv_abs_bound(k, t1, exp_t0, *amp);
+            assert!(
+                (direct - ours).abs() <= 1e-12 * direct,
+                "k = {k}: {direct} vs {ours}"
+            );
+            dk = dk.deriv(osc);
+        }
+    }
+
+    #[test]
+    fn hermite_range_brackets_dense_samples_of_the_cubic() {
+        // Independent oracle: the cubic in Hermite basis form, sampled densely.
+        let cases = [
+            (0.0, 1.0, 0.0, 0.0),
+            (0.2, -0.3, 2.5, 1.5),
+            (1.0, 1.0, -3.0, 3.0),
+            (0.0, 0.0, 1.0, 1.0),
+            (-0.5, 0.7, 0.0, -4.0),
+        ];
+        for (f0, f1, m0, m1) in cases {
+            let h = |s: f64| {
+                let (s2, s3) = (s * s, s * s * s);
+                f0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+                    + m0 * (s3 - 2.0 * s2 + s)
+                    + f1 * (-2.0 * s3 + 3.0 * s2)
+                    + m1 * (s3 - s2)
+            };
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for i in 0..=100_000 {
+                let v = h(i as f64 / 100_000.0);
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+            let (rlo, rhi) = hermite_range(f0, f1, m0, m1);
+            assert!(rlo <= lo + 1e-12 && rlo >= lo - 1e-9, "{rlo} vs {lo}");
+            assert!(rhi >= hi - 1e-12 && rhi <= hi + 1e-9, "{rhi} vs {hi}");
+        }
     }
 
     #[test]

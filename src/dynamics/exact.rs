@@ -30,7 +30,7 @@
 // Parallel per-body and per-interface arrays read best with index loops.
 #![allow(clippy::needless_range_loop)]
 
-use super::closed_form::{Basis, Osc, Wave, integral_of_square};
+use super::closed_form::{Basis, Osc, Wave, hermite_range, integral_of_square};
 use super::contact::{Contact, ContactSelector};
 use super::model::System;
 use super::response::{Energy, History, Response};
@@ -88,32 +88,68 @@ enum EventKind {
     Break(usize),
 }
 
-/// A switching function `g ≥ 0` while the mode holds, with its first three derivatives.
+/// A function of the piece's local time with its derivative and the oscillation amplitudes of
+/// its first four derivatives ([`Osc::amplitudes`]), from which every bound below is formed.
+#[derive(Debug, Clone, Copy)]
+struct Tracked {
+    f: Wave,
+    d1: Wave,
+    amps: [f64; 5],
+}
+
+impl Tracked {
+    fn new(f: Wave, osc: Osc, natural: f64) -> Self {
+        Self {
+            f,
+            d1: f.deriv(osc),
+            amps: Osc::amplitudes(natural, f.amplitude()),
+        }
+    }
+
+    /// Bound of `|f⁽ᵏ⁾|` over `[b.tau, t1]`.
+    #[inline]
+    fn bound(&self, k: usize, b: &Basis, t1: f64) -> f64 {
+        self.f.deriv_abs_bound(k, t1, b.exp, self.amps[k])
+    }
+
+    /// Whether `lower ≤ f ≤ upper` on `[lo, hi]` is certified from the values and slopes of `f`
+    /// at the ends, by the better of the curvature bound (`max|f''|·w²/8` beyond the end values)
+    /// and the Hermite bound (`max|f⁗|·w⁴/384` beyond the cubic Hermite interpolant). The
+    /// curvature bound is tried first; the Hermite bound costs a quadratic solve.
+    fn range_within(&self, lo: Node, hi: Node, lower: f64, upper: f64) -> bool {
+        let ((blo, f_lo, s_lo), (bhi, f_hi, s_hi)) = (lo, hi);
+        let w = bhi.tau - blo.tau;
+        let curv = self.bound(2, blo, bhi.tau) * w * w / 8.0;
+        if f_lo.min(f_hi) - curv >= lower && f_lo.max(f_hi) + curv <= upper {
+            return true;
+        }
+        let quart = self.bound(4, blo, bhi.tau) * (w * w) * (w * w) / 384.0;
+        let (h_lo, h_hi) = hermite_range(f_lo, f_hi, s_lo * w, s_hi * w);
+        (f_lo.min(f_hi) - curv).max(h_lo - quart) >= lower
+            && (f_lo.max(f_hi) + curv).min(h_hi + quart) <= upper
+    }
+
+    /// Whether `f'` keeps one sign on `[lo, hi]` (its end values share a sign and exceed the
+    /// chord bound `max|f'''|·w²/8`): then `f` is monotone and its extremes are the end values.
+    fn monotone(&self, (blo, _, s_lo): Node, (bhi, _, s_hi): Node) -> bool {
+        let w = bhi.tau - blo.tau;
+        s_lo * s_hi > 0.0 && s_lo.abs().min(s_hi.abs()) > self.bound(3, blo, bhi.tau) * w * w / 8.0
+    }
+
+    /// The basis at `b` with `f` and `f'` there.
+    fn node(&self, b: Basis) -> (Basis, f64, f64) {
+        (b, self.f.eval(&b), self.d1.eval(&b))
+    }
+}
+
+/// A point of a piece: its basis, the function's value and slope there.
+type Node<'a> = (&'a Basis, f64, f64);
+
+/// A switching function `g ≥ 0` while the mode holds.
 #[derive(Debug, Clone, Copy)]
 struct Event {
     kind: EventKind,
-    g: Wave,
-    d1: Wave,
-    d2: Wave,
-    d3: Wave,
-}
-
-/// A quantity whose peak |value| is tracked, with its first three derivatives.
-#[derive(Debug, Clone, Copy)]
-struct Peaked {
-    f: Wave,
-    d1: Wave,
-    d2: Wave,
-    d3: Wave,
-}
-
-impl Peaked {
-    fn new(f: Wave, osc: Osc) -> Self {
-        let d1 = f.deriv(osc);
-        let d2 = d1.deriv(osc);
-        let d3 = d2.deriv(osc);
-        Self { f, d1, d2, d3 }
-    }
+    g: Tracked,
 }
 
 struct Exact<'s> {
@@ -255,12 +291,12 @@ impl<'s> Exact<'s> {
                 let mut first: Option<(f64, usize)> = None;
                 for (e, ev) in self.events.iter().enumerate() {
                     let limit = first.map_or(h, |f| f.0);
-                    let g_end = if limit == h {
-                        ev.g.eval(&basis_h)
+                    let b_end = if limit == h {
+                        basis_h
                     } else {
-                        ev.g.eval(&Basis::at(osc, limit))
+                        Basis::at(osc, limit)
                     };
-                    if let Some(t) = first_violation(ev, osc, limit, g_end, self.dt) {
+                    if let Some(t) = first_violation(&ev.g, osc, &b_end, self.dt) {
                         if first.is_none_or(|f| t < f.0) {
                             first = Some((t, e));
                         }
@@ -289,12 +325,18 @@ impl<'s> Exact<'s> {
                 }
             }
             let t1 = (k + 1) as f64 * self.dt;
-            let mut e = self.energy.clone();
-            self.fill_state_energy(&mut e);
-            input_peak = input_peak.max(e.input.abs());
-            if input_peak > 0.0 && self.opts.energy_balance {
-                let err = e.residual().abs() / input_peak;
-                self.out.energy_balance_error_max = self.out.energy_balance_error_max.max(err);
+            if self.opts.energy_balance {
+                let (kinetic, strain) = Energy::state_terms(
+                    self.sys.masses(),
+                    &self.v,
+                    self.sys.stiffness(),
+                    self.x[0],
+                );
+                input_peak = input_peak.max(self.energy.input.abs());
+                if input_peak > 0.0 {
+                    let err = self.energy.residual_with(kinetic, strain).abs() / input_peak;
+                    self.out.energy_balance_error_max = self.out.energy_balance_error_max.max(err);
+                }
             }
             if let Some(h) = history.as_mut() {
                 let slope_next = if k + 2 <= steps {
@@ -374,6 +416,7 @@ impl<'s> Exact<'s> {
             self.vel[cidx] = self.disp[cidx].deriv(osc);
         }
         self.events.clear();
+        let natural = osc.natural();
         let accel0 = self.accel0_wave();
         for i in 0..n {
             match self.contacts[i] {
@@ -385,30 +428,25 @@ impl<'s> Exact<'s> {
                     // Anchor the value at τ = 0 to the state (exactly 0 for a fresh slip).
                     let g0_state = sgn * (self.v[i + 1] - self.v[i]);
                     g.p[0] += g0_state - (g.p[0] + g.c);
-                    self.push_event(EventKind::SlipStop(i), g, osc);
+                    self.push_event(EventKind::SlipStop(i), g, osc, natural);
                 }
                 Contact::Stick if i < e0 => {
                     let m_above = self.mass_prefix[e0 + 1] - self.mass_prefix[i + 1];
                     let f = accel0.scale(m_above).plus_constant(f_top0);
                     let room = self.lim_s[i] * (1.0 + BREAK_TOLERANCE);
-                    self.push_event(EventKind::Break(i), f.scale(-1.0).plus_constant(room), osc);
-                    self.push_event(EventKind::Break(i), f.plus_constant(room), osc);
+                    let (lower, upper) = (f.scale(-1.0).plus_constant(room), f.plus_constant(room));
+                    self.push_event(EventKind::Break(i), lower, osc, natural);
+                    self.push_event(EventKind::Break(i), upper, osc, natural);
                 }
                 _ => {}
             }
         }
     }
 
-    fn push_event(&mut self, kind: EventKind, g: Wave, osc: Osc) {
-        let d1 = g.deriv(osc);
-        let d2 = d1.deriv(osc);
-        let d3 = d2.deriv(osc);
+    fn push_event(&mut self, kind: EventKind, g: Wave, osc: Osc, natural: f64) {
         self.events.push(Event {
             kind,
-            g,
-            d1,
-            d2,
-            d3,
+            g: Tracked::new(g, osc, natural),
         });
     }
 
@@ -431,15 +469,16 @@ impl<'s> Exact<'s> {
         let osc = self.osc();
         let e0 = self.top[0];
         let end = b.tau;
-        let b0 = Basis::at(osc, 0.0);
+        let b0 = Basis::ZERO;
+        let natural = osc.natural();
         // Peaks of the structure's displacement and its cluster's absolute acceleration.
-        let u = Peaked::new(self.disp[0], osc);
+        let u = Tracked::new(self.disp[0], osc, natural);
         let (best, at) = peak_abs(&u, osc, &b0, b, self.out.peak_displacement_m, self.dt);
         if best > self.out.peak_displacement_m {
             self.out.peak_displacement_m = best;
             self.out.peak_displacement_time_s = t_start + at;
         }
-        let acc = Peaked::new(self.accel0_wave(), osc);
+        let acc = Tracked::new(self.accel0_wave(), osc, natural);
         // Bodies of the structure's cluster share its acceleration: search above the smallest
         // of their peaks; a result above it is this piece's maximum.
         let floor = self.out.peak_abs_accel_mps2[..=e0]
@@ -612,32 +651,42 @@ impl<'s> Exact<'s> {
 }
 
 /// Earliest `τ ∈ (0, h]` where the switching function goes negative, refined to a few ulps of
-/// the sample interval `dt`; `None` if it stays non-negative. `g_h` is `g(h)`.
-fn first_violation(ev: &Event, osc: Osc, h: f64, g_h: f64, dt: f64) -> Option<f64> {
-    let g0 = ev.g.p[0] + ev.g.c;
+/// the sample interval `dt`; `None` if it stays non-negative. `b_end` is the basis at `h`.
+fn first_violation(g: &Tracked, osc: Osc, b_end: &Basis, dt: f64) -> Option<f64> {
+    let h = b_end.tau;
+    let g0 = g.f.p[0] + g.f.c;
     if g0 < 0.0 {
         return Some(0.0);
     }
-    let mut lo = 0.0;
+    let mut start = Basis::ZERO;
     if g0 == 0.0 {
         // Starts on the boundary (a fresh slip): certify an initial stretch from the Taylor
         // bound g(τ) ≥ g'(0)τ + g''(0)τ²/2 − G₃τ³/6.
-        let g1 = ev.d1.p[0] + ev.d1.c;
-        let g2 = ev.d2.p[0] + ev.d2.c;
-        let g3 = ev.d3.abs_bound(osc, 0.0, h);
+        let g1 = g.d1.p[0] + g.d1.c;
+        let d2 = g.d1.deriv(osc);
+        let g2 = d2.p[0] + d2.c;
+        let g3 = g.bound(3, &Basis::ZERO, h);
         let tc = taylor_clearance(g1, g2, g3);
         if tc <= 0.0 {
             return Some(0.0);
         }
-        lo = (0.999 * tc).min(h);
+        let lo = (0.999 * tc).min(h);
         if lo >= h {
             return None;
         }
+        start = Basis::at(osc, lo);
     }
-    let glo = ev.g.eval(&Basis::at(osc, lo));
     let min_width = 4.0 * f64::EPSILON * dt;
-    let (a, b) = search(ev, osc, lo, h, glo, g_h, min_width, 0)?;
-    Some(refine(|t| ev.g.eval(&Basis::at(osc, t)), a, b, min_width))
+    let (lo, hi) = (g.node(start), g.node(*b_end));
+    let (a, b) = search(
+        g,
+        osc,
+        (&lo.0, lo.1, lo.2),
+        (&hi.0, hi.1, hi.2),
+        min_width,
+        0,
+    )?;
+    Some(refine(|t| g.f.eval(&Basis::at(osc, t)), a, b, min_width))
 }
 
 /// Largest `τ_c` with `g₁τ + g₂τ²/2 − g₃τ³/6 > 0` on `(0, τ_c)`; 0 if there is none.
@@ -654,36 +703,31 @@ fn taylor_clearance(g1: f64, g2: f64, g3: f64) -> f64 {
 }
 
 /// Bracket `(a, b)` with `g(a) ≥ 0 > g(b)` around the earliest sign change in `[lo, hi]`.
-#[allow(clippy::too_many_arguments)]
 fn search(
-    ev: &Event,
+    g: &Tracked,
     osc: Osc,
-    lo: f64,
-    hi: f64,
-    glo: f64,
-    ghi: f64,
+    lo: Node,
+    hi: Node,
     min_width: f64,
     depth: u32,
 ) -> Option<(f64, f64)> {
-    let width = hi - lo;
-    let curv = ev.d2.abs_bound(osc, lo, hi);
-    if glo.min(ghi) - curv * width * width / 8.0 >= 0.0 {
+    let (blo, _, _) = lo;
+    let (bhi, ghi, _) = hi;
+    if g.range_within(lo, hi, 0.0, f64::INFINITY) {
         return None;
     }
-    if ghi < 0.0 {
-        // Monotone on [lo, hi] if g' cannot change sign there: a single root, the earliest.
-        let slope = ev.d1.eval(&Basis::at(osc, lo));
-        if slope < 0.0 && -slope > curv * width {
-            return Some((lo, hi));
-        }
+    let width = bhi.tau - blo.tau;
+    if g.monotone(lo, hi) {
+        // A single root if the end values differ in sign, the earliest; none otherwise.
+        return (ghi < 0.0).then_some((blo.tau, bhi.tau));
     }
     if width <= min_width || depth > 80 {
-        return (ghi < 0.0).then_some((lo, hi));
+        return (ghi < 0.0).then_some((blo.tau, bhi.tau));
     }
-    let mid = lo + 0.5 * width;
-    let gm = ev.g.eval(&Basis::at(osc, mid));
-    search(ev, osc, lo, mid, glo, gm, min_width, depth + 1)
-        .or_else(|| search(ev, osc, mid, hi, gm, ghi, min_width, depth + 1))
+    let (bm, gm, sm) = g.node(Basis::at(osc, blo.tau + 0.5 * width));
+    let mid = (&bm, gm, sm);
+    search(g, osc, lo, mid, min_width, depth + 1)
+        .or_else(|| search(g, osc, mid, hi, min_width, depth + 1))
 }
 
 /// Shrinks a bracket `g(a) ≥ 0 > g(b)` (Illinois regula falsi with bisection safeguard) and
@@ -724,54 +768,48 @@ fn refine(g: impl Fn(f64) -> f64, mut a: f64, mut b: f64, min_width: f64) -> f64
 }
 
 /// Peak `|f|` over `[b0.tau, b1.tau]` if it exceeds `best`, with its time; else `(best, _)`.
-/// Branch and bound: a sub-interval is dropped when `max(|f(lo)|,|f(hi)|) + G₂·w²/8 ≤ best`;
-/// where `f'` changes sign once (certified by the bound on `f'''`), the extremum is refined.
-fn peak_abs(p: &Peaked, osc: Osc, b0: &Basis, b1: &Basis, best: f64, dt: f64) -> (f64, f64) {
+/// Branch and bound: a sub-interval is dropped when [`Tracked::range_within`] shows
+/// `|f| ≤ best` on it or [`Tracked::monotone`] shows its end values are its extremes; where `f'`
+/// changes sign once (certified by the bound on `f'''`), the extremum is refined.
+fn peak_abs(p: &Tracked, osc: Osc, b0: &Basis, b1: &Basis, best: f64, dt: f64) -> (f64, f64) {
     let mut best = (best, 0.0);
-    for b in [b0, b1] {
-        let v = p.f.eval(b).abs();
-        if v > best.0 {
-            best = (v, b.tau);
+    let (lo, hi) = (p.node(*b0), p.node(*b1));
+    for (b, v, _) in [lo, hi] {
+        if v.abs() > best.0 {
+            best = (v.abs(), b.tau);
         }
     }
     let min_width = 4.0 * f64::EPSILON * dt;
-    peak_rec(
-        p,
-        osc,
-        (b0, p.f.eval(b0)),
-        (b1, p.f.eval(b1)),
-        &mut best,
-        min_width,
-        0,
-    );
+    let (lo, hi) = ((&lo.0, lo.1, lo.2), (&hi.0, hi.1, hi.2));
+    peak_rec(p, osc, lo, hi, &mut best, min_width, 0);
     best
 }
 
-/// One node of the branch and bound: the interval between two bases (with `f` there), so that
-/// each split evaluates the exponential and trigonometric functions once, at the midpoint.
+/// One node of the branch and bound: the interval between two bases (with `f` and `f'` there),
+/// so that each split evaluates the exponential and trigonometric functions once, at the midpoint.
 fn peak_rec(
-    p: &Peaked,
+    p: &Tracked,
     osc: Osc,
-    (blo, flo): (&Basis, f64),
-    (bhi, fhi): (&Basis, f64),
+    lo: Node,
+    hi: Node,
     best: &mut (f64, f64),
     min_width: f64,
     depth: u32,
 ) {
-    let (lo, hi) = (blo.tau, bhi.tau);
-    let width = hi - lo;
-    let curv = p.d2.abs_bound_from(blo, hi);
-    if flo.abs().max(fhi.abs()) + curv * width * width / 8.0 <= best.0 {
+    let (blo, _, slo) = lo;
+    let (bhi, _, shi) = hi;
+    if p.range_within(lo, hi, -best.0, best.0) || p.monotone(lo, hi) {
+        // Nothing above `best`, or monotone: the end values, already counted, are the extremes.
         return;
     }
-    let (slo, shi) = (p.d1.eval(blo), p.d1.eval(bhi));
+    let width = bhi.tau - blo.tau;
     if slo * shi < 0.0 {
-        let jerk_bound = p.d3.abs_bound_from(blo, hi);
-        let c_lo = p.d2.eval(blo);
+        let jerk_bound = p.bound(3, blo, bhi.tau);
+        let c_lo = p.d1.deriv(osc).eval(blo);
         if c_lo.abs() > jerk_bound * width {
             // f' is monotone here: its single zero is the only interior extremum.
             let g = |t: f64| p.d1.eval(&Basis::at(osc, t)) * slo.signum();
-            let t = refine(g, lo, hi, min_width);
+            let t = refine(g, blo.tau, bhi.tau, min_width);
             let v = p.f.eval(&Basis::at(osc, t)).abs();
             if v > best.0 {
                 *best = (v, t);
@@ -782,11 +820,11 @@ fn peak_rec(
     if width <= min_width || depth > 60 {
         return;
     }
-    let bm = Basis::at(osc, lo + 0.5 * width);
-    let fm = p.f.eval(&bm);
+    let (bm, fm, sm) = p.node(Basis::at(osc, blo.tau + 0.5 * width));
     if fm.abs() > best.0 {
         *best = (fm.abs(), bm.tau);
     }
-    peak_rec(p, osc, (blo, flo), (&bm, fm), best, min_width, depth + 1);
-    peak_rec(p, osc, (&bm, fm), (bhi, fhi), best, min_width, depth + 1);
+    let mid = (&bm, fm, sm);
+    peak_rec(p, osc, lo, mid, best, min_width, depth + 1);
+    peak_rec(p, osc, mid, hi, best, min_width, depth + 1);
 }

@@ -20,19 +20,29 @@ pub struct Energy {
 impl Energy {
     /// `input − (kinetic + strain + damping + friction)`.
     pub fn residual(&self) -> f64 {
-        self.input - (self.kinetic + self.strain + self.damping + self.friction)
+        self.residual_with(self.kinetic, self.strain)
     }
 
     /// Sets the kinetic (`½Σm_j·v_j²`) and strain (`½k·u₀²`) terms from a state: masses and
     /// relative velocities of all bodies, stiffness and structure displacement.
     pub fn set_state(&mut self, masses: &[f64], velocity: &[f64], stiffness: f64, u0: f64) {
-        self.kinetic = 0.5
+        (self.kinetic, self.strain) = Self::state_terms(masses, velocity, stiffness, u0);
+    }
+
+    /// The kinetic and strain terms of [`Energy::set_state`].
+    pub fn state_terms(masses: &[f64], velocity: &[f64], stiffness: f64, u0: f64) -> (f64, f64) {
+        let kinetic = 0.5
             * masses
                 .iter()
                 .zip(velocity)
                 .map(|(m, v)| m * v * v)
                 .sum::<f64>();
-        self.strain = 0.5 * stiffness * u0 * u0;
+        (kinetic, 0.5 * stiffness * u0 * u0)
+    }
+
+    /// [`Energy::residual`] with the kinetic and strain terms given instead of stored.
+    pub fn residual_with(&self, kinetic: f64, strain: f64) -> f64 {
+        self.input - (kinetic + strain + self.damping + self.friction)
     }
 
     /// Every term divided by the structure mass, so in J per kg of it.
