@@ -7,9 +7,11 @@
 //! * [`report`]: SVG figures and the HTML report.
 //! * [`study`]: the study configuration and its stages.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
+//! * [`accuracy`]: work-precision measures (errors against a reference, observed orders).
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
 
+pub mod accuracy;
 pub mod dynamics;
 pub mod fit;
 pub mod motion;

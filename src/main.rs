@@ -34,6 +34,9 @@ enum Command {
     Report(cmd::report::Args),
     /// The whole study: motions, sweep, tnew, fit, report (each skipped when up to date).
     Run(cmd::run::Args),
+    /// Evidence: work-precision of the integrators and the numerical stress suite.
+    #[command(subcommand)]
+    Bench(cmd::bench::BenchCommand),
 }
 
 fn main() -> std::process::ExitCode {
@@ -56,6 +59,7 @@ fn main() -> std::process::ExitCode {
         Command::Fit(args) => cmd::fit::run(args),
         Command::Report(args) => cmd::report::run(args),
         Command::Run(args) => cmd::run::run(args),
+        Command::Bench(command) => cmd::bench::run(command),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -180,21 +180,77 @@ impl Wave {
 
     /// `∫₀^τ g(t) dt` at the basis point.
     pub fn integral(&self, osc: Osc, b: &Basis) -> f64 {
+        self.integral_with(b, &PieceIntegrals::new(osc, b))
+    }
+
+    /// [`Wave::integral`] with the oscillation's integral precomputed for this piece.
+    pub fn integral_with(&self, b: &Basis, pi: &PieceIntegrals) -> f64 {
         let t = b.tau;
         let poly =
             t * (self.p[0] + t * (self.p[1] / 2.0 + t * (self.p[2] / 3.0 + t * self.p[3] / 4.0)));
-        // ∫₀^h e^{−aτ}(c cos ωτ + d sin ωτ) dτ = Re[(c − i·d)·(e^{zh} − 1)/z], z = −a + iω,
-        // through φ₁ so that short pieces lose no digits to cancellation.
-        let zh = Cx(-osc.decay * t, osc.omega * t);
-        let e_zh_minus_1_over_z = if zh.norm_sqr() < 0.25 {
+        let osc_part = Cx(self.c, -self.d).mul(pi.osc).0;
+        poly + osc_part
+    }
+}
+
+/// The integrals over a piece `[0, h]` that every wave of a mode shares: they depend only on the
+/// oscillator and `h`, so a full sample interval's are computed once per cluster and reused.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PieceIntegrals {
+    /// `∫₀^h e^{zτ} dτ = (e^{zh} − 1)/z`, `z = −a + iω`.
+    osc: Cx,
+    /// `∫₀^h e^{−2aτ} dτ` and `∫₀^h e^{−2aτ}(cos 2ωτ, sin 2ωτ) dτ`.
+    exp2: f64,
+    exp2_cos: f64,
+    exp2_sin: f64,
+}
+
+impl PieceIntegrals {
+    /// Through φ₁ so that short pieces lose no digits to cancellation.
+    pub fn new(osc: Osc, b: &Basis) -> Self {
+        let t = b.tau;
+        let (a, w) = (osc.decay, osc.omega);
+        let zh = Cx(-a * t, w * t);
+        let osc_int = if zh.norm_sqr() < 0.25 {
             let p = phi1(zh);
             Cx(p.0 * t, p.1 * t)
         } else {
-            Cx(b.exp * b.cos - 1.0, b.exp * b.sin).div(Cx(-osc.decay, osc.omega))
+            Cx(b.exp * b.cos - 1.0, b.exp * b.sin).div(Cx(-a, w))
         };
-        let osc_part = Cx(self.c, -self.d).mul(e_zh_minus_1_over_z).0;
-        poly + osc_part
+        let z2 = phi1(Cx(-2.0 * a * t, 2.0 * w * t));
+        Self {
+            osc: osc_int,
+            exp2: t * phi1(Cx(-2.0 * a * t, 0.0)).0,
+            exp2_cos: t * z2.0,
+            exp2_sin: t * z2.1,
+        }
     }
+}
+
+/// `∫₀^h (B + e^{−aτ}(c·cos ωτ + d·sin ωτ))² dτ` for a velocity wave whose polynomial part is the
+/// constant `B` (the structure's velocity within a mode). Used for the damping energy `∫c·u̇²`.
+pub fn integral_of_square(v: &Wave, osc: Osc, b: &Basis) -> f64 {
+    integral_of_square_with(v, b, &PieceIntegrals::new(osc, b))
+}
+
+/// [`integral_of_square`] with the piece's integrals precomputed.
+pub fn integral_of_square_with(v: &Wave, b: &Basis, pi: &PieceIntegrals) -> f64 {
+    debug_assert!(v.p[1] == 0.0 && v.p[2] == 0.0 && v.p[3] == 0.0);
+    let h = b.tau;
+    let big_b = v.p[0];
+    let osc_only = Wave {
+        p: [0.0; 4],
+        c: v.c,
+        d: v.d,
+    };
+    let cross = 2.0 * big_b * osc_only.integral_with(b, pi);
+    // (c cos + d sin)² = (c²+d²)/2 + (c²−d²)/2·cos 2ωτ + c·d·sin 2ωτ
+    let mean = 0.5 * (v.c * v.c + v.d * v.d);
+    big_b * big_b * h
+        + cross
+        + mean * pi.exp2
+        + 0.5 * (v.c * v.c - v.d * v.d) * pi.exp2_cos
+        + v.c * v.d * pi.exp2_sin
 }
 
 /// Smallest and largest value over `s ∈ [0, 1]` of the cubic Hermite interpolant with end values
@@ -231,31 +287,6 @@ pub fn hermite_range(f0: f64, f1: f64, m0: f64, m1: f64) -> (f64, f64) {
         }
     }
     (lo, hi)
-}
-
-/// `∫₀^h (B + e^{−aτ}(c·cos ωτ + d·sin ωτ))² dτ` for a velocity wave whose polynomial part is the
-/// constant `B` (the structure's velocity within a mode). Used for the damping energy `∫c·u̇²`.
-pub fn integral_of_square(v: &Wave, osc: Osc, b: &Basis) -> f64 {
-    debug_assert!(v.p[1] == 0.0 && v.p[2] == 0.0 && v.p[3] == 0.0);
-    let h = b.tau;
-    let big_b = v.p[0];
-    let (a, w) = (osc.decay, osc.omega);
-    let osc_only = Wave {
-        p: [0.0; 4],
-        c: v.c,
-        d: v.d,
-    };
-    let cross = 2.0 * big_b * osc_only.integral(osc, b);
-    // (c cos + d sin)² = (c²+d²)/2 + (c²−d²)/2·cos 2ωτ + c·d·sin 2ωτ
-    let mean = 0.5 * (v.c * v.c + v.d * v.d);
-    let i_exp = h * phi1(Cx(-2.0 * a * h, 0.0)).0;
-    let z = phi1(Cx(-2.0 * a * h, 2.0 * w * h));
-    let (i_cos, i_sin) = (h * z.0, h * z.1);
-    big_b * big_b * h
-        + cross
-        + mean * i_exp
-        + 0.5 * (v.c * v.c - v.d * v.d) * i_cos
-        + v.c * v.d * i_sin
 }
 
 #[cfg(test)]

@@ -30,7 +30,9 @@
 // Parallel per-body and per-interface arrays read best with index loops.
 #![allow(clippy::needless_range_loop)]
 
-use super::closed_form::{Basis, Osc, Wave, hermite_range, integral_of_square};
+use super::closed_form::{
+    Basis, Osc, PieceIntegrals, Wave, hermite_range, integral_of_square_with,
+};
 use super::contact::{Contact, ContactSelector};
 use super::model::System;
 use super::response::{Energy, History, Response};
@@ -78,6 +80,8 @@ struct Cluster0 {
     osc: Osc,
     omega2: f64,
     basis_dt: Basis,
+    /// The energy integrals over a whole sample interval.
+    integrals_dt: PieceIntegrals,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -201,11 +205,13 @@ impl<'s> Exact<'s> {
                     decay,
                     omega: (omega2 - decay * decay).sqrt(),
                 };
+                let basis_dt = Basis::at(osc, dt);
                 Cluster0 {
                     mass,
                     osc,
                     omega2,
-                    basis_dt: Basis::at(osc, dt),
+                    basis_dt,
+                    integrals_dt: PieceIntegrals::new(osc, &basis_dt),
                 }
             })
             .collect();
@@ -499,6 +505,12 @@ impl<'s> Exact<'s> {
         // Energy: input −Σ M_c∫a_g·v_c, damping ∫c·u̇².
         let nc = self.cluster_of[self.n] + 1;
         if self.opts.energy_balance {
+            let cl = &self.cluster0[e0];
+            let pi = if b.tau == self.dt && *b == cl.basis_dt {
+                cl.integrals_dt
+            } else {
+                PieceIntegrals::new(osc, b)
+            };
             let mut input = 0.0;
             for cidx in 0..nc {
                 let mass =
@@ -506,11 +518,12 @@ impl<'s> Exact<'s> {
                 let w = &self.disp[cidx];
                 let x0 = w.p[0] + w.c;
                 let x1 = w.eval(b);
-                let int_av = ga * (x1 - x0) + slope * (end * x1 - w.integral(osc, b));
+                let int_av = ga * (x1 - x0) + slope * (end * x1 - w.integral_with(b, &pi));
                 input -= mass * int_av;
             }
             self.energy.input += input;
-            self.energy.damping += self.sys.damping() * integral_of_square(&self.vel[0], osc, b);
+            self.energy.damping +=
+                self.sys.damping() * integral_of_square_with(&self.vel[0], b, &pi);
         }
         // New state of every body; offsets within a cluster are constant.
         for i in 0..self.n {

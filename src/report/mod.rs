@@ -67,6 +67,40 @@ fn range(series: &[Series], pick: impl Fn(&Series) -> &Vec<f64>) -> (f64, f64) {
 
 /// A line/point chart as an SVG document.
 pub fn chart(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> String {
+    draw_chart(title, x_label, y_label, series, false)
+}
+
+/// [`chart`] with logarithmic axes; values ≤ 0 are left out.
+pub fn chart_log_log(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> String {
+    let log = |v: &[f64]| -> Vec<f64> {
+        v.iter()
+            .map(|x| if *x > 0.0 { x.log10() } else { f64::NAN })
+            .collect()
+    };
+    let logged: Vec<Series> = series
+        .iter()
+        .map(|s| Series {
+            x: log(&s.x),
+            y: log(&s.y),
+            ..s.clone()
+        })
+        .collect();
+    draw_chart(title, x_label, y_label, &logged, true)
+}
+
+/// Tick label of a log10 axis value: `1e-3`, or the value itself near 1.
+fn power_label(v: &f64) -> String {
+    if (v - v.round()).abs() > 1e-9 {
+        return String::new();
+    }
+    match v.round() as i32 {
+        0 => "1".to_string(),
+        1 => "10".to_string(),
+        e => format!("1e{e}"),
+    }
+}
+
+fn draw_chart(title: &str, x_label: &str, y_label: &str, series: &[Series], log: bool) -> String {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (640, 420)).into_drawing_area();
@@ -80,11 +114,18 @@ pub fn chart(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> St
                 .x_label_area_size(40)
                 .y_label_area_size(60)
                 .build_cartesian_2d(x0..x1, y0..y1)?;
-            c.configure_mesh()
-                .x_desc(x_label)
+            let mut mesh = c.configure_mesh();
+            mesh.x_desc(x_label)
                 .y_desc(y_label)
-                .light_line_style(RGBColor(235, 235, 235))
-                .draw()?;
+                .light_line_style(RGBColor(235, 235, 235));
+            if log {
+                let ticks = |a: f64, b: f64| ((b.floor() - a.ceil()) as usize + 1).clamp(2, 12);
+                mesh.x_labels(ticks(x0, x1) * 4)
+                    .y_labels(ticks(y0, y1) * 4)
+                    .x_label_formatter(&power_label)
+                    .y_label_formatter(&power_label);
+            }
+            mesh.draw()?;
             let mut colour = 0;
             for s in series {
                 let pts: Vec<(f64, f64)> =
