@@ -178,6 +178,8 @@ pub fn run(args: Args) -> Result<()> {
     };
     let start = std::time::Instant::now();
     let sims = std::sync::atomic::AtomicUsize::new(0);
+    // Record samples crossed by all simulations together.
+    let samples = std::sync::atomic::AtomicUsize::new(0);
     todo.par_iter().try_for_each(|u| -> Result<()> {
         let (z, m, p) = *u;
         let rec = &motions[z][m];
@@ -189,6 +191,10 @@ pub fn run(args: Args) -> Result<()> {
         let r = run_unit(&stage.grid, &ground, p, UnitOptions { skip: true })
             .with_context(|| format!("zone {}, motion {}", stage.cfg.zones[z].name, rec.name))?;
         sims.fetch_add(r.simulations, std::sync::atomic::Ordering::Relaxed);
+        samples.fetch_add(
+            r.simulations * accel.len(),
+            std::sync::atomic::Ordering::Relaxed,
+        );
         let path = path_of(u);
         write_unit(&path, &stage.fingerprint, &r)
             .with_context(|| format!("cannot write {}", path.display()))?;
@@ -199,15 +205,17 @@ pub fn run(args: Args) -> Result<()> {
     let secs = start.elapsed().as_secs_f64();
     if !todo.is_empty() {
         let sims = sims.into_inner();
+        let threads = rayon::current_num_threads();
         println!(
             "sweep: {} cases in {:.1} s ({:.0} cases/s); {} simulations ({:.0}/s; the skip rules \
-             saved {:.0} %)",
+             saved {:.0} %); {:.0} ns per simulated record sample per thread ({threads} threads)",
             cases,
             secs,
             cases as f64 / secs.max(1e-9),
             sims,
             sims as f64 / secs.max(1e-9),
-            100.0 * (1.0 - sims as f64 / (3 * cases) as f64)
+            100.0 * (1.0 - sims as f64 / (3 * cases) as f64),
+            secs * 1e9 * threads as f64 / samples.into_inner().max(1) as f64
         );
     }
     if let Some((k, n)) = args.shard {

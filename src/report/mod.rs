@@ -141,7 +141,7 @@ fn draw_chart(title: &str, x_label: &str, y_label: &str, series: &[Series], log:
                 let col = COLOURS[colour % COLOURS.len()];
                 colour += 1;
                 let drawn = if s.points {
-                    c.draw_series(pts.into_iter().map(|p| Circle::new(p, 2, col.filled())))?
+                    c.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, col.filled())))?
                 } else {
                     c.draw_series(LineSeries::new(pts, col.stroke_width(2)))?
                 };
