@@ -79,6 +79,8 @@ struct Cluster0 {
     mass: f64,
     osc: Osc,
     omega2: f64,
+    /// `ω_n` of the cluster ([`Osc::natural`]), rad/s.
+    natural: f64,
     basis_dt: Basis,
     /// The energy integrals over a whole sample interval.
     integrals_dt: PieceIntegrals,
@@ -102,6 +104,21 @@ struct Tracked {
 }
 
 impl Tracked {
+    const ZERO: Tracked = Tracked {
+        f: Wave::ZERO,
+        d1: Wave::ZERO,
+        amps: [0.0; 5],
+    };
+
+    /// `s·f + v`: the amplitudes scale by `|s|`.
+    fn affine(&self, s: f64, v: f64) -> Self {
+        Self {
+            f: self.f.scale(s).plus_constant(v),
+            d1: self.d1.scale(s),
+            amps: self.amps.map(|a| a * s.abs()),
+        }
+    }
+
     fn new(f: Wave, osc: Osc, natural: f64) -> Self {
         Self {
             f,
@@ -178,6 +195,9 @@ struct Exact<'s> {
     top: Vec<usize>,
     disp: Vec<Wave>,
     vel: Vec<Wave>,
+    /// The structure's displacement and its cluster's absolute acceleration over the piece.
+    u0: Tracked,
+    a0: Tracked,
     /// Constant absolute acceleration of each free cluster, m/s².
     accel_free: Vec<f64>,
     events: Vec<Event>,
@@ -210,6 +230,7 @@ impl<'s> Exact<'s> {
                     mass,
                     osc,
                     omega2,
+                    natural: osc.natural(),
                     basis_dt,
                     integrals_dt: PieceIntegrals::new(osc, &basis_dt),
                 }
@@ -256,6 +277,8 @@ impl<'s> Exact<'s> {
             top: vec![0; n + 1],
             disp: vec![Wave::ZERO; n + 1],
             vel: vec![Wave::ZERO; n + 1],
+            u0: Tracked::ZERO,
+            a0: Tracked::ZERO,
             accel_free: vec![0.0; n + 1],
             events: Vec::with_capacity(2 * n),
             slip_start: vec![0.0; n],
@@ -408,6 +431,12 @@ impl<'s> Exact<'s> {
             d,
         };
         self.vel[0] = self.disp[0].deriv(osc);
+        self.u0 = Tracked {
+            f: self.disp[0],
+            d1: self.vel[0],
+            amps: Osc::amplitudes(cl.natural, self.disp[0].amplitude()),
+        };
+        self.a0 = Tracked::new(self.accel0_wave(), osc, cl.natural);
         for cidx in 1..nc {
             let (bj, ej) = (self.bottom[cidx], self.top[cidx]);
             let mass = self.mass_prefix[ej + 1] - self.mass_prefix[bj];
@@ -422,38 +451,55 @@ impl<'s> Exact<'s> {
             self.vel[cidx] = self.disp[cidx].deriv(osc);
         }
         self.events.clear();
-        let natural = osc.natural();
-        let accel0 = self.accel0_wave();
-        for i in 0..n {
-            match self.contacts[i] {
-                Contact::Slip(dir) => {
-                    let sgn = f64::from(dir);
-                    let lower = self.cluster_of[i];
-                    let upper = self.cluster_of[i + 1];
-                    let mut g = self.vel[upper].combine(sgn, &self.vel[lower], -sgn);
-                    // Anchor the value at τ = 0 to the state (exactly 0 for a fresh slip).
-                    let g0_state = sgn * (self.v[i + 1] - self.v[i]);
-                    g.p[0] += g0_state - (g.p[0] + g.c);
-                    self.push_event(EventKind::SlipStop(i), g, osc, natural);
-                }
-                Contact::Stick if i < e0 => {
-                    let m_above = self.mass_prefix[e0 + 1] - self.mass_prefix[i + 1];
-                    let f = accel0.scale(m_above).plus_constant(f_top0);
-                    let room = self.lim_s[i] * (1.0 + BREAK_TOLERANCE);
-                    let (lower, upper) = (f.scale(-1.0).plus_constant(room), f.plus_constant(room));
-                    self.push_event(EventKind::Break(i), lower, osc, natural);
-                    self.push_event(EventKind::Break(i), upper, osc, natural);
-                }
-                _ => {}
+        // Every interface inside the structure's cluster carries `m_above·A₀(τ) + f_top0`, so
+        // its static limit bounds A₀ to an interval; the tightest bounds above and below are the
+        // only ones that can be reached first. Bounds equal to within a tenth of the break
+        // tolerance (equal μ up to round-off) count as a tie, won by the lowest interface: a stack
+        // that moves as one slips at its base.
+        let tie = 0.1 * BREAK_TOLERANCE;
+        // (bound on A₀, interface) above and below.
+        let mut upper: Option<(f64, usize)> = None;
+        let mut lower: Option<(f64, usize)> = None;
+        for i in 0..e0 {
+            let m_above = self.mass_prefix[e0 + 1] - self.mass_prefix[i + 1];
+            let room = self.lim_s[i] * (1.0 + BREAK_TOLERANCE);
+            let (hi, lo) = ((room - f_top0) / m_above, (-room - f_top0) / m_above);
+            if upper.is_none_or(|(h, _)| hi < h - tie * h.abs()) {
+                upper = Some((hi, i));
+            }
+            if lower.is_none_or(|(l, _)| lo > l + tie * l.abs()) {
+                lower = Some((lo, i));
             }
         }
-    }
-
-    fn push_event(&mut self, kind: EventKind, g: Wave, osc: Osc, natural: f64) {
-        self.events.push(Event {
-            kind,
-            g: Tracked::new(g, osc, natural),
-        });
+        if let Some((hi, i)) = upper {
+            let g = self.a0.affine(-1.0, hi);
+            self.events.push(Event {
+                kind: EventKind::Break(i),
+                g,
+            });
+        }
+        if let Some((lo, i)) = lower {
+            let g = self.a0.affine(1.0, -lo);
+            self.events.push(Event {
+                kind: EventKind::Break(i),
+                g,
+            });
+        }
+        for i in 0..n {
+            let Contact::Slip(dir) = self.contacts[i] else {
+                continue;
+            };
+            let sgn = f64::from(dir);
+            let (lower, upper) = (self.cluster_of[i], self.cluster_of[i + 1]);
+            let mut g = self.vel[upper].combine(sgn, &self.vel[lower], -sgn);
+            // Anchor the value at τ = 0 to the state (exactly 0 for a fresh slip).
+            let g0_state = sgn * (self.v[i + 1] - self.v[i]);
+            g.p[0] += g0_state - (g.p[0] + g.c);
+            self.events.push(Event {
+                kind: EventKind::SlipStop(i),
+                g: Tracked::new(g, osc, cl.natural),
+            });
+        }
     }
 
     /// Absolute acceleration of the structure's cluster: `(F − c·u̇ − k·u)/M`.
@@ -476,22 +522,19 @@ impl<'s> Exact<'s> {
         let e0 = self.top[0];
         let end = b.tau;
         let b0 = Basis::ZERO;
-        let natural = osc.natural();
         // Peaks of the structure's displacement and its cluster's absolute acceleration.
-        let u = Tracked::new(self.disp[0], osc, natural);
-        let (best, at) = peak_abs(&u, osc, &b0, b, self.out.peak_displacement_m, self.dt);
+        let (best, at) = peak_abs(&self.u0, osc, &b0, b, self.out.peak_displacement_m, self.dt);
         if best > self.out.peak_displacement_m {
             self.out.peak_displacement_m = best;
             self.out.peak_displacement_time_s = t_start + at;
         }
-        let acc = Tracked::new(self.accel0_wave(), osc, natural);
         // Bodies of the structure's cluster share its acceleration: search above the smallest
         // of their peaks; a result above it is this piece's maximum.
         let floor = self.out.peak_abs_accel_mps2[..=e0]
             .iter()
             .copied()
             .fold(f64::INFINITY, f64::min);
-        let (best_acc, _) = peak_abs(&acc, osc, &b0, b, floor, self.dt);
+        let (best_acc, _) = peak_abs(&self.a0, osc, &b0, b, floor, self.dt);
         if best_acc > floor {
             for p in &mut self.out.peak_abs_accel_mps2[..=e0] {
                 *p = p.max(best_acc);
