@@ -7,6 +7,7 @@
 //! * [`report`]: SVG figures and the HTML report.
 //! * [`study`]: the study configuration and its stages.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
+//! * [`stress`]: the numerical stress suite: extreme but legal cases and their checks.
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
 
@@ -17,4 +18,5 @@ mod numeric;
 pub mod report;
 pub mod spectrum;
 pub mod store;
+pub mod stress;
 pub mod study;

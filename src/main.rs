@@ -34,6 +34,8 @@ enum Command {
     Report(cmd::report::Args),
     /// The whole study: motions, sweep, tnew, fit, report (each skipped when up to date).
     Run(cmd::run::Args),
+    /// Checks and measurements of the numerics (`bench stress`: the numerical stress suite).
+    Bench(cmd::bench::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -56,6 +58,7 @@ fn main() -> std::process::ExitCode {
         Command::Fit(args) => cmd::fit::run(args),
         Command::Report(args) => cmd::report::run(args),
         Command::Run(args) => cmd::run::run(args),
+        Command::Bench(args) => cmd::bench::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -1,5 +1,6 @@
 //! One module per subcommand; each starts with what it reads and writes.
 
+pub mod bench;
 pub mod fit;
 pub mod matching;
 pub mod motions;
