@@ -8,6 +8,7 @@
 //! * [`study`]: the study configuration and its stages.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
 //! * [`accuracy`]: work-precision measures (errors against a reference, observed orders).
+//! * [`stress`]: the numerical stress suite: extreme but legal cases and their checks.
 //!
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
 
@@ -19,4 +20,5 @@ mod numeric;
 pub mod report;
 pub mod spectrum;
 pub mod store;
+pub mod stress;
 pub mod study;

@@ -2,6 +2,7 @@
 //! (`scripts/evidence` runs every part and collects it under `docs/evidence/`).
 
 pub mod accuracy;
+pub mod stress;
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -11,11 +12,15 @@ pub enum BenchCommand {
     /// Work-precision: error against time of the exact integrator, the paper's RK4 at 1–1000
     /// sub-steps and (optionally) OpenSees, on real records → accuracy.{md,csv,svg,html}.
     Accuracy(accuracy::Args),
+    /// Numerical stress suite: extreme but legal cases and their checks → a Markdown report
+    /// (docs/stress.md); fails if a case fails.
+    Stress(stress::Args),
 }
 
 pub fn run(command: BenchCommand) -> anyhow::Result<()> {
     match command {
         BenchCommand::Accuracy(args) => accuracy::run(&args),
+        BenchCommand::Stress(args) => stress::run(args),
     }
 }
 
