@@ -159,12 +159,20 @@ impl Tracked {
 
     /// The basis at `b` with `f` and `f'` there.
     fn node(&self, b: Basis) -> (Basis, f64, f64) {
+        if b.tau == 0.0 {
+            // `eval` at τ = 0, bit for bit, without the arithmetic.
+            return (b, self.f.p[0] + self.f.c, self.d1.p[0] + self.d1.c);
+        }
         (b, self.f.eval(&b), self.d1.eval(&b))
     }
 }
 
 /// A point of a piece: its basis, the function's value and slope there.
 type Node<'a> = (&'a Basis, f64, f64);
+
+/// The tightest bounds on the structure cluster's absolute acceleration above and below
+/// (m/s²), each with the interface whose static limit sets it.
+type BreakBounds = (Option<(f64, usize)>, Option<(f64, usize)>);
 
 /// A switching function `g ≥ 0` while the mode holds.
 #[derive(Debug, Clone, Copy)]
@@ -198,6 +206,8 @@ struct Exact<'s> {
     /// The structure's displacement and its cluster's absolute acceleration over the piece.
     u0: Tracked,
     a0: Tracked,
+    /// [`Exact::break_bounds`] of the current mode; `None` after a new mode is selected.
+    bounds: Option<BreakBounds>,
     /// Constant absolute acceleration of each free cluster, m/s².
     accel_free: Vec<f64>,
     events: Vec<Event>,
@@ -279,6 +289,7 @@ impl<'s> Exact<'s> {
             vel: vec![Wave::ZERO; n + 1],
             u0: Tracked::ZERO,
             a0: Tracked::ZERO,
+            bounds: None,
             accel_free: vec![0.0; n + 1],
             events: Vec::with_capacity(2 * n),
             slip_start: vec![0.0; n],
@@ -386,6 +397,7 @@ impl<'s> Exact<'s> {
 
     /// External forces at the current state and the Coulomb-consistent mode.
     fn select(&mut self, ga: f64) -> Result<(), SimError> {
+        self.bounds = None;
         let m = self.sys.masses();
         for j in 0..=self.n {
             self.external[j] = -m[j] * ga;
@@ -451,26 +463,10 @@ impl<'s> Exact<'s> {
             self.vel[cidx] = self.disp[cidx].deriv(osc);
         }
         self.events.clear();
-        // Every interface inside the structure's cluster carries `m_above·A₀(τ) + f_top0`, so
-        // its static limit bounds A₀ to an interval; the tightest bounds above and below are the
-        // only ones that can be reached first. Bounds equal to within a tenth of the break
-        // tolerance (equal μ up to round-off) count as a tie, won by the lowest interface: a stack
-        // that moves as one slips at its base.
-        let tie = 0.1 * BREAK_TOLERANCE;
-        // (bound on A₀, interface) above and below.
-        let mut upper: Option<(f64, usize)> = None;
-        let mut lower: Option<(f64, usize)> = None;
-        for i in 0..e0 {
-            let m_above = self.mass_prefix[e0 + 1] - self.mass_prefix[i + 1];
-            let room = self.lim_s[i] * (1.0 + BREAK_TOLERANCE);
-            let (hi, lo) = ((room - f_top0) / m_above, (-room - f_top0) / m_above);
-            if upper.is_none_or(|(h, _)| hi < h - tie * h.abs()) {
-                upper = Some((hi, i));
-            }
-            if lower.is_none_or(|(l, _)| lo > l + tie * l.abs()) {
-                lower = Some((lo, i));
-            }
+        if self.bounds.is_none() {
+            self.bounds = Some(self.break_bounds(e0, f_top0));
         }
+        let (upper, lower) = self.bounds.unwrap_or_default();
         if let Some((hi, i)) = upper {
             let g = self.a0.affine(-1.0, hi);
             self.events.push(Event {
@@ -500,6 +496,29 @@ impl<'s> Exact<'s> {
                 g: Tracked::new(g, osc, cl.natural),
             });
         }
+    }
+
+    /// Every interface inside the structure's cluster (top body `e0`, friction `f_top0` from
+    /// above) carries `m_above·A₀(τ) + f_top0`, so its static limit bounds A₀ to an interval; the
+    /// tightest bounds above and below, with their interfaces, are the only ones that can be
+    /// reached first. Bounds equal to within a tenth of the break tolerance (equal μ up to
+    /// round-off) count as a tie, won by the lowest interface: a stack that moves as one slips at
+    /// its base. Constant within a mode.
+    fn break_bounds(&self, e0: usize, f_top0: f64) -> BreakBounds {
+        let tie = 0.1 * BREAK_TOLERANCE;
+        let (mut upper, mut lower): BreakBounds = (None, None);
+        for i in 0..e0 {
+            let m_above = self.mass_prefix[e0 + 1] - self.mass_prefix[i + 1];
+            let room = self.lim_s[i] * (1.0 + BREAK_TOLERANCE);
+            let (hi, lo) = ((room - f_top0) / m_above, (-room - f_top0) / m_above);
+            if upper.is_none_or(|(h, _)| hi < h - tie * h.abs()) {
+                upper = Some((hi, i));
+            }
+            if lower.is_none_or(|(l, _)| lo > l + tie * l.abs()) {
+                lower = Some((lo, i));
+            }
+        }
+        (upper, lower)
     }
 
     /// Absolute acceleration of the structure's cluster: `(F − c·u̇ − k·u)/M`.
