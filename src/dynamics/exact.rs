@@ -332,8 +332,13 @@ impl<'s> Exact<'s> {
                 } else {
                     Basis::at(osc, h)
                 };
+                // Both break events at once: A₀ certified inside its bounds over the piece.
+                let breaks_clear = self.breaks_clear(&basis_h);
                 let mut first: Option<(f64, usize)> = None;
                 for (e, ev) in self.events.iter().enumerate() {
+                    if breaks_clear && matches!(ev.kind, EventKind::Break(_)) {
+                        continue;
+                    }
                     let limit = first.map_or(h, |f| f.0);
                     let b_end = if limit == h {
                         basis_h
@@ -471,19 +476,14 @@ impl<'s> Exact<'s> {
             self.bounds = Some(self.break_bounds(e0, f_top0));
         }
         let (upper, lower) = self.bounds.unwrap_or_default();
-        if let Some((hi, i)) = upper {
-            let g = self.a0.affine(-1.0, hi);
-            self.events.push(Event {
-                kind: EventKind::Break(i),
-                g,
-            });
-        }
-        if let Some((lo, i)) = lower {
-            let g = self.a0.affine(1.0, -lo);
-            self.events.push(Event {
-                kind: EventKind::Break(i),
-                g,
-            });
+        // g = bound − A₀ above, A₀ − bound below.
+        for (bound, sign) in [(upper, -1.0), (lower, 1.0)] {
+            if let Some((value, i)) = bound {
+                self.events.push(Event {
+                    kind: EventKind::Break(i),
+                    g: self.a0.affine(sign, -sign * value),
+                });
+            }
         }
         for i in 0..n {
             let Contact::Slip(dir) = self.contacts[i] else {
@@ -523,6 +523,21 @@ impl<'s> Exact<'s> {
             }
         }
         (upper, lower)
+    }
+
+    /// Whether the structure cluster's acceleration stays inside its break bounds over the piece
+    /// ending at `b` (the same test the two break events' searches start with, done once);
+    /// when not, the searches run.
+    fn breaks_clear(&self, b: &Basis) -> bool {
+        let (upper, lower) = self.bounds.unwrap_or_default();
+        if upper.is_none() && lower.is_none() {
+            return true;
+        }
+        let hi = upper.map_or(f64::INFINITY, |u| u.0);
+        let lo = lower.map_or(f64::NEG_INFINITY, |l| l.0);
+        let (n0, n1) = (self.a0.node(Basis::ZERO), self.a0.node(*b));
+        self.a0
+            .range_within((&n0.0, n0.1, n0.2), (&n1.0, n1.1, n1.2), lo, hi)
     }
 
     /// Absolute acceleration of the structure's cluster: `(F − c·u̇ − k·u)/M`.
@@ -572,7 +587,7 @@ impl<'s> Exact<'s> {
         let nc = self.cluster_of[self.n] + 1;
         if self.opts.energy_balance {
             let cl = &self.cluster0[e0];
-            let pi = if b.tau == self.dt && *b == cl.basis_dt {
+            let pi = if *b == cl.basis_dt {
                 cl.integrals_dt
             } else {
                 PieceIntegrals::new(osc, b)

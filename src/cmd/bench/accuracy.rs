@@ -196,6 +196,20 @@ impl CaseResult {
 }
 
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(python) = &args.opensees {
+        for (what, path) in [
+            ("Python", python),
+            ("OpenSees script", &args.opensees_script),
+        ] {
+            if !path.exists() {
+                bail!(
+                    "{what} {} not found (`scripts/bench-peers --only simulation` makes \
+                     .venv-peers/bin/python with openseespy; run from the repository root)",
+                    path.display()
+                );
+            }
+        }
+    }
     let records = read_records(&args.records)?;
     let (substeps, timing, opensees_runs) = if args.quick {
         (SUBSTEPS_QUICK, Timing::SINGLE, OPENSEES_QUICK)
@@ -436,12 +450,6 @@ fn opensees_lib_dir(python: &Path) -> Option<PathBuf> {
 }
 
 fn run_opensees(python: &Path, script: &Path, out: &Path, input: &OsInput) -> Result<OsOutput> {
-    if !script.exists() {
-        bail!(
-            "{} not found: run from the repository root or pass --opensees-script",
-            script.display()
-        );
-    }
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let in_path = out.join(".opensees-in.json");
     let out_path = out.join(".opensees-out.json");
