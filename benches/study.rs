@@ -10,6 +10,10 @@ use std::process::Command;
 fn main() {
     let config =
         std::env::var("SLIDESTACK_BENCH_CONFIG").unwrap_or_else(|_| "configs/paper.yaml".into());
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "unknown".into());
     let dir = std::env::temp_dir().join(format!("slidestack-bench-{}", std::process::id()));
     let out = Command::new(env!("CARGO_BIN_EXE_slidestack"))
         .args([
@@ -36,7 +40,8 @@ fn main() {
         })
         .unwrap_or_default();
     println!(
-        "\nStudy benchmark: `slidestack run {config}` ({cpu}, {} threads)",
+        "\nStudy benchmark: `slidestack run {config}` ({cpu}, {} threads, load average {load} \
+         at the start)",
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
     println!("| stage | time (s) |\n|---|---|");
