@@ -14,8 +14,9 @@
 //!
 //! Errors are of the structure's displacement relative to the ground at the record samples,
 //! against the exact history, relative to its peak over the same samples ([`accuracy::errors`]).
-//! Times are wall time per simulation without history, median of batches in this process (Rust)
-//! or in the Python process (OpenSees: model build plus analysis, one run per setting).
+//! Times are CPU time per simulation without history, of the thread that runs it: median of
+//! batches in this process (Rust), or one run in the Python process (OpenSees: model build plus
+//! analysis). CPU time, unlike wall time, barely changes with other load on a shared machine.
 //!
 //! Writes into `--out` (default `docs/evidence`): `accuracy.md` (also printed), `accuracy.csv`
 //! (one row per case and method), `accuracy.svg` and `accuracy-peak.svg` (work-precision plots)
@@ -152,7 +153,7 @@ struct Row {
     /// Sub-steps (RK4) or analysis steps (OpenSees) per record interval; the refinement factor
     /// for the self-check; 1 for the exact run.
     steps: usize,
-    /// Wall time per simulation, s (NaN where not timed).
+    /// CPU time per simulation, s (NaN where not timed).
     time_s: f64,
     errors: Errors,
     switches: Option<u64>,
@@ -360,6 +361,8 @@ fn run_case(
 /// `scripts/opensees_stack.py`'s input (see its docstring for the protocol).
 #[derive(Serialize)]
 struct OsInput {
+    /// "cpu": time OpenSees by the CPU time of its thread, as the Rust side is timed.
+    clock: &'static str,
     cases: Vec<OsCase>,
 }
 
@@ -434,7 +437,10 @@ fn opensees_input(records: &[Record], cases: &[CaseResult], runs: &[(usize, f64)
             });
         }
     }
-    OsInput { cases: out }
+    OsInput {
+        clock: "cpu",
+        cases: out,
+    }
 }
 
 /// The directory of the shared libraries bundled with the openseespy wheel in the virtual
@@ -694,7 +700,7 @@ impl Tables {
                     "record",
                     "system",
                     "samples",
-                    "exact time",
+                    "exact CPU time",
                     "ns / sample",
                     "switches",
                     "energy balance err",
@@ -713,7 +719,7 @@ impl Tables {
                     "record",
                     "system",
                     "method",
-                    "time / sim",
+                    "CPU time / sim",
                     "× exact",
                     "peak err (signed)",
                     "history err",
@@ -738,9 +744,9 @@ fn markdown(machine: &str, args: &Args, opensees: Option<&str>, t: &Tables) -> S
     );
     s += "Errors are of the structure's displacement at the record samples against the exact \
           integrator, relative to its peak over those samples: peak = (max|û| − max|u|)/max|u| \
-          (signed), history = max|û − u|/max|u|. Times are per simulation without history \
-          (Rust: median of batches in-process; OpenSees: one run in Python, model build plus \
-          analysis). `*`: a coarser sub-step count already met the tolerance before the error \
+          (signed), history = max|û − u|/max|u|. Times are CPU time of the running thread per \
+          simulation without history (Rust: median of batches in-process; OpenSees: one run in \
+          Python, model build plus analysis). `*`: a coarser sub-step count already met the tolerance before the error \
           rose above it again. Static = kinetic friction throughout.\n\n";
     s += &match opensees {
         Some(v) => format!(
@@ -790,7 +796,7 @@ fn html(machine: &str, t: &Tables, svg_history: &str, svg_peak: &str) -> String 
 
 fn csv(cases: &[CaseResult]) -> String {
     let mut s = String::from(
-        "record,system,samples,method,steps_per_interval,stick_stiffness,time_per_sim_s,\
+        "record,system,samples,method,steps_per_interval,stick_stiffness,cpu_time_per_sim_s,\
          time_over_exact,peak_err_signed,history_err,switches,exact_peak_between_samples_m\n",
     );
     for c in cases {
@@ -885,7 +891,7 @@ fn charts(cases: &[CaseResult]) -> (String, String) {
         }
         report::chart_log_log(
             &format!("{what} error against time (geometric means over the cases)"),
-            "time per simulation / exact integrator's",
+            "CPU time per simulation / exact integrator's",
             &format!("{what} error / peak"),
             &series,
         )

@@ -5,7 +5,7 @@ pub mod accuracy;
 pub mod stress;
 
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 #[derive(Debug, clap::Subcommand)]
 pub enum BenchCommand {
@@ -47,7 +47,20 @@ pub fn machine_description() -> String {
     )
 }
 
-/// How a call is timed.
+/// CPU time of the calling thread, s (`CLOCK_THREAD_CPUTIME_ID`): what a computation costs,
+/// which other load on a shared machine barely changes, unlike its wall time.
+pub fn thread_cpu_time_s() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec for the duration of the call.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    assert_eq!(rc, 0, "clock_gettime(CLOCK_THREAD_CPUTIME_ID) failed");
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// How a call is timed: CPU time of this thread ([`thread_cpu_time_s`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Timing {
     /// At least this many timed batches…
@@ -71,22 +84,22 @@ impl Timing {
         batch_target: Duration::from_millis(50),
     };
 
-    /// Median wall time of one call of `f` over the batches, s.
+    /// Median CPU time of one call of `f` over the batches, s.
     pub fn per_call<T>(&self, mut f: impl FnMut() -> T) -> f64 {
-        let start = Instant::now();
+        let start = thread_cpu_time_s();
         black_box(f());
-        let warm = start.elapsed().as_secs_f64();
+        let warm = thread_cpu_time_s() - start;
         let batch = ((self.batch_target.as_secs_f64() / warm.max(1e-9)).ceil() as usize).max(1);
         let mut per_call = Vec::new();
-        let mut total = Duration::ZERO;
-        while per_call.len() < self.min_batches || total < self.min_total {
-            let start = Instant::now();
+        let mut total = 0.0;
+        while per_call.len() < self.min_batches || total < self.min_total.as_secs_f64() {
+            let start = thread_cpu_time_s();
             for _ in 0..batch {
                 black_box(f());
             }
-            let elapsed = start.elapsed();
+            let elapsed = thread_cpu_time_s() - start;
             total += elapsed;
-            per_call.push(elapsed.as_secs_f64() / batch as f64);
+            per_call.push(elapsed / batch as f64);
         }
         per_call.sort_by(f64::total_cmp);
         let n = per_call.len();
