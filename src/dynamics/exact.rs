@@ -324,6 +324,9 @@ impl<'s> Exact<'s> {
             let mut switches_here = 0;
             loop {
                 let ga = accel[k] + slope * tau;
+                if tau == 0.0 && self.quiet_interval(ga, slope) {
+                    break;
+                }
                 self.build(ga, slope);
                 let h = self.dt - tau;
                 let osc = self.osc();
@@ -438,19 +441,8 @@ impl<'s> Exact<'s> {
         let e0 = self.top[0];
         let cl = self.cluster0[e0];
         let f_top0 = if e0 < n { self.force[e0] } else { 0.0 };
-        // Structure cluster: ü + 2aü + ω²u = p0 + p1·τ (Nigam–Jennings, constant friction added).
-        let p0 = -f_top0 / cl.mass - ga;
-        let p1 = -slope;
-        let b = p1 / cl.omega2;
-        let a = (p0 - 2.0 * cl.osc.decay * b) / cl.omega2;
-        let c = self.x[0] - a;
-        let d = (self.v[0] - b + cl.osc.decay * c) / cl.osc.omega;
         let osc = cl.osc;
-        self.disp[0] = Wave {
-            p: [a, b, 0.0, 0.0],
-            c,
-            d,
-        };
+        self.disp[0] = self.structure_wave(&cl, f_top0, ga, slope);
         self.vel[0] = self.disp[0].deriv(osc);
         self.u0 = Tracked {
             f: self.disp[0],
@@ -500,6 +492,73 @@ impl<'s> Exact<'s> {
                 g: Tracked::new(g, osc, cl.natural),
             });
         }
+    }
+
+    /// The structure cluster's displacement over a piece from the current state:
+    /// `ü + 2aü + ω²u = p0 + p1·τ` (Nigam–Jennings, the constant friction from above added).
+    fn structure_wave(&self, cl: &Cluster0, f_top0: f64, ga: f64, slope: f64) -> Wave {
+        let p0 = -f_top0 / cl.mass - ga;
+        let p1 = -slope;
+        let b = p1 / cl.omega2;
+        let a = (p0 - 2.0 * cl.osc.decay * b) / cl.omega2;
+        let c = self.x[0] - a;
+        let d = (self.v[0] - b + cl.osc.decay * c) / cl.osc.omega;
+        Wave {
+            p: [a, b, 0.0, 0.0],
+            c,
+            d,
+        }
+    }
+
+    /// A whole sample interval on which, with every interface stuck, nothing can happen: the
+    /// acceleration stays inside its break bounds and neither the displacement nor the
+    /// acceleration can exceed its peak so far, each certified by the curvature bound on the
+    /// values at the two ends. Then the piece needs only its energy and new state
+    /// ([`Exact::settle`]), the same as the general path would give, and this returns `true`;
+    /// otherwise it changes nothing and returns `false`.
+    fn quiet_interval(&mut self, ga: f64, slope: f64) -> bool {
+        let n = self.n;
+        // The cluster arrays are those of the current mode (built at the last piece).
+        if self.top[0] != n {
+            return false;
+        }
+        let cl = self.cluster0[n];
+        let (h, b) = (self.dt, cl.basis_dt);
+        let u = self.structure_wave(&cl, 0.0, ga, slope);
+        let (u_lo, u_hi) = (u.p[0] + u.c, u.eval(&b));
+        let amp2 = cl.natural * cl.natural * u.amplitude();
+        let curv_u = u.deriv_abs_bound(2, h, 1.0, amp2) * h * h / 8.0;
+        if u_lo.abs().max(u_hi.abs()) + curv_u > self.out.peak_displacement_m {
+            return false;
+        }
+        let vel = u.deriv(cl.osc);
+        let (c_m, k_m) = (self.sys.damping() / cl.mass, self.sys.stiffness() / cl.mass);
+        let acc = vel.combine(-c_m, &u, -k_m);
+        let (a_lo, a_hi) = (acc.p[0] + acc.c, acc.eval(&b));
+        let amp_acc2 = cl.natural * cl.natural * acc.amplitude();
+        let curv_a = acc.deriv_abs_bound(2, h, 1.0, amp_acc2) * h * h / 8.0;
+        let floor = self
+            .out
+            .peak_abs_accel_mps2
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        if a_lo.abs().max(a_hi.abs()) + curv_a > floor {
+            return false;
+        }
+        if self.bounds.is_none() {
+            self.bounds = Some(self.break_bounds(n, 0.0));
+        }
+        let (upper, lower) = self.bounds.unwrap_or_default();
+        let hi = upper.map_or(f64::INFINITY, |u| u.0);
+        let lo = lower.map_or(f64::NEG_INFINITY, |l| l.0);
+        if a_lo.min(a_hi) - curv_a < lo || a_lo.max(a_hi) + curv_a > hi {
+            return false;
+        }
+        self.disp[0] = u;
+        self.vel[0] = vel;
+        self.settle(ga, slope, &b);
+        true
     }
 
     /// Every interface inside the structure's cluster (top body `e0`, friction `f_top0` from
@@ -558,7 +617,6 @@ impl<'s> Exact<'s> {
     fn advance(&mut self, t_start: f64, ga: f64, slope: f64, b: &Basis) {
         let osc = self.osc();
         let e0 = self.top[0];
-        let end = b.tau;
         let b0 = Basis::ZERO;
         // Peaks of the structure's displacement and its cluster's absolute acceleration.
         let (best, at) = peak_abs(&self.u0, osc, &b0, b, self.out.peak_displacement_m, self.dt);
@@ -583,6 +641,15 @@ impl<'s> Exact<'s> {
             let p = &mut self.out.peak_abs_accel_mps2[j];
             *p = p.max(a);
         }
+        self.settle(ga, slope, b);
+    }
+
+    /// The energy terms over the piece ending at `b` and the new state of every body (the
+    /// clusters' waves are those of the piece).
+    fn settle(&mut self, ga: f64, slope: f64, b: &Basis) {
+        let osc = self.osc();
+        let e0 = self.top[0];
+        let end = b.tau;
         // Energy: input −Σ M_c∫a_g·v_c, damping ∫c·u̇².
         let nc = self.cluster_of[self.n] + 1;
         if self.opts.energy_balance {
