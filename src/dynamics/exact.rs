@@ -17,6 +17,12 @@
 //! found by the same kind of bound-and-refine search, so they are exact, not sampled. Energy terms
 //! are integrated in closed form piece by piece.
 //!
+//! Bounds come from the oscillation's amplitude (each `τ`-derivative scales it by `ω_n`), the
+//! end values and slopes (a cubic Hermite bound), and a monotonicity certificate, so most pieces
+//! need no search at all; a whole sample interval with every interface stuck on which the
+//! acceleration provably stays inside its break bounds and no peak can grow only settles its
+//! energy and state.
+//!
 //! A friction force counts as exceeding its static limit only beyond `1e-10` of that limit, so a
 //! demand that sits exactly at the limit (ground acceleration equal to `μ·g`) sticks instead of
 //! chattering. More than `max_switches_per_step` switches within one sample interval stop the run
