@@ -184,6 +184,15 @@ type Node<'a> = (&'a Basis, f64, f64);
 /// (m/s²), each with the interface whose static limit sets it.
 type BreakBounds = (Option<(f64, usize)>, Option<(f64, usize)>);
 
+/// The interval `[lower, upper]` the structure cluster's acceleration must stay in, m/s²
+/// (unbounded where no interface sets a side).
+fn accel_limits((upper, lower): BreakBounds) -> (f64, f64) {
+    (
+        lower.map_or(f64::NEG_INFINITY, |(value, _)| value),
+        upper.map_or(f64::INFINITY, |(value, _)| value),
+    )
+}
+
 /// A switching function `g ≥ 0` while the mode holds.
 #[derive(Debug, Clone, Copy)]
 struct Event {
@@ -470,10 +479,7 @@ impl<'s> Exact<'s> {
             self.vel[cidx] = self.disp[cidx].deriv(osc);
         }
         self.events.clear();
-        if self.bounds.is_none() {
-            self.bounds = Some(self.break_bounds(e0, f_top0));
-        }
-        let (upper, lower) = self.bounds.unwrap_or_default();
+        let (upper, lower) = self.mode_bounds(e0, f_top0);
         // g = bound − A₀ above, A₀ − bound below.
         for (bound, sign) in [(upper, -1.0), (lower, 1.0)] {
             if let Some((value, i)) = bound {
@@ -552,12 +558,7 @@ impl<'s> Exact<'s> {
         if a_lo.abs().max(a_hi.abs()) + curv_a > floor {
             return false;
         }
-        if self.bounds.is_none() {
-            self.bounds = Some(self.break_bounds(n, 0.0));
-        }
-        let (upper, lower) = self.bounds.unwrap_or_default();
-        let hi = upper.map_or(f64::INFINITY, |u| u.0);
-        let lo = lower.map_or(f64::NEG_INFINITY, |l| l.0);
+        let (lo, hi) = accel_limits(self.mode_bounds(n, 0.0));
         if a_lo.min(a_hi) - curv_a < lo || a_lo.max(a_hi) + curv_a > hi {
             return false;
         }
@@ -565,6 +566,14 @@ impl<'s> Exact<'s> {
         self.vel[0] = vel;
         self.settle(ga, slope, &b);
         true
+    }
+
+    /// [`Exact::break_bounds`] of the current mode, computed once per mode.
+    fn mode_bounds(&mut self, e0: usize, f_top0: f64) -> BreakBounds {
+        if self.bounds.is_none() {
+            self.bounds = Some(self.break_bounds(e0, f_top0));
+        }
+        self.bounds.unwrap_or_default()
     }
 
     /// Every interface inside the structure's cluster (top body `e0`, friction `f_top0` from
@@ -594,12 +603,11 @@ impl<'s> Exact<'s> {
     /// ending at `b` (the same test the two break events' searches start with, done once);
     /// when not, the searches run.
     fn breaks_clear(&self, b: &Basis) -> bool {
-        let (upper, lower) = self.bounds.unwrap_or_default();
-        if upper.is_none() && lower.is_none() {
+        let bounds = self.bounds.unwrap_or_default();
+        if bounds == (None, None) {
             return true;
         }
-        let hi = upper.map_or(f64::INFINITY, |u| u.0);
-        let lo = lower.map_or(f64::NEG_INFINITY, |l| l.0);
+        let (lo, hi) = accel_limits(bounds);
         let (n0, n1) = (self.a0.node(Basis::ZERO), self.a0.node(*b));
         self.a0
             .range_within((&n0.0, n0.1, n0.2), (&n1.0, n1.1, n1.2), lo, hi)
