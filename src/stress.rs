@@ -120,6 +120,7 @@ use crate::dynamics::{
     Contact, ExactOptions, Ground, Response, SimError, System, SystemSpec, simulate_exact,
 };
 use crate::motion::StochasticModel;
+use crate::report::sci;
 use std::fmt::Write as _;
 
 /// How a case's ground acceleration is built: synthetic signals in code, or the built-in
@@ -692,15 +693,6 @@ pub fn friction_bound_excess(sys: &System, r: &Response) -> f64 {
         }
     }
     worst
-}
-
-/// A number for the tables: `0`, or two significant digits in scientific notation.
-pub(crate) fn sci(x: f64) -> String {
-    if x == 0.0 {
-        "0".into()
-    } else {
-        format!("{x:.1e}")
-    }
 }
 
 /// The switches cell: the count against its budget, or how the run ended if it did not complete.

@@ -182,6 +182,15 @@ pub fn table(header: &[&str], rows: &[Vec<String>]) -> String {
     s + "</table>"
 }
 
+/// A number for tables: `0`, or two significant digits in scientific notation (`1.5e-13`).
+pub fn sci(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        format!("{x:.1e}")
+    }
+}
+
 pub fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")

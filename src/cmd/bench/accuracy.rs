@@ -30,7 +30,7 @@ use slidestack::dynamics::{
     ExactOptions, Ground, Response, System, SystemSpec, simulate_exact, simulate_rk4,
 };
 use slidestack::motion::{self, Record, read_record};
-use slidestack::report::{self, Series};
+use slidestack::report::{self, Series, sci};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -557,14 +557,6 @@ struct Tables {
     summary: Table,
     overall: Vec<String>,
     details: Table,
-}
-
-fn sci(x: f64) -> String {
-    if x == 0.0 {
-        "0".to_string()
-    } else {
-        format!("{x:.1e}")
-    }
 }
 
 fn opt(x: Option<f64>, digits: usize) -> String {
