@@ -5,7 +5,9 @@
 //! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
 //! * [`fit`]: the design equation for T_new: forms, argmin problems, metrics.
 //! * [`report`]: SVG figures and the HTML report.
-//! * [`study`]: the study configuration and its stages.
+//! * [`grid`]: the study's case grid (axes and indexing).
+//! * [`study`]: the study's numerics and configuration.
+//! * [`pipeline`]: the study's stages as library code: one shape, the output lock, checks.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
 //! * [`accuracy`]: work-precision measures (errors against a reference, observed orders).
 //! * [`stress`]: the numerical stress suite: extreme but legal cases and their checks.
@@ -15,8 +17,10 @@
 pub mod accuracy;
 pub mod dynamics;
 pub mod fit;
+pub mod grid;
 pub mod motion;
 mod numeric;
+pub mod pipeline;
 pub mod report;
 pub mod spectrum;
 pub mod store;

@@ -3,6 +3,7 @@
 mod cmd;
 
 use clap::{Parser, Subcommand};
+use slidestack::pipeline::StageId;
 
 /// Seismic response of a structure carrying stacks of sliding rigid blocks.
 #[derive(Debug, Parser)]
@@ -21,19 +22,21 @@ enum Command {
     /// Match records to a target spectrum (wavelet adjustment) and write them as .AT2 files.
     Match(cmd::matching::Args),
     /// Study stage 1: seed motions matched to every zone's target → motions.h5.
-    Motions(cmd::motions::Args),
+    Motions(cmd::StudyArgs),
     /// Study stage 2: every case of the grid under every motion → sweep.h5 (resumable, shards).
     Sweep(cmd::sweep::Args),
     /// Join the units of a sharded sweep into sweep.h5.
-    Merge(cmd::sweep::MergeArgs),
+    Merge(cmd::StudyArgs),
     /// Study stage 3: T_new and the displacement response ratios → tnew.h5.
-    Tnew(cmd::tnew::Args),
+    Tnew(cmd::StudyArgs),
     /// Study stage 4: fit the design equation for T_new (argmin) → fit.h5, fit.yaml.
-    Fit(cmd::fit::Args),
+    Fit(cmd::StudyArgs),
     /// Study stage 5: figures and tables → report/index.html.
-    Report(cmd::report::Args),
+    Report(cmd::StudyArgs),
     /// The whole study: motions, sweep, tnew, fit, report (each skipped when up to date).
-    Run(cmd::run::Args),
+    Run(cmd::StudyArgs),
+    /// What is on disk for every stage of a study (for people and job scripts).
+    Status(cmd::status::Args),
     /// Evidence: work-precision of the integrators and the numerical stress suite.
     #[command(subcommand)]
     Bench(cmd::bench::BenchCommand),
@@ -52,20 +55,21 @@ fn main() -> std::process::ExitCode {
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Spectrum(args) => cmd::spectrum::run(args),
         Command::Match(args) => cmd::matching::run(args),
-        Command::Motions(args) => cmd::motions::run(args),
+        Command::Motions(args) => cmd::stage::run(args, StageId::Motions),
         Command::Sweep(args) => cmd::sweep::run(args),
         Command::Merge(args) => cmd::sweep::merge(args),
-        Command::Tnew(args) => cmd::tnew::run(args),
-        Command::Fit(args) => cmd::fit::run(args),
-        Command::Report(args) => cmd::report::run(args),
+        Command::Tnew(args) => cmd::stage::run(args, StageId::Tnew),
+        Command::Fit(args) => cmd::stage::run(args, StageId::Fit),
+        Command::Report(args) => cmd::stage::run(args, StageId::Report),
         Command::Run(args) => cmd::run::run(args),
+        Command::Status(args) => cmd::status::run(args),
         Command::Bench(command) => cmd::bench::run(command),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
-            std::process::ExitCode::FAILURE
+            eprintln!("error: {}", cmd::message(&e));
+            std::process::ExitCode::from(cmd::exit_code(&e))
         }
     }
 }

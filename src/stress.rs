@@ -491,7 +491,7 @@ fn square(dt_s: f64, duration_s: f64, amplitude_mps2: f64, half_period_s: f64) -
         .map(|k| {
             if k == 0 {
                 0.0
-            } else if ((k - 1) / per_half) % 2 == 0 {
+            } else if ((k - 1) / per_half).is_multiple_of(2) {
                 amplitude_mps2
             } else {
                 -amplitude_mps2

@@ -239,9 +239,10 @@ fn motions_stage_writes_skips_and_rebuilds() {
     let motions = slidestack::store::motions::read_zone_motions(&path, "III").unwrap();
     let report = slidestack::store::motions::read_zone_report(&path, "III").unwrap();
     assert_eq!(motions.len(), report.iter().filter(|r| r.1).count());
-    let (periods, target, mean) =
-        slidestack::store::motions::read_zone_spectra(&path, "III").unwrap();
-    assert_eq!((periods.len(), target.len(), mean.len()), (200, 200, 200));
+    let s = slidestack::store::motions::read_zone_spectra(&path, "III").unwrap();
+    let sizes = (s.periods_s.len(), s.target_psa_g.len(), s.mean_psa_g.len());
+    assert_eq!(sizes, (200, 200, 200));
+    assert_eq!(s.psa_g.dim(), (motions.len(), 200));
     let before = std::fs::read(&path).unwrap();
 
     // Up to date: nothing is redone and the file is untouched.

@@ -4,11 +4,12 @@ mod common;
 
 use common::real_records;
 use slidestack::dynamics::Ground;
+use slidestack::grid::Grid;
 use slidestack::study::config::{GridConfig, Values};
-use slidestack::study::sweep::{Grid, UnitOptions, run_unit};
+use slidestack::study::sweep::{Physics, UnitOptions, run_unit};
 
-fn grid(ratio: f64) -> Grid {
-    Grid::from_config(&GridConfig {
+fn grid(ratio: f64) -> (Grid, Physics) {
+    let g = GridConfig {
         period_s: Values::List(vec![0.3, 1.0]),
         alpha: vec![Values::List(vec![0.1, 1.0]), Values::List(vec![0.5, 1.0])],
         // From "never slips" (0.9) to sliding (0.05), with increasing and decreasing pairs.
@@ -18,7 +19,8 @@ fn grid(ratio: f64) -> Grid {
         ],
         mu_static_ratio: ratio,
         damping: 0.05,
-    })
+    };
+    (g.axes(), g.physics())
 }
 
 #[test]
@@ -28,7 +30,7 @@ fn skip_rules_equal_brute_force() {
     // the stack whose upper interfaces never slip (1e-9, the limit tests' bound is 1e-10).
     let mut counts = [0usize; 3];
     for ratio in [1.0, 1.5] {
-        let g = grid(ratio);
+        let (g, physics) = grid(ratio);
         for rec in &real_records()[..2] {
             let accel = rec.accel_mps2(1.0);
             let ground = Ground {
@@ -36,8 +38,8 @@ fn skip_rules_equal_brute_force() {
                 accel_mps2: &accel,
             };
             for p in 0..g.periods_s.len() {
-                let fast = run_unit(&g, &ground, p, UnitOptions { skip: true }).unwrap();
-                let slow = run_unit(&g, &ground, p, UnitOptions { skip: false }).unwrap();
+                let fast = run_unit(&g, &physics, &ground, p, UnitOptions { skip: true }).unwrap();
+                let slow = run_unit(&g, &physics, &ground, p, UnitOptions { skip: false }).unwrap();
                 assert!(slow.skip_rule.iter().all(|&r| r == 0));
                 for c in 0..g.cases_per_unit() {
                     counts[fast.skip_rule[c] as usize] += 1;

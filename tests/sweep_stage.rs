@@ -39,9 +39,12 @@ fn config(dir: &Path) -> PathBuf {
     cfg
 }
 
+/// Copies `motions.h5` and its checksum sidecar.
 fn copy_motions(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
-    std::fs::copy(from.join("motions.h5"), to.join("motions.h5")).unwrap();
+    for f in ["motions.h5", "motions.h5.sha256"] {
+        std::fs::copy(from.join(f), to.join(f)).unwrap();
+    }
 }
 
 #[test]
@@ -176,7 +179,8 @@ fn sweep_refuses_what_it_cannot_do() {
     let o = slidestack(&["sweep", cfg_s], "1");
     assert!(!o.status.success());
     assert!(
-        String::from_utf8_lossy(&o.stderr).contains("is missing or out of date"),
+        String::from_utf8_lossy(&o.stderr)
+            .contains("motions.h5 is missing: run `slidestack motions"),
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );

@@ -1,19 +1,140 @@
-//! One module per subcommand; each starts with what it reads and writes.
+//! One module per subcommand: each parses its arguments, calls the library and prints. The
+//! study's stages share [`StudyArgs`], [`CliReporter`] and [`print_outcome`].
 
 pub mod bench;
-pub mod fit;
 pub mod matching;
-pub mod motions;
-pub mod report;
 pub mod run;
 pub mod simulate;
 pub mod spectrum;
+pub mod stage;
+pub mod status;
 pub mod sweep;
-pub mod tnew;
 
 use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
 use slidestack::motion::{ReadOptions, Record, Units, read_record_with};
+use slidestack::pipeline::lock::LockMode;
+use slidestack::pipeline::{
+    Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, Study,
+};
+use std::io::IsTerminal;
 use std::path::PathBuf;
+
+/// What every study stage takes.
+#[derive(Debug, Clone, clap::Args)]
+pub struct StudyArgs {
+    /// Study file (YAML).
+    pub config: PathBuf,
+    /// Output directory [default: the config's output_dir].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Rebuild even when the stored fingerprint says the output is up to date.
+    #[arg(long)]
+    pub force: bool,
+    /// Refuse instead of waiting when another run holds the output directory.
+    #[arg(long)]
+    pub no_wait: bool,
+}
+
+impl StudyArgs {
+    pub fn study(&self) -> Result<Study, PipelineError> {
+        Study::load(&self.config, self.out.clone())
+    }
+
+    /// The study with its output directory locked.
+    pub fn session<'r>(
+        &self,
+        mode: LockMode,
+        reporter: &'r CliReporter,
+    ) -> Result<Session<'r>, PipelineError> {
+        Session::open(self.study()?, mode, !self.no_wait, reporter)
+    }
+
+    pub fn options(&self) -> StageOptions {
+        StageOptions { force: self.force }
+    }
+}
+
+/// Progress on stdout (`stage: …`), warnings on stderr, a bar on a terminal.
+pub struct CliReporter;
+
+impl Reporter for CliReporter {
+    fn info(&self, stage: StageId, message: &str) {
+        println!("{stage}: {message}");
+    }
+    fn warn(&self, stage: StageId, message: &str) {
+        eprintln!("{stage}: warning: {message}");
+    }
+    fn progress(&self, _stage: StageId, total: u64) -> Box<dyn Progress + '_> {
+        if !std::io::stderr().is_terminal() {
+            return Box::new(Bar(ProgressBar::hidden()));
+        }
+        let style =
+            ProgressStyle::with_template("{bar:40} {pos}/{len} units, {per_sec}, ETA {eta}")
+                .expect("valid template");
+        Box::new(Bar(ProgressBar::new(total).with_style(style)))
+    }
+}
+
+struct Bar(ProgressBar);
+
+impl Progress for Bar {
+    fn inc(&self) {
+        self.0.inc(1);
+    }
+    fn finish(&self) {
+        self.0.finish_and_clear();
+    }
+}
+
+/// One line saying what a stage did.
+pub fn print_outcome(stage: StageId, outcome: &Outcome, config: &std::path::Path) {
+    match outcome {
+        Outcome::UpToDate(p) => println!("{stage}: {} is up to date", p.display()),
+        Outcome::Wrote(paths) => {
+            let list: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+            println!("{stage}: wrote {}", list.join(" and "));
+        }
+        Outcome::ShardDone { k, n } => println!(
+            "{stage}: shard {k}/{n} done; run `slidestack merge {}` when every shard is done",
+            config.display()
+        ),
+    }
+}
+
+/// The process exit code for an error: 2 when the input was at fault (a bad config, file or
+/// argument), 1 when the run failed.
+pub fn exit_code(e: &anyhow::Error) -> u8 {
+    let bad_input = e.chain().any(|c| {
+        c.downcast_ref::<PipelineError>()
+            .is_some_and(PipelineError::is_bad_input)
+            || c.is::<slidestack::study::config::ConfigError>()
+            || c.is::<slidestack::motion::RecordError>()
+            || c.is::<BadInput>()
+    });
+    if bad_input { 2 } else { 1 }
+}
+
+/// An argument the user got wrong (exit code 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+/// The message of an error and its causes, each cause once: a cause whose text the message
+/// already holds (error types that repeat their source) is not printed again.
+pub fn message(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let c = cause.to_string();
+        if !text.contains(&c) {
+            if !text.is_empty() {
+                text += ": ";
+            }
+            text += &c;
+        }
+    }
+    text
+}
 
 /// Ground-motion files and how to read them, shared by the commands that take records.
 #[derive(Debug, clap::Args)]

@@ -363,10 +363,10 @@ impl<'s> Exact<'s> {
                     } else {
                         Basis::at(osc, limit)
                     };
-                    if let Some(t) = first_violation(&ev.g, osc, &b_end, self.dt) {
-                        if first.is_none_or(|f| t < f.0) {
-                            first = Some((t, e));
-                        }
+                    if let Some(t) = first_violation(&ev.g, osc, &b_end, self.dt)
+                        && first.is_none_or(|f| t < f.0)
+                    {
+                        first = Some((t, e));
                     }
                 }
                 let end = first.map_or(h, |f| f.0);
@@ -734,14 +734,14 @@ impl<'s> Exact<'s> {
             self.merge_stopped();
         }
         self.select(ga)?;
-        if let EventKind::Break(i) = kind {
-            if self.contacts == self.before {
-                // The event proved the demand exceeds the static limit; a selection that changes
-                // nothing (the force pinned at the limit with a relative acceleration below
-                // round-off) is resolved here: the interface slips against its force.
-                self.contacts[i] = Contact::Slip(if self.force[i] > 0.0 { -1 } else { 1 });
-                self.select(ga)?;
-            }
+        if let EventKind::Break(i) = kind
+            && self.contacts == self.before
+        {
+            // The event proved the demand exceeds the static limit; a selection that changes
+            // nothing (the force pinned at the limit with a relative acceleration below
+            // round-off) is resolved here: the interface slips against its force.
+            self.contacts[i] = Contact::Slip(if self.force[i] > 0.0 { -1 } else { 1 });
+            self.select(ga)?;
         }
         let changed = self
             .contacts

@@ -238,11 +238,12 @@ impl<'s> Rk4<'s> {
                     .filter(|(a, b)| a != b)
                     .count() as u64;
                 prev.copy_from_slice(&self.contacts);
-                if k == 0 && sub == 0 {
-                    if let Some(hist) = history.as_mut() {
-                        self.accelerations(&self.x, &self.v, acc_g[0], &mut kv[0], &mut abs);
-                        record(hist, 0.0, acc_g[0], &self.x, &self.v, &abs, &self.contacts);
-                    }
+                if k == 0
+                    && sub == 0
+                    && let Some(hist) = history.as_mut()
+                {
+                    self.accelerations(&self.x, &self.v, acc_g[0], &mut kv[0], &mut abs);
+                    record(hist, 0.0, acc_g[0], &self.x, &self.v, &abs, &self.contacts);
                 }
                 for i in 0..n {
                     s_before[i] = self.v[i + 1] - self.v[i];

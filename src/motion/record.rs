@@ -697,16 +697,16 @@ pub fn parse_text(text: &str, file: &str, opts: &ReadOptions) -> Result<Record, 
     };
     if !times.is_empty() {
         // The time column is the file's own statement of the step.
-        if let Some(d) = &dt_decl {
-            if !same_dt(step, d.value) {
-                return Err(RecordError::DtColumn {
-                    file: file.to_string(),
-                    line: d.line,
-                    declared: d.value,
-                    step,
-                    step_line,
-                });
-            }
+        if let Some(d) = &dt_decl
+            && !same_dt(step, d.value)
+        {
+            return Err(RecordError::DtColumn {
+                file: file.to_string(),
+                line: d.line,
+                declared: d.value,
+                step,
+                step_line,
+            });
         }
         check_dt_agrees(step, step_line, opts, file)?;
     }

@@ -461,15 +461,15 @@ fn parse_table(text: &str, file: &str) -> Result<(Vec<f64>, Vec<f64>), TargetErr
                 period_s: period,
             });
         }
-        if let Some(&previous_s) = periods_s.last() {
-            if period <= previous_s {
-                return Err(TargetError::TablePeriodOrder {
-                    file: file.to_string(),
-                    line,
-                    period_s: period,
-                    previous_s,
-                });
-            }
+        if let Some(&previous_s) = periods_s.last()
+            && period <= previous_s
+        {
+            return Err(TargetError::TablePeriodOrder {
+                file: file.to_string(),
+                line,
+                period_s: period,
+                previous_s,
+            });
         }
         if sa <= 0.0 {
             return Err(TargetError::TableSa {

@@ -1,7 +1,19 @@
-//! Small HDF5 helpers shared by the stage files: string attributes, 1-D and 2-D `f64` datasets
-//! with `units` and `long_name`, string datasets.
+//! HDF5 helpers shared by the stage files: attributes, labelled variables, dimension scales and
+//! the stage-file envelope.
+//!
+//! Every stage file is written by [`write_stage_file`]: into a temporary unique to the process,
+//! flushed and closed with both results checked, read back, synced and renamed; then its SHA-256
+//! goes into a sidecar `NAME.sha256` (the format of `sha256sum`, so `sha256sum -c` checks it
+//! too). [`stored_fingerprint`] accepts a file only when it matches its sidecar, so a file
+//! changed, truncated or damaged after it was written is never taken as up to date. Chunked
+//! variables also carry HDF5's Fletcher32 filter, so any reader (h5py, xarray) fails on a
+//! damaged chunk instead of returning wrong numbers.
 
+use super::atomic::Temp;
+use super::{H5Context, StoreError, checksum};
 use hdf5::types::VarLenUnicode;
+use ndarray::{ArrayD, ArrayViewD};
+use std::path::Path;
 
 /// Writes (or replaces) the string attribute `name`.
 pub fn attr_str(obj: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
@@ -31,6 +43,25 @@ pub fn read_attr_f64(obj: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
     obj.attr(name)?.read_scalar::<f64>()
 }
 
+/// A small contiguous `f64` dataset of any shape with its units and description.
+pub fn write_small(
+    g: &hdf5::Group,
+    name: &str,
+    data: ArrayViewD<f64>,
+    units: &str,
+    long_name: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = g
+        .new_dataset::<f64>()
+        .shape(data.shape())
+        .obj_track_times(false)
+        .create(name)?;
+    ds.write(data)?;
+    attr_str(&ds, "units", units)?;
+    attr_str(&ds, "long_name", long_name)?;
+    Ok(ds)
+}
+
 /// A 1-D `f64` dataset with its units and description.
 pub fn write_1d(
     g: &hdf5::Group,
@@ -39,27 +70,13 @@ pub fn write_1d(
     units: &str,
     long_name: &str,
 ) -> hdf5::Result<hdf5::Dataset> {
-    let ds = g.new_dataset::<f64>().shape(data.len()).create(name)?;
-    ds.write_raw(data)?;
-    attr_str(&ds, "units", units)?;
-    attr_str(&ds, "long_name", long_name)?;
-    Ok(ds)
-}
-
-/// A row-major 2-D `f64` dataset `[rows][cols]`.
-pub fn write_2d(
-    g: &hdf5::Group,
-    name: &str,
-    data: &[f64],
-    shape: (usize, usize),
-    units: &str,
-    long_name: &str,
-) -> hdf5::Result<hdf5::Dataset> {
-    let ds = g.new_dataset::<f64>().shape(shape).create(name)?;
-    ds.write_raw(data)?;
-    attr_str(&ds, "units", units)?;
-    attr_str(&ds, "long_name", long_name)?;
-    Ok(ds)
+    write_small(
+        g,
+        name,
+        ndarray::ArrayView1::from(data).into_dyn(),
+        units,
+        long_name,
+    )
 }
 
 /// A 1-D dataset of strings.
@@ -119,28 +136,71 @@ pub fn attach_scale(data: &hdf5::Dataset, scale: &hdf5::Dataset, idx: usize) -> 
     Ok(())
 }
 
-/// A chunked, deflate+shuffle compressed `f64` variable with NaN fill.
-pub fn scalar_var(
+/// Attaches `scales` to the leading dimensions of `ds`, in order.
+pub fn attach_all(ds: &hdf5::Dataset, scales: &[hdf5::Dataset]) -> hdf5::Result<()> {
+    for (d, s) in scales.iter().enumerate() {
+        attach_scale(ds, s, d)?;
+    }
+    Ok(())
+}
+
+/// A chunked variable: shuffle + deflate compressed, Fletcher32-checksummed, with `fill` as the
+/// fill value.
+fn chunked<T: hdf5::H5Type + Copy>(
     g: &hdf5::Group,
     name: &str,
-    shape: &[usize],
+    data: ArrayViewD<T>,
     chunk: &[usize],
-    data: &[f64],
-    units: &str,
-    long: &str,
+    fill: T,
 ) -> hdf5::Result<hdf5::Dataset> {
     let ds = g
-        .new_dataset::<f64>()
-        .shape(shape.to_vec())
+        .new_dataset::<T>()
+        .shape(data.shape())
         .chunk(chunk.to_vec())
         .shuffle()
         .deflate(4)
-        .fill_value(f64::NAN)
+        .fletcher32()
+        .fill_value(fill)
         .obj_track_times(false)
         .create(name)?;
-    ds.write_raw(data)?;
+    ds.write(data)?;
+    Ok(ds)
+}
+
+/// A chunked `f64` variable with NaN fill, its units and description.
+pub fn write_var(
+    g: &hdf5::Group,
+    name: &str,
+    data: ArrayViewD<f64>,
+    chunk: &[usize],
+    units: &str,
+    long_name: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = chunked(g, name, data, chunk, f64::NAN)?;
     attr_str(&ds, "units", units)?;
-    attr_str(&ds, "long_name", long)?;
+    attr_str(&ds, "long_name", long_name)?;
+    Ok(ds)
+}
+
+/// A chunked `u8` code variable with fill 255 and CF `flag_values`/`flag_meanings` attributes
+/// (`meanings` pairs each code with a one-word meaning).
+pub fn write_flags(
+    g: &hdf5::Group,
+    name: &str,
+    data: ArrayViewD<u8>,
+    chunk: &[usize],
+    long_name: &str,
+    meanings: &[(u8, &str)],
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = chunked(g, name, data, chunk, 255u8)?;
+    attr_str(&ds, "long_name", long_name)?;
+    let values: Vec<u8> = meanings.iter().map(|m| m.0).collect();
+    ds.new_attr::<u8>()
+        .shape(values.len())
+        .create("flag_values")?
+        .write_raw(&values)?;
+    let words: Vec<&str> = meanings.iter().map(|m| m.1).collect();
+    attr_str(&ds, "flag_meanings", &words.join(" "))?;
     Ok(ds)
 }
 
@@ -152,51 +212,150 @@ pub fn coordinate(
     units: &str,
     long: &str,
 ) -> hdf5::Result<hdf5::Dataset> {
-    let ds = g
-        .new_dataset::<f64>()
-        .shape(values.len())
-        .obj_track_times(false)
-        .create(name)?;
-    ds.write_raw(values)?;
-    attr_str(&ds, "units", units)?;
-    attr_str(&ds, "long_name", long)?;
+    let ds = write_1d(g, name, values, units, long)?;
     set_scale(&ds, name)?;
     Ok(ds)
 }
 
-/// A whole `f64` dataset `group/name` of the file at `path`, flat.
-pub fn read_f64(path: &std::path::Path, group: &str, name: &str) -> hdf5::Result<Vec<f64>> {
-    hdf5::File::open(path)?
-        .group(group)?
-        .dataset(name)?
-        .read_raw::<f64>()
+/// A whole `f64` dataset of a group, with its shape.
+pub fn read_var(g: &hdf5::Group, name: &str) -> hdf5::Result<ArrayD<f64>> {
+    g.dataset(name)?.read_dyn::<f64>()
 }
 
-/// A scalar `f64` attribute of `group` in the file at `path`.
-pub fn read_group_attr(path: &std::path::Path, group: &str, name: &str) -> hdf5::Result<f64> {
-    let g = hdf5::File::open(path)?.group(group)?;
-    read_attr_f64(&g, name)
+/// A whole `u8` dataset of a group, with its shape.
+pub fn read_flags(g: &hdf5::Group, name: &str) -> hdf5::Result<ArrayD<u8>> {
+    g.dataset(name)?.read_dyn::<u8>()
 }
 
-/// Writes a stage file at `path` atomically: `fill` writes into a new file `path.h5.tmp` (object
-/// times not tracked, so equal contents give equal bytes) that already carries the `contents`,
-/// `slidestack_version` and `fingerprint` attributes; the file is then renamed to `path`, so a
-/// reader never sees a half-written stage file.
+/// Opens a stage file for reading, naming it on failure.
+pub fn open(path: &Path) -> Result<hdf5::File, StoreError> {
+    hdf5::File::open(path).at(path)
+}
+
+/// A group of a file opened with [`open`], naming the file on failure.
+pub fn group(f: &hdf5::File, path: &Path, name: &str) -> Result<hdf5::Group, StoreError> {
+    f.group(name).at(path)
+}
+
+/// Writes a stage file at `path` (see the module doc). `fill` writes the contents into a file
+/// that already carries the `contents`, `slidestack_version` and `fingerprint` attributes (object
+/// times not tracked, so equal contents give equal bytes).
 pub fn write_stage_file(
-    path: &std::path::Path,
+    path: &Path,
     contents: &str,
     fingerprint: &str,
     fill: impl FnOnce(&hdf5::File) -> hdf5::Result<()>,
-) -> hdf5::Result<()> {
-    let tmp = path.with_extension("h5.tmp");
-    {
+) -> Result<(), StoreError> {
+    let tmp = Temp::for_path(path);
+    let write = || -> hdf5::Result<()> {
         let f = hdf5::File::with_options()
             .with_fcpl(|p| p.obj_track_times(false))
-            .create(&tmp)?;
+            .create(tmp.path())?;
         attr_str(&f, "contents", contents)?;
         attr_str(&f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
         attr_str(&f, "fingerprint", fingerprint)?;
         fill(&f)?;
+        f.flush()?;
+        f.close()
+    };
+    write().at(path)?;
+    let back = hdf5::File::open(tmp.path()).at(path)?;
+    let stored = read_attr_str(&back, "fingerprint");
+    drop(back);
+    if stored.as_deref() != Some(fingerprint) {
+        return Err(StoreError::corrupt(
+            path,
+            "the written file does not read back its fingerprint",
+        ));
     }
-    std::fs::rename(&tmp, path).map_err(|e| hdf5::Error::from(e.to_string()))
+    checksum::commit_with_sidecar(tmp, path)
+}
+
+/// The fingerprint stored in the stage file at `path`: `None` when there is no file; an error
+/// when the file does not match its checksum sidecar (changed or damaged after it was written,
+/// or its write was interrupted) or cannot be read.
+pub fn stored_fingerprint(path: &Path) -> Result<Option<String>, StoreError> {
+    if !checksum::verify(path)? {
+        return Ok(None);
+    }
+    let f = open(path)?;
+    read_attr_str(&f, "fingerprint")
+        .map(Some)
+        .ok_or_else(|| StoreError::corrupt(path, "has no fingerprint attribute"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(path: &Path, fp: &str) {
+        write_stage_file(path, "test", fp, |f| {
+            let g = f.create_group("g")?;
+            let a = ndarray::Array::from_shape_fn((3, 4), |(i, j)| (i * 4 + j) as f64).into_dyn();
+            write_var(&g, "v", a.view(), &[1, 4], "m", "a variable")?;
+            Ok(())
+        })
+        .unwrap();
+    }
+
+    #[test]
+    fn stage_file_verifies_itself() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x.h5");
+        assert!(stored_fingerprint(&p).unwrap().is_none());
+        sample(&p, "abc");
+        assert_eq!(stored_fingerprint(&p).unwrap().as_deref(), Some("abc"));
+        let text = std::fs::read_to_string(checksum::sidecar_path(&p)).unwrap();
+        assert!(text.ends_with("  x.h5\n"), "{text}");
+        // The chunked variable reads back with its shape.
+        let f = open(&p).unwrap();
+        let v = read_var(&f.group("g").unwrap(), "v").unwrap();
+        assert_eq!(v.shape(), &[3, 4]);
+        assert_eq!(v[[2, 3]], 11.0);
+        drop(f);
+
+        // One flipped byte anywhere: refused by the sidecar.
+        let mut bytes = std::fs::read(&p).unwrap();
+        let mid = bytes.len() / 2;
+        bytes[mid] ^= 0x40;
+        std::fs::write(&p, &bytes).unwrap();
+        let e = stored_fingerprint(&p).unwrap_err().to_string();
+        assert!(e.contains("does not match its checksum"), "{e}");
+
+        // No sidecar: refused.
+        sample(&p, "abc");
+        std::fs::remove_file(checksum::sidecar_path(&p)).unwrap();
+        let e = stored_fingerprint(&p).unwrap_err().to_string();
+        assert!(e.contains("has no checksum file"), "{e}");
+    }
+
+    #[test]
+    fn fletcher32_catches_a_damaged_chunk_without_the_sidecar() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x.h5");
+        // Incompressible values so the chunk's bytes can be found and damaged.
+        write_stage_file(&p, "test", "f", |f| {
+            let g = f.create_group("g")?;
+            let a = ndarray::Array::from_shape_fn(64, |i| 1.0 + (i as f64).sin() * 1e-3).into_dyn();
+            write_var(&g, "v", a.view(), &[64], "m", "v")?;
+            Ok(())
+        })
+        .unwrap();
+        let f = open(&p).unwrap();
+        let chunk = f
+            .group("g")
+            .unwrap()
+            .dataset("v")
+            .unwrap()
+            .chunk_info(0)
+            .unwrap();
+        drop(f);
+        let mut bytes = std::fs::read(&p).unwrap();
+        let mid = (chunk.addr + chunk.size / 2) as usize;
+        bytes[mid] ^= 0x55;
+        std::fs::write(&p, &bytes).unwrap();
+        let f = hdf5::File::open(&p);
+        let read = f.and_then(|f| f.group("g")?.dataset("v")?.read_raw::<f64>());
+        assert!(read.is_err(), "a damaged chunk must not read back");
+    }
 }

@@ -1,18 +1,89 @@
-//! Writing and reading result files: time histories (HDF5 or CSV), the stage files, input
-//! fingerprints.
+//! Result files: their layouts, how they are written (atomically, checked) and how they prove on
+//! reading that they are what was written. Knows file layouts, not the study: every writer takes
+//! plain data (slices, [`ndarray`] arrays, the [`crate::grid::Grid`] axes).
 //!
+//! * [`atomic`]: checked atomic writes (unique temporary, fsync, rename).
+//! * [`h5`]: HDF5 helpers: labelled variables with checksummed chunks, dimension scales, the
+//!   stage-file envelope (fingerprint, checksum sidecar, verification).
+//! * [`units`]: the sweep's per-unit files (identity, checksum) for resuming and sharding.
+//! * [`motions`], [`sweep`], [`tnew`], [`fit`]: the stage files.
 //! * [`history`]: one simulation's time history.
-//! * [`motions`]: `motions.h5`, the ground-motion stage.
-//! * [`sweep`]: the sweep's unit files and `sweep.h5`.
-//! * [`tnew`]: the T_new stage file, `tnew.h5`.
 //! * [`fingerprint`]: SHA-256 of inputs, for up-to-date checks.
-//! * [`h5`]: small HDF5 helpers.
 
+pub mod atomic;
+pub mod checksum;
 pub mod fingerprint;
+pub mod fit;
 pub mod h5;
 pub mod history;
 pub mod motions;
+pub mod report;
 pub mod sweep;
 pub mod tnew;
+pub mod units;
 
-pub use history::{HistoryFormat, StoreError, write_history};
+pub use history::{HistoryFormat, write_history};
+
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// A file that could not be written or read as it should be; always names the file.
+#[derive(Debug, Error)]
+pub enum StoreError {
+    #[error("{}: {op}: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        op: &'static str,
+        source: std::io::Error,
+    },
+    #[error("{}: HDF5: {source}", file.display())]
+    Hdf5 { file: PathBuf, source: hdf5::Error },
+    /// The file exists but is not what was written: checksum, identity or layout differs.
+    #[error("{}: {why}", file.display())]
+    Corrupt { file: PathBuf, why: String },
+    #[error("{}: history file must end in .h5, .hdf5 or .csv", .0.display())]
+    Format(PathBuf),
+}
+
+impl StoreError {
+    pub fn io(file: &Path, op: &'static str, source: std::io::Error) -> Self {
+        Self::Io {
+            file: file.to_path_buf(),
+            op,
+            source,
+        }
+    }
+
+    pub fn hdf5(file: &Path, source: hdf5::Error) -> Self {
+        Self::Hdf5 {
+            file: file.to_path_buf(),
+            source,
+        }
+    }
+
+    pub fn corrupt(file: &Path, why: impl Into<String>) -> Self {
+        Self::Corrupt {
+            file: file.to_path_buf(),
+            why: why.into(),
+        }
+    }
+
+    /// The file this error is about.
+    pub fn file(&self) -> &Path {
+        match self {
+            Self::Io { file, .. } | Self::Hdf5 { file, .. } | Self::Corrupt { file, .. } => file,
+            Self::Format(file) => file,
+        }
+    }
+}
+
+/// Attaches the file name to an HDF5 result.
+pub(crate) trait H5Context<T> {
+    fn at(self, file: &Path) -> Result<T, StoreError>;
+}
+
+impl<T> H5Context<T> for hdf5::Result<T> {
+    fn at(self, file: &Path) -> Result<T, StoreError> {
+        self.map_err(|e| StoreError::hdf5(file, e))
+    }
+}

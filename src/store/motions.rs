@@ -17,9 +17,10 @@
 //! ```
 
 use super::h5::{
-    attr_f64, attr_str, read_attr_f64, read_attr_str, read_strings, write_1d, write_2d,
+    attr_f64, attr_str, open, read_attr_f64, read_attr_str, read_strings, write_1d, write_small,
     write_stage_file, write_strings,
 };
+use super::{H5Context, StoreError};
 use crate::motion::Record;
 use crate::motion::matching::MatchReport;
 use crate::study::motions::ZoneMotions;
@@ -49,14 +50,13 @@ fn read_record(g: &hdf5::Group, key: &str) -> hdf5::Result<Record> {
     })
 }
 
-/// Writes `motions.h5` at `path` (through a temporary file renamed at the end, so a reader
-/// never sees a half-written file).
+/// Writes `motions.h5` at `path` (checked and atomic, [`write_stage_file`]).
 pub fn write_motions(
     path: &Path,
     meta: &StageMeta,
     seeds: &[Record],
     zones: &[(ZoneMotions, String)],
-) -> hdf5::Result<()> {
+) -> Result<(), StoreError> {
     write_stage_file(
         path,
         "slidestack motions stage: seed motions, motions matched per zone, their spectra",
@@ -108,11 +108,12 @@ fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Resul
     let names: Vec<String> = z.motions.iter().map(|m| m.name.clone()).collect();
     write_strings(&g, "motion", &names, "kept (matched and accepted) motions")?;
     let flat: Vec<f64> = z.psa_g.iter().flatten().copied().collect();
-    let ds = write_2d(
+    let psa = ndarray::Array2::from_shape_vec((z.psa_g.len(), z.periods_s.len()), flat)
+        .map_err(|e| hdf5::Error::from(e.to_string()))?;
+    let ds = write_small(
         &g,
         "psa_g",
-        &flat,
-        (z.psa_g.len(), z.periods_s.len()),
+        psa.view().into_dyn(),
         "g",
         "pseudo-spectral acceleration of each kept motion (5 % damping)",
     )?;
@@ -200,46 +201,64 @@ fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Resul
     Ok(())
 }
 
-/// The stage fingerprint stored in an existing file, if it can be read.
-pub fn read_fingerprint(path: &Path) -> Option<String> {
-    let f = hdf5::File::open(path).ok()?;
-    read_attr_str(&f, "fingerprint")
-}
-
 /// The zone names of a motions file, in file order.
-pub fn zone_names(path: &Path) -> hdf5::Result<Vec<String>> {
-    let f = hdf5::File::open(path)?;
-    Ok(f.member_names()?
+pub fn zone_names(path: &Path) -> Result<Vec<String>, StoreError> {
+    let f = open(path)?;
+    Ok(f.member_names()
+        .at(path)?
         .into_iter()
         .filter_map(|n| n.strip_prefix("zone_").map(str::to_string))
         .collect())
 }
 
 /// The kept motions of one zone, in order.
-pub fn read_zone_motions(path: &Path, zone: &str) -> hdf5::Result<Vec<Record>> {
-    let f = hdf5::File::open(path)?;
-    let acc = f.group(&format!("zone_{zone}/accel"))?;
-    let mut names = acc.member_names()?;
-    names.sort();
-    names.iter().map(|k| read_record(&acc, k)).collect()
+pub fn read_zone_motions(path: &Path, zone: &str) -> Result<Vec<Record>, StoreError> {
+    let f = open(path)?;
+    let read = || -> hdf5::Result<Vec<Record>> {
+        let acc = f.group(&format!("zone_{zone}/accel"))?;
+        let mut names = acc.member_names()?;
+        names.sort();
+        names.iter().map(|k| read_record(&acc, k)).collect()
+    };
+    read().at(path)
 }
 
-/// `(period_s, target_psa_g, mean_psa_g)` of one zone.
-pub fn read_zone_spectra(path: &Path, zone: &str) -> hdf5::Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
-    let f = hdf5::File::open(path)?;
-    let g = f.group(&format!("zone_{zone}"))?;
-    let read = |n: &str| g.dataset(n)?.read_raw::<f64>();
-    Ok((read("period")?, read("target_psa_g")?, read("mean_psa_g")?))
+/// One zone's spectra: the check periods, the target and the set mean (PSA, g), and every kept
+/// motion's PSA (`[motion][period]`, g).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ZoneSpectra {
+    pub periods_s: Vec<f64>,
+    pub target_psa_g: Vec<f64>,
+    pub mean_psa_g: Vec<f64>,
+    pub psa_g: ndarray::Array2<f64>,
+}
+
+pub fn read_zone_spectra(path: &Path, zone: &str) -> Result<ZoneSpectra, StoreError> {
+    let f = open(path)?;
+    let read = || -> hdf5::Result<ZoneSpectra> {
+        let g = f.group(&format!("zone_{zone}"))?;
+        let read = |n: &str| g.dataset(n)?.read_raw::<f64>();
+        Ok(ZoneSpectra {
+            periods_s: read("period")?,
+            target_psa_g: read("target_psa_g")?,
+            mean_psa_g: read("mean_psa_g")?,
+            psa_g: g.dataset("psa_g")?.read_2d::<f64>()?,
+        })
+    };
+    read().at(path)
 }
 
 /// The seed names of one zone's report and whether each was kept.
-pub fn read_zone_report(path: &Path, zone: &str) -> hdf5::Result<Vec<(String, bool)>> {
-    let f = hdf5::File::open(path)?;
-    let g = f.group(&format!("zone_{zone}"))?;
-    let names = read_strings(&g, "seed")?;
-    let conv = g.dataset("converged")?.read_raw::<f64>()?;
-    Ok(names
-        .into_iter()
-        .zip(conv.into_iter().map(|c| c == 1.0))
-        .collect())
+pub fn read_zone_report(path: &Path, zone: &str) -> Result<Vec<(String, bool)>, StoreError> {
+    let f = open(path)?;
+    let read = || -> hdf5::Result<Vec<(String, bool)>> {
+        let g = f.group(&format!("zone_{zone}"))?;
+        let names = read_strings(&g, "seed")?;
+        let conv = g.dataset("converged")?.read_raw::<f64>()?;
+        Ok(names
+            .into_iter()
+            .zip(conv.into_iter().map(|c| c == 1.0))
+            .collect())
+    };
+    read().at(path)
 }

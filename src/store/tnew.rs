@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! /                  attrs: contents, slidestack_version, fingerprint, sweep_fingerprint,
-//!                           T_new_flag_codes
+//!                           T_new_flag_codes, + the writer's settings
 //! /zone_<name>/      attrs: target
 //!     T_p, alpha_1 … alpha_n, mu_1 … mu_n                 coordinates (dimension scales)
 //!     u_stack_mean, u_single_mean, u_rigid_mean (m), T_rigid, T_new (s), DRR_1, DRR_2,
@@ -10,172 +10,204 @@
 //!     period_sd (s), sd_mean (m): the zone's mean 5 %-damped displacement spectrum
 //! ```
 
-use super::h5::{attach_scale, attr_str, coordinate, scalar_var, write_stage_file};
-use crate::study::sweep::Grid;
-use crate::study::tnew::TNEW_FLAG_CODES;
+use super::h5::{
+    attach_all, attach_scale, attr_f64, attr_str, coordinate, group, open, read_var, write_small,
+    write_stage_file, write_var,
+};
+use super::sweep::{case_coordinates, read_case_coordinates};
+use super::{H5Context, StoreError};
+use crate::grid::Grid;
+use ndarray::ArrayD;
 use std::path::Path;
 
-/// One zone's derived quantities, flat over the case dimensions `[T_p][alpha…][mu…]`.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// One zone's derived quantities, each shaped `[T_p, alpha…, mu…]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TnewVars {
+    pub u_stack_mean: ArrayD<f64>,
+    pub u_single_mean: ArrayD<f64>,
+    pub u_rigid_mean: ArrayD<f64>,
+    pub t_rigid: ArrayD<f64>,
+    pub t_new: ArrayD<f64>,
+    pub drr_1: ArrayD<f64>,
+    pub drr_2: ArrayD<f64>,
+    pub slides: ArrayD<f64>,
+    pub flag: ArrayD<f64>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
 pub struct ZoneTnew {
     pub name: String,
     pub target: String,
-    pub u_stack_mean: Vec<f64>,
-    pub u_single_mean: Vec<f64>,
-    pub u_rigid_mean: Vec<f64>,
-    pub t_rigid: Vec<f64>,
-    pub t_new: Vec<f64>,
-    pub drr_1: Vec<f64>,
-    pub drr_2: Vec<f64>,
-    pub slides: Vec<f64>,
-    pub flag: Vec<f64>,
+    pub vars: TnewVars,
+    /// The zone's mean 5 %-damped displacement spectrum: periods, s, and values, m.
     pub period_sd_s: Vec<f64>,
     pub sd_mean_m: Vec<f64>,
 }
 
-/// Writes `tnew.h5` (through a temporary file renamed at the end).
+/// Provenance written on `tnew.h5`.
+#[derive(Debug, Clone)]
+pub struct TnewMeta<'a> {
+    pub fingerprint: &'a str,
+    pub sweep_fingerprint: &'a str,
+    /// Long description of the `T_new_flag` codes.
+    pub flag_codes: &'a str,
+    /// Static friction = this × kinetic.
+    pub mu_static_ratio: f64,
+    pub settings: &'a [(&'a str, f64)],
+}
+
+/// Writes `tnew.h5` (checked and atomic).
 pub fn write_tnew(
     path: &Path,
-    fingerprint: &str,
-    sweep_fingerprint: &str,
+    meta: &TnewMeta,
     grid: &Grid,
     zones: &[ZoneTnew],
-) -> hdf5::Result<()> {
+) -> Result<(), StoreError> {
     write_stage_file(
         path,
         "slidestack tnew stage: T_new and displacement response ratios",
-        fingerprint,
+        meta.fingerprint,
         |f| {
-            attr_str(f, "sweep_fingerprint", sweep_fingerprint)?;
-            attr_str(f, "T_new_flag_codes", TNEW_FLAG_CODES)?;
+            attr_str(f, "sweep_fingerprint", meta.sweep_fingerprint)?;
+            attr_str(f, "T_new_flag_codes", meta.flag_codes)?;
+            for (k, v) in meta.settings {
+                attr_f64(f, k, *v)?;
+            }
             for z in zones {
-                let g = f.create_group(&format!("zone_{}", z.name))?;
-                attr_str(&g, "target", &z.target)?;
-                let scales = super::sweep::case_coordinates(&g, grid)?;
-                let mut shape = vec![grid.periods_s.len()];
-                shape.extend(grid.case_shape());
-                let mut chunk = vec![1];
-                chunk.extend(grid.case_shape());
-                let vars: [(&str, &Vec<f64>, &str, &str); 9] = [
-                    (
-                        "u_stack_mean",
-                        &z.u_stack_mean,
-                        "m",
-                        "mean over the motions of the peak structure displacement with the sliding stack",
-                    ),
-                    (
-                        "u_single_mean",
-                        &z.u_single_mean,
-                        "m",
-                        "mean peak structure displacement with the stack as one block",
-                    ),
-                    (
-                        "u_rigid_mean",
-                        &z.u_rigid_mean,
-                        "m",
-                        "mean peak structure displacement with the stack rigidly attached",
-                    ),
-                    (
-                        "T_rigid",
-                        &z.t_rigid,
-                        "s",
-                        "period with the stack rigidly attached, T_p·sqrt(1+α)",
-                    ),
-                    (
-                        "T_new",
-                        &z.t_new,
-                        "s",
-                        "period whose mean 5 %-damped spectral displacement equals u_stack_mean (Section 7.1)",
-                    ),
-                    (
-                        "DRR_1",
-                        &z.drr_1,
-                        "1",
-                        "u_stack_mean / u_rigid_mean (Eq. 7)",
-                    ),
-                    (
-                        "DRR_2",
-                        &z.drr_2,
-                        "1",
-                        "u_single_mean / u_rigid_mean (Eq. 8)",
-                    ),
-                    (
-                        "slides",
-                        &z.slides,
-                        "1",
-                        "1 when some interface slips under some motion",
-                    ),
-                    (
-                        "T_new_flag",
-                        &z.flag,
-                        "1",
-                        "how T_new was found (file attribute T_new_flag_codes)",
-                    ),
-                ];
-                for (name, data, units, long) in vars {
-                    let ds = scalar_var(&g, name, &shape, &chunk, data, units, long)?;
-                    for (d, s) in scales.iter().enumerate() {
-                        attach_scale(&ds, s, d)?;
-                    }
-                }
-                let p = coordinate(
-                    &g,
-                    "period_sd",
-                    &z.period_sd_s,
-                    "s",
-                    "period of the mean displacement spectrum",
-                )?;
-                let ds = g
-                    .new_dataset::<f64>()
-                    .shape(z.sd_mean_m.len())
-                    .obj_track_times(false)
-                    .create("sd_mean")?;
-                ds.write_raw(&z.sd_mean_m)?;
-                attr_str(&ds, "units", "m")?;
-                attr_str(
-                    &ds,
-                    "long_name",
-                    "mean 5 %-damped displacement spectrum of the zone's motions",
-                )?;
-                attach_scale(&ds, &p, 0)?;
+                write_zone(f, grid, z, meta.mu_static_ratio)?;
             }
             Ok(())
         },
     )
 }
 
-/// The stage fingerprint stored in an existing `tnew.h5`.
-pub fn read_fingerprint(path: &Path) -> Option<String> {
-    let f = hdf5::File::open(path).ok()?;
-    super::h5::read_attr_str(&f, "fingerprint")
+fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, mu_static_ratio: f64) -> hdf5::Result<()> {
+    let g = f.create_group(&format!("zone_{}", z.name))?;
+    attr_str(&g, "target", &z.target)?;
+    let scales = case_coordinates(&g, grid, mu_static_ratio)?;
+    let mut chunk = vec![1];
+    chunk.extend(grid.case_shape());
+    let v = &z.vars;
+    let vars: [(&str, &ArrayD<f64>, &str, &str); 9] = [
+        (
+            "u_stack_mean",
+            &v.u_stack_mean,
+            "m",
+            "mean over the motions of the peak structure displacement with the sliding stack",
+        ),
+        (
+            "u_single_mean",
+            &v.u_single_mean,
+            "m",
+            "mean peak structure displacement with the stack as one block",
+        ),
+        (
+            "u_rigid_mean",
+            &v.u_rigid_mean,
+            "m",
+            "mean peak structure displacement with the stack rigidly attached",
+        ),
+        (
+            "T_rigid",
+            &v.t_rigid,
+            "s",
+            "period with the stack rigidly attached, T_p·sqrt(1+α)",
+        ),
+        (
+            "T_new",
+            &v.t_new,
+            "s",
+            "period whose mean 5 %-damped spectral displacement equals u_stack_mean (Section 7.1)",
+        ),
+        (
+            "DRR_1",
+            &v.drr_1,
+            "1",
+            "u_stack_mean / u_rigid_mean (Eq. 7)",
+        ),
+        (
+            "DRR_2",
+            &v.drr_2,
+            "1",
+            "u_single_mean / u_rigid_mean (Eq. 8)",
+        ),
+        (
+            "slides",
+            &v.slides,
+            "1",
+            "1 when some interface slips under some motion",
+        ),
+        (
+            "T_new_flag",
+            &v.flag,
+            "1",
+            "how T_new was found (file attribute T_new_flag_codes)",
+        ),
+    ];
+    for (name, data, units, long) in vars {
+        let ds = write_var(&g, name, data.view(), &chunk, units, long)?;
+        attach_all(&ds, &scales)?;
+    }
+    let p = coordinate(
+        &g,
+        "period_sd",
+        &z.period_sd_s,
+        "s",
+        "period of the mean displacement spectrum",
+    )?;
+    let ds = write_small(
+        &g,
+        "sd_mean",
+        ndarray::ArrayView1::from(&z.sd_mean_m).into_dyn(),
+        "m",
+        "mean 5 %-damped displacement spectrum of the zone's motions",
+    )?;
+    attach_scale(&ds, &p, 0)?;
+    Ok(())
 }
 
-/// What the fit stage reads from one zone of `tnew.h5`: the case coordinates and, flat over
-/// `[T_p][alpha…][mu…]`, `T_rigid`, `T_new` and its flag.
-#[derive(Debug, Clone)]
-pub struct ZoneTnewRead {
-    pub periods_s: Vec<f64>,
-    pub alpha: Vec<Vec<f64>>,
-    pub mu: Vec<Vec<f64>>,
-    pub t_rigid: Vec<f64>,
-    pub t_new: Vec<f64>,
-    pub flag: Vec<f64>,
-}
-
-pub fn read_zone_tnew(path: &Path, zone: &str, blocks: usize) -> hdf5::Result<ZoneTnewRead> {
-    let f = hdf5::File::open(path)?;
-    let g = f.group(&format!("zone_{zone}"))?;
-    let read = |n: &str| g.dataset(n)?.read_raw::<f64>();
-    Ok(ZoneTnewRead {
-        periods_s: read("T_p")?,
-        alpha: (1..=blocks)
-            .map(|i| read(&format!("alpha_{i}")))
-            .collect::<hdf5::Result<_>>()?,
-        mu: (1..=blocks)
-            .map(|i| read(&format!("mu_{i}")))
-            .collect::<hdf5::Result<_>>()?,
-        t_rigid: read("T_rigid")?,
-        t_new: read("T_new")?,
-        flag: read("T_new_flag")?,
-    })
+/// Zone `zone` of `tnew.h5` and the grid axes stored with it.
+pub fn read_zone_tnew(
+    path: &Path,
+    zone: &str,
+    blocks: usize,
+) -> Result<(Grid, ZoneTnew), StoreError> {
+    let f = open(path)?;
+    let g = group(&f, path, &format!("zone_{zone}"))?;
+    let read = || -> hdf5::Result<(Grid, ZoneTnew)> {
+        let grid = read_case_coordinates(&g, blocks)?;
+        let vars = TnewVars {
+            u_stack_mean: read_var(&g, "u_stack_mean")?,
+            u_single_mean: read_var(&g, "u_single_mean")?,
+            u_rigid_mean: read_var(&g, "u_rigid_mean")?,
+            t_rigid: read_var(&g, "T_rigid")?,
+            t_new: read_var(&g, "T_new")?,
+            drr_1: read_var(&g, "DRR_1")?,
+            drr_2: read_var(&g, "DRR_2")?,
+            slides: read_var(&g, "slides")?,
+            flag: read_var(&g, "T_new_flag")?,
+        };
+        Ok((
+            grid,
+            ZoneTnew {
+                name: zone.to_string(),
+                target: super::h5::read_attr_str(&g, "target").unwrap_or_default(),
+                vars,
+                period_sd_s: g.dataset("period_sd")?.read_raw()?,
+                sd_mean_m: g.dataset("sd_mean")?.read_raw()?,
+            },
+        ))
+    };
+    let (grid, z) = read().at(path)?;
+    if z.vars.t_new.shape() != grid.shape().as_slice() {
+        return Err(StoreError::corrupt(
+            path,
+            format!(
+                "zone_{zone}: T_new has shape {:?} where its coordinates give {:?}",
+                z.vars.t_new.shape(),
+                grid.shape()
+            ),
+        ));
+    }
+    Ok((grid, z))
 }

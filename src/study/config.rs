@@ -15,6 +15,8 @@
 //!   set_mean_min: 1.0              # the set's mean spectrum / target must not fall below this
 //! ```
 
+use super::sweep::Physics;
+use crate::grid::Grid;
 use crate::motion::matching::{MatchError, MatchSettings};
 use crate::motion::stochastic::{StochasticError, StochasticModel};
 use crate::motion::{ReadOptions, Units};
@@ -89,6 +91,25 @@ pub struct GridConfig {
     /// Damping ratio of the bare structure.
     #[serde(default = "five_percent")]
     pub damping: f64,
+}
+
+impl GridConfig {
+    /// The grid's axes, expanded.
+    pub fn axes(&self) -> Grid {
+        Grid {
+            periods_s: self.period_s.values(),
+            alpha: self.alpha.iter().map(Values::values).collect(),
+            mu: self.mu.iter().map(Values::values).collect(),
+        }
+    }
+
+    /// The physics settings of every case.
+    pub fn physics(&self) -> Physics {
+        Physics {
+            damping: self.damping,
+            mu_static_ratio: self.mu_static_ratio,
+        }
+    }
 }
 
 fn five_percent() -> f64 {

@@ -1,10 +1,13 @@
-//! The parametric study: its configuration and the stages that compose the numerical kernels.
+//! The parametric study's numerics and configuration (the stages that drive them are in
+//! [`crate::pipeline`]).
 //!
+//! * [`cases`]: the paper's named cases (Section 7.1, Table 2, Section 9).
 //! * [`config`]: the study file (YAML), validated before any work.
-//! * [`motions`]: the first stage: seeds, spectral matching per zone, the set checks.
-//! * [`sweep`]: the grid of cases, the skip rules, one work unit.
-//! * [`tnew`]: `T_new` from the mean displacement spectrum.
+//! * [`motions`]: seeds, spectral matching per zone, the set checks.
+//! * [`sweep`]: the physics of a case, the skip rules, one work unit.
+//! * [`tnew`]: `T_new` from the mean displacement spectrum; the fit's samples.
 
+pub mod cases;
 pub mod config;
 pub mod motions;
 pub mod sweep;

@@ -15,10 +15,10 @@
 //!   can slip before the one below it, so the stack acts as one block ([`SkipRule::SingleBlock`],
 //!   NOTES.md "Stated special cases").
 
-use super::config::GridConfig;
 use crate::dynamics::{
     ExactOptions, G, Ground, ModelError, Response, SimError, System, SystemSpec, simulate_exact,
 };
+use crate::grid::Grid;
 use std::collections::HashMap;
 use thiserror::Error;
 
@@ -57,65 +57,12 @@ pub const SKIP_RULE_CODES: &str = "0 simulated; 1 no interface can slip (rigid a
      acceleration never exceeds min μ_s·g): stack = rigid; 2 friction never decreases upward \
      with static = kinetic: stack = single block";
 
-/// The grid with its values expanded.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Grid {
-    pub periods_s: Vec<f64>,
-    /// Per block, bottom first.
-    pub alpha: Vec<Vec<f64>>,
-    /// Kinetic, per interface.
-    pub mu: Vec<Vec<f64>>,
-    pub mu_static_ratio: f64,
-    pub damping: f64,
-}
-
-impl Grid {
-    pub fn from_config(g: &GridConfig) -> Self {
-        Self {
-            periods_s: g.period_s.values(),
-            alpha: g.alpha.iter().map(|v| v.values()).collect(),
-            mu: g.mu.iter().map(|v| v.values()).collect(),
-            mu_static_ratio: g.mu_static_ratio,
-            damping: g.damping,
-        }
-    }
-
-    pub fn blocks(&self) -> usize {
-        self.alpha.len()
-    }
-
-    /// Sizes of the case dimensions `alpha_1 … alpha_n, mu_1 … mu_n`.
-    pub fn case_shape(&self) -> Vec<usize> {
-        self.alpha.iter().chain(&self.mu).map(|v| v.len()).collect()
-    }
-
-    /// Cases in one work unit.
-    pub fn cases_per_unit(&self) -> usize {
-        self.case_shape().iter().product()
-    }
-
-    /// `(T_p, α, μ)` at `index` over `[T_p][case]`, the order of the case variables of
-    /// `tnew.h5` (and of `sweep.h5` within one motion).
-    pub fn point(&self, index: usize) -> (f64, Vec<f64>, Vec<f64>) {
-        let per = self.cases_per_unit();
-        let (alpha, mu) = self.case(index % per);
-        (self.periods_s[index / per], alpha, mu)
-    }
-
-    /// `(α, μ)` of case `index` (row-major over `case_shape`, the last `μ` fastest).
-    pub fn case(&self, mut index: usize) -> (Vec<f64>, Vec<f64>) {
-        let shape = self.case_shape();
-        let mut pick = vec![0; shape.len()];
-        for d in (0..shape.len()).rev() {
-            pick[d] = index % shape[d];
-            index /= shape[d];
-        }
-        let n = self.blocks();
-        let alpha = (0..n).map(|i| self.alpha[i][pick[i]]).collect();
-        let mu = (0..n).map(|i| self.mu[i][pick[n + i]]).collect();
-        (alpha, mu)
-    }
-}
+/// `(code, word)` of each rule, for the CF `flag_values`/`flag_meanings` attributes.
+pub const SKIP_RULE_FLAGS: [(u8, &str); 3] = [
+    (SkipRule::Simulated as u8, "simulated"),
+    (SkipRule::NoSlip as u8, "no_slip"),
+    (SkipRule::SingleBlock as u8, "single_block"),
+];
 
 /// Results of one work unit, one entry per case (order of [`Grid::case`]).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -142,6 +89,36 @@ pub struct UnitResult {
 pub struct UnitOptions {
     /// Apply the skip rules (off: simulate every system of every case, for checking them).
     pub skip: bool,
+}
+
+/// How a case becomes the study's three systems (NOTES.md, "Derived quantities"): the one source
+/// of the physics for the sweep, the report and `design`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Physics {
+    /// Viscous damping ratio `ζ` of the bare structure.
+    pub damping: f64,
+    /// Static friction coefficients are this × the kinetic ones (≥ 1).
+    pub mu_static_ratio: f64,
+}
+
+impl Physics {
+    /// The structure with its stack of blocks.
+    pub fn stack(&self, period_s: f64, alpha: &[f64], mu: &[f64]) -> SystemSpec {
+        let mut spec = SystemSpec::new(period_s, alpha, mu);
+        spec.damping_ratio = self.damping;
+        spec.mu_static = Some(mu.iter().map(|m| m * self.mu_static_ratio).collect());
+        spec
+    }
+
+    /// The whole stack as one block of mass ratio `alpha_total` sliding on interface 1.
+    pub fn single(&self, period_s: f64, alpha_total: f64, mu_1: f64) -> SystemSpec {
+        self.stack(period_s, &[alpha_total], &[mu_1])
+    }
+
+    /// The stack rigidly attached: a linear SDOF (paper Eqs. 10–13).
+    pub fn rigid(&self, period_s: f64, alpha_total: f64) -> SystemSpec {
+        rigid_spec(period_s, alpha_total, self.damping)
+    }
 }
 
 /// The stack rigidly attached: the bare structure's `k` and `c` on the mass `m_p(1+α)`, so
@@ -186,12 +163,12 @@ fn simulate(
 /// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`.
 pub fn run_unit(
     grid: &Grid,
+    physics: &Physics,
     ground: &Ground,
     period_index: usize,
     opts: UnitOptions,
 ) -> Result<UnitResult, SweepError> {
     let tp = grid.periods_s[period_index];
-    let zeta = grid.damping;
     let n = grid.blocks();
     let cases = grid.cases_per_unit();
     let mut out = UnitResult::default();
@@ -200,12 +177,12 @@ pub fn run_unit(
     let mut single: HashMap<(u64, u64), Response> = HashMap::new();
     for c in 0..cases {
         let (alpha, mu) = grid.case(c);
-        let mu_s: Vec<f64> = mu.iter().map(|m| m * grid.mu_static_ratio).collect();
+        let mu_s: Vec<f64> = mu.iter().map(|m| m * physics.mu_static_ratio).collect();
         let total: f64 = alpha.iter().sum();
         let key = total.to_bits();
         let case = (tp, alpha.as_slice(), mu.as_slice());
         if !rigid.contains_key(&key) || !opts.skip {
-            rigid.insert(key, simulate(&rigid_spec(tp, total, zeta), ground, case)?);
+            rigid.insert(key, simulate(&physics.rigid(tp, total), ground, case)?);
             out.simulations += 1;
         }
         let r = &rigid[&key];
@@ -217,10 +194,10 @@ pub fn run_unit(
         let skey = (key, mu[0].to_bits());
         let single_holds = opts.skip && holds(mu_s[0]);
         if !single_holds && (!single.contains_key(&skey) || !opts.skip) {
-            let mut spec = SystemSpec::new(tp, &[total], &mu[..1]);
-            spec.damping_ratio = zeta;
-            spec.mu_static = Some(vec![mu_s[0]]);
-            single.insert(skey, simulate(&spec, ground, case)?);
+            single.insert(
+                skey,
+                simulate(&physics.single(tp, total, mu[0]), ground, case)?,
+            );
             out.simulations += 1;
         }
         let u_single = if single_holds {
@@ -230,16 +207,14 @@ pub fn run_unit(
         };
 
         let min_mu_s = mu_s.iter().copied().fold(f64::INFINITY, f64::min);
-        let non_decreasing = grid.mu_static_ratio == 1.0 && mu.windows(2).all(|w| w[1] >= w[0]);
+        let non_decreasing = physics.mu_static_ratio == 1.0 && mu.windows(2).all(|w| w[1] >= w[0]);
         let (rule, resp) = if opts.skip && holds(min_mu_s) {
             (SkipRule::NoSlip, None)
         } else if opts.skip && non_decreasing {
             (SkipRule::SingleBlock, None)
         } else {
-            let mut spec = SystemSpec::new(tp, &alpha, &mu);
-            spec.damping_ratio = zeta;
-            spec.mu_static = Some(mu_s.clone());
             out.simulations += 1;
+            let spec = physics.stack(tp, &alpha, &mu);
             (SkipRule::Simulated, Some(simulate(&spec, ground, case)?))
         };
         out.u_rigid.push(r.peak_displacement_m);

@@ -12,8 +12,8 @@
 //! attached mass, and the crossing near `T_rigid` is the one that continues the `μ → ∞` limit.
 //! The flag says which case applied.
 
-use super::sweep::Grid;
 use crate::fit::Sample;
+use crate::grid::Grid;
 
 /// The fit's samples: every case of `grid` (flat over `[T_p][case]`) with a finite `T_new`,
 /// features `(T_p, μ_1 … μ_n, α_1 … α_n)`.
@@ -21,10 +21,10 @@ pub fn samples(grid: &Grid, t_rigid_s: &[f64], t_new_s: &[f64]) -> Vec<Sample> {
     (0..t_new_s.len())
         .filter(|&c| t_new_s[c].is_finite())
         .map(|c| {
-            let (tp, alpha, mu) = grid.point(c);
-            let mut x = vec![tp];
-            x.extend(mu);
-            x.extend(alpha);
+            let case = grid.point(c);
+            let mut x = vec![case.period_s];
+            x.extend(case.mu);
+            x.extend(case.alpha);
             Sample {
                 x,
                 t_rigid_s: t_rigid_s[c],

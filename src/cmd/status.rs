@@ -1,0 +1,62 @@
+//! `slidestack status CONFIG [--out DIR] [--format text|env]`: what is on disk for every stage
+//! and the sweep's work units, without changing anything (no lock is taken). `--format env`
+//! prints `KEY=value` lines for shell scripts (`eval "$(slidestack status … --format env)"`).
+
+use super::StudyArgs;
+use anyhow::Result;
+use clap::ValueEnum;
+use slidestack::pipeline::{StageState, status};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    Text,
+    Env,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub study: StudyArgs,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let study = args.study.study()?;
+    let st = status(&study)?;
+    match args.format {
+        Format::Env => {
+            for (stage, state) in &st.stages {
+                println!("{}={}", stage.name().to_uppercase(), state.word());
+            }
+            println!("SWEEP_UNITS={}", st.sweep_units);
+            println!("SWEEP_UNITS_DONE={}", st.sweep_units_done);
+            println!("SWEEP_CASES_PER_UNIT={}", st.cases_per_unit);
+            println!("SWEEP_SAMPLES_PER_MOTION={}", st.samples_per_motion);
+            // At most three simulations per case (stack, single block, rigid): the work bound
+            // job scripts size their tasks with.
+            println!(
+                "SWEEP_SAMPLES_PER_UNIT={}",
+                3 * st.cases_per_unit * st.samples_per_motion
+            );
+        }
+        Format::Text => {
+            println!("output directory {}", study.out.display());
+            for (stage, state) in &st.stages {
+                let detail = match state {
+                    StageState::Damaged(why) => format!("damaged: {why}"),
+                    other => other.word().replace('_', " "),
+                };
+                println!("{:<8} {:<20} {detail}", stage.name(), stage.output());
+            }
+            if st.sweep_units > 0 {
+                println!(
+                    "sweep units: {} of {} stored ({} cases each)",
+                    st.sweep_units_done, st.sweep_units, st.cases_per_unit
+                );
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,124 @@
+//! The case grid of the study: its axes and how a flat case index maps onto them.
+//!
+//! A grid is the outer product of the structure periods `T_p`, one list of mass ratios per block
+//! (`α_1 … α_n`, bottom first) and one list of kinetic friction coefficients per interface
+//! (`μ_1 … μ_n`, interface 1 first). Stored arrays use the axis order
+//! `[T_p, alpha_1 … alpha_n, mu_1 … mu_n]` (with `motion` in front in `sweep.h5`), row-major, the
+//! last `μ` fastest. A *work unit* is one `T_p` (under one motion): all `α` and `μ` combinations.
+//!
+//! Pure data: no physics, no files. The study's physics settings (damping, static friction)
+//! live in [`crate::study::sweep::Physics`], the file layouts in [`crate::store`].
+
+/// The grid's axes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    /// Periods of the bare structure `T_p`, s, increasing.
+    pub periods_s: Vec<f64>,
+    /// Mass ratios `α_i = m_i/m_p`, one list per block, bottom first.
+    pub alpha: Vec<Vec<f64>>,
+    /// Kinetic friction coefficients, one list per interface, interface 1 first.
+    pub mu: Vec<Vec<f64>>,
+}
+
+/// One case: `(T_p, α, μ)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Case {
+    pub period_s: f64,
+    /// Per block, bottom first.
+    pub alpha: Vec<f64>,
+    /// Kinetic, per interface.
+    pub mu: Vec<f64>,
+}
+
+impl Case {
+    /// `α = Σα_i`, the whole stack's mass ratio.
+    pub fn alpha_total(&self) -> f64 {
+        self.alpha.iter().sum()
+    }
+}
+
+impl Grid {
+    pub fn blocks(&self) -> usize {
+        self.alpha.len()
+    }
+
+    /// Sizes of the case dimensions `alpha_1 … alpha_n, mu_1 … mu_n`.
+    pub fn case_shape(&self) -> Vec<usize> {
+        self.alpha.iter().chain(&self.mu).map(|v| v.len()).collect()
+    }
+
+    /// Shape `[T_p, alpha_1 … alpha_n, mu_1 … mu_n]` of a per-case array.
+    pub fn shape(&self) -> Vec<usize> {
+        let mut s = vec![self.periods_s.len()];
+        s.extend(self.case_shape());
+        s
+    }
+
+    /// Names of the dimensions of [`Grid::shape`], as stored.
+    pub fn dim_names(&self) -> Vec<String> {
+        let n = self.blocks();
+        std::iter::once("T_p".to_string())
+            .chain((1..=n).map(|i| format!("alpha_{i}")))
+            .chain((1..=n).map(|i| format!("mu_{i}")))
+            .collect()
+    }
+
+    /// Cases in one work unit.
+    pub fn cases_per_unit(&self) -> usize {
+        self.case_shape().iter().product()
+    }
+
+    /// Cases over all periods.
+    pub fn cases(&self) -> usize {
+        self.periods_s.len() * self.cases_per_unit()
+    }
+
+    /// The case at flat `index` over `[T_p][case]`.
+    pub fn point(&self, index: usize) -> Case {
+        let per = self.cases_per_unit();
+        let (alpha, mu) = self.case(index % per);
+        Case {
+            period_s: self.periods_s[index / per],
+            alpha,
+            mu,
+        }
+    }
+
+    /// `(α, μ)` of case `index` within a unit (row-major over `case_shape`, the last `μ`
+    /// fastest).
+    pub fn case(&self, mut index: usize) -> (Vec<f64>, Vec<f64>) {
+        let shape = self.case_shape();
+        let mut pick = vec![0; shape.len()];
+        for d in (0..shape.len()).rev() {
+            pick[d] = index % shape[d];
+            index /= shape[d];
+        }
+        let n = self.blocks();
+        let alpha = (0..n).map(|i| self.alpha[i][pick[i]]).collect();
+        let mu = (0..n).map(|i| self.mu[i][pick[n + i]]).collect();
+        (alpha, mu)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flat_index_is_row_major_with_the_last_mu_fastest() {
+        let g = Grid {
+            periods_s: vec![0.5, 1.0],
+            alpha: vec![vec![0.1, 0.5], vec![1.0]],
+            mu: vec![vec![0.2], vec![0.05, 0.1, 0.3]],
+        };
+        assert_eq!(g.shape(), vec![2, 2, 1, 1, 3]);
+        assert_eq!(g.cases(), 12);
+        assert_eq!(g.dim_names(), ["T_p", "alpha_1", "alpha_2", "mu_1", "mu_2"]);
+        // Index 10 = T_p 1 (6 per unit), then case 4 = alpha_1 index 1, mu_2 index 1.
+        let c = g.point(10);
+        assert_eq!(c.period_s, 1.0);
+        assert_eq!(c.alpha, vec![0.5, 1.0]);
+        assert_eq!(c.mu, vec![0.2, 0.1]);
+        assert_eq!(c.alpha_total(), 1.5);
+    }
+}

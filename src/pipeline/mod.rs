@@ -1,0 +1,527 @@
+//! The study as library code: its stages, one shape for all of them, and what they promise about
+//! the files they leave.
+//!
+//! ```text
+//! config ─► motions ─► motions.h5 ─► sweep ─► sweep.h5 ─► tnew ─► tnew.h5 ─► fit ─► fit.h5, fit.yaml
+//!                          │                                  ▲                       │
+//!                          └──────────────────────────────────┴──────── report ◄──────┘
+//! ```
+//!
+//! Every stage ([`StageId`]) has the same shape: the upstream stages it reads, the fingerprint
+//! its output must carry (computed from the config and the record files alone, so every stage
+//! knows what each upstream file should be without trusting it), the files it writes, and its
+//! `build`. [`execute`] runs any stage the same way:
+//! 1. every upstream file must verify (checksum sidecar) and carry the fingerprint the config
+//!    gives it, else the stage refuses and names the stage to rerun;
+//! 2. when its own output verifies and carries the expected fingerprint, nothing is done (unless
+//!    forced); a damaged output is rebuilt;
+//! 3. `build` writes every file checked and atomically ([`crate::store`]).
+//!
+//! A [`Session`] holds the output directory's lock ([`lock`]) for its life, so two runs into one
+//! directory never interleave; `run`, `make`, Slurm and a future Python binding all go through
+//! [`Study::load`], [`Session::open`] and [`execute`]. Nothing here prints: progress goes to a
+//! [`Reporter`].
+
+pub mod fit;
+pub mod lock;
+pub mod motions;
+pub mod report;
+pub mod sweep;
+pub mod tnew;
+
+use crate::grid::Grid;
+use crate::store::{StoreError, atomic};
+use crate::study::config::{ConfigError, StudyConfig};
+use crate::study::sweep::Physics;
+use lock::{LockError, LockMode, OutputLock};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// A stage of the study, in the order they run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum StageId {
+    Motions,
+    Sweep,
+    Tnew,
+    Fit,
+    Report,
+}
+
+impl StageId {
+    pub const ALL: [StageId; 5] = [
+        StageId::Motions,
+        StageId::Sweep,
+        StageId::Tnew,
+        StageId::Fit,
+        StageId::Report,
+    ];
+
+    /// The subcommand's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            StageId::Motions => "motions",
+            StageId::Sweep => "sweep",
+            StageId::Tnew => "tnew",
+            StageId::Fit => "fit",
+            StageId::Report => "report",
+        }
+    }
+
+    /// The file whose stored fingerprint says whether the stage is up to date, relative to the
+    /// output directory.
+    pub fn output(self) -> &'static str {
+        match self {
+            StageId::Motions => "motions.h5",
+            StageId::Sweep => "sweep.h5",
+            StageId::Tnew => "tnew.h5",
+            StageId::Fit => "fit.h5",
+            StageId::Report => "report/index.html",
+        }
+    }
+
+    /// The stages whose files this one reads.
+    pub fn upstream(self) -> &'static [StageId] {
+        match self {
+            StageId::Motions => &[],
+            StageId::Sweep => &[StageId::Motions],
+            StageId::Tnew => &[StageId::Motions, StageId::Sweep],
+            StageId::Fit => &[StageId::Tnew],
+            StageId::Report => &[StageId::Motions, StageId::Tnew, StageId::Fit],
+        }
+    }
+}
+
+impl std::fmt::Display for StageId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum PipelineError {
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    #[error("{}: {why}", file.display())]
+    BadInput { file: PathBuf, why: String },
+    #[error(transparent)]
+    Lock(#[from] LockError),
+    #[error(transparent)]
+    Store(#[from] StoreError),
+    /// An upstream file is missing, stale or damaged; `why` names it.
+    #[error("{why}: run `slidestack {stage} {}` first", config.display())]
+    Upstream {
+        why: String,
+        stage: StageId,
+        config: PathBuf,
+    },
+    #[error("{}: the `{stage}` stage needs a `grid` section", config.display())]
+    NoGrid { config: PathBuf, stage: StageId },
+    #[error(transparent)]
+    Motions(#[from] motions::MotionsError),
+    #[error(transparent)]
+    Sweep(#[from] sweep::SweepStageError),
+    #[error(transparent)]
+    Tnew(#[from] tnew::TnewError),
+    #[error(transparent)]
+    Fit(#[from] fit::FitStageError),
+    #[error(transparent)]
+    Report(#[from] report::ReportError),
+}
+
+impl PipelineError {
+    /// Whether the error is the user's input (exit code 2) rather than a failure of the run.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            PipelineError::Config(_)
+            | PipelineError::BadInput { .. }
+            | PipelineError::NoGrid { .. } => true,
+            PipelineError::Sweep(e) => e.is_bad_input(),
+            _ => false,
+        }
+    }
+}
+
+/// What a stage found on disk.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StageState {
+    UpToDate,
+    Missing,
+    /// Made from other inputs.
+    Stale,
+    /// Fails its checksum or cannot be read.
+    Damaged(String),
+}
+
+impl StageState {
+    /// The word `status --format env` prints.
+    pub fn word(&self) -> &'static str {
+        match self {
+            StageState::UpToDate => "up_to_date",
+            StageState::Missing => "missing",
+            StageState::Stale => "stale",
+            StageState::Damaged(_) => "damaged",
+        }
+    }
+}
+
+/// Where progress goes; the CLI prints it, tests and bindings may collect or drop it.
+pub trait Reporter: Sync {
+    /// A line of progress from `stage`.
+    fn info(&self, stage: StageId, message: &str);
+    /// Something the user should know that does not stop the stage.
+    fn warn(&self, stage: StageId, message: &str);
+    /// A counter of `total` steps (work units); the default shows nothing.
+    fn progress(&self, _stage: StageId, _total: u64) -> Box<dyn Progress + '_> {
+        Box::new(NoProgress)
+    }
+}
+
+/// A counter handed out by [`Reporter::progress`].
+pub trait Progress: Sync {
+    fn inc(&self);
+    fn finish(&self) {}
+}
+
+struct NoProgress;
+
+impl Progress for NoProgress {
+    fn inc(&self) {}
+}
+
+/// A reporter that drops everything.
+pub struct Quiet;
+
+impl Reporter for Quiet {
+    fn info(&self, _: StageId, _: &str) {}
+    fn warn(&self, _: StageId, _: &str) {}
+}
+
+/// The expected fingerprint of every stage's output, from the config (and record files) alone.
+#[derive(Debug, Clone)]
+struct Fingerprints {
+    motions: String,
+    /// `None` without a `grid` section.
+    rest: Option<[String; 4]>,
+}
+
+/// A loaded, validated study: its config, output directory, grid and expected fingerprints.
+#[derive(Debug, Clone)]
+pub struct Study {
+    pub config_path: PathBuf,
+    pub cfg: StudyConfig,
+    /// The output directory (`--out`, else the config's `output_dir`).
+    pub out: PathBuf,
+    /// SHA-256 of the config file's bytes.
+    pub config_sha256: String,
+    grid: Option<Grid>,
+    fingerprints: Fingerprints,
+}
+
+/// Refuses output directories that are surely mistakes: empty, the file-system root, an
+/// unexpanded `~`.
+pub fn check_output_dir(out: &Path, origin: &Path, key: &str) -> Result<(), PipelineError> {
+    let text = out.to_string_lossy();
+    let why = if text.trim().is_empty() {
+        Some("is empty".to_string())
+    } else if text.starts_with('~') {
+        Some(format!(
+            "`{text}`: `~` is not expanded here; write the full path"
+        ))
+    } else if out.parent().is_none() {
+        Some(format!("`{text}` is the root of the file system"))
+    } else if out.is_file() {
+        Some(format!("`{text}` is a file, not a directory"))
+    } else {
+        None
+    };
+    match why {
+        Some(why) => Err(PipelineError::BadInput {
+            file: origin.to_path_buf(),
+            why: format!("`{key}` {why}"),
+        }),
+        None => Ok(()),
+    }
+}
+
+impl Study {
+    /// Reads and validates the config (every limit is checked here, before any work) and
+    /// computes every stage's expected fingerprint.
+    pub fn load(config: &Path, out: Option<PathBuf>) -> Result<Self, PipelineError> {
+        let bytes = std::fs::read(config).map_err(|source| ConfigError::Io {
+            file: config.display().to_string(),
+            source,
+        })?;
+        let cfg = StudyConfig::load(config)?;
+        let out = match out {
+            Some(o) => {
+                check_output_dir(&o, Path::new("--out"), "--out")?;
+                o
+            }
+            None => {
+                check_output_dir(&cfg.output_dir, config, "output_dir")?;
+                cfg.output_dir.clone()
+            }
+        };
+        let grid = cfg.grid.as_ref().map(|g| g.axes());
+        let motions_fp = motions::fingerprint(&cfg)?;
+        let rest = match &cfg.grid {
+            Some(_) => {
+                let sweep = sweep::fingerprint(&cfg, &motions_fp);
+                let tnew = tnew::fingerprint(&sweep);
+                let fit = fit::fingerprint(&tnew);
+                let report = report::fingerprint(&fit, &motions_fp);
+                Some([sweep, tnew, fit, report])
+            }
+            None => None,
+        };
+        Ok(Self {
+            config_path: config.to_path_buf(),
+            config_sha256: crate::store::fingerprint::sha256_hex(&bytes),
+            cfg,
+            out,
+            grid,
+            fingerprints: Fingerprints {
+                motions: motions_fp,
+                rest,
+            },
+        })
+    }
+
+    /// The grid, or an error naming the stage that needs it.
+    pub fn grid(&self, stage: StageId) -> Result<&Grid, PipelineError> {
+        self.grid.as_ref().ok_or_else(|| PipelineError::NoGrid {
+            config: self.config_path.clone(),
+            stage,
+        })
+    }
+
+    /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`).
+    pub fn physics(&self) -> Physics {
+        self.cfg.grid.as_ref().map_or(
+            Physics {
+                damping: 0.05,
+                mu_static_ratio: 1.0,
+            },
+            |g| g.physics(),
+        )
+    }
+
+    /// A file of the output directory.
+    pub fn path(&self, name: &str) -> PathBuf {
+        self.out.join(name)
+    }
+
+    /// The fingerprint the stage's output must carry.
+    pub fn fingerprint(&self, stage: StageId) -> Result<&str, PipelineError> {
+        if stage == StageId::Motions {
+            return Ok(&self.fingerprints.motions);
+        }
+        let rest = self
+            .fingerprints
+            .rest
+            .as_ref()
+            .ok_or_else(|| PipelineError::NoGrid {
+                config: self.config_path.clone(),
+                stage,
+            })?;
+        Ok(match stage {
+            StageId::Sweep => &rest[0],
+            StageId::Tnew => &rest[1],
+            StageId::Fit => &rest[2],
+            StageId::Report => &rest[3],
+            StageId::Motions => unreachable!("handled above"),
+        })
+    }
+
+    /// The verified fingerprint stored in the stage's output, `None` when it is missing.
+    pub fn stored(&self, stage: StageId) -> Result<Option<String>, StoreError> {
+        let path = self.path(stage.output());
+        match stage {
+            StageId::Fit => crate::store::fit::stored_fingerprint(&path, &self.path("fit.yaml")),
+            StageId::Report => crate::store::report::stored_fingerprint(&self.path("report")),
+            _ => crate::store::h5::stored_fingerprint(&path),
+        }
+    }
+
+    /// What is on disk for `stage`.
+    pub fn state(&self, stage: StageId) -> Result<StageState, PipelineError> {
+        let want = self.fingerprint(stage)?;
+        Ok(match self.stored(stage) {
+            Ok(None) => StageState::Missing,
+            Ok(Some(fp)) if fp == want => StageState::UpToDate,
+            Ok(Some(_)) => StageState::Stale,
+            Err(e) => StageState::Damaged(e.to_string()),
+        })
+    }
+
+    /// Refuses unless `stage`'s output is on disk, whole and made from this config.
+    pub fn require(&self, stage: StageId) -> Result<(), PipelineError> {
+        let file = self.path(stage.output());
+        let why = match self.state(stage)? {
+            StageState::UpToDate => return Ok(()),
+            StageState::Missing => format!("{} is missing", file.display()),
+            StageState::Stale => format!(
+                "{} was made from other inputs than {}",
+                file.display(),
+                self.config_path.display()
+            ),
+            StageState::Damaged(e) => e,
+        };
+        Err(PipelineError::Upstream {
+            why,
+            stage,
+            config: self.config_path.clone(),
+        })
+    }
+}
+
+/// A study with its output directory locked; stages run inside one.
+pub struct Session<'r> {
+    pub study: Study,
+    pub reporter: &'r dyn Reporter,
+    mode: LockMode,
+    _lock: OutputLock,
+}
+
+impl<'r> Session<'r> {
+    /// Locks the study's output directory (creating it): exclusively for every stage but a
+    /// sweep shard. With `wait`, waits for another holder (telling the reporter); without,
+    /// refuses naming it. An exclusive session first removes temporaries left by killed runs.
+    pub fn open(
+        study: Study,
+        mode: LockMode,
+        wait: bool,
+        reporter: &'r dyn Reporter,
+    ) -> Result<Self, PipelineError> {
+        let first = StageId::Motions;
+        let lock = OutputLock::acquire(&study.out, mode, wait, |holder| {
+            reporter.info(
+                first,
+                &format!(
+                    "waiting for {holder}, which holds {}",
+                    study.out.join(lock::LOCK_FILE).display()
+                ),
+            )
+        })?;
+        if lock.unsupported {
+            reporter.warn(
+                first,
+                &format!(
+                    "the file system of {} does not support locks: nothing stops another run from \
+                     writing into it at the same time",
+                    study.out.display()
+                ),
+            );
+        }
+        if mode == LockMode::Exclusive {
+            for dir in [study.out.clone(), study.path(sweep::UNITS_DIR)] {
+                atomic::remove_stale_temps(&dir)?;
+            }
+        }
+        Ok(Self {
+            study,
+            reporter,
+            mode,
+            _lock: lock,
+        })
+    }
+
+    pub fn exclusive(&self) -> bool {
+        self.mode == LockMode::Exclusive
+    }
+}
+
+/// How a stage runs.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StageOptions {
+    /// Rebuild even when the output is up to date.
+    pub force: bool,
+}
+
+/// What a stage did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    /// The output was already up to date.
+    UpToDate(PathBuf),
+    /// These files were written.
+    Wrote(Vec<PathBuf>),
+    /// A sweep shard stored its units; `merge` assembles them.
+    ShardDone { k: usize, n: usize },
+}
+
+/// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
+pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
+    for &up in stage.upstream() {
+        s.study.require(up)?;
+    }
+    let path = s.study.path(stage.output());
+    if !opts.force {
+        match s.study.state(stage)? {
+            StageState::UpToDate => {
+                if stage == StageId::Sweep && s.exclusive() {
+                    sweep::remove_units(&s.study)?;
+                }
+                return Ok(Outcome::UpToDate(path));
+            }
+            StageState::Damaged(why) => s.reporter.warn(stage, &format!("{why}: rebuilding it")),
+            StageState::Missing | StageState::Stale => {}
+        }
+    }
+    match stage {
+        StageId::Motions => motions::build(s),
+        StageId::Sweep => sweep::build(s, None),
+        StageId::Tnew => tnew::build(s),
+        StageId::Fit => fit::build(s),
+        StageId::Report => report::build(s),
+    }
+}
+
+/// Every stage in order, each skipped when up to date, telling `done` what each did and how
+/// long it took, s.
+pub fn run_all(
+    s: &Session,
+    opts: StageOptions,
+    mut done: impl FnMut(StageId, &Outcome, f64),
+) -> Result<(), PipelineError> {
+    for stage in StageId::ALL {
+        let start = std::time::Instant::now();
+        let outcome = execute(s, stage, opts)?;
+        done(stage, &outcome, start.elapsed().as_secs_f64());
+    }
+    Ok(())
+}
+
+/// The state of every stage and of the sweep's work units (for job schedulers).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Status {
+    pub stages: Vec<(StageId, StageState)>,
+    /// Work units of the sweep (zones × motions × periods).
+    pub sweep_units: usize,
+    /// Units already stored for the current sweep.
+    pub sweep_units_done: usize,
+    pub cases_per_unit: usize,
+    /// Record samples per motion, the mean over the stored motions (0 before `motions` ran).
+    pub samples_per_motion: usize,
+}
+
+/// What is on disk for every stage; reads only, takes no lock.
+pub fn status(study: &Study) -> Result<Status, PipelineError> {
+    let mut stages = Vec::new();
+    for stage in StageId::ALL {
+        if stage != StageId::Motions && study.grid.is_none() {
+            continue;
+        }
+        stages.push((stage, study.state(stage)?));
+    }
+    let (sweep_units, sweep_units_done, samples_per_motion) = match &study.grid {
+        Some(_) => sweep::unit_status(study)?,
+        None => (0, 0, 0),
+    };
+    Ok(Status {
+        stages,
+        sweep_units,
+        sweep_units_done,
+        cases_per_unit: study.grid.as_ref().map_or(0, Grid::cases_per_unit),
+        samples_per_motion,
+    })
+}

@@ -1,0 +1,135 @@
+//! The motions stage: seed motions (the built-in stochastic model or record files) matched to
+//! every zone's target, with the set checks → `motions.h5` (layout in
+//! [`crate::store::motions`]).
+//!
+//! Fingerprint: the tool version, the `zones` and `motions` sections, and the SHA-256 of every
+//! record file (not its path, which differs between machines).
+
+use super::{Outcome, PipelineError, Session, StageId};
+use crate::motion::matching::MatchError;
+use crate::store::fingerprint::{file_sha256, fingerprint as hash_parts};
+use crate::store::motions::{StageMeta, write_motions};
+use crate::study::config::{ConfigError, Seeds, StudyConfig};
+use crate::study::motions::{SeedError, match_zone, seed_records};
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum MotionsError {
+    #[error("cannot make the seed motions: {0}")]
+    Seeds(#[from] SeedError),
+    #[error("zone {zone}: matching failed: {source}")]
+    Matching { zone: String, source: MatchError },
+    #[error("zone {zone}: no seed met the matching acceptance")]
+    NothingMatched { zone: String },
+}
+
+/// The JSON list of the record files (name and SHA-256) the stage reads.
+fn inputs(cfg: &StudyConfig) -> Result<String, ConfigError> {
+    let mut inputs = Vec::new();
+    if let Seeds::Records(r) = cfg.motions.seeds.kind() {
+        for f in &r.files {
+            let h = file_sha256(f).map_err(|source| ConfigError::Io {
+                file: f.display().to_string(),
+                source,
+            })?;
+            let name = f
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            inputs.push(serde_json::json!({ "file": name, "sha256": h }));
+        }
+    }
+    Ok(serde_json::to_string(&inputs).expect("JSON of strings"))
+}
+
+/// The fingerprint `motions.h5` must carry for `cfg`.
+pub fn fingerprint(cfg: &StudyConfig) -> Result<String, ConfigError> {
+    let section = serde_json::json!({
+        "zones": cfg.zones,
+        "motions": match cfg.motions.seeds.kind() {
+            // Record paths differ between machines; their contents are in `inputs`.
+            Seeds::Records(r) => serde_json::json!({
+                "units": r.units, "dt_s": r.dt_s,
+                "matching": cfg.motions.matching, "set_mean_min": cfg.motions.set_mean_min,
+            }),
+            Seeds::Stochastic(_) => serde_json::to_value(&cfg.motions).expect("serialisable"),
+        },
+    });
+    Ok(hash_parts(&[&section.to_string(), &inputs(cfg)?]))
+}
+
+/// Builds `motions.h5`.
+pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+    let study = &s.study;
+    let cfg = &study.cfg;
+    let me = StageId::Motions;
+    let seeds = seed_records(&cfg.motions).map_err(MotionsError::from)?;
+    let mut zones = Vec::new();
+    for (i, z) in cfg.zones.iter().enumerate() {
+        let target = cfg.target(i).map_err(|e| ConfigError::Invalid {
+            file: study.config_path.display().to_string(),
+            key: format!("zones[{i}].target"),
+            why: e.to_string(),
+        })?;
+        let start = std::time::Instant::now();
+        let zm = match_zone(&z.name, &target, &seeds, &cfg.motions).map_err(|source| {
+            MotionsError::Matching {
+                zone: z.name.clone(),
+                source,
+            }
+        })?;
+        let met = |b: bool| if b { "met" } else { "NOT met" };
+        s.reporter.info(
+            me,
+            &format!(
+                "zone {}: {} motions kept of {} seeds tried, matched to {} in {:.1} s; set scale \
+                 {:.4}, mean/target ≥ {:.3} (set_mean_min {}: {}; ASCE 7 90 %: {})",
+                z.name,
+                zm.kept.len(),
+                zm.seeds.len(),
+                target,
+                start.elapsed().as_secs_f64(),
+                zm.set_scale,
+                zm.mean_ratio_min,
+                cfg.motions.set_mean_min,
+                met(zm.set_mean_ok),
+                met(zm.asce7_ok),
+            ),
+        );
+        for (seed, r) in zm.seeds.iter().zip(&zm.reports) {
+            if !r.converged {
+                s.reporter.warn(
+                    me,
+                    &format!(
+                        "zone {}: {seed} left out: worst misfit {:.3} after {} iterations",
+                        z.name, r.worst_misfit, r.iterations
+                    ),
+                );
+            }
+        }
+        if !zm.all_within_band {
+            s.reporter.warn(
+                me,
+                &format!(
+                    "zone {}: after the set scale {:.4} some motions exceed the upper bound {}",
+                    z.name, zm.set_scale, cfg.motions.matching.upper
+                ),
+            );
+        }
+        if zm.kept.is_empty() {
+            return Err(MotionsError::NothingMatched {
+                zone: z.name.clone(),
+            }
+            .into());
+        }
+        let zone_fp = hash_parts(&[study.fingerprint(me)?, &z.name]);
+        zones.push((zm, zone_fp));
+    }
+    let meta = StageMeta {
+        fingerprint: study.fingerprint(me)?.to_string(),
+        config_sha256: study.config_sha256.clone(),
+        inputs: inputs(cfg)?,
+    };
+    let path = study.path(me.output());
+    write_motions(&path, &meta, &seeds, &zones)?;
+    Ok(Outcome::Wrote(vec![path]))
+}

@@ -1,0 +1,500 @@
+//! The sweep stage: every case of the grid under every motion → `sweep.h5` (layout in
+//! [`crate::store::sweep`]; the numerics of one work unit in [`crate::study::sweep`]).
+//!
+//! Work units (one zone, one motion, one `T_p`) are computed in parallel, each stored as its own
+//! file under `OUT/sweep.units/` the moment it is done ([`crate::store::units`]): a rerun after
+//! an interruption computes only the rest. With a shard `K/N` only the units `i` with
+//! `i mod N = K−1` are computed and nothing is assembled (`merge` does that when every shard is
+//! done). Assembling reads every unit back (checksum and identity checked), writes `sweep.h5`,
+//! reads it back and compares it with what was meant, and only then removes the units.
+//!
+//! Fingerprint: the `zones` and `grid` sections, the solver, and the motions' fingerprint.
+
+use super::{Outcome, PipelineError, Session, StageId, Study};
+use crate::dynamics::Ground;
+use crate::grid::Grid;
+use crate::motion::Record;
+use crate::store::StoreError;
+use crate::store::fingerprint::fingerprint as hash_parts;
+use crate::store::motions::read_zone_motions;
+use crate::store::sweep::{SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep};
+use crate::store::units::{Columns, Stored, UnitId, read_unit, unit_path, write_unit};
+use crate::study::config::{Seeds, StudyConfig};
+use crate::study::sweep::{
+    SKIP_RULE_CODES, SKIP_RULE_FLAGS, SweepError, UnitOptions, UnitResult, run_unit,
+};
+use ndarray::{ArrayD, IxDyn};
+use rayon::prelude::*;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use thiserror::Error;
+
+/// Directory of the unit files inside the output directory.
+pub const UNITS_DIR: &str = "sweep.units";
+
+#[derive(Debug, Error)]
+pub enum SweepStageError {
+    #[error("shard {k}/{n}: needs 1 ≤ K ≤ N ≤ {units} (the sweep has {units} work units)")]
+    Shard { k: usize, n: usize, units: usize },
+    #[error("zone {zone}, motion {motion}: {source}")]
+    Simulation {
+        zone: String,
+        motion: String,
+        source: Box<SweepError>,
+    },
+    #[error(
+        "{missing} of {total} units are missing from {}: run the remaining shards (or `slidestack sweep` without --shard)",
+        dir.display()
+    )]
+    MissingUnits {
+        missing: usize,
+        total: usize,
+        dir: PathBuf,
+    },
+    #[error(
+        "{} of the units in {} are damaged or misplaced, first: {first}; rerun the shards that made \
+         them (or `slidestack sweep` without --shard), which recompute them",
+        count, dir.display()
+    )]
+    BadUnits {
+        count: usize,
+        dir: PathBuf,
+        first: String,
+    },
+    #[error("{}: read back, it differs from what was written in {what}", file.display())]
+    Verify { file: PathBuf, what: String },
+}
+
+impl SweepStageError {
+    pub fn is_bad_input(&self) -> bool {
+        matches!(self, SweepStageError::Shard { .. })
+    }
+}
+
+/// The fingerprint `sweep.h5` must carry.
+pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> String {
+    let section = serde_json::json!({
+        "zones": cfg.zones, "grid": cfg.grid, "solver": "exact",
+    });
+    hash_parts(&[&section.to_string(), motions_fingerprint])
+}
+
+/// One work unit: zone, motion and period indices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Unit {
+    zone: usize,
+    motion: usize,
+    period: usize,
+}
+
+/// Every unit in the fixed order shards count in.
+fn all_units(grid: &Grid, motions: &[Vec<Record>]) -> Vec<Unit> {
+    let mut v = Vec::new();
+    for (zone, ms) in motions.iter().enumerate() {
+        for motion in 0..ms.len() {
+            for period in 0..grid.periods_s.len() {
+                v.push(Unit {
+                    zone,
+                    motion,
+                    period,
+                });
+            }
+        }
+    }
+    v
+}
+
+/// The kept motions of every zone, from `motions.h5`.
+pub fn load_motions(study: &Study) -> Result<Vec<Vec<Record>>, StoreError> {
+    let path = study.path(StageId::Motions.output());
+    study
+        .cfg
+        .zones
+        .iter()
+        .map(|z| read_zone_motions(&path, &z.name))
+        .collect()
+}
+
+struct Units<'a> {
+    study: &'a Study,
+    grid: &'a Grid,
+    motions: &'a [Vec<Record>],
+    fingerprint: &'a str,
+}
+
+impl Units<'_> {
+    fn path(&self, u: Unit) -> PathBuf {
+        unit_path(
+            &self.study.path(UNITS_DIR),
+            &self.study.cfg.zones[u.zone].name,
+            u.motion,
+            u.period,
+        )
+    }
+
+    fn id(&self, u: Unit) -> UnitId {
+        UnitId {
+            fingerprint: self.fingerprint.to_string(),
+            zone: self.study.cfg.zones[u.zone].name.clone(),
+            motion_index: u.motion,
+            motion: self.motions[u.zone][u.motion].name.clone(),
+            period_index: u.period,
+            period_s: self.grid.periods_s[u.period],
+        }
+    }
+
+    fn read(&self, u: Unit) -> Result<Stored, StoreError> {
+        read_unit(&self.path(u), &self.id(u))
+    }
+}
+
+const F64_COLUMNS: usize = 6;
+
+fn to_columns(r: &UnitResult) -> Columns {
+    Columns {
+        f64s: vec![
+            r.u_stack.clone(),
+            r.u_single.clone(),
+            r.u_rigid.clone(),
+            r.a_stack.clone(),
+            r.friction_energy.clone(),
+            r.slip_peak.clone(),
+        ],
+        u8s: vec![r.skip_rule.clone(), r.single_rule.clone()],
+    }
+}
+
+/// Builds `sweep.h5`, or with `shard = Some((K, N))` only that shard's units.
+pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, PipelineError> {
+    let study = &s.study;
+    let me = StageId::Sweep;
+    let grid = study.grid(me)?;
+    let fp = study.fingerprint(me)?;
+    let motions = load_motions(study)?;
+    let units = Units {
+        study,
+        grid,
+        motions: &motions,
+        fingerprint: fp,
+    };
+    let all = all_units(grid, &motions);
+    if let Some((k, n)) = shard
+        && !(1 <= k && k <= n && n <= all.len())
+    {
+        return Err(SweepStageError::Shard {
+            k,
+            n,
+            units: all.len(),
+        }
+        .into());
+    }
+    let mine: Vec<Unit> = all
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1))
+        .map(|(_, u)| *u)
+        .collect();
+    let dir = study.path(UNITS_DIR);
+    std::fs::create_dir_all(&dir).map_err(|e| StoreError::io(&dir, "cannot create", e))?;
+    let mut todo = Vec::new();
+    for &u in &mine {
+        match units.read(u) {
+            Ok(Stored::Valid(_)) => {}
+            Ok(Stored::Missing | Stored::Stale) => todo.push(u),
+            Err(e) => {
+                s.reporter.warn(me, &format!("{e}: computing it again"));
+                todo.push(u);
+            }
+        }
+    }
+    let cases = todo.len() * grid.cases_per_unit();
+    s.reporter.info(
+        me,
+        &format!(
+            "{} of {} units to compute ({} cases; {} already done)",
+            todo.len(),
+            mine.len(),
+            cases,
+            mine.len() - todo.len()
+        ),
+    );
+    let bar = s.reporter.progress(me, todo.len() as u64);
+    let start = std::time::Instant::now();
+    let sims = AtomicUsize::new(0);
+    // Record samples crossed by all simulations together.
+    let samples = AtomicUsize::new(0);
+    let physics = study.physics();
+    todo.par_iter()
+        .try_for_each(|&u| -> Result<(), PipelineError> {
+            let rec = &motions[u.zone][u.motion];
+            let accel = rec.accel_mps2(1.0);
+            let ground = Ground {
+                dt_s: rec.dt_s,
+                accel_mps2: &accel,
+            };
+            let r = run_unit(
+                grid,
+                &physics,
+                &ground,
+                u.period,
+                UnitOptions { skip: true },
+            )
+            .map_err(|source| SweepStageError::Simulation {
+                zone: study.cfg.zones[u.zone].name.clone(),
+                motion: rec.name.clone(),
+                source: Box::new(source),
+            })?;
+            sims.fetch_add(r.simulations, Ordering::Relaxed);
+            samples.fetch_add(r.simulations * accel.len(), Ordering::Relaxed);
+            write_unit(&units.path(u), &units.id(u), &to_columns(&r))?;
+            bar.inc();
+            Ok(())
+        })?;
+    bar.finish();
+    let secs = start.elapsed().as_secs_f64();
+    if !todo.is_empty() {
+        let sims = sims.into_inner();
+        let threads = rayon::current_num_threads();
+        s.reporter.info(
+            me,
+            &format!(
+                "{cases} cases in {secs:.1} s ({:.0} cases/s); {sims} simulations ({:.0}/s; the \
+                 skip rules saved {:.0} %); {:.0} ns per simulated record sample per thread \
+                 ({threads} threads)",
+                cases as f64 / secs.max(1e-9),
+                sims as f64 / secs.max(1e-9),
+                100.0 * (1.0 - sims as f64 / (3 * cases) as f64),
+                secs * 1e9 * threads as f64 / samples.into_inner().max(1) as f64
+            ),
+        );
+    }
+    if let Some((k, n)) = shard {
+        return Ok(Outcome::ShardDone { k, n });
+    }
+    assemble(s, &units, &all)
+}
+
+/// Assembles `sweep.h5` from the stored units of every shard (`merge`).
+pub fn merge(s: &Session) -> Result<Outcome, PipelineError> {
+    let study = &s.study;
+    let me = StageId::Sweep;
+    study.require(StageId::Motions)?;
+    if study.state(me)? == super::StageState::UpToDate {
+        remove_units(study)?;
+        return Ok(Outcome::UpToDate(study.path(me.output())));
+    }
+    let grid = study.grid(me)?;
+    let motions = load_motions(study)?;
+    let units = Units {
+        study,
+        grid,
+        motions: &motions,
+        fingerprint: study.fingerprint(me)?,
+    };
+    let all = all_units(grid, &motions);
+    assemble(s, &units, &all)
+}
+
+fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, PipelineError> {
+    let study = units.study;
+    let grid = units.grid;
+    let dir = study.path(UNITS_DIR);
+    let mut missing = 0;
+    let mut bad = Vec::new();
+    let mut read: Vec<Columns> = Vec::with_capacity(all.len());
+    for &u in all {
+        match units.read(u) {
+            Ok(Stored::Valid(c)) if c.f64s.len() == F64_COLUMNS && c.u8s.len() == 2 => read.push(c),
+            Ok(Stored::Valid(_)) => bad.push(format!(
+                "{}: has the wrong columns",
+                units.path(u).display()
+            )),
+            Ok(Stored::Missing | Stored::Stale) => missing += 1,
+            Err(e) => bad.push(e.to_string()),
+        }
+    }
+    if !bad.is_empty() {
+        return Err(SweepStageError::BadUnits {
+            count: bad.len(),
+            dir,
+            first: bad.swap_remove(0),
+        }
+        .into());
+    }
+    if missing > 0 {
+        return Err(SweepStageError::MissingUnits {
+            missing,
+            total: all.len(),
+            dir,
+        }
+        .into());
+    }
+    let n = grid.blocks();
+    let mut zones = Vec::new();
+    let mut at = 0;
+    for (z, zc) in study.cfg.zones.iter().enumerate() {
+        let count = units.motions[z].len() * grid.periods_s.len();
+        let cols = &read[at..at + count];
+        at += count;
+        let mut shape = vec![units.motions[z].len()];
+        shape.extend(grid.shape());
+        let mut shape_i = shape.clone();
+        shape_i.push(n);
+        let f = |i: usize, shape: &[usize]| -> Result<ArrayD<f64>, PipelineError> {
+            let flat: Vec<f64> = cols
+                .iter()
+                .flat_map(|c| c.f64s[i].iter().copied())
+                .collect();
+            array(flat, shape, &dir)
+        };
+        let codes = |i: usize| -> Result<ArrayD<u8>, PipelineError> {
+            let flat: Vec<u8> = cols.iter().flat_map(|c| c.u8s[i].iter().copied()).collect();
+            array(flat, &shape, &dir)
+        };
+        zones.push(ZoneSweep {
+            name: zc.name.clone(),
+            target: zc.target.clone(),
+            motions: units.motions[z].iter().map(|m| m.name.clone()).collect(),
+            vars: SweepVars {
+                u_stack: f(0, &shape)?,
+                u_single: f(1, &shape)?,
+                u_rigid: f(2, &shape)?,
+                a_stack: f(3, &shape)?,
+                friction_energy: f(4, &shape)?,
+                slip_peak: f(5, &shape_i)?,
+                skip_rule: codes(0)?,
+                single_rule: codes(1)?,
+            },
+        });
+    }
+    let me = StageId::Sweep;
+    let fp = study.fingerprint(me)?;
+    let motions_fp = study.fingerprint(StageId::Motions)?;
+    let meta = SweepMeta {
+        fingerprint: fp,
+        config_sha256: &study.config_sha256,
+        motions_fingerprint: motions_fp,
+        skip_rule_codes: SKIP_RULE_CODES,
+        skip_rule_flags: &SKIP_RULE_FLAGS,
+        mu_static_ratio: study.physics().mu_static_ratio,
+        settings: &[("damping", study.physics().damping)],
+    };
+    let path = study.path(me.output());
+    write_sweep(&path, &meta, grid, &zones)?;
+    // Verified on disk before the units go: what reads back is bit for bit what was meant.
+    if study.stored(me)?.as_deref() != Some(fp) {
+        return Err(SweepStageError::Verify {
+            file: path,
+            what: "its fingerprint".into(),
+        }
+        .into());
+    }
+    for z in &zones {
+        let (_, back) = read_zone_sweep(&path, &z.name, n)?;
+        if !same_bits(&back, z) {
+            return Err(SweepStageError::Verify {
+                file: path,
+                what: format!("zone_{}", z.name),
+            }
+            .into());
+        }
+    }
+    remove_units(study)?;
+    s.reporter.info(me, &format!("verified {}", path.display()));
+    Ok(Outcome::Wrote(vec![path]))
+}
+
+fn array<T>(
+    flat: Vec<T>,
+    shape: &[usize],
+    dir: &std::path::Path,
+) -> Result<ArrayD<T>, PipelineError> {
+    ArrayD::from_shape_vec(IxDyn(shape), flat).map_err(|_| {
+        SweepStageError::BadUnits {
+            count: 1,
+            dir: dir.to_path_buf(),
+            first: "a unit holds the wrong number of cases".into(),
+        }
+        .into()
+    })
+}
+
+/// Equal to the bit (NaN fill included).
+fn same_bits(a: &ZoneSweep, b: &ZoneSweep) -> bool {
+    let f = |x: &ArrayD<f64>, y: &ArrayD<f64>| {
+        x.shape() == y.shape() && x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())
+    };
+    let (va, vb) = (&a.vars, &b.vars);
+    a.motions == b.motions
+        && f(&va.u_stack, &vb.u_stack)
+        && f(&va.u_single, &vb.u_single)
+        && f(&va.u_rigid, &vb.u_rigid)
+        && f(&va.a_stack, &vb.a_stack)
+        && f(&va.friction_energy, &vb.friction_energy)
+        && f(&va.slip_peak, &vb.slip_peak)
+        && va.skip_rule == vb.skip_rule
+        && va.single_rule == vb.single_rule
+}
+
+/// Removes the unit files (after `sweep.h5` was verified, or left over from an interrupted
+/// cleanup).
+pub fn remove_units(study: &Study) -> Result<(), StoreError> {
+    let dir = study.path(UNITS_DIR);
+    match std::fs::remove_dir_all(&dir) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(StoreError::io(&dir, "cannot remove", e)),
+    }
+}
+
+/// `(work units, units stored for the current sweep, record samples per motion)`; before the
+/// motions stage ran the motion counts come from the config and the samples are 0.
+pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError> {
+    let grid = study.grid(StageId::Sweep)?;
+    if study.state(StageId::Motions)? != super::StageState::UpToDate {
+        let per_zone = match study.cfg.motions.seeds.kind() {
+            Seeds::Stochastic(s) => s.count,
+            Seeds::Records(r) => r.files.len(),
+        };
+        return Ok((
+            per_zone * study.cfg.zones.len() * grid.periods_s.len(),
+            0,
+            0,
+        ));
+    }
+    let motions = load_motions(study)?;
+    let units = Units {
+        study,
+        grid,
+        motions: &motions,
+        fingerprint: study.fingerprint(StageId::Sweep)?,
+    };
+    let all = all_units(grid, &motions);
+    let done = if study.state(StageId::Sweep)? == super::StageState::UpToDate {
+        all.len()
+    } else {
+        all.iter()
+            .filter(|&&u| matches!(units.read(u), Ok(Stored::Valid(_))))
+            .count()
+    };
+    let (count, samples) = motions
+        .iter()
+        .flatten()
+        .fold((0, 0), |(c, n), m| (c + 1, n + m.accel_g.len()));
+    Ok((all.len(), done, samples / count.max(1)))
+}
+
+/// Shard `K/N` of the sweep: nothing when `sweep.h5` is already up to date (unless forced).
+pub fn run_shard(
+    s: &Session,
+    k: usize,
+    n: usize,
+    opts: super::StageOptions,
+) -> Result<Outcome, PipelineError> {
+    let me = StageId::Sweep;
+    s.study.require(StageId::Motions)?;
+    if !opts.force && s.study.state(me)? == super::StageState::UpToDate {
+        return Ok(Outcome::UpToDate(s.study.path(me.output())));
+    }
+    build(s, Some((k, n)))
+}

@@ -1,0 +1,160 @@
+//! The T_new stage: per zone and case, the mean peak displacements over the motions, `T_rigid`,
+//! `T_new` read off the zone's mean 5 %-damped displacement spectrum (paper Section 7.1; the
+//! rule for several crossings in [`crate::study::tnew`]), whether anything slid, `DRR_1` and
+//! `DRR_2` → `tnew.h5` (layout in [`crate::store::tnew`]).
+//!
+//! Fingerprint: the sweep's, and the step of the spectrum's period grid.
+
+use super::{Outcome, PipelineError, Session, StageId};
+use crate::grid::Grid;
+use crate::spectrum::{SpectrumError, response_spectrum};
+use crate::store::StoreError;
+use crate::store::fingerprint::fingerprint as hash_parts;
+use crate::store::sweep::read_zone_sweep;
+use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, write_tnew};
+use crate::study::tnew::{TNEW_FLAG_CODES, TnewFlag, period_at_displacement};
+use ndarray::{ArrayD, Axis};
+use rayon::prelude::*;
+use thiserror::Error;
+
+/// Step of the period grid of the mean displacement spectrum, s.
+pub const SD_STEP_S: f64 = 0.005;
+
+#[derive(Debug, Error)]
+pub enum TnewError {
+    #[error("zone {zone}: spectrum of motion {motion}: {source}")]
+    Spectrum {
+        zone: String,
+        motion: String,
+        source: SpectrumError,
+    },
+}
+
+/// The fingerprint `tnew.h5` must carry.
+pub fn fingerprint(sweep_fingerprint: &str) -> String {
+    hash_parts(&[sweep_fingerprint, &format!("sd_step_s={SD_STEP_S}")])
+}
+
+/// The periods of the mean displacement spectrum: they reach past every `T_rigid` of the grid.
+pub fn spectrum_periods_s(grid: &Grid) -> Vec<f64> {
+    let alpha_max: f64 = grid
+        .alpha
+        .iter()
+        .map(|a| a.iter().copied().fold(0.0, f64::max))
+        .sum();
+    let t_max = grid.periods_s.last().copied().unwrap_or(1.0) * (1.0 + alpha_max).sqrt() * 1.5;
+    let steps = (t_max.max(4.0) / SD_STEP_S).ceil() as usize;
+    (1..=steps).map(|k| k as f64 * SD_STEP_S).collect()
+}
+
+/// Builds `tnew.h5`.
+pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+    let study = &s.study;
+    let me = StageId::Tnew;
+    let grid = study.grid(me)?;
+    let motions = super::sweep::load_motions(study)?;
+    let sweep_path = study.path(StageId::Sweep.output());
+    let period_sd_s = spectrum_periods_s(grid);
+    let n = grid.blocks();
+    let physics = study.physics();
+    let mut zones = Vec::new();
+    for (z, zc) in study.cfg.zones.iter().enumerate() {
+        let (axes, sw) = read_zone_sweep(&sweep_path, &zc.name, n)?;
+        if axes != *grid {
+            return Err(StoreError::corrupt(
+                &sweep_path,
+                format!("zone_{}: its grid differs from the config's", zc.name),
+            )
+            .into());
+        }
+        let m = sw.motions.len();
+        let spectra = motions[z]
+            .par_iter()
+            .map(|r| {
+                response_spectrum(&r.accel_mps2(1.0), r.dt_s, &period_sd_s, 0.05)
+                    .map(|s| s.sd_m())
+                    .map_err(|source| TnewError::Spectrum {
+                        zone: zc.name.clone(),
+                        motion: r.name.clone(),
+                        source,
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let sd_mean_m: Vec<f64> = (0..period_sd_s.len())
+            .map(|p| spectra.iter().map(|s| s[p]).sum::<f64>() / m as f64)
+            .collect();
+        // Means over the motion axis (summed in motion order, then divided).
+        let mean = |v: &ArrayD<f64>| v.sum_axis(Axis(0)) / m as f64;
+        let v = &sw.vars;
+        let (u_stack, u_single, u_rigid) = (mean(&v.u_stack), mean(&v.u_single), mean(&v.u_rigid));
+        // A case slides when any interface slips under any motion: slip_peak [motion, case…,
+        // interface] folded over its first and last axes.
+        let cases = grid.cases();
+        let slip = v
+            .slip_peak
+            .view()
+            .into_shape_with_order((m, cases, n))
+            .expect("slip_peak has shape [motion, cases, interface]");
+        let slides: Vec<bool> = (0..cases)
+            .map(|c| slip.index_axis(Axis(1), c).iter().any(|&x| x > 0.0))
+            .collect();
+        let mut t_rigid = Vec::with_capacity(cases);
+        let mut t_new = Vec::with_capacity(cases);
+        let mut flag = Vec::with_capacity(cases);
+        for (c, (&us, &slid)) in u_stack.iter().zip(&slides).enumerate() {
+            let case = grid.point(c);
+            let tr = physics.rigid(case.period_s, case.alpha_total()).period_s;
+            let (tn, f) = if slid {
+                period_at_displacement(&period_sd_s, &sd_mean_m, us, tr)
+            } else {
+                (tr, TnewFlag::NoSlip)
+            };
+            t_rigid.push(tr);
+            t_new.push(tn);
+            flag.push(f64::from(f as u8));
+        }
+        let shaped = |v: Vec<f64>| {
+            ArrayD::from_shape_vec(grid.shape(), v).expect("one value per case of the grid")
+        };
+        let count = |f: TnewFlag| flag.iter().filter(|&&x| x == f64::from(f as u8)).count();
+        s.reporter.info(
+            me,
+            &format!(
+                "zone {}: {cases} cases, {} slide; T_new from several crossings: {}, outside the \
+                 spectrum: {}",
+                zc.name,
+                slides.iter().filter(|&&x| x).count(),
+                count(TnewFlag::Several),
+                count(TnewFlag::OutsideRange),
+            ),
+        );
+        let vars = TnewVars {
+            drr_1: &u_stack / &u_rigid,
+            drr_2: &u_single / &u_rigid,
+            u_stack_mean: u_stack,
+            u_single_mean: u_single,
+            u_rigid_mean: u_rigid,
+            t_rigid: shaped(t_rigid),
+            t_new: shaped(t_new),
+            slides: shaped(slides.iter().map(|&b| f64::from(u8::from(b))).collect()),
+            flag: shaped(flag),
+        };
+        zones.push(ZoneTnew {
+            name: zc.name.clone(),
+            target: zc.target.clone(),
+            vars,
+            period_sd_s: period_sd_s.clone(),
+            sd_mean_m,
+        });
+    }
+    let meta = TnewMeta {
+        fingerprint: study.fingerprint(me)?,
+        sweep_fingerprint: study.fingerprint(StageId::Sweep)?,
+        flag_codes: TNEW_FLAG_CODES,
+        mu_static_ratio: physics.mu_static_ratio,
+        settings: &[("damping", physics.damping)],
+    };
+    let path = study.path(me.output());
+    write_tnew(&path, &meta, grid, &zones)?;
+    Ok(Outcome::Wrote(vec![path]))
+}

@@ -1,0 +1,124 @@
+//! The fit stage's files: `fit.yaml` (the numbers, for people and scripts) and `fit.h5` (the same
+//! numbers for HDF5 readers), written with the same fingerprint. Both are written checked and
+//! atomically with a checksum sidecar; the stage is up to date only when both verify and agree.
+//!
+//! ```text
+//! fit.h5:  /  attrs: contents, slidestack_version, fingerprint, features
+//!          /zone_<name>/<form>/coefficients   attrs: names, r2, r, rmse_s, mse_s2, mae_s, n,
+//!                                                     cv_r2, cv_r, …
+//!          /zone_<name>/published             attrs: r2, r, rmse_s, mse_s2, mae_s, n
+//! ```
+
+use super::h5::{attr_f64, attr_str, write_1d, write_stage_file};
+use super::{StoreError, checksum};
+use crate::fit::{Form, Metrics};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// One fitted form of one zone.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FormFit {
+    pub form: Form,
+    /// Parameter names and values.
+    pub coefficients: Vec<(String, f64)>,
+    pub all_cases: Metrics,
+    pub cross_validated: Metrics,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ZoneFit {
+    pub zone: String,
+    pub cases: usize,
+    pub forms: Vec<FormFit>,
+    /// The paper's published equation for this zone on our T_new, when it applies.
+    pub published: Option<Metrics>,
+}
+
+/// Everything the fit stage stores.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitReport {
+    pub slidestack_version: String,
+    pub fingerprint: String,
+    pub features: Vec<String>,
+    pub zones: Vec<ZoneFit>,
+}
+
+fn write_metrics(g: &hdf5::Location, prefix: &str, m: &Metrics) -> hdf5::Result<()> {
+    for (k, v) in [
+        ("r2", m.r2),
+        ("r", m.r),
+        ("rmse_s", m.rmse),
+        ("mse_s2", m.mse),
+        ("mae_s", m.mae),
+        ("n", m.n as f64),
+    ] {
+        attr_f64(g, &format!("{prefix}{k}"), v)?;
+    }
+    Ok(())
+}
+
+/// Writes `fit.h5` at `h5` and `fit.yaml` at `yaml`.
+pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError> {
+    write_stage_file(
+        h5,
+        "slidestack fit stage: design equations for T_new (see fit.yaml)",
+        &r.fingerprint,
+        |f| {
+            attr_str(f, "features", &r.features.join(", "))?;
+            for z in &r.zones {
+                let g = f.create_group(&format!("zone_{}", z.zone))?;
+                for fr in &z.forms {
+                    let sub = g.create_group(fr.form.name())?;
+                    let values: Vec<f64> = fr.coefficients.iter().map(|c| c.1).collect();
+                    let names: Vec<String> = fr.coefficients.iter().map(|c| c.0.clone()).collect();
+                    let ds = write_1d(
+                        &sub,
+                        "coefficients",
+                        &values,
+                        "mixed (s, s per unit feature)",
+                        "fitted coefficients",
+                    )?;
+                    attr_str(&ds, "names", &names.join(", "))?;
+                    write_metrics(&sub, "", &fr.all_cases)?;
+                    write_metrics(&sub, "cv_", &fr.cross_validated)?;
+                }
+                if let Some(m) = &z.published {
+                    let sub = g.create_group("published")?;
+                    write_metrics(&sub, "", m)?;
+                }
+            }
+            Ok(())
+        },
+    )?;
+    let text = serde_yaml::to_string(r).expect("the fit report serialises");
+    checksum::write_with_sidecar(yaml, text.as_bytes())
+}
+
+/// `fit.yaml`, verified against its sidecar.
+pub fn read_fit(yaml: &Path) -> Result<Option<FitReport>, StoreError> {
+    if !checksum::verify(yaml)? {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(yaml).map_err(|e| StoreError::io(yaml, "cannot read", e))?;
+    serde_yaml::from_str(&text)
+        .map(Some)
+        .map_err(|e| StoreError::corrupt(yaml, format!("is not a slidestack fit report: {e}")))
+}
+
+/// The fingerprint of the fit stage's files: `None` when either is missing; an error when either
+/// fails its checksum or they disagree.
+pub fn stored_fingerprint(h5: &Path, yaml: &Path) -> Result<Option<String>, StoreError> {
+    let Some(fp) = super::h5::stored_fingerprint(h5)? else {
+        return Ok(None);
+    };
+    let Some(report) = read_fit(yaml)? else {
+        return Ok(None);
+    };
+    if report.fingerprint != fp {
+        return Err(StoreError::corrupt(
+            yaml,
+            format!("belongs to another fit than {}", h5.display()),
+        ));
+    }
+    Ok(Some(fp))
+}
