@@ -9,6 +9,31 @@
 //! Pure data: no physics, no files. The study's physics settings (damping, static friction)
 //! live in [`crate::study::sweep::Physics`], the file layouts in [`crate::store`].
 
+/// `from, from + step, …` up to `to` (inclusive within 1e-9 of a step), each value rounded to
+/// 12 significant digits so that `0.1 + 2·0.1` reads back as `0.3`; at most `max` values,
+/// counted before anything is allocated. The one expansion of a `{from, to, step}` range, for
+/// the study grid and for period lists alike.
+pub fn linear_range(from: f64, to: f64, step: f64, max: usize) -> Result<Vec<f64>, String> {
+    if !(from.is_finite() && to.is_finite() && step.is_finite() && step > 0.0 && to >= from) {
+        return Err(format!(
+            "range from {from} to {to} by {step}: needs finite values, step > 0 and to ≥ from"
+        ));
+    }
+    let steps = ((to - from) / step + 1e-9).floor();
+    if steps + 1.0 > max as f64 {
+        return Err(format!(
+            "range from {from} to {to} by {step} has {:.0} values; at most {max}",
+            steps + 1.0
+        ));
+    }
+    Ok((0..=steps as usize)
+        .map(|k| {
+            let v = from + step * k as f64;
+            format!("{v:.12e}").parse().unwrap_or(v)
+        })
+        .collect())
+}
+
 /// The grid's axes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Grid {
@@ -103,6 +128,20 @@ impl Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ranges_round_and_refuse_before_allocating() {
+        assert_eq!(
+            linear_range(0.1, 0.5, 0.1, 100).unwrap(),
+            vec![0.1, 0.2, 0.3, 0.4, 0.5]
+        );
+        assert_eq!(linear_range(1.0, 1.0, 0.5, 100).unwrap(), vec![1.0]);
+        let e = linear_range(0.0, 1e12, 1e-6, 100_000).unwrap_err();
+        assert!(e.contains("values; at most 100000"), "{e}");
+        assert!(linear_range(1.0, 0.0, 0.1, 10).is_err());
+        assert!(linear_range(0.0, 1.0, 0.0, 10).is_err());
+        assert!(linear_range(0.0, f64::INFINITY, 1.0, 10).is_err());
+    }
 
     #[test]
     fn flat_index_is_row_major_with_the_last_mu_fastest() {

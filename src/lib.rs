@@ -5,6 +5,7 @@
 //! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
 //! * [`fit`]: the design equation for T_new: forms, argmin problems, metrics.
 //! * [`report`]: SVG figures and the HTML report.
+//! * [`limits`]: the limits every input is checked against, with their reasons.
 //! * [`grid`]: the study's case grid (axes and indexing).
 //! * [`study`]: the study's numerics and configuration.
 //! * [`pipeline`]: the study's stages as library code: one shape, the output lock, checks.
@@ -18,6 +19,7 @@ pub mod accuracy;
 pub mod dynamics;
 pub mod fit;
 pub mod grid;
+pub mod limits;
 pub mod motion;
 mod numeric;
 pub mod pipeline;

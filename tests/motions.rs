@@ -123,7 +123,7 @@ fn spectrum_command_prints_the_exact_spectrum() {
     ]);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("period 0 s must be finite and > 0"),
+        stderr(&out).contains("periods `0:1:0.1`: period 0.0 s is outside 0.001 … 10000 s"),
         "{}",
         stderr(&out)
     );
@@ -282,7 +282,7 @@ fn motions_stage_refuses_bad_configs_naming_the_key() {
     .unwrap();
     let out = run(&["motions", cfg.to_str().unwrap()]);
     assert!(
-        stderr(&out).contains("`motions.seeds.stochastic.count`: must be ≥ 1"),
+        stderr(&out).contains("`motions.seeds.stochastic.count`: must be ≥ 1 and ≤ 10000"),
         "{}",
         stderr(&out)
     );

@@ -289,7 +289,10 @@ fn write_at2_refuses_what_it_cannot_read_back() {
     r.dt_s = 0.0;
     assert_eq!(
         write_at2(&r, "x", &out).unwrap_err().to_string(),
-        format!("{}:4: time step dt must be > 0, got 0", out.display())
+        format!(
+            "{}:4: time step dt = 0.0 s is outside 0.00001 … 1 s (a unit or header mistake?)",
+            out.display()
+        )
     );
     assert!(!out.exists());
 }

@@ -195,7 +195,7 @@ fn sweep_refuses_what_it_cannot_do() {
     let o = slidestack(&["sweep", cfg_s], "1");
     assert!(
         String::from_utf8_lossy(&o.stderr)
-            .contains("`grid.alpha[0]`: value -1 must be finite and > 0"),
+            .contains("`grid.alpha[0]`: value -1.0 must be finite, > 0 and ≤ 10000"),
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );

@@ -110,6 +110,10 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
             .is_some_and(PipelineError::is_bad_input)
             || c.is::<slidestack::study::config::ConfigError>()
             || c.is::<slidestack::motion::RecordError>()
+            || c.is::<slidestack::spectrum::PeriodsError>()
+            || c.is::<slidestack::dynamics::ModelError>()
+            || c.downcast_ref::<slidestack::dynamics::SimError>()
+                .is_some_and(slidestack::dynamics::SimError::is_bad_input)
             || c.is::<BadInput>()
     });
     if bad_input { 2 } else { 1 }
@@ -168,49 +172,4 @@ impl RecordArgs {
             .collect::<Result<Vec<_>>>()
             .context("cannot read the ground motions")
     }
-}
-
-/// Periods from `START:STOP:STEP` (linear, inclusive), `log:START:STOP:COUNT` (log-spaced) or a
-/// comma-separated list, all in seconds; each must be finite and > 0.
-pub fn parse_periods(text: &str) -> Result<Vec<f64>> {
-    let num = |s: &str| -> Result<f64> {
-        s.trim()
-            .parse::<f64>()
-            .with_context(|| format!("periods `{text}`: `{s}` is not a number"))
-    };
-    let periods = if let Some(rest) = text.strip_prefix("log:") {
-        let parts: Vec<&str> = rest.split(':').collect();
-        if parts.len() != 3 {
-            bail!("periods `{text}`: expected log:START:STOP:COUNT");
-        }
-        let (a, b) = (num(parts[0])?, num(parts[1])?);
-        let n: usize = parts[2]
-            .trim()
-            .parse()
-            .with_context(|| format!("periods `{text}`: COUNT must be a whole number"))?;
-        if n < 2 || !(a > 0.0 && b > a) {
-            bail!("periods `{text}`: needs 0 < START < STOP and COUNT ≥ 2");
-        }
-        slidestack::motion::matching::log_space(a, b, n)
-    } else if text.contains(':') {
-        let parts: Vec<&str> = text.split(':').collect();
-        if parts.len() != 3 {
-            bail!("periods `{text}`: expected START:STOP:STEP");
-        }
-        let (a, b, step) = (num(parts[0])?, num(parts[1])?, num(parts[2])?);
-        if !(step > 0.0 && b >= a) {
-            bail!("periods `{text}`: needs STOP ≥ START and STEP > 0");
-        }
-        let n = ((b - a) / step + 1e-9).floor() as usize;
-        if n > 1_000_000 {
-            bail!("periods `{text}`: more than a million periods");
-        }
-        (0..=n).map(|i| a + step * i as f64).collect()
-    } else {
-        text.split(',').map(num).collect::<Result<Vec<_>>>()?
-    };
-    if let Some(bad) = periods.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-        bail!("periods `{text}`: period {bad} s must be finite and > 0");
-    }
-    Ok(periods)
 }

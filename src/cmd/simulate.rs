@@ -6,7 +6,8 @@
 //! count and energy terms as a table or, with `--json`, one JSON object on stdout. Writes the full
 //! time history when `--history OUT.h5|OUT.csv` is given.
 
-use anyhow::{Context, Result, bail};
+use super::BadInput;
+use anyhow::{Context, Result};
 use clap::ValueEnum;
 use serde::{Deserialize, Serialize};
 use slidestack::dynamics::{
@@ -14,6 +15,7 @@ use slidestack::dynamics::{
 };
 use slidestack::motion::{self, Record};
 use slidestack::store::write_history;
+use slidestack::study::config::read_yaml_text;
 use std::path::PathBuf;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize, Serialize)]
@@ -26,6 +28,7 @@ pub enum Integrator {
 }
 
 #[derive(Debug, clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// YAML file with the case (keys: record, period, alpha, mu, mu_static, damping, scale,
     /// integrator, rk4_substeps, history); flags given on the command line override it.
@@ -122,10 +125,14 @@ struct Output {
 pub fn run(args: Args) -> Result<()> {
     let file = match &args.config {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read case file {}", path.display()))?;
-            serde_yaml::from_str::<CaseFile>(&text)
-                .with_context(|| format!("invalid case file {}", path.display()))?
+            let text = read_yaml_text(path)?;
+            serde_yaml::from_str::<CaseFile>(&text).map_err(|e| {
+                BadInput(format!(
+                    "{}: {}",
+                    path.display(),
+                    slidestack::limits::excerpt_message(&e.to_string())
+                ))
+            })?
         }
         None => CaseFile::default(),
     };
@@ -138,8 +145,8 @@ pub fn run(args: Args) -> Result<()> {
         mu_static: args.mu_static.or(file.mu_static),
     };
     let scale = args.scale.or(file.scale).unwrap_or(1.0);
-    if !(scale.is_finite() && scale > 0.0) {
-        bail!("scale must be finite and > 0, got {scale}");
+    if !(scale.is_finite() && scale > 0.0 && scale <= 1e6) {
+        return Err(BadInput(format!("scale must be finite, > 0 and ≤ 1e6, got {scale}")).into());
     }
     let integrator = args
         .integrator
@@ -150,7 +157,7 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(p) = &history_path {
         slidestack::store::HistoryFormat::from_path(p)?;
     }
-    let system = System::new(&spec).context("invalid case")?;
+    let system = System::new(&spec).map_err(|e| BadInput(format!("invalid case: {e}")))?;
     let record: Record = match args.record.or(file.record) {
         Some(path) => motion::read_record(&path)?,
         None => motion::builtin(),
@@ -160,6 +167,9 @@ pub fn run(args: Args) -> Result<()> {
         dt_s: record.dt_s,
         accel_mps2: &accel,
     };
+    for w in slidestack::dynamics::accuracy_warnings(&system, &ground) {
+        eprintln!("simulate: warning: {w}");
+    }
     let want_history = history_path.is_some();
     let response = match integrator {
         Integrator::Exact => simulate_exact(

@@ -6,10 +6,11 @@
 //! the time of the peak. Prints a table, or CSV (`--csv`) or JSON (`--json`), one row per record,
 //! damping and period; `--out FILE` writes it to a file instead of stdout.
 
-use super::{RecordArgs, parse_periods};
+use super::RecordArgs;
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use serde::Serialize;
+use slidestack::spectrum::parse_periods;
 use slidestack::spectrum::response_spectrum;
 use std::io::Write;
 use std::path::PathBuf;

@@ -80,7 +80,10 @@ pub fn simulate_exact(
     opts: &ExactOptions,
 ) -> Result<Response, SimError> {
     ground.validate()?;
-    Exact::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)
+    super::check_accuracy(sys, ground)?;
+    let r = Exact::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?;
+    r.check_finite()?;
+    Ok(r)
 }
 
 /// Coefficients of the structure's cluster when its top body is `e0`.

@@ -20,6 +20,10 @@ pub use model::{G, ModelError, System, SystemSpec};
 pub use response::{Energy, History, Response};
 pub use rk4::simulate_rk4;
 
+use crate::limits::{
+    DT_RANGE_S, MAX_RIGID_PERIOD_STEPS, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP,
+    WARN_RIGID_PERIOD_STEPS,
+};
 use thiserror::Error;
 
 /// A ground acceleration sampled at a constant step, linear between samples.
@@ -33,8 +37,14 @@ pub struct Ground<'a> {
 
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SimError {
-    #[error("time step dt must be finite and > 0, got {0} s")]
+    #[error(
+        "time step dt must be within {lo} … {hi} s, got {0:?} s",
+        lo = DT_RANGE_S.0,
+        hi = DT_RANGE_S.1
+    )]
     TimeStep(f64),
+    #[error("a ground motion may have at most {MAX_SAMPLES} samples, got {0}")]
+    TooLong(usize),
     #[error("ground motion needs at least 2 samples, got {0}")]
     TooShort(usize),
     #[error("ground acceleration sample {index} is not finite ({value})")]
@@ -44,19 +54,57 @@ pub enum SimError {
          sample interval starting at t = {time_s} s; the case is refused rather than run forever"
     )]
     Zeno { time_s: f64, limit: usize },
-    #[error("rk4 sub-steps per sample must be >= 1, got {0}")]
+    #[error("rk4 sub-steps per sample must be 1 … {MAX_RK4_SUBSTEPS}, got {0}")]
     Substeps(usize),
+    #[error(
+        "rk4 with {substeps} sub-steps of dt = {dt_s} s is unstable for T_p = {period_s} s \
+         (ω·h = {omega_step:.2} > {RK4_MAX_OMEGA_STEP}); use at least {needed} sub-steps, or the \
+         exact integrator"
+    )]
+    Rk4Unstable {
+        period_s: f64,
+        dt_s: f64,
+        substeps: usize,
+        omega_step: f64,
+        needed: usize,
+    },
+    #[error(
+        "T_rigid = {t_rigid_s} s is {ratio:.3e} record steps (dt = {dt_s} s); the exact integrator \
+         is accurate up to {MAX_RIGID_PERIOD_STEPS:e} steps (its energy error grows like \
+         3e-15·(T_rigid/dt)²): use a shorter period or a coarser record"
+    )]
+    BeyondAccuracy {
+        t_rigid_s: f64,
+        dt_s: f64,
+        ratio: f64,
+    },
+    #[error("the response is not finite (the integration diverged)")]
+    Diverged,
     #[error(transparent)]
     Contact(#[from] contact::ContactError),
 }
 
+impl SimError {
+    /// Whether the input is at fault (a record, a step count, a system beyond the integrator's
+    /// accurate range) rather than the run.
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(
+            self,
+            SimError::Zeno { .. } | SimError::Contact(_) | SimError::Diverged
+        )
+    }
+}
+
 impl Ground<'_> {
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(self.dt_s.is_finite() && self.dt_s > 0.0) {
+        if !(DT_RANGE_S.0..=DT_RANGE_S.1).contains(&self.dt_s) {
             return Err(SimError::TimeStep(self.dt_s));
         }
         if self.accel_mps2.len() < 2 {
             return Err(SimError::TooShort(self.accel_mps2.len()));
+        }
+        if self.accel_mps2.len() > MAX_SAMPLES {
+            return Err(SimError::TooLong(self.accel_mps2.len()));
         }
         if let Some((index, &value)) = self
             .accel_mps2
@@ -73,4 +121,43 @@ impl Ground<'_> {
     pub fn duration_s(&self) -> f64 {
         (self.accel_mps2.len() - 1) as f64 * self.dt_s
     }
+}
+
+/// Refuses a system the exact integrator cannot run accurately on this record (limit in
+/// [`crate::limits::MAX_RIGID_PERIOD_STEPS`]).
+pub fn check_accuracy(sys: &System, ground: &Ground) -> Result<(), SimError> {
+    let t_rigid_s = sys.period_rigid_s();
+    let ratio = t_rigid_s / ground.dt_s;
+    if ratio > MAX_RIGID_PERIOD_STEPS {
+        return Err(SimError::BeyondAccuracy {
+            t_rigid_s,
+            dt_s: ground.dt_s,
+            ratio,
+        });
+    }
+    Ok(())
+}
+
+/// What a user should know before trusting a run that is allowed but near the edge of what the
+/// record and the integrator resolve.
+pub fn accuracy_warnings(sys: &System, ground: &Ground) -> Vec<String> {
+    let t_rigid_s = sys.period_rigid_s();
+    let mut out = Vec::new();
+    let ratio = t_rigid_s / ground.dt_s;
+    if ratio > WARN_RIGID_PERIOD_STEPS {
+        out.push(format!(
+            "T_rigid = {t_rigid_s} s is {ratio:.2e} record steps: the exact integrator's energy \
+             error may reach {:.0e} of the input (it grows like 3e-15·(T_rigid/dt)²)",
+            3e-15 * ratio * ratio
+        ));
+    }
+    let duration = ground.duration_s();
+    if t_rigid_s > 10.0 * duration {
+        out.push(format!(
+            "T_rigid = {t_rigid_s} s is more than ten times the record's {duration} s: the \
+             structure barely responds dynamically and its displacement follows the ground's, \
+             which depends on the record's baseline correction"
+        ));
+    }
+    out
 }

@@ -4,6 +4,7 @@
 //! Body 0 is the PS, bodies `1..=n` are the blocks bottom-up; interface `i` lies under block `i`,
 //! so interface 1 is PS–block 1. All displacements are relative to the ground.
 
+use crate::limits::{MAX_ALPHA, MAX_MU, STRUCTURE_PERIOD_RANGE_S};
 use thiserror::Error;
 
 /// Standard gravity, m/s².
@@ -12,16 +13,27 @@ pub const G: f64 = 9.80665;
 /// A parameter that makes the model impossible, named as the user wrote it.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ModelError {
-    #[error("period_s must be finite and > 0, got {0}")]
+    #[error(
+        "period_s must be within {lo} … {hi} s, got {0:?}",
+        lo = STRUCTURE_PERIOD_RANGE_S.0,
+        hi = STRUCTURE_PERIOD_RANGE_S.1
+    )]
     Period(f64),
     #[error("damping ratio must be finite and in [0, 1), got {0}")]
     Damping(f64),
     #[error("structure mass_kg must be finite and > 0, got {0}")]
     Mass(f64),
-    #[error("alpha_{index} (mass ratio of block {index}) must be finite and > 0, got {value}")]
+    #[error(
+        "alpha_{index} (mass ratio of block {index}) must be finite, > 0 and ≤ {MAX_ALPHA}, got {value:?}"
+    )]
     Alpha { index: usize, value: f64 },
     #[error(
-        "mu_{index} (kinetic friction of interface {index}) must be finite and >= 0, got {value}"
+        "the stack's mass ratio Σα = {0:?} exceeds {MAX_ALPHA}: beyond it round-off spoils the \
+         energy balance (the structure is a negligible appendage of its load)"
+    )]
+    AlphaTotal(f64),
+    #[error(
+        "mu_{index} (kinetic friction of interface {index}) must be finite, >= 0 and <= {MAX_MU}, got {value}"
     )]
     MuKinetic { index: usize, value: f64 },
     #[error("mu_static_{index} must be finite and >= mu_{index} (kinetic, {kinetic}), got {value}")]
@@ -98,7 +110,7 @@ impl System {
             ref mu,
             ref mu_static,
         } = *spec;
-        if !(period_s.is_finite() && period_s > 0.0) {
+        if !(STRUCTURE_PERIOD_RANGE_S.0..=STRUCTURE_PERIOD_RANGE_S.1).contains(&period_s) {
             return Err(ModelError::Period(period_s));
         }
         if !(damping_ratio.is_finite() && (0.0..1.0).contains(&damping_ratio)) {
@@ -116,15 +128,19 @@ impl System {
             });
         }
         for (i, &a) in alpha.iter().enumerate() {
-            if !(a.is_finite() && a > 0.0) {
+            if !(a.is_finite() && a > 0.0 && a <= MAX_ALPHA) {
                 return Err(ModelError::Alpha {
                     index: i + 1,
                     value: a,
                 });
             }
         }
+        let total: f64 = alpha.iter().sum();
+        if total > MAX_ALPHA {
+            return Err(ModelError::AlphaTotal(total));
+        }
         for (i, &m) in mu.iter().enumerate() {
-            if !(m.is_finite() && m >= 0.0) {
+            if !(m.is_finite() && (0.0..=MAX_MU).contains(&m)) {
                 return Err(ModelError::MuKinetic {
                     index: i + 1,
                     value: m,
@@ -142,7 +158,7 @@ impl System {
                     });
                 }
                 for (i, (&ms, &mk)) in s.iter().zip(mu).enumerate() {
-                    if !(ms.is_finite() && ms >= mk) {
+                    if !(ms.is_finite() && ms >= mk && ms <= MAX_MU) {
                         return Err(ModelError::MuStatic {
                             index: i + 1,
                             value: ms,

@@ -136,3 +136,26 @@ pub struct Response {
     pub energy_balance_error_max: f64,
     pub history: Option<History>,
 }
+
+impl Response {
+    /// Refuses a response with a non-finite peak or energy term (a diverged integration) instead
+    /// of reporting it. NaN energy terms the options left out are not checked.
+    pub fn check_finite(&self) -> Result<(), super::SimError> {
+        let e = &self.energy;
+        let finite = self.peak_displacement_m.is_finite()
+            && self
+                .peak_abs_accel_mps2
+                .iter()
+                .chain(&self.peak_slip_m)
+                .chain(&self.residual_slip_m)
+                .all(|v| v.is_finite())
+            && [e.kinetic, e.strain, e.friction]
+                .iter()
+                .all(|v| v.is_finite());
+        if finite {
+            Ok(())
+        } else {
+            Err(super::SimError::Diverged)
+        }
+    }
+}

@@ -25,6 +25,7 @@ use super::contact::Contact;
 use super::model::System;
 use super::response::{Energy, History, Response};
 use super::{Ground, SimError};
+use crate::limits::{MAX_RK4_SUBSTEPS, RK4_MAX_OMEGA_STEP};
 
 /// Runs the paper's RK4 with `substeps` sub-steps per record interval.
 pub fn simulate_rk4(
@@ -34,10 +35,24 @@ pub fn simulate_rk4(
     history: bool,
 ) -> Result<Response, SimError> {
     ground.validate()?;
-    if substeps == 0 {
+    if !(1..=MAX_RK4_SUBSTEPS).contains(&substeps) {
         return Err(SimError::Substeps(substeps));
     }
-    Ok(Rk4::new(sys).run(ground, substeps, history))
+    // The stiffest mode is the bare structure (every block sliding): ω_p = 2π/T_p.
+    let omega = std::f64::consts::TAU / sys.period_s();
+    let omega_step = omega * ground.dt_s / substeps as f64;
+    if omega_step > RK4_MAX_OMEGA_STEP {
+        return Err(SimError::Rk4Unstable {
+            period_s: sys.period_s(),
+            dt_s: ground.dt_s,
+            substeps,
+            omega_step,
+            needed: (omega * ground.dt_s / RK4_MAX_OMEGA_STEP).ceil() as usize,
+        });
+    }
+    let r = Rk4::new(sys).run(ground, substeps, history);
+    r.check_finite()?;
+    Ok(r)
 }
 
 struct Rk4<'s> {

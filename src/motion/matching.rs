@@ -18,6 +18,8 @@
 //! Units: accelerations and spectral values in g. Nothing here reads files.
 
 use super::process::{BaselineCorrection, ProcessError};
+use crate::limits::{MAX_PERIODS, PERIOD_RANGE_S};
+pub use crate::spectrum::log_space;
 use crate::spectrum::response::{NjStep, response_spectrum, validate_record};
 use crate::spectrum::{SpectrumError, TargetError, TargetSpectrum};
 use serde::{Deserialize, Serialize};
@@ -121,18 +123,32 @@ impl MatchSettings {
             return bad("damping", self.damping.to_string(), "must be in [0, 1)");
         }
         let (lo, hi) = self.check_range_s;
-        if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+        if !(lo >= PERIOD_RANGE_S.0 && hi <= PERIOD_RANGE_S.1 && hi > lo) {
             return bad(
                 "check_range_s",
                 format!("[{lo}, {hi}]"),
-                "needs 0 < low < high",
+                "needs 0.001 s ≤ low < high ≤ 10⁴ s",
             );
         }
-        if self.check_periods < 2 {
+        if !(2..=MAX_PERIODS).contains(&self.check_periods) {
             return bad(
                 "check_periods",
                 self.check_periods.to_string(),
-                "must be ≥ 2",
+                "must be 2 … 100000",
+            );
+        }
+        if self.max_iterations > 10_000 {
+            return bad(
+                "max_iterations",
+                self.max_iterations.to_string(),
+                "must be ≤ 10000",
+            );
+        }
+        if self.passes.iter().any(|&n| n > MAX_PERIODS) {
+            return bad(
+                "passes",
+                format!("{:?}", self.passes),
+                "a pass controls at most 100000 periods",
             );
         }
         if !(self.lower > 0.0 && self.lower <= 1.0) {
@@ -175,14 +191,6 @@ impl MatchSettings {
             self.check_periods,
         )
     }
-}
-
-/// `n` log-spaced values from `lo` to `hi` inclusive.
-pub fn log_space(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    let r = (hi / lo).ln();
-    (0..n)
-        .map(|i| lo * (r * i as f64 / (n - 1) as f64).exp())
-        .collect()
 }
 
 /// What matching did to one record.

@@ -24,6 +24,7 @@ use std::str::FromStr;
 use thiserror::Error;
 
 use crate::dynamics::G;
+use crate::limits::{DT_RANGE_S, MAX_FILE_BYTES, MAX_SAMPLES, excerpt};
 
 /// Relative tolerance for "the same time step": the uniform-sampling check of two-column files
 /// and the agreement between a file's step and [`ReadOptions::dt_s`].
@@ -144,6 +145,8 @@ pub struct ReadOptions {
     pub dt_s: Option<f64>,
 }
 
+/// A record file that cannot be read as a ground motion: the file and, for a problem with its
+/// contents, the line ([`Problem`]).
 #[derive(Debug, Error)]
 pub enum RecordError {
     #[error("{file}: cannot read: {source}")]
@@ -152,119 +155,81 @@ pub enum RecordError {
         #[source]
         source: std::io::Error,
     },
+    #[error("{file}: {bytes} bytes: a record file may have at most {MAX_FILE_BYTES}")]
+    TooLarge { file: String, bytes: u64 },
+    #[error("{file}:{line}: {problem}")]
+    Located {
+        file: String,
+        line: usize,
+        problem: Problem,
+    },
+}
+
+/// What is wrong on a line of a record file.
+#[derive(Debug, Error)]
+pub enum Problem {
+    #[error("missing AT2 header: expected `NPTS= n, DT= x SEC` or `n x NPTS, DT` on line 4")]
+    MissingHeader,
+    #[error("`{token}` is not a number")]
+    NotANumber { token: String },
+    #[error("value {value} is not finite")]
+    NonFinite { value: f64 },
     #[error(
-        "{file}:{line}: missing AT2 header: expected `NPTS= n, DT= x SEC` or `n x NPTS, DT` on line 4"
+        "time step dt = {dt:?} s is outside {} … {} s (a unit or header mistake?)",
+        DT_RANGE_S.0, DT_RANGE_S.1
     )]
-    MissingHeader { file: String, line: usize },
-    #[error("{file}:{line}: `{token}` is not a number")]
-    NotANumber {
-        file: String,
-        line: usize,
-        token: String,
-    },
-    #[error("{file}:{line}: value {value} is not finite")]
-    NonFinite {
-        file: String,
-        line: usize,
-        value: f64,
-    },
-    #[error("{file}:{line}: time step dt must be > 0, got {dt}")]
-    TimeStep { file: String, line: usize, dt: f64 },
-    #[error("{file}:{line}: header says NPTS = {expected} but the file has {found} values")]
-    Count {
-        file: String,
-        line: usize,
-        expected: usize,
-        found: usize,
-    },
-    #[error("{file}:{line}: expected 2 columns (time, acceleration in g), found {found}")]
-    Columns {
-        file: String,
-        line: usize,
-        found: usize,
-    },
-    #[error(
-        "{file}:{line}: expected 1 value per line (single-column record, as on line {first}), found {found}"
-    )]
-    SingleColumn {
-        file: String,
-        line: usize,
-        first: usize,
-        found: usize,
-    },
-    #[error(
-        "{file}:{line}: expected 1 column (acceleration) or 2 columns (time, acceleration), found {found}"
-    )]
-    Layout {
-        file: String,
-        line: usize,
-        found: usize,
-    },
-    #[error(
-        "{file}:{line}: time step {found} s differs from the first step {expected} s (non-uniform sampling)"
-    )]
-    NonUniform {
-        file: String,
-        line: usize,
-        expected: f64,
-        found: f64,
-    },
-    #[error("{file}:{line}: a record needs at least 2 samples, found {found}")]
-    TooShort {
-        file: String,
-        line: usize,
-        found: usize,
-    },
-    #[error("{file}:{line}: {source}")]
+    TimeStep { dt: f64 },
+    #[error("{npts:?} samples: a record may have at most {MAX_SAMPLES}")]
+    TooMany { npts: f64 },
+    #[error("header says NPTS = {expected} but the file has {found} values")]
+    Count { expected: usize, found: usize },
+    #[error("expected 2 columns (time, acceleration in g), found {found}")]
+    Columns { found: usize },
+    #[error("expected 1 value per line (single-column record, as on line {first}), found {found}")]
+    SingleColumn { first: usize, found: usize },
+    #[error("expected 1 column (acceleration) or 2 columns (time, acceleration), found {found}")]
+    Layout { found: usize },
+    #[error("time step {found} s differs from the first step {expected} s (non-uniform sampling)")]
+    NonUniform { expected: f64, found: f64 },
+    #[error("a record needs at least 2 samples, found {found}")]
+    TooShort { found: usize },
+    #[error("{source}")]
     UnknownUnits {
-        file: String,
-        line: usize,
         #[source]
         source: UnknownUnits,
     },
-    #[error("{file}:{line}: the file says units {in_file} but {given} was given")]
-    UnitsConflict {
-        file: String,
-        line: usize,
-        in_file: Units,
-        given: Units,
-    },
-    #[error("{file}:{line}: the file says dt = {in_file} s but dt = {given} s was given")]
-    DtConflict {
-        file: String,
-        line: usize,
-        in_file: f64,
-        given: f64,
-    },
-    #[error("{file}:{line}: `{key}: {value}` contradicts `{key}: {first_value}` on line {first}")]
+    #[error("the file says units {in_file} but {given} was given")]
+    UnitsConflict { in_file: Units, given: Units },
+    #[error("the file says dt = {in_file} s but dt = {given} s was given")]
+    DtConflict { in_file: f64, given: f64 },
+    #[error("`{key}: {value}` contradicts `{key}: {first_value}` on line {first}")]
     Redeclared {
-        file: String,
-        line: usize,
         key: &'static str,
         value: String,
         first: usize,
         first_value: String,
     },
     #[error(
-        "{file}:{line}: `# dt: {declared}` disagrees with the time column, whose step is {step} s (line {step_line})"
+        "`# dt: {declared}` disagrees with the time column, whose step is {step} s (line {step_line})"
     )]
     DtColumn {
-        file: String,
-        line: usize,
         declared: f64,
         step: f64,
         step_line: usize,
     },
-    #[error(
-        "{file}:{line}: single-column record needs a time step: add `# dt: <s>` to the file or give dt"
-    )]
-    NoTimeStep { file: String, line: usize },
-    #[error("{file}:{line}: this is a {kind} time series, not an acceleration record")]
-    NotAcceleration {
-        file: String,
-        line: usize,
-        kind: &'static str,
-    },
+    #[error("single-column record needs a time step: add `# dt: <s>` to the file or give dt")]
+    NoTimeStep,
+    #[error("this is a {kind} time series, not an acceleration record")]
+    NotAcceleration { kind: &'static str },
+}
+
+/// `problem` on `line` of `file`.
+fn at(file: &str, line: usize, problem: Problem) -> RecordError {
+    RecordError::Located {
+        file: file.to_string(),
+        line,
+        problem,
+    }
 }
 
 /// Reads a `.AT2` file (detected by extension or a `PEER` first line) or a plain-text record
@@ -279,10 +244,16 @@ pub fn read_record(path: &Path) -> Result<Record, RecordError> {
 /// declare; a disagreement with the file is an error (module docs).
 pub fn read_record_with(path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| RecordError::Io {
+    let io = |source| RecordError::Io {
         file: file.clone(),
         source,
-    })?;
+    };
+    let bytes = std::fs::metadata(path).map_err(io)?.len();
+    if bytes > MAX_FILE_BYTES {
+        return Err(RecordError::TooLarge { file, bytes });
+    }
+    let text = std::fs::read_to_string(path).map_err(io)?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let is_at2 = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("at2"))
@@ -291,24 +262,19 @@ pub fn read_record_with(path: &Path, opts: &ReadOptions) -> Result<Record, Recor
             .next()
             .is_some_and(|l| l.to_ascii_uppercase().contains("PEER"));
     if is_at2 {
-        parse_at2_with(&text, &file, opts)
+        parse_at2_with(text, &file, opts)
     } else {
-        parse_text(&text, &file, opts)
+        parse_text(text, &file, opts)
     }
 }
 
 fn number(tok: &str, file: &str, line: usize) -> Result<f64, RecordError> {
-    let v: f64 = tok.parse().map_err(|_| RecordError::NotANumber {
-        file: file.to_string(),
-        line,
-        token: tok.to_string(),
+    let v: f64 = tok.parse().map_err(|_| {
+        let token = excerpt(tok);
+        at(file, line, Problem::NotANumber { token })
     })?;
     if !v.is_finite() {
-        return Err(RecordError::NonFinite {
-            file: file.to_string(),
-            line,
-            value: v,
-        });
+        return Err(at(file, line, Problem::NonFinite { value: v }));
     }
     Ok(v)
 }
@@ -319,14 +285,10 @@ fn same_dt(a: f64, b: f64) -> bool {
 
 /// Checks a step given in options: finite and > 0, reported against `line`.
 fn checked_dt(dt: f64, file: &str, line: usize) -> Result<f64, RecordError> {
-    if dt.is_finite() && dt > 0.0 {
+    if (DT_RANGE_S.0..=DT_RANGE_S.1).contains(&dt) {
         Ok(dt)
     } else {
-        Err(RecordError::TimeStep {
-            file: file.to_string(),
-            line,
-            dt,
-        })
+        Err(at(file, line, Problem::TimeStep { dt }))
     }
 }
 
@@ -337,12 +299,9 @@ fn resolve_units(
     file: &str,
 ) -> Result<Units, RecordError> {
     match (in_file, opts.units) {
-        (Some((f, line)), Some(given)) if f != given => Err(RecordError::UnitsConflict {
-            file: file.to_string(),
-            line,
-            in_file: f,
-            given,
-        }),
+        (Some((f, line)), Some(given)) if f != given => {
+            Err(at(file, line, Problem::UnitsConflict { in_file: f, given }))
+        }
         (Some((f, _)), _) => Ok(f),
         (None, Some(given)) => Ok(given),
         (None, None) => Ok(Units::G),
@@ -357,12 +316,9 @@ fn check_dt_agrees(
     file: &str,
 ) -> Result<(), RecordError> {
     match opts.dt_s {
-        Some(given) if !same_dt(in_file, given) => Err(RecordError::DtConflict {
-            file: file.to_string(),
-            line,
-            in_file,
-            given,
-        }),
+        Some(given) if !same_dt(in_file, given) => {
+            Err(at(file, line, Problem::DtConflict { in_file, given }))
+        }
         _ => Ok(()),
     }
 }
@@ -405,31 +361,24 @@ fn at2_units(line: &str, file: &str, no: usize) -> Result<Option<Units>, RecordE
     let up = line.trim().to_ascii_uppercase();
     for kind in ["VELOCITY", "DISPLACEMENT"] {
         if up.starts_with(kind) {
-            return Err(RecordError::NotAcceleration {
-                file: file.to_string(),
-                line: no,
-                kind: if kind == "VELOCITY" {
-                    "velocity"
-                } else {
-                    "displacement"
-                },
-            });
+            let kind = if kind == "VELOCITY" {
+                "velocity"
+            } else {
+                "displacement"
+            };
+            return Err(at(file, no, Problem::NotAcceleration { kind }));
         }
     }
-    let Some(at) = up.find("UNITS OF") else {
+    let Some(from) = up.find("UNITS OF") else {
         return Ok(None);
     };
-    let name = up[at + "UNITS OF".len()..]
+    let name = up[from + "UNITS OF".len()..]
         .split_whitespace()
         .next()
         .unwrap_or("");
     name.parse::<Units>()
         .map(Some)
-        .map_err(|source| RecordError::UnknownUnits {
-            file: file.to_string(),
-            line: no,
-            source,
-        })
+        .map_err(|source| at(file, no, Problem::UnknownUnits { source }))
 }
 
 /// Parses the text of a PEER `.AT2` file in g or the units its line 3 names. Same as
@@ -452,28 +401,18 @@ pub fn parse_at2_with(text: &str, file: &str, opts: &ReadOptions) -> Result<Reco
             header = at2_header(line).map(|h| (h, idx + 1));
         }
     }
-    let ((npts_tok, dt_tok), hline) = header.ok_or_else(|| RecordError::MissingHeader {
-        file: file.to_string(),
-        line: 4,
-    })?;
+    let ((npts_tok, dt_tok), hline) = header.ok_or_else(|| at(file, 4, Problem::MissingHeader))?;
     let units = resolve_units(units_line, opts, file)?;
     let npts_f = number(&npts_tok, file, hline)?;
     if npts_f < 0.0 || npts_f.fract() != 0.0 {
-        return Err(RecordError::NotANumber {
-            file: file.to_string(),
-            line: hline,
-            token: npts_tok,
-        });
+        let token = excerpt(&npts_tok);
+        return Err(at(file, hline, Problem::NotANumber { token }));
+    }
+    if npts_f > MAX_SAMPLES as f64 {
+        return Err(at(file, hline, Problem::TooMany { npts: npts_f }));
     }
     let npts = npts_f as usize;
-    let dt = number(&dt_tok, file, hline)?;
-    if dt <= 0.0 {
-        return Err(RecordError::TimeStep {
-            file: file.to_string(),
-            line: hline,
-            dt,
-        });
-    }
+    let dt = checked_dt(number(&dt_tok, file, hline)?, file, hline)?;
     check_dt_agrees(dt, hline, opts, file)?;
     let mut accel = Vec::with_capacity(npts);
     let mut last_line = hline;
@@ -481,31 +420,31 @@ pub fn parse_at2_with(text: &str, file: &str, opts: &ReadOptions) -> Result<Reco
         for tok in line.split_whitespace() {
             let v = number(tok, file, idx + 1)?;
             if accel.len() == npts {
-                return Err(RecordError::Count {
-                    file: file.to_string(),
-                    line: idx + 1,
-                    expected: npts,
-                    found: accel.len() + 1,
-                });
+                return Err(at(
+                    file,
+                    idx + 1,
+                    Problem::Count {
+                        expected: npts,
+                        found: accel.len() + 1,
+                    },
+                ));
             }
             accel.push(v);
             last_line = idx + 1;
         }
     }
     if accel.len() != npts {
-        return Err(RecordError::Count {
-            file: file.to_string(),
-            line: last_line,
-            expected: npts,
-            found: accel.len(),
-        });
+        return Err(at(
+            file,
+            last_line,
+            Problem::Count {
+                expected: npts,
+                found: accel.len(),
+            },
+        ));
     }
     if npts < 2 {
-        return Err(RecordError::TooShort {
-            file: file.to_string(),
-            line: last_line,
-            found: npts,
-        });
+        return Err(at(file, last_line, Problem::TooShort { found: npts }));
     }
     Ok(Record {
         name: base_name(file),
@@ -536,14 +475,16 @@ fn declare<T: PartialEq>(
     file: &str,
 ) -> Result<(), RecordError> {
     match slot {
-        Some(old) if old.value != new.value => Err(RecordError::Redeclared {
-            file: file.to_string(),
-            line: new.line,
-            key,
-            value: new.text,
-            first: old.line,
-            first_value: old.text.clone(),
-        }),
+        Some(old) if old.value != new.value => Err(at(
+            file,
+            new.line,
+            Problem::Redeclared {
+                key,
+                value: new.text,
+                first: old.line,
+                first_value: old.text.clone(),
+            },
+        )),
         Some(_) => Ok(()),
         None => {
             *slot = Some(new);
@@ -580,11 +521,7 @@ pub fn parse_text(text: &str, file: &str, opts: &ReadOptions) -> Result<Record, 
                 "units" => {
                     let u = value
                         .parse::<Units>()
-                        .map_err(|source| RecordError::UnknownUnits {
-                            file: file.to_string(),
-                            line: no,
-                            source,
-                        })?;
+                        .map_err(|source| at(file, no, Problem::UnknownUnits { source }))?;
                     let new = Declared {
                         value: u,
                         text: value.to_string(),
@@ -619,14 +556,13 @@ pub fn parse_text(text: &str, file: &str, opts: &ReadOptions) -> Result<Record, 
         }
         let (ncols, first) = *layout.get_or_insert((cols.len(), no));
         match (ncols, cols.len()) {
+            _ if accel.len() == MAX_SAMPLES => {
+                let npts = (MAX_SAMPLES + 1) as f64;
+                return Err(at(file, no, Problem::TooMany { npts }));
+            }
             (1, 1) => accel.push(number(cols[0], file, no)?),
             (1, found) => {
-                return Err(RecordError::SingleColumn {
-                    file: file.to_string(),
-                    line: no,
-                    first,
-                    found,
-                });
+                return Err(at(file, no, Problem::SingleColumn { first, found }));
             }
             (2, 2) => {
                 let t = number(cols[0], file, no)?;
@@ -636,48 +572,36 @@ pub fn parse_text(text: &str, file: &str, opts: &ReadOptions) -> Result<Record, 
                     if times.len() == 1 {
                         step = this;
                         step_line = no;
-                        if step <= 0.0 {
-                            return Err(RecordError::TimeStep {
-                                file: file.to_string(),
-                                line: no,
-                                dt: step,
-                            });
-                        }
+                        checked_dt(step, file, no)?;
                     } else if (this - step).abs() > DT_REL_TOL * step {
-                        return Err(RecordError::NonUniform {
-                            file: file.to_string(),
-                            line: no,
-                            expected: step,
-                            found: this,
-                        });
+                        return Err(at(
+                            file,
+                            no,
+                            Problem::NonUniform {
+                                expected: step,
+                                found: this,
+                            },
+                        ));
                     }
                 }
                 times.push(t);
                 accel.push(a);
             }
             (2, found) => {
-                return Err(RecordError::Columns {
-                    file: file.to_string(),
-                    line: no,
-                    found,
-                });
+                return Err(at(file, no, Problem::Columns { found }));
             }
             (_, found) => {
-                return Err(RecordError::Layout {
-                    file: file.to_string(),
-                    line: no,
-                    found,
-                });
+                return Err(at(file, no, Problem::Layout { found }));
             }
         }
         last_line = no;
     }
     if accel.len() < 2 {
-        return Err(RecordError::TooShort {
-            file: file.to_string(),
-            line: last_line.max(1),
-            found: accel.len(),
-        });
+        return Err(at(
+            file,
+            last_line.max(1),
+            Problem::TooShort { found: accel.len() },
+        ));
     }
     let units = resolve_units(units.map(|d| (d.value, d.line)), opts, file)?;
     let first_data_line = layout.map_or(1, |(_, line)| line);
@@ -688,10 +612,7 @@ pub fn parse_text(text: &str, file: &str, opts: &ReadOptions) -> Result<Record, 
         }
         (None, Some(given)) => checked_dt(given, file, first_data_line)?,
         (None, None) if times.is_empty() => {
-            return Err(RecordError::NoTimeStep {
-                file: file.to_string(),
-                line: first_data_line,
-            });
+            return Err(at(file, first_data_line, Problem::NoTimeStep));
         }
         (None, None) => step,
     };
@@ -700,13 +621,15 @@ pub fn parse_text(text: &str, file: &str, opts: &ReadOptions) -> Result<Record, 
         if let Some(d) = &dt_decl
             && !same_dt(step, d.value)
         {
-            return Err(RecordError::DtColumn {
-                file: file.to_string(),
-                line: d.line,
-                declared: d.value,
-                step,
-                step_line,
-            });
+            return Err(at(
+                file,
+                d.line,
+                Problem::DtColumn {
+                    declared: d.value,
+                    step,
+                    step_line,
+                },
+            ));
         }
         check_dt_agrees(step, step_line, opts, file)?;
     }
@@ -777,8 +700,9 @@ pub fn format_at2(record: &Record, description: &str) -> String {
     out
 }
 
-/// Writes [`format_at2`] of `record` to `path`. Refuses a step that is not finite and > 0, or a
-/// non-finite value, naming the line of the file it would have gone to.
+/// Writes [`format_at2`] of `record` to `path`, atomically (a temporary renamed over it). Refuses
+/// a step outside the readable range, or a non-finite value, naming the line of the file it
+/// would have gone to.
 pub fn write_at2(record: &Record, description: &str, path: &Path) -> Result<(), RecordError> {
     let file = path.display().to_string();
     checked_dt(record.dt_s, &file, 4)?;
@@ -788,14 +712,17 @@ pub fn write_at2(record: &Record, description: &str, path: &Path) -> Result<(), 
         .enumerate()
         .find(|(_, v)| !v.is_finite())
     {
-        return Err(RecordError::NonFinite {
-            file,
-            line: 5 + k / 5,
-            value,
-        });
+        return Err(at(&file, 5 + k / 5, Problem::NonFinite { value }));
     }
-    std::fs::write(path, format_at2(record, description))
-        .map_err(|source| RecordError::Io { file, source })
+    crate::store::atomic::write_bytes(path, format_at2(record, description).as_bytes()).map_err(
+        |e| match e {
+            crate::store::StoreError::Io { source, .. } => RecordError::Io { file, source },
+            other => RecordError::Io {
+                file,
+                source: std::io::Error::other(other.to_string()),
+            },
+        },
+    )
 }
 
 #[cfg(test)]
@@ -857,11 +784,11 @@ mod tests {
         );
         assert_eq!(
             err(&format!("{HEAD}NPTS=  2, DT= 0.0 SEC\n 0.1 0.2\n")),
-            "bad.AT2:4: time step dt must be > 0, got 0"
+            "bad.AT2:4: time step dt = 0.0 s is outside 0.00001 … 1 s (a unit or header mistake?)"
         );
         assert_eq!(
             err(&format!("{HEAD}    2   -0.01  NPTS, DT\n 0.1 0.2\n")),
-            "bad.AT2:4: time step dt must be > 0, got -0.01"
+            "bad.AT2:4: time step dt = -0.01 s is outside 0.00001 … 1 s (a unit or header mistake?)"
         );
     }
 
@@ -881,7 +808,10 @@ mod tests {
             "tc.txt:2: expected 2 columns (time, acceleration in g), found 3"
         );
         let e = parse_two_column("0 0\n0 0.1\n", "tc.txt").unwrap_err();
-        assert_eq!(e.to_string(), "tc.txt:2: time step dt must be > 0, got 0");
+        assert_eq!(
+            e.to_string(),
+            "tc.txt:2: time step dt = 0.0 s is outside 0.00001 … 1 s (a unit or header mistake?)"
+        );
         let e = parse_two_column("0 0\n", "tc.txt").unwrap_err();
         assert_eq!(
             e.to_string(),
@@ -1021,7 +951,7 @@ mod tests {
         );
         assert_eq!(
             text("# dt: -0.01\n", &NONE).unwrap_err(),
-            "r.txt:1: time step dt must be > 0, got -0.01"
+            "r.txt:1: time step dt = -0.01 s is outside 0.00001 … 1 s (a unit or header mistake?)"
         );
         assert_eq!(
             text(
@@ -1032,7 +962,7 @@ mod tests {
                 }
             )
             .unwrap_err(),
-            "r.txt:1: time step dt must be > 0, got 0"
+            "r.txt:1: time step dt = 0.0 s is outside 0.00001 … 1 s (a unit or header mistake?)"
         );
         assert_eq!(
             text("# dt: 0.01\n0.1\n0.2 0.3\n", &NONE).unwrap_err(),
@@ -1174,7 +1104,7 @@ mod tests {
             }
             values.push((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
         }
-        for dt_s in [0.005, 0.01, 1.0 / 3.0, 0.1 + 0.2, 1e-7] {
+        for dt_s in [0.005, 0.01, 1.0 / 3.0, 0.1 + 0.2, 1.7e-5] {
             let r = Record {
                 name: "rt".into(),
                 dt_s,

@@ -20,19 +20,28 @@
 //! groups of four run in parallel.
 
 use crate::dynamics::closed_form::{Basis, Osc, Wave};
+use crate::limits::{DT_RANGE_S, MAX_SAMPLES, PERIOD_RANGE_S};
 use crate::numeric::{Cx, bracketed_root, phi1, phi2};
 use rayon::prelude::*;
 use thiserror::Error;
 
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SpectrumError {
-    #[error("period {0} s must be finite and > 0")]
+    #[error(
+        "period {0:?} s must be within {lo} … {hi} s",
+        lo = PERIOD_RANGE_S.0,
+        hi = PERIOD_RANGE_S.1
+    )]
     Period(f64),
     #[error("damping ratio {0} must be in [0, 1)")]
     Damping(f64),
-    #[error("time step {0} s must be finite and > 0")]
+    #[error(
+        "time step {0:?} s must be within {lo} … {hi} s",
+        lo = DT_RANGE_S.0,
+        hi = DT_RANGE_S.1
+    )]
     TimeStep(f64),
-    #[error("a record needs at least 2 samples, got {0}")]
+    #[error("a record needs 2 to {MAX_SAMPLES} samples, got {0}")]
     TooShort(usize),
     #[error("ground acceleration sample {index} is not finite ({value})")]
     NonFinite { index: usize, value: f64 },
@@ -139,10 +148,10 @@ impl NjStep {
 
 /// Checks a record before any spectrum is computed.
 pub fn validate_record(accel_mps2: &[f64], dt_s: f64) -> Result<(), SpectrumError> {
-    if !(dt_s.is_finite() && dt_s > 0.0) {
+    if !(DT_RANGE_S.0..=DT_RANGE_S.1).contains(&dt_s) {
         return Err(SpectrumError::TimeStep(dt_s));
     }
-    if accel_mps2.len() < 2 {
+    if !(2..=MAX_SAMPLES).contains(&accel_mps2.len()) {
         return Err(SpectrumError::TooShort(accel_mps2.len()));
     }
     if let Some((index, &value)) = accel_mps2.iter().enumerate().find(|(_, a)| !a.is_finite()) {
@@ -152,7 +161,7 @@ pub fn validate_record(accel_mps2: &[f64], dt_s: f64) -> Result<(), SpectrumErro
 }
 
 fn validate_oscillator(period_s: f64, damping: f64) -> Result<(), SpectrumError> {
-    if !(period_s.is_finite() && period_s > 0.0) {
+    if !(PERIOD_RANGE_S.0..=PERIOD_RANGE_S.1).contains(&period_s) {
         return Err(SpectrumError::Period(period_s));
     }
     if !(damping.is_finite() && (0.0..1.0).contains(&damping)) {
@@ -535,7 +544,7 @@ mod tests {
         let e = |r: Result<ResponseSpectrum, SpectrumError>| r.unwrap_err().to_string();
         assert_eq!(
             e(response_spectrum(&a, 0.01, &[0.0], 0.05)),
-            "period 0 s must be finite and > 0"
+            "period 0.0 s must be within 0.001 … 10000 s"
         );
         assert_eq!(
             e(response_spectrum(&a, 0.01, &[1.0], 1.0)),
@@ -543,11 +552,11 @@ mod tests {
         );
         assert_eq!(
             e(response_spectrum(&a, -0.01, &[1.0], 0.05)),
-            "time step -0.01 s must be finite and > 0"
+            "time step -0.01 s must be within 0.00001 … 1 s"
         );
         assert_eq!(
             e(response_spectrum(&a[..1], 0.01, &[1.0], 0.05)),
-            "a record needs at least 2 samples, got 1"
+            "a record needs 2 to 16777216 samples, got 1"
         );
         assert_eq!(
             e(response_spectrum(&[0.0, f64::NAN], 0.01, &[1.0], 0.05)),

@@ -1,11 +1,12 @@
 //! A simulation's time history as HDF5 (one dataset per quantity, `[time, body]` or
 //! `[time, interface]`, with `units` and `long_name` attributes) or CSV (one row per sample).
 
+use super::atomic::Temp;
 use super::h5::attr_str as attr;
+use super::{H5Context, StoreError};
 use crate::dynamics::History;
 use std::io::Write;
 use std::path::Path;
-use thiserror::Error;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HistoryFormat {
@@ -24,40 +25,24 @@ impl HistoryFormat {
         {
             Some("h5" | "hdf5") => Ok(Self::Hdf5),
             Some("csv") => Ok(Self::Csv),
-            _ => Err(StoreError::Format(path.display().to_string())),
+            _ => Err(StoreError::Format(path.to_path_buf())),
         }
     }
 }
 
-#[derive(Debug, Error)]
-pub enum StoreError {
-    #[error("{0}: history file must end in .h5, .hdf5 or .csv")]
-    Format(String),
-    #[error("{file}: {source}")]
-    Io {
-        file: String,
-        #[source]
-        source: std::io::Error,
-    },
-    #[error("{file}: HDF5 error: {source}")]
-    Hdf5 {
-        file: String,
-        #[source]
-        source: hdf5::Error,
-    },
-}
-
-/// Writes `history` to `path` in the format its extension names.
+/// Writes `history` to `path` in the format its extension names: into a temporary, checked
+/// (every write, the flush and, for HDF5, the close), synced and renamed, so a full disk or a
+/// kill leaves no partial or zero-filled file behind.
 pub fn write_history(path: &Path, history: &History) -> Result<(), StoreError> {
-    let file = path.display().to_string();
-    match HistoryFormat::from_path(path)? {
+    let format = HistoryFormat::from_path(path)?;
+    let tmp = Temp::for_path(path);
+    match format {
         HistoryFormat::Csv => {
-            write_csv(path, history).map_err(|source| StoreError::Io { file, source })
+            write_csv(tmp.path(), history).map_err(|e| StoreError::io(path, "cannot write", e))?
         }
-        HistoryFormat::Hdf5 => {
-            write_hdf5(path, history).map_err(|source| StoreError::Hdf5 { file, source })
-        }
+        HistoryFormat::Hdf5 => write_hdf5(tmp.path(), history).at(path)?,
     }
+    tmp.commit(path)
 }
 
 fn write_csv(path: &Path, h: &History) -> std::io::Result<()> {
@@ -93,16 +78,22 @@ fn write_csv(path: &Path, h: &History) -> std::io::Result<()> {
 
 fn write_hdf5(path: &Path, h: &History) -> hdf5::Result<()> {
     let f = hdf5::File::create(path)?;
+    fill_hdf5(&f, h)?;
+    f.flush()?;
+    f.close()
+}
+
+fn fill_hdf5(f: &hdf5::File, h: &History) -> hdf5::Result<()> {
     let rows = h.rows();
     let nb = h.bodies;
     attr(
-        &f,
+        f,
         "contents",
         "slidestack simulate time history; body 0 is the structure, blocks bottom-up",
     )?;
-    attr(&f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
+    attr(f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
     attr(
-        &f,
+        f,
         "contact_codes",
         "0 stick, 1 slip with positive relative velocity, -1 slip negative, 2 frictionless",
     )?;

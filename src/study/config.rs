@@ -17,6 +17,11 @@
 
 use super::sweep::Physics;
 use crate::grid::Grid;
+use crate::grid::linear_range;
+use crate::limits::{
+    MAX_ALPHA, MAX_AXIS_VALUES, MAX_BLOCKS, MAX_CASE_RESULTS, MAX_FILE_BYTES, MAX_MOTIONS, MAX_MU,
+    MAX_YAML_DEPTH, PERIOD_RANGE_S, excerpt_message, yaml_depth,
+};
 use crate::motion::matching::{MatchError, MatchSettings};
 use crate::motion::stochastic::{StochasticError, StochasticModel};
 use crate::motion::{ReadOptions, Units};
@@ -53,24 +58,21 @@ pub struct Range {
 }
 
 impl Values {
-    /// The values in order; a range is `from + k·step` up to `to` (within 1e-9 of a step), each
-    /// rounded to 12 significant digits so that `0.1 + 2·0.1` reads back as `0.3`.
-    pub fn values(&self) -> Vec<f64> {
+    /// The values in order (a range expanded by [`linear_range`]), at most
+    /// [`MAX_AXIS_VALUES`].
+    pub fn expand(&self) -> Result<Vec<f64>, String> {
         match self {
-            Values::List(v) => v.clone(),
-            Values::Range(r) => {
-                if !(r.step > 0.0 && r.to >= r.from && r.step.is_finite()) {
-                    return Vec::new();
-                }
-                let n = ((r.to - r.from) / r.step + 1e-9).floor() as usize;
-                (0..=n)
-                    .map(|k| {
-                        let v = r.from + r.step * k as f64;
-                        format!("{v:.12e}").parse().unwrap_or(v)
-                    })
-                    .collect()
+            Values::List(v) if v.len() > MAX_AXIS_VALUES => {
+                Err(format!("{} values; at most {MAX_AXIS_VALUES}", v.len()))
             }
+            Values::List(v) => Ok(v.clone()),
+            Values::Range(r) => linear_range(r.from, r.to, r.step, MAX_AXIS_VALUES),
         }
+    }
+
+    /// The values of a validated list or range.
+    pub fn values(&self) -> Vec<f64> {
+        self.expand().unwrap_or_default()
     }
 }
 
@@ -206,11 +208,9 @@ pub enum ConfigError {
         file: String,
         source: std::io::Error,
     },
-    #[error("{file}: {source}")]
-    Yaml {
-        file: String,
-        source: serde_yaml::Error,
-    },
+    /// Not valid YAML or not a study file; the parser's message, shortened.
+    #[error("{file}: {message}")]
+    Yaml { file: String, message: String },
     #[error("{file}: `{key}`: {why}")]
     Invalid {
         file: String,
@@ -219,19 +219,45 @@ pub enum ConfigError {
     },
 }
 
+/// The text of a YAML file, checked before any parser sees it: at most [`MAX_FILE_BYTES`],
+/// UTF-8, a byte-order mark dropped, nesting at most [`MAX_YAML_DEPTH`] deep.
+pub fn read_yaml_text(path: &Path) -> Result<String, ConfigError> {
+    let file = path.display().to_string();
+    let io = |source| ConfigError::Io {
+        file: file.clone(),
+        source,
+    };
+    let bytes = std::fs::metadata(path).map_err(io)?.len();
+    let invalid = |why: String| ConfigError::Invalid {
+        file: file.clone(),
+        key: "(file)".into(),
+        why,
+    };
+    if bytes > MAX_FILE_BYTES {
+        return Err(invalid(format!(
+            "{bytes} bytes: a YAML file may have at most {MAX_FILE_BYTES}"
+        )));
+    }
+    let text = std::fs::read_to_string(path).map_err(io)?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text).to_string();
+    let depth = yaml_depth(&text);
+    if depth > MAX_YAML_DEPTH {
+        return Err(invalid(format!(
+            "nested {depth} levels deep; a config nests at most {MAX_YAML_DEPTH}"
+        )));
+    }
+    Ok(text)
+}
+
 impl StudyConfig {
     /// Reads and validates a study file; relative record paths become relative to its folder.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+        let text = read_yaml_text(path)?;
+        let mut cfg: StudyConfig = serde_yaml::from_str(&text).map_err(|e| ConfigError::Yaml {
             file: file.clone(),
-            source,
+            message: excerpt_message(&e.to_string()),
         })?;
-        let mut cfg: StudyConfig =
-            serde_yaml::from_str(&text).map_err(|source| ConfigError::Yaml {
-                file: file.clone(),
-                source,
-            })?;
         let base = path.parent().unwrap_or(Path::new("."));
         if let Some(r) = &mut cfg.motions.seeds.records {
             for f in &mut r.files {
@@ -290,6 +316,23 @@ impl StudyConfig {
         }
         if let Some(g) = &self.grid {
             validate_grid(g)?;
+            let per_zone = match (&self.motions.seeds.stochastic, &self.motions.seeds.records) {
+                (Some(s), _) => s.count,
+                (None, Some(r)) => r.files.len(),
+                (None, None) => 0,
+            };
+            // Counted in floating point: a product of axis lengths can overflow any integer.
+            let cases: f64 = g.axes().shape().iter().map(|&n| n as f64).product();
+            let results = cases * per_zone as f64 * self.zones.len() as f64;
+            if results > MAX_CASE_RESULTS as f64 {
+                return err(
+                    "grid",
+                    format!(
+                        "{results} case results (cases × motions × zones); at most \
+                         {MAX_CASE_RESULTS} (sweep.h5 is assembled in memory)"
+                    ),
+                );
+            }
         }
         let seeds = &self.motions.seeds;
         if seeds.stochastic.is_some() == seeds.records.is_some() {
@@ -300,14 +343,29 @@ impl StudyConfig {
         }
         match seeds.kind() {
             Seeds::Stochastic(s) => {
-                if s.count == 0 {
-                    return err("motions.seeds.stochastic.count", "must be ≥ 1".into());
+                if s.count == 0 || s.count > MAX_MOTIONS {
+                    return err(
+                        "motions.seeds.stochastic.count",
+                        format!("must be ≥ 1 and ≤ {MAX_MOTIONS}"),
+                    );
+                }
+                if s.spare > MAX_MOTIONS {
+                    return err(
+                        "motions.seeds.stochastic.spare",
+                        format!("must be ≤ {MAX_MOTIONS}"),
+                    );
                 }
                 s.model.validate().map_err(|e: StochasticError| {
                     ("motions.seeds.stochastic.model".to_string(), e.to_string())
                 })?;
             }
             Seeds::Records(r) => {
+                if r.files.len() > MAX_MOTIONS {
+                    return err(
+                        "motions.seeds.records.files",
+                        format!("{} files; at most {MAX_MOTIONS}", r.files.len()),
+                    );
+                }
                 if r.files.is_empty() {
                     return err(
                         "motions.seeds.records.files",
@@ -324,12 +382,17 @@ impl StudyConfig {
                     return err("motions.seeds.records.dt_s", format!("{dt} must be > 0"));
                 }
                 for f in &r.files {
-                    if !f.is_file() {
-                        return err(
-                            "motions.seeds.records.files",
-                            format!("{} does not exist", f.display()),
-                        );
-                    }
+                    let why = if f.is_dir() {
+                        "is a directory, not a record file"
+                    } else if !f.exists() {
+                        "does not exist"
+                    } else {
+                        continue;
+                    };
+                    return err(
+                        "motions.seeds.records.files",
+                        format!("{} {why}", f.display()),
+                    );
                 }
             }
         }
@@ -360,19 +423,19 @@ impl StudyConfig {
 }
 
 fn validate_grid(g: &GridConfig) -> Result<(), (String, String)> {
-    let check = |key: String, v: &Values, lo: f64, lo_open: bool| -> Result<(), (String, String)> {
-        let vals = v.values();
+    let check = |key: String, v: &Values, lo: f64, lo_open: bool, hi: f64| {
+        let vals = v.expand().map_err(|why| (key.clone(), why))?;
         if vals.is_empty() {
-            return Err((
-                key,
-                "needs at least one value (a range needs step > 0, to ≥ from)".into(),
-            ));
+            return Err((key, "needs at least one value".into()));
         }
         for x in &vals {
-            let ok = x.is_finite() && if lo_open { *x > lo } else { *x >= lo };
+            let ok = x.is_finite() && (if lo_open { *x > lo } else { *x >= lo }) && *x <= hi;
             if !ok {
                 let rel = if lo_open { ">" } else { "≥" };
-                return Err((key, format!("value {x} must be finite and {rel} {lo}")));
+                return Err((
+                    key,
+                    format!("value {x:?} must be finite, {rel} {lo} and ≤ {hi}"),
+                ));
             }
         }
         if vals.windows(2).any(|w| w[1] <= w[0]) {
@@ -380,11 +443,21 @@ fn validate_grid(g: &GridConfig) -> Result<(), (String, String)> {
         }
         Ok(())
     };
-    check("grid.period_s".into(), &g.period_s, 0.0, true)?;
-    if g.alpha.is_empty() {
+    check(
+        "grid.period_s".into(),
+        &g.period_s,
+        PERIOD_RANGE_S.0,
+        false,
+        PERIOD_RANGE_S.1,
+    )?;
+    if g.alpha.is_empty() || g.alpha.len() > MAX_BLOCKS {
         return Err((
             "grid.alpha".into(),
-            "needs one list per block (at least one block)".into(),
+            format!(
+                "needs one list per block, 1 to {MAX_BLOCKS} blocks (HDF5 stores at most 32 \
+                 dimensions), got {}",
+                g.alpha.len()
+            ),
         ));
     }
     if g.mu.len() != g.alpha.len() {
@@ -398,10 +471,24 @@ fn validate_grid(g: &GridConfig) -> Result<(), (String, String)> {
         ));
     }
     for (i, a) in g.alpha.iter().enumerate() {
-        check(format!("grid.alpha[{i}]"), a, 0.0, true)?;
+        check(format!("grid.alpha[{i}]"), a, 0.0, true, MAX_ALPHA)?;
+    }
+    let heaviest: f64 = g
+        .alpha
+        .iter()
+        .map(|a| a.values().into_iter().fold(0.0, f64::max))
+        .sum();
+    if heaviest > MAX_ALPHA {
+        return Err((
+            "grid.alpha".into(),
+            format!(
+                "the heaviest stack has α = {heaviest}; at most {MAX_ALPHA} (beyond it round-off \
+                 spoils the energy balance)"
+            ),
+        ));
     }
     for (i, m) in g.mu.iter().enumerate() {
-        check(format!("grid.mu[{i}]"), m, 0.0, false)?;
+        check(format!("grid.mu[{i}]"), m, 0.0, false, MAX_MU)?;
     }
     if !(g.mu_static_ratio.is_finite() && g.mu_static_ratio >= 1.0) {
         return Err((

@@ -1,0 +1,160 @@
+//! The limits every input is checked against before any work, each with its reason. Inside
+//! them the solvers are accurate and every loop ends; outside, an input is refused with a
+//! message that names it (or, for accuracy, warned about), never run into a wrong answer, an
+//! endless loop or an allocation failure. `docs/faults.md` lists them with their tests.
+
+/// Samples of one record (2²⁴ ≈ 16.8 million: 46 h at 0.01 s). Records are held in memory and
+/// every simulation crosses every sample.
+pub const MAX_SAMPLES: usize = 1 << 24;
+
+/// Bytes of one input file read whole (a record or a config): 1 GiB.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Sample interval of a record, s: 10 µs … 1 s. Accelerograms are sampled at 0.001–0.05 s; a
+/// step outside this range is a unit or header mistake, and a step of 1e-15 s would make every
+/// record-length loop astronomically long.
+pub const DT_RANGE_S: (f64, f64) = (1e-5, 1.0);
+
+/// Oscillator periods of a spectrum or of a matching grid, s: 1 ms … 10⁴ s.
+pub const PERIOD_RANGE_S: (f64, f64) = (1e-3, 1e4);
+
+/// Period of the bare structure in a simulation, s: 1 µs (rigid to double precision against any
+/// record step; the tests use it as a rigid base) … 10⁴ s.
+pub const STRUCTURE_PERIOD_RANGE_S: (f64, f64) = (1e-6, 1e4);
+
+/// Periods in one list (a spectrum's, the matcher's check grid, the study grid's `T_p`).
+pub const MAX_PERIODS: usize = 100_000;
+
+/// Motions per zone (stochastic seeds or record files).
+pub const MAX_MOTIONS: usize = 10_000;
+
+/// Blocks in a stack. Stored sweep variables have one dimension per block mass ratio and per
+/// friction coefficient, plus motion, `T_p` and interface, and HDF5 allows 32 dimensions:
+/// `3 + 2n ≤ 32`.
+pub const MAX_BLOCKS: usize = 14;
+
+/// Values in one grid axis (a list or an expanded `{from, to, step}` range).
+pub const MAX_AXIS_VALUES: usize = 100_000;
+
+/// Case results of a study (cases × motions, all zones together). `sweep.h5` is assembled in
+/// memory at about 60 bytes per case result: 50 million is about 3 GB.
+pub const MAX_CASE_RESULTS: u64 = 50_000_000;
+
+/// Largest mass ratio of one block, and of the whole stack. Beyond `10⁴` the structure is a
+/// negligible appendage of its load and the energy balance of the exact integrator loses more
+/// than `1e-6` of the input to round-off (measured: `2e-6` at `α = 10⁴`, `4e-2` at `10⁶`).
+pub const MAX_ALPHA: f64 = 1e4;
+
+/// Largest friction coefficient: no surface pair has more than a few; above this a stack simply
+/// never slides, which any `μ` of a few tens already gives.
+pub const MAX_MU: f64 = 1e3;
+
+/// Largest `T_rigid/dt` the exact integrator runs: its structure cluster is written as a
+/// particular plus a homogeneous solution whose terms cancel when `ω·dt` is small, so the energy
+/// error grows like `3e-15·(T_rigid/dt)²` (module doc of `dynamics::exact`): about `1e-3` here.
+pub const MAX_RIGID_PERIOD_STEPS: f64 = 5.5e5;
+
+/// Above this `T_rigid/dt` the same error exceeds about `1e-6`: a warning.
+pub const WARN_RIGID_PERIOD_STEPS: f64 = 1.7e4;
+
+/// RK4 sub-steps per record interval (the accuracy bench goes to 1000).
+pub const MAX_RK4_SUBSTEPS: usize = 100_000;
+
+/// `ω_max·h` of an RK4 step: the method is stable on the imaginary axis up to `2√2 ≈ 2.83`; a
+/// margin keeps the damped structure safely inside.
+pub const RK4_MAX_OMEGA_STEP: f64 = 2.5;
+
+/// Nesting depth of a YAML config (the study's is 4).
+pub const MAX_YAML_DEPTH: usize = 32;
+
+/// Characters of user input echoed back in a message.
+pub const ECHO_CHARS: usize = 40;
+
+/// `text` shortened for a message: at most [`ECHO_CHARS`] characters, with `…` and the total
+/// length when cut.
+pub fn excerpt(text: &str) -> String {
+    let mut chars = text.chars();
+    let head: String = chars.by_ref().take(ECHO_CHARS).collect();
+    if chars.next().is_none() {
+        head
+    } else {
+        format!("{head}… ({} bytes)", text.len())
+    }
+}
+
+/// A parser's message cut to a readable length (its location, at the end, kept): a message may
+/// quote an input value whole.
+pub fn excerpt_message(message: &str) -> String {
+    const HEAD: usize = 160;
+    const TAIL: usize = 80;
+    let chars: Vec<char> = message.chars().collect();
+    if chars.len() <= HEAD + TAIL + 20 {
+        return message.to_string();
+    }
+    let head: String = chars[..HEAD].iter().collect();
+    let tail: String = chars[chars.len() - TAIL..].iter().collect();
+    format!("{head} … {tail}")
+}
+
+/// Nesting depth of YAML text by its flow brackets and block indentation, without parsing it:
+/// checked before a parser that is quadratic in the depth sees it.
+pub fn yaml_depth(text: &str) -> usize {
+    let mut deepest = 0;
+    let mut indents: Vec<usize> = Vec::new();
+    for line in text.lines() {
+        let body = line.trim_start();
+        if body.is_empty() || body.starts_with('#') {
+            continue;
+        }
+        let indent = line.len() - body.len();
+        while indents.last().is_some_and(|&i| i >= indent) {
+            indents.pop();
+        }
+        indents.push(indent);
+        let mut flow: usize = 0;
+        let mut flow_max = 0;
+        let mut quote: Option<char> = None;
+        for c in body.chars() {
+            match (quote, c) {
+                (Some(q), c) if c == q => quote = None,
+                (Some(_), _) => {}
+                (None, '"' | '\'') => quote = Some(c),
+                (None, '#') => break,
+                (None, '[' | '{') => {
+                    flow += 1;
+                    flow_max = flow_max.max(flow);
+                }
+                (None, ']' | '}') => flow = flow.saturating_sub(1),
+                _ => {}
+            }
+        }
+        deepest = deepest.max(indents.len() + flow_max);
+    }
+    deepest
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn excerpt_cuts_long_text_only() {
+        assert_eq!(excerpt("0.x3"), "0.x3");
+        let long = "9".repeat(1000);
+        let e = excerpt(&long);
+        assert!(e.starts_with(&"9".repeat(ECHO_CHARS)) && e.ends_with("… (1000 bytes)"));
+        assert!(e.chars().count() < 60);
+    }
+
+    #[test]
+    fn yaml_depth_counts_blocks_and_brackets() {
+        assert_eq!(yaml_depth("a: 1\nb: 2\n"), 1);
+        assert_eq!(yaml_depth("a:\n  b:\n    c: [1, {d: 2}]\n"), 5);
+        assert_eq!(yaml_depth("x: \"[[[[\" # [[[\n"), 1);
+        assert_eq!(yaml_depth(&format!("x: {}", "[".repeat(100))), 101);
+        let study =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/paper.yaml"))
+                .unwrap();
+        assert!(yaml_depth(&study) <= 5);
+    }
+}
