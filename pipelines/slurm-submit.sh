@@ -176,20 +176,22 @@ if [ $HAVE_STATUS = 1 ]; then
 fi
 
 # --- What the cluster allows. ----------------------------------------------------------------
-HAVE_SLURM=1
-command -v sbatch >/dev/null 2>&1 && command -v sinfo >/dev/null 2>&1 && command -v scontrol >/dev/null 2>&1 ||
-  HAVE_SLURM=0
+HAVE_SLURM=1 why=""
+if ! command -v sbatch >/dev/null 2>&1 || ! command -v sinfo >/dev/null 2>&1 ||
+  ! command -v scontrol >/dev/null 2>&1; then
+  HAVE_SLURM=0 why="sbatch, sinfo or scontrol not found: run this on a Slurm login node"
+elif ! partitions=$(sinfo -h -o '%P' 2>&1); then
+  HAVE_SLURM=0 why="cannot reach the Slurm controller (sinfo: $(head -n1 <<<"$partitions"))"
+fi
 if [ $HAVE_SLURM = 0 ]; then
-  [ $DRY_RUN = 1 ] || die "sbatch, sinfo or scontrol not found: run this on a Slurm login node"
-  note "no Slurm commands here: the cluster's limits are not checked (--dry-run)"
+  [ $DRY_RUN = 1 ] || die "$why"
+  note "$why; --dry-run goes on without the cluster's limits"
 fi
 MAX_ARRAY="" NODE_CPUS="" PART_LIMIT="" part=""
 if [ $HAVE_SLURM = 1 ]; then
   MAX_ARRAY=$(scontrol show config 2>/dev/null | awk '$1 == "MaxArraySize" {print $3}') || true
   part=$PARTITION
-  if [ -z "$part" ]; then
-    part=$(sinfo -h -o '%P' 2>/dev/null | sed -n 's/\*$//p' | head -n1) || true
-  fi
+  [ -n "$part" ] || part=$(sed -n 's/\*$//p' <<<"$partitions" | head -n1)
   if [ -n "$part" ]; then
     NODE_CPUS=$(sinfo -h -N -p "$part" -o '%c' 2>/dev/null | sort -n | tail -n1) || true
     PART_LIMIT=$(sinfo -h -p "$part" -o '%l' 2>/dev/null | head -n1) || true
@@ -281,7 +283,7 @@ if [ -z "$STAGE_TIME" ]; then
   if [ -n "$plim" ] && [ "$plim" -lt 30 ]; then STAGE_TIME=$PART_LIMIT; fi
 fi
 show_time() { if is_uint "$1"; then echo "$1 min"; else echo "$1"; fi; }
-note "jobs: $SHARDS shards, $CPUS CPUs per job, $(show_time "$TIME") per sweep task, $(show_time "$STAGE_TIME") for motions and finishing${given:+ (given:$given)}"
+note "jobs: shards $SHARDS, CPUs per job $CPUS, time limits $(show_time "$TIME") per sweep task and $(show_time "$STAGE_TIME") for motions and finishing${given:+ (given:$given)}"
 
 # --- Checks before any work. ------------------------------------------------------------------
 if [ -n "$SWEEP_UNITS" ] && [ "$SHARDS" -gt "$SWEEP_UNITS" ]; then
@@ -359,7 +361,7 @@ finish_cmd=(sbatch "${common[@]}" --job-name=slidestack-finish --time="$STAGE_TI
   "$SHARDS" "$RESUBMIT_CMD" "$RESUBMIT_ARGS")
 
 parts="finishing job"
-[ $NEED_SWEEP = 0 ] || parts="sweep array ($ARRAY_SPEC of $SHARDS shards, $CPUS CPUs and $(show_time "$TIME") each), $parts"
+[ $NEED_SWEEP = 0 ] || parts="sweep array (tasks $ARRAY_SPEC of N = $SHARDS shards, $CPUS CPUs and $(show_time "$TIME") each), $parts"
 [ $NEED_MOTIONS = 0 ] || parts="motions job, $parts"
 note "submitting: $parts"
 
@@ -422,7 +424,7 @@ fi
 if [ $NEED_SWEEP = 1 ]; then
   array_job=$("${sweep_cmd[@]}")
   array_job=${array_job%%;*}
-  note "sweep array $array_job: shards $ARRAY_SPEC of $SHARDS"
+  note "sweep array $array_job: tasks $ARRAY_SPEC, shard K of N = $SHARDS in task K"
   deps=("$array_job")
 fi
 if [ ${#deps[@]} -gt 0 ]; then
