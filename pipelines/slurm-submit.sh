@@ -326,6 +326,17 @@ else
 fi
 [ -z "$MAX_RUNNING" ] || ARRAY_SPEC="$ARRAY_SPEC%$MAX_RUNNING"
 
+# Jobs of an earlier submission into OUT (their working directory) still queued or running: a
+# second submission would run the same shards twice at the same time.
+if [ $HAVE_SLURM = 1 ]; then
+  active=$(squeue -h -u "$(id -un)" -o '%i %j %Z' 2>/dev/null |
+    awk -v d="$OUT" '$2 ~ /^slidestack-/ && $3 == d {print $1}' | tr '\n' ' ')
+  if [ -n "$active" ]; then
+    die "jobs of an earlier submission into $OUT are still queued or running (${active% }):
+wait for them to end (squeue -u $(id -un)) or cancel them (scancel ${active% }), then submit again"
+  fi
+fi
+
 # --- The jobs. --------------------------------------------------------------------------------
 LOGS=$SLURM_DIR/logs
 common=(--parsable --chdir="$OUT" --open-mode=append --cpus-per-task="$CPUS")
