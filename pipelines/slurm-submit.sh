@@ -144,9 +144,9 @@ if "$SLIDESTACK" status --help >/dev/null 2>&1; then
   HAVE_STATUS=1
   status=$("$SLIDESTACK" status "$CONFIG" --out "$OUT" --format env) ||
     die "slidestack status failed on $CONFIG (message above); nothing was submitted"
+  # KEY=VALUE lines; the keys used here are checked below, others are left alone.
   while IFS= read -r line; do
-    [ -z "$line" ] && continue
-    [[ $line =~ ^([A-Z_]+)=([A-Za-z0-9_.]*)$ ]] || die "unexpected line from slidestack status: $line"
+    [[ $line =~ ^([A-Z_]+)=(.*)$ ]] || continue
     case ${BASH_REMATCH[1]} in
     MOTIONS | SWEEP | TNEW | FIT | REPORT | SWEEP_UNITS | SWEEP_UNITS_DONE | SWEEP_CASES_PER_UNIT | \
       SWEEP_SAMPLES_PER_UNIT)
@@ -273,16 +273,16 @@ fi
 CPUS=${CPUS:-1}
 SHARDS=${SHARDS:-1}
 TIME=${TIME:-4:00:00}
+show_time() { if is_uint "$1"; then echo "$1 min"; else echo "$1"; fi; }
 plim=$(minutes "$PART_LIMIT") || plim=""
 if [[ $sized == *time* ]] && [ -n "$plim" ] && [ "$(minutes "$TIME")" -gt "$plim" ]; then
-  note "warning: the default time limit, $TIME, is above partition '$part''s $PART_LIMIT: using $PART_LIMIT (give more --shards if tasks time out)"
+  note "warning: the default time limit, $(show_time "$TIME"), is above the limit of partition '$part' ($PART_LIMIT): using $PART_LIMIT (give more --shards if tasks time out)"
   TIME=$PART_LIMIT
 fi
 if [ -z "$STAGE_TIME" ]; then
   STAGE_TIME=30:00
   if [ -n "$plim" ] && [ "$plim" -lt 30 ]; then STAGE_TIME=$PART_LIMIT; fi
 fi
-show_time() { if is_uint "$1"; then echo "$1 min"; else echo "$1"; fi; }
 note "jobs: shards $SHARDS, CPUs per job $CPUS, time limits $(show_time "$TIME") per sweep task and $(show_time "$STAGE_TIME") for motions and finishing${given:+ (given:$given)}"
 
 # --- Checks before any work. ------------------------------------------------------------------
