@@ -13,11 +13,12 @@
 # stage is asked on every make: it hashes every record file the config names (SHA-256) and
 # rewrites motions.h5 only when a record, the config's sections or the tool version changed, and
 # only then do the later stages run again. (make cannot list the record files itself: the config
-# names them, relative to its own folder.) The report is one of these stages: it is rebuilt only
-# when its inputs change.
+# names them, relative to its own folder.) The report is one of these stages: it keeps the
+# fingerprint of its inputs in OUT/report/FINGERPRINT and is rebuilt only when they change.
 #
 # make -j is safe: the stages form one chain, and every stage holds the output directory's lock
-# (OUT/.slidestack.lock), so two makes into the same OUT wait for each other.
+# (OUT/.slidestack.lock) while it runs, so two makes into the same OUT wait for each other (the
+# stage that waits prints "waiting for PID ..."), and the second finds the files up to date.
 #
 # The binary is built (cargo build --release) only when it is missing; after changing the
 # sources, run cargo build --release yourself, or give SLIDESTACK=/path/to/slidestack.
@@ -38,9 +39,12 @@ fit: $(OUT)/fit.h5
 report: $(OUT)/report/index.html
 .PHONY: all motions sweep tnew fit report always
 
+# Built only when missing, also under make -B (which remakes every target, this one included).
 $(SLIDESTACK):
-	@echo "paper.mk: no binary at $@: building it (cargo build --release in $(ROOT))"
-	cd '$(ROOT)' && cargo build --release
+	@if [ ! -x '$@' ]; then \
+	  echo "paper.mk: no binary at $@: building it (cargo build --release in $(ROOT))"; \
+	  cd '$(ROOT)' && cargo build --release; \
+	fi
 
 # Asked every time (prerequisite `always`); rewrites motions.h5 only when its inputs changed,
 # and no touch here, so the later stages see a newer motions.h5 only then.
@@ -49,17 +53,17 @@ $(OUT)/motions.h5: $(CONFIG) $(SLIDESTACK) always
 
 $(OUT)/sweep.h5: $(OUT)/motions.h5 $(CONFIG) $(SLIDESTACK)
 	'$(SLIDESTACK)' sweep '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
-	@touch '$@'
+	@touch -c '$@'
 
 $(OUT)/tnew.h5: $(OUT)/sweep.h5 $(OUT)/motions.h5 $(CONFIG) $(SLIDESTACK)
 	'$(SLIDESTACK)' tnew '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
-	@touch '$@'
+	@touch -c '$@'
 
 $(OUT)/fit.h5: $(OUT)/tnew.h5 $(CONFIG) $(SLIDESTACK)
 	'$(SLIDESTACK)' fit '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
-	@touch '$@'
+	@touch -c '$@'
 
 $(OUT)/report/index.html: $(OUT)/fit.h5 $(OUT)/tnew.h5 $(OUT)/sweep.h5 $(OUT)/motions.h5 \
 		$(CONFIG) $(SLIDESTACK)
 	'$(SLIDESTACK)' report '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
-	@touch '$@'
+	@touch -c '$@'

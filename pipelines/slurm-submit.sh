@@ -14,9 +14,13 @@ ROOT=$(dirname "$HERE")
 PROG=pipelines/slurm-submit.sh
 
 # A sweep unit's cost: 188 ns per simulated record sample per thread, measured by the paper
-# study on a 2-core Xeon (docs/evidence/study.md, README "The paper's study"); the time limit
+# study on 2 threads (docs/evidence/study.md, README "The paper's study"); the time limit
 # adds a factor 2 and 5 minutes on top of the bound this gives.
 NS_PER_SAMPLE=${SLIDESTACK_NS_PER_SAMPLE:-188}
+# Before the motions job has run, `slidestack status` cannot know the motions' length: the sizing
+# then assumes this many record samples per motion (the built-in stochastic motion has 4001, the
+# eleven FEMA P695 records of tests/fixtures 1800 to 7991).
+ASSUMED_SAMPLES_PER_MOTION=${SLIDESTACK_SAMPLES_PER_MOTION:-8000}
 # Default sizing aims at tasks of at most this many seconds (on the bound) and at most this many
 # CPUs per task (small tasks start sooner on a shared cluster).
 TARGET_TASK_S=1800
@@ -40,6 +44,7 @@ options (defaults in brackets; "sized" = from the grid's work units and their me
       --array LIST          submit only these shard indices, e.g. 3 or 2,5-7: to rerun failed
                             tasks; N is that of the last submission into OUT unless --shards
       --max-running M       at most M sweep tasks at a time (sbatch --array=...%M)
+      --force               recompute every stage even when up to date (slidestack --force)
       --dry-run             check everything and print the sbatch commands, submit nothing
   -h, --help                this text
   -- SBATCH_OPTION...       passed to every sbatch call (e.g. -- --qos=short --mail-type=END)
@@ -61,7 +66,7 @@ note() { echo "$PROG: $*"; }
 is_uint() { [[ $1 =~ ^[0-9]+$ ]]; }
 
 CONFIG="" OUT="" SHARDS="" CPUS="" TIME="" STAGE_TIME="" MEM="" ACCOUNT="" PARTITION=""
-ARRAY="" MAX_RUNNING="" DRY_RUN=0
+ARRAY="" MAX_RUNNING="" DRY_RUN=0 FORCE=0
 EXTRA=()
 POSITIONAL=()
 need_value() { [ "$2" -ge 2 ] || die "$1 needs a value (see --help)"; }
@@ -86,6 +91,7 @@ while [ $# -gt 0 ]; do
     set -- "$opt" "${1#*=}" "${@:2}"
     ;;
   --dry-run) DRY_RUN=1; shift ;;
+  --force) FORCE=1; shift ;;
   --)
     shift
     EXTRA=("$@")
@@ -137,42 +143,44 @@ case $OUT in
 esac
 
 # --- What is up to date (`slidestack status`, no computing). ---------------------------------
-HAVE_STATUS=0
+"$SLIDESTACK" status --help >/dev/null 2>&1 ||
+  die "$SLIDESTACK has no 'status' command: it is older than these scripts; build the current
+sources (see pipelines/README.md, \"Building\")"
+status=$("$SLIDESTACK" status "$CONFIG" --out "$OUT" --format env) ||
+  die "slidestack status failed on $CONFIG (message above); nothing was submitted"
 MOTIONS="" SWEEP="" TNEW="" FIT="" REPORT="" SWEEP_UNITS="" SWEEP_UNITS_DONE=""
-SWEEP_CASES_PER_UNIT="" SWEEP_SAMPLES_PER_UNIT=""
-if "$SLIDESTACK" status --help >/dev/null 2>&1; then
-  HAVE_STATUS=1
-  status=$("$SLIDESTACK" status "$CONFIG" --out "$OUT" --format env) ||
-    die "slidestack status failed on $CONFIG (message above); nothing was submitted"
-  # KEY=VALUE lines; the keys used here are checked below, others are left alone.
-  while IFS= read -r line; do
-    [[ $line =~ ^([A-Z_]+)=(.*)$ ]] || continue
-    case ${BASH_REMATCH[1]} in
-    MOTIONS | SWEEP | TNEW | FIT | REPORT | SWEEP_UNITS | SWEEP_UNITS_DONE | SWEEP_CASES_PER_UNIT | \
-      SWEEP_SAMPLES_PER_UNIT)
-      printf -v "${BASH_REMATCH[1]}" '%s' "${BASH_REMATCH[2]}" ;;
-    esac
-  done <<<"$status"
-  for v in MOTIONS SWEEP TNEW FIT REPORT; do
-    case ${!v} in up_to_date | stale | missing) ;; *) die "slidestack status gave $v='${!v}'" ;; esac
-  done
-  for v in SWEEP_UNITS SWEEP_UNITS_DONE SWEEP_CASES_PER_UNIT SWEEP_SAMPLES_PER_UNIT; do
-    is_uint "${!v}" || die "slidestack status gave $v='${!v}'"
-  done
-  note "status: motions $MOTIONS, sweep $SWEEP ($SWEEP_UNITS_DONE of $SWEEP_UNITS units stored), tnew $TNEW, fit $FIT, report $REPORT"
-  if [ "$MOTIONS$SWEEP$TNEW$FIT$REPORT" = "up_to_dateup_to_dateup_to_dateup_to_dateup_to_date" ]; then
-    note "the study in $OUT is up to date: nothing to submit ($OUT/report/index.html)"
-    exit 0
-  fi
-else
-  note "warning: $SLIDESTACK has no 'status' command, so this script cannot tell what is up to date
-  or size the jobs from the grid: every stage is submitted (each does nothing when its file is up
-  to date) and the sizes default to 1 shard, 1 CPU, 4 hours unless given"
+SWEEP_CASES_PER_UNIT="" SWEEP_SAMPLES_PER_MOTION="" SWEEP_SAMPLES_PER_UNIT=""
+# KEY=VALUE lines; the keys used here are checked below, others are left alone.
+while IFS= read -r line; do
+  [[ $line =~ ^([A-Z_]+)=(.*)$ ]] || continue
+  case ${BASH_REMATCH[1]} in
+  MOTIONS | SWEEP | TNEW | FIT | REPORT | SWEEP_UNITS | SWEEP_UNITS_DONE | SWEEP_CASES_PER_UNIT | \
+    SWEEP_SAMPLES_PER_MOTION | SWEEP_SAMPLES_PER_UNIT)
+    printf -v "${BASH_REMATCH[1]}" '%s' "${BASH_REMATCH[2]}" ;;
+  esac
+done <<<"$status"
+[ -n "$SWEEP" ] || die "$CONFIG has no grid, so there is no sweep to run on a cluster; its only stage
+runs on one machine: $SLIDESTACK motions $CONFIG --out $OUT"
+for v in MOTIONS SWEEP TNEW FIT REPORT; do
+  case ${!v} in up_to_date | stale | missing | damaged) ;; *) die "slidestack status gave $v='${!v}'" ;; esac
+done
+for v in SWEEP_UNITS SWEEP_UNITS_DONE SWEEP_CASES_PER_UNIT SWEEP_SAMPLES_PER_MOTION SWEEP_SAMPLES_PER_UNIT; do
+  is_uint "${!v}" || die "slidestack status gave $v='${!v}'"
+done
+note "status: motions $MOTIONS, sweep $SWEEP ($SWEEP_UNITS_DONE of $SWEEP_UNITS units stored), tnew $TNEW, fit $FIT, report $REPORT"
+if [ $FORCE = 0 ] && [ "$MOTIONS$SWEEP$TNEW$FIT$REPORT" = "up_to_dateup_to_dateup_to_dateup_to_dateup_to_date" ]; then
+  note "the study in $OUT is up to date: nothing to submit ($OUT/report/index.html; --force recomputes it)"
+  exit 0
 fi
+# What is submitted: the motions job when motions.h5 is not up to date, the sweep array when
+# sweep.h5 is not, the finishing job always. --force submits all three (without the motions job
+# when only some shards are resubmitted with --array) and passes --force to every stage.
 NEED_MOTIONS=1 NEED_SWEEP=1
-if [ $HAVE_STATUS = 1 ]; then
-  [ "$MOTIONS" = up_to_date ] && NEED_MOTIONS=0
-  [ "$SWEEP" = up_to_date ] && NEED_SWEEP=0
+[ "$MOTIONS" != up_to_date ] || NEED_MOTIONS=0
+[ "$SWEEP" != up_to_date ] || NEED_SWEEP=0
+if [ $FORCE = 1 ]; then
+  NEED_SWEEP=1
+  if [ -z "$ARRAY" ]; then NEED_MOTIONS=1; fi
 fi
 
 # --- What the cluster allows. ----------------------------------------------------------------
@@ -229,7 +237,7 @@ if [ -n "$ARRAY" ] && [ -z "$SHARDS" ]; then
   is_uint "$SHARDS" || die "cannot read SHARDS from $LAST: give --shards N"
   note "--array: N = $SHARDS, from the last submission ($LAST)"
 fi
-if [ -n "$ARRAY" ] && [ $NEED_MOTIONS = 1 ] && [ $HAVE_STATUS = 1 ]; then
+if [ -n "$ARRAY" ] && [ $NEED_MOTIONS = 1 ]; then
   die "motions.h5 is $MOTIONS, so every shard must run again: submit without --array"
 fi
 
@@ -241,13 +249,23 @@ given="" sized=""
 for v in SHARDS CPUS TIME; do
   if [ -n "${!v}" ]; then given="$given ${v,,}"; else sized="$sized ${v,,}"; fi
 done
-if [ -n "$SWEEP_SAMPLES_PER_UNIT" ] && [ "$SWEEP_SAMPLES_PER_UNIT" -gt 0 ] && [ "$SWEEP_UNITS" -gt 0 ]; then
+# The work bound of a unit: at most three simulations per case, each over the motion's samples
+# (status: SWEEP_SAMPLES_PER_UNIT = 3 x cases per unit x mean samples per motion).
+if [ "$SWEEP_SAMPLES_PER_MOTION" -gt 0 ]; then
+  SAMPLES_PER_UNIT=$SWEEP_SAMPLES_PER_UNIT
+  samples_from="$SWEEP_SAMPLES_PER_MOTION samples per motion, from motions.h5"
+else
+  is_uint "$ASSUMED_SAMPLES_PER_MOTION" || die "SLIDESTACK_SAMPLES_PER_MOTION must be a whole number"
+  SAMPLES_PER_UNIT=$((3 * SWEEP_CASES_PER_UNIT * ASSUMED_SAMPLES_PER_MOTION))
+  samples_from="$ASSUMED_SAMPLES_PER_MOTION samples per motion assumed, as motions.h5 is $MOTIONS"
+fi
+if [ "$SAMPLES_PER_UNIT" -gt 0 ] && [ "$SWEEP_UNITS" -gt 0 ]; then
   # U: bound of one unit's CPU seconds; W: of all units. CPUs: enough for tasks of
   # TARGET_TASK_S with the shards given (1 if not), at most cpu_cap and no more than a shard's
   # units. Shards: enough for tasks of TARGET_TASK_S, at most the units and the array limit. Time
   # limit: twice the bound of a task's wall time (its units, CPUs at a time) plus 5 minutes, at
   # least 10 minutes.
-  read -r UNIT_S W CPUS SHARDS EST TMIN < <(awk -v s="$SWEEP_SAMPLES_PER_UNIT" -v ns="$NS_PER_SAMPLE" \
+  read -r UNIT_S W CPUS SHARDS EST TMIN < <(awk -v s="$SAMPLES_PER_UNIT" -v ns="$NS_PER_SAMPLE" \
     -v units="$SWEEP_UNITS" -v c="${CPUS:-0}" -v n="${SHARDS:-0}" -v target=$TARGET_TASK_S \
     -v ccap="$cpu_cap" -v acap="${array_cap:-0}" '
     function ceil(x) { return (x == int(x)) ? x : int(x) + 1 }
@@ -266,9 +284,9 @@ if [ -n "$SWEEP_SAMPLES_PER_UNIT" ] && [ "$SWEEP_SAMPLES_PER_UNIT" -gt 0 ] && [ 
       printf "%.3f %.1f %d %d %.0f %d\n", u, w, c, n, est, t
     }')
   [ -n "$TIME" ] || TIME=$TMIN
-  note "sizing: $SWEEP_UNITS work units of $SWEEP_CASES_PER_UNIT cases, each at most $UNIT_S CPU-s (at most $SWEEP_SAMPLES_PER_UNIT simulated record samples x $NS_PER_SAMPLE ns); $W CPU-s in all, at most $EST s per task"
+  note "sizing: $SWEEP_UNITS work units of $SWEEP_CASES_PER_UNIT cases, each at most $UNIT_S CPU-s (at most $SAMPLES_PER_UNIT simulated record samples x $NS_PER_SAMPLE ns; $samples_from); $W CPU-s in all, at most $EST s per task"
 elif [ -n "$sized" ]; then
-  note "warning: no grid size from slidestack status: default 1 shard, 1 CPU, 4 hours where not given"
+  note "warning: the grid has no work to size from: default 1 shard, 1 CPU, 4 hours where not given"
 fi
 CPUS=${CPUS:-1}
 SHARDS=${SHARDS:-1}
@@ -357,18 +375,22 @@ resubmit=(--shards "$SHARDS" --cpus-per-task "$CPUS" --time "$TIME" --stage-time
 [ -z "$PARTITION" ] || resubmit+=(--partition "$PARTITION")
 [ -z "$MEM" ] || resubmit+=(--mem "$MEM")
 [ -z "$MAX_RUNNING" ] || resubmit+=(--max-running "$MAX_RUNNING")
+[ $FORCE = 0 ] || resubmit+=(--force)
 resubmit+=("$CONFIG" "$OUT")
 [ ${#EXTRA[@]} -eq 0 ] || resubmit+=(-- "${EXTRA[@]}")
 RESUBMIT_ARGS=$(printf '%q ' "${resubmit[@]}")
 RESUBMIT_ARGS=${RESUBMIT_ARGS% }
 
+# --force goes first to each batch script, which passes it to every slidestack stage it runs.
+FORCE_ARG=()
+[ $FORCE = 0 ] || FORCE_ARG=(--force)
 motions_cmd=(sbatch "${common[@]}" --job-name=slidestack-motions --time="$STAGE_TIME"
-  --output="$LOGS/motions-%j.out" "${EXTRA[@]}" "$HERE/motions.slurm" "$JOB_BIN" "$CONFIG" "$OUT")
+  --output="$LOGS/motions-%j.out" "${EXTRA[@]}" "$HERE/motions.slurm" "${FORCE_ARG[@]}" "$JOB_BIN" "$CONFIG" "$OUT")
 sweep_cmd=(sbatch "${common[@]}" --job-name=slidestack-sweep --time="$TIME" --array="$ARRAY_SPEC"
-  --output="$LOGS/sweep-%A_%a.out" "${EXTRA[@]}" "$HERE/sweep.slurm" "$JOB_BIN" "$CONFIG" "$OUT"
+  --output="$LOGS/sweep-%A_%a.out" "${EXTRA[@]}" "$HERE/sweep.slurm" "${FORCE_ARG[@]}" "$JOB_BIN" "$CONFIG" "$OUT"
   "$SHARDS")
 finish_cmd=(sbatch "${common[@]}" --job-name=slidestack-finish --time="$STAGE_TIME"
-  --output="$LOGS/finish-%j.out" "${EXTRA[@]}" "$HERE/finish.slurm" "$JOB_BIN" "$CONFIG" "$OUT"
+  --output="$LOGS/finish-%j.out" "${EXTRA[@]}" "$HERE/finish.slurm" "${FORCE_ARG[@]}" "$JOB_BIN" "$CONFIG" "$OUT"
   "$SHARDS" "$RESUBMIT_CMD" "$RESUBMIT_ARGS")
 
 parts="finishing job"
