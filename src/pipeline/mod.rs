@@ -354,11 +354,23 @@ impl Study {
         })
     }
 
-    /// Refuses unless `stage`'s output is on disk, whole and made from this config.
+    /// Refuses unless `stage`'s output is on disk, whole and made from this config; the error
+    /// names the file and the earliest stage that must run again.
     pub fn require(&self, stage: StageId) -> Result<(), PipelineError> {
         let file = self.path(stage.output());
-        let why = match self.state(stage)? {
-            StageState::UpToDate => return Ok(()),
+        let state = self.state(stage)?;
+        if state == StageState::UpToDate {
+            return Ok(());
+        }
+        let mut first = stage;
+        for earlier in StageId::ALL.into_iter().take_while(|&s| s != stage) {
+            if self.state(earlier)? != StageState::UpToDate {
+                first = earlier;
+                break;
+            }
+        }
+        let why = match state {
+            StageState::UpToDate => unreachable!("returned above"),
             StageState::Missing => format!("{} is missing", file.display()),
             StageState::Stale => format!(
                 "{} was made from other inputs than {}",
@@ -369,7 +381,7 @@ impl Study {
         };
         Err(PipelineError::Upstream {
             why,
-            stage,
+            stage: first,
             config: self.config_path.clone(),
         })
     }

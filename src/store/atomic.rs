@@ -150,6 +150,31 @@ mod tests {
     }
 
     #[test]
+    fn stale_temporaries_are_recognised_and_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let keep = [
+            "sweep.h5",
+            "sweep.h5.sha256",
+            ".slidestack.lock",
+            "notes.tmp",
+        ];
+        for k in keep {
+            std::fs::write(dir.path().join(k), "").unwrap();
+        }
+        std::fs::write(temp_path(&dir.path().join("fit.h5")), "").unwrap();
+        std::fs::create_dir(temp_path(&dir.path().join("report"))).unwrap();
+        assert_eq!(remove_stale_temps(dir.path()).unwrap(), 2);
+        let mut left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        left.sort();
+        let mut want: Vec<String> = keep.iter().map(|s| s.to_string()).collect();
+        want.sort();
+        assert_eq!(left, want);
+    }
+
+    #[test]
     fn a_failed_write_leaves_the_old_file_and_no_temporary() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("a.txt");

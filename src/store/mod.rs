@@ -36,8 +36,9 @@ pub enum StoreError {
         op: &'static str,
         source: std::io::Error,
     },
-    #[error("{}: HDF5: {source}", file.display())]
-    Hdf5 { file: PathBuf, source: hdf5::Error },
+    /// The HDF5 library's message, condensed to its description and system error.
+    #[error("{}: HDF5: {message}", file.display())]
+    Hdf5 { file: PathBuf, message: String },
     /// The file exists but is not what was written: checksum, identity or layout differs.
     #[error("{}: {why}", file.display())]
     Corrupt { file: PathBuf, why: String },
@@ -57,7 +58,7 @@ impl StoreError {
     pub fn hdf5(file: &Path, source: hdf5::Error) -> Self {
         Self::Hdf5 {
             file: file.to_path_buf(),
-            source,
+            message: condense(&source.to_string()),
         }
     }
 
@@ -74,6 +75,25 @@ impl StoreError {
             Self::Io { file, .. } | Self::Hdf5 { file, .. } | Self::Corrupt { file, .. } => file,
             Self::Format(file) => file,
         }
+    }
+}
+
+/// HDF5's message without its time stamp, temporary name, buffer address and byte counts:
+/// `H5Fflush(): … file write failed (File too large)`.
+fn condense(message: &str) -> String {
+    let description = message
+        .split(": time =")
+        .next()
+        .unwrap_or(message)
+        .trim()
+        .to_string();
+    match message
+        .split("error message = '")
+        .nth(1)
+        .and_then(|rest| rest.split('\'').next())
+    {
+        Some(os) => format!("{description} ({os})"),
+        None => description,
     }
 }
 

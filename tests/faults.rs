@@ -1,0 +1,656 @@
+//! The fault-injection suite: concurrent runs, a full disk, damaged and swapped files, stale
+//! inputs, and inputs that used to hang, abort or be silently wrong. Each fault must end in one
+//! clear message and a non-zero exit, lose nothing that existed, and a rerun must give the files
+//! of a clean run bit for bit. `docs/faults.md` lists every fault with the test that proves it.
+//!
+//! Every child process runs under a wall-clock guard: a hang fails the test instead of the suite.
+
+mod common;
+
+use common::fixture;
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// What a run of the binary did.
+#[derive(Debug)]
+struct Ran {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+impl Ran {
+    fn ok(self) -> Self {
+        assert_eq!(self.code, 0, "{}{}", self.stdout, self.stderr);
+        self
+    }
+    /// Failed with `code`, saying `text` on stderr exactly once.
+    fn fails(self, code: i32, text: &str) -> Self {
+        assert_eq!(self.code, code, "{}{}", self.stdout, self.stderr);
+        assert_eq!(
+            self.stderr.matches(text).count(),
+            1,
+            "`{text}` once in: {}",
+            self.stderr
+        );
+        self
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Opts {
+    /// Largest file the process may write, bytes (`RLIMIT_FSIZE`): a full disk for it.
+    file_size_limit: Option<u64>,
+    guard: Duration,
+}
+
+const PLAIN: Opts = Opts {
+    file_size_limit: None,
+    guard: Duration::from_secs(120),
+};
+
+/// A run that must end within `guard`: fast refusals get a few seconds.
+const QUICK: Opts = Opts {
+    file_size_limit: None,
+    guard: Duration::from_secs(15),
+};
+
+fn spawn(args: &[&str], opts: Opts) -> std::process::Child {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
+    cmd.args(args)
+        .env("RAYON_NUM_THREADS", "2")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    if let Some(limit) = opts.file_size_limit {
+        // SAFETY: only async-signal-safe calls between fork and exec.
+        unsafe {
+            cmd.pre_exec(move || {
+                libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+                let rl = libc::rlimit {
+                    rlim_cur: limit,
+                    rlim_max: limit,
+                };
+                if libc::setrlimit(libc::RLIMIT_FSIZE, &rl) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+    }
+    cmd.spawn().unwrap()
+}
+
+fn finish(mut child: std::process::Child, guard: Duration, what: &str) -> Ran {
+    let start = Instant::now();
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        if start.elapsed() > guard {
+            child.kill().unwrap();
+            panic!("`{what}` did not end within {guard:?}");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let out = child.wait_with_output().unwrap();
+    Ran {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+fn run(args: &[&str], opts: Opts) -> Ran {
+    finish(spawn(args, opts), opts.guard, &args.join(" "))
+}
+
+/// A small study on two real records, zone III, 24 work units of 12 cases.
+fn study(dir: &Path, extra: &str) -> PathBuf {
+    let cfg = dir.join("study.yaml");
+    std::fs::write(
+        &cfg,
+        format!(
+            "output_dir: {out}\nzones: [{{ name: III, target: \"is1893:zone=III,soil=I\" }}]\n\
+             motions:\n  seeds:\n    records:\n      files: [{a}, {b}]\n\
+             grid:\n  period_s: {{ from: 0.2, to: 2.4, step: 0.2 }}\n\
+             \x20 alpha: [[0.5, 1.0], [0.5]]\n  mu: [[0.1, 0.3, 0.5], [0.05, 0.2]]\n{extra}",
+            out = dir.join("out").display(),
+            a = fixture("RSN829_CAPEMEND_RIO360.AT2").display(),
+            b = fixture("RSN960_NORTHR_LOS270.AT2").display(),
+        ),
+    )
+    .unwrap();
+    cfg
+}
+
+/// Every file of a study's output directory (the lock file aside), by relative path.
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.file_name().unwrap() != ".slidestack.lock" {
+                let rel = p.strip_prefix(dir).unwrap().display().to_string();
+                out.push((rel, std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn assert_same_files(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    let names = |f: &[(String, Vec<u8>)]| f.iter().map(|x| x.0.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&fa), names(&fb));
+    for ((n, x), (_, y)) in fa.iter().zip(&fb) {
+        assert!(
+            x == y,
+            "{n} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+}
+
+/// A clean full run of `cfg` into `out`.
+fn clean_run(cfg: &Path, out: &Path) {
+    run(&["run", s(cfg), "--out", s(out)], PLAIN).ok();
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        let q = to.join(p.file_name().unwrap());
+        if p.is_dir() {
+            copy_dir(&p, &q);
+        } else {
+            std::fs::copy(&p, &q).unwrap();
+        }
+    }
+}
+
+#[test]
+fn concurrent_runs_into_one_directory_wait_and_end_as_a_clean_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = study(dir.path(), "");
+    let reference = dir.path().join("ref");
+    clean_run(&cfg, &reference);
+
+    // Two whole runs at once: one waits for the other, both succeed, the files are a clean run's.
+    let out = dir.path().join("both");
+    let args = ["run", s(&cfg), "--out", s(&out)];
+    let (a, b) = (spawn(&args, PLAIN), spawn(&args, PLAIN));
+    let (a, b) = (finish(a, PLAIN.guard, "run"), finish(b, PLAIN.guard, "run"));
+    let (a, b) = (a.ok(), b.ok());
+    let waited = [&a, &b]
+        .iter()
+        .filter(|r| r.stdout.contains("waiting for PID"))
+        .count();
+    assert_eq!(waited, 1, "{}\n{}", a.stdout, b.stdout);
+    assert_same_files(&reference, &out);
+
+    // Without waiting, the second refuses and names the holder.
+    let out2 = dir.path().join("nowait");
+    let first = spawn(&["run", s(&cfg), "--out", s(&out2)], PLAIN);
+    let lock = out2.join(".slidestack.lock");
+    let start = Instant::now();
+    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.starts_with("PID ")) {
+        assert!(start.elapsed() < Duration::from_secs(30));
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    run(&["tnew", s(&cfg), "--out", s(&out2), "--no-wait"], QUICK).fails(1, "is in use by PID");
+    finish(first, PLAIN.guard, "run").ok();
+    assert_same_files(&reference, &out2);
+
+    // Ten rounds of two forced fits at once: every round leaves a fit that verifies and equals
+    // the clean run's.
+    for _ in 0..10 {
+        let args = ["fit", s(&cfg), "--out", s(&out), "--force"];
+        let (a, b) = (spawn(&args, PLAIN), spawn(&args, PLAIN));
+        finish(a, PLAIN.guard, "fit").ok();
+        finish(b, PLAIN.guard, "fit").ok();
+        let r = run(&["report", s(&cfg), "--out", s(&out)], PLAIN).ok();
+        assert!(r.stdout.contains("is up to date"), "{}", r.stdout);
+    }
+    assert_same_files(&reference, &out);
+}
+
+#[test]
+fn a_full_disk_fails_naming_the_file_keeps_everything_and_a_rerun_is_clean() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = study(dir.path(), "");
+    let reference = dir.path().join("ref");
+    clean_run(&cfg, &reference);
+    let out = dir.path().join("out");
+    let full = |limit: u64| Opts {
+        file_size_limit: Some(limit),
+        ..PLAIN
+    };
+
+    // motions.h5 (hundreds of kB) cannot be written under 64 kB.
+    run(&["motions", s(&cfg), "--out", s(&out)], full(64_000))
+        .fails(1, "motions.h5: HDF5: H5Fflush(): unable to flush file's cached information: file write failed (File too large)");
+    assert!(!out.join("motions.h5").exists());
+    run(&["motions", s(&cfg), "--out", s(&out)], PLAIN).ok();
+
+    // Units (about 1.5 kB each) fit, sweep.h5 does not: the sweep fails naming it and keeps
+    // every unit, so the rerun only assembles.
+    let r = run(&["sweep", s(&cfg), "--out", s(&out)], full(8_000));
+    r.fails(1, "sweep.h5: HDF5:");
+    let units = std::fs::read_dir(out.join("sweep.units")).unwrap().count();
+    assert_eq!(units, 24);
+    let r = run(&["sweep", s(&cfg), "--out", s(&out)], PLAIN).ok();
+    assert!(
+        r.stdout.contains("0 of 24 units to compute"),
+        "{}",
+        r.stdout
+    );
+    run(&["run", s(&cfg), "--out", s(&out)], PLAIN).ok();
+    assert_same_files(&reference, &out);
+
+    // A stage that fails on a full disk leaves the old files of a changed study as they were.
+    let before = files(&out);
+    let cfg2 = study(dir.path(), "  damping: 0.04\n");
+    for stage in ["sweep", "tnew", "fit", "report"] {
+        if stage != "sweep" {
+            // The upstream stages of the changed study, written with space.
+            let prev = match stage {
+                "tnew" => "sweep",
+                "fit" => "tnew",
+                _ => "fit",
+            };
+            run(&[prev, s(&cfg2), "--out", s(&out)], PLAIN).ok();
+        }
+        let before = files(&out);
+        let r = run(&[stage, s(&cfg2), "--out", s(&out)], full(1_000));
+        assert_ne!(r.code, 0, "{stage}: {}", r.stdout);
+        assert!(
+            r.stderr.contains("File too large") || r.stderr.contains("HDF5"),
+            "{stage}: {}",
+            r.stderr
+        );
+        let after = files(&out);
+        // Nothing that existed is lost or changed (units written before the failure may be
+        // new).
+        for (name, bytes) in &before {
+            let now = after.iter().find(|f| &f.0 == name);
+            assert!(
+                now.is_some_and(|f| &f.1 == bytes),
+                "{stage}: {name} changed"
+            );
+        }
+        run(&[stage, s(&cfg2), "--out", s(&out)], PLAIN).ok();
+    }
+    drop(before);
+    // motions.h5 rightly keeps the first config's hash (the damping does not touch it), so it is
+    // the first reference's; everything else is the changed study's.
+    let reference2 = dir.path().join("ref2");
+    copy_dir(&reference, &reference2);
+    run(&["run", s(&cfg2), "--out", s(&reference2)], PLAIN).ok();
+    assert_same_files(&reference2, &out);
+
+    // A time history on a full disk: an error naming the file, no file of zeros.
+    let h = dir.path().join("h.h5");
+    let r = run(
+        &["simulate", "--history", s(&h), "--json"],
+        Opts {
+            file_size_limit: Some(2_000),
+            guard: QUICK.guard,
+        },
+    );
+    r.fails(1, "h.h5");
+    assert!(!h.exists());
+    let h = dir.path().join("h.csv");
+    run(
+        &["simulate", "--history", s(&h)],
+        Opts {
+            file_size_limit: Some(2_000),
+            guard: QUICK.guard,
+        },
+    )
+    .fails(1, "h.csv: cannot write: File too large");
+    assert!(!h.exists());
+}
+
+#[test]
+fn a_real_small_file_system_fills_up_cleanly() {
+    // A 256 kB tmpfs, where the test may mount one (root on Linux); elsewhere the rlimit test
+    // above stands for it.
+    let dir = tempfile::tempdir().unwrap();
+    let mnt = dir.path().join("mnt");
+    std::fs::create_dir(&mnt).unwrap();
+    let mounted = Command::new("mount")
+        .args(["-t", "tmpfs", "-o", "size=256k", "tmpfs", s(&mnt)])
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|st| st.success());
+    if !mounted {
+        eprintln!("skipped: cannot mount a tmpfs here (needs root on Linux)");
+        return;
+    }
+    let cfg = study(dir.path(), "");
+    let out = mnt.join("out");
+    let r = run(&["run", s(&cfg), "--out", s(&out)], PLAIN);
+    // What the full file system left: no temporary, and a status that calls nothing damaged.
+    let left: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    let status = run(&["status", s(&cfg), "--out", s(&out)], QUICK);
+    let _ = Command::new("umount").arg(&mnt).status();
+    // Two records' motions fit, sweep.h5 does not: the sweep says so and keeps its units.
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    let want = format!("{}: HDF5:", out.join("sweep.h5").display());
+    assert!(
+        r.stderr.contains(&want) && r.stderr.contains("(No space left on device)"),
+        "{}",
+        r.stderr
+    );
+    assert!(left.iter().all(|n| !n.ends_with(".tmp")), "{left:?}");
+    assert!(left.contains(&"sweep.units".to_string()), "{left:?}");
+    let status = status.ok().stdout;
+    assert!(status.contains("sweep.h5             missing"), "{status}");
+    assert!(
+        status.contains("motions.h5           up to date"),
+        "{status}"
+    );
+    assert!(!status.contains("damaged"), "{status}");
+}
+
+#[test]
+fn damaged_swapped_and_stale_files_are_never_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = study(dir.path(), "");
+    let c = s(&cfg);
+    let reference = dir.path().join("ref");
+    clean_run(&cfg, &reference);
+    let out = dir.path().join("out");
+    let o = s(&out);
+    run(&["motions", c, "--out", o], PLAIN).ok();
+
+    // Units from two shards; one damaged, two swapped: merge refuses naming them.
+    for k in ["1/2", "2/2"] {
+        run(&["sweep", c, "--out", o, "--shard", k], PLAIN).ok();
+    }
+    let units = out.join("sweep.units");
+    let unit = units.join("III_000_003.unit");
+    let good = std::fs::read(&unit).unwrap();
+    let mut bad = good.clone();
+    bad[good.len() / 2] ^= 0x10;
+    std::fs::write(&unit, &bad).unwrap();
+    run(&["merge", c, "--out", o], PLAIN).fails(1, "III_000_003.unit: fails its checksum");
+    std::fs::write(&unit, &good).unwrap();
+    let other = units.join("III_001_007.unit");
+    let (x, y) = (
+        std::fs::read(&unit).unwrap(),
+        std::fs::read(&other).unwrap(),
+    );
+    std::fs::write(&unit, &y).unwrap();
+    std::fs::write(&other, &x).unwrap();
+    run(&["merge", c, "--out", o], PLAIN).fails(1, "holds unit (zone III, motion 2");
+    // The sweep itself recomputes what it cannot trust.
+    let r = run(&["sweep", c, "--out", o], PLAIN).ok();
+    assert!(r.stderr.contains("computing it again"), "{}", r.stderr);
+    assert!(
+        r.stdout.contains("2 of 24 units to compute"),
+        "{}",
+        r.stdout
+    );
+    assert!(!units.exists());
+
+    // A flipped byte in sweep.h5: tnew refuses naming it; sweep rebuilds it.
+    let sweep = out.join("sweep.h5");
+    let mut b = std::fs::read(&sweep).unwrap();
+    let n = b.len();
+    b[n / 2] ^= 1;
+    std::fs::write(&sweep, &b).unwrap();
+    run(&["tnew", c, "--out", o], PLAIN).fails(1, "sweep.h5: does not match its checksum in");
+    let r = run(&["sweep", c, "--out", o], PLAIN).ok();
+    assert!(r.stderr.contains("rebuilding it"), "{}", r.stderr);
+
+    // fit.yaml cut to nothing, or replaced by another YAML: report refuses, fit rebuilds.
+    run(&["run", c, "--out", o], PLAIN).ok();
+    for text in ["", "zones: []\n"] {
+        std::fs::write(out.join("fit.yaml"), text).unwrap();
+        run(&["report", c, "--out", o, "--force"], PLAIN)
+            .fails(1, "fit.yaml: does not match its checksum");
+        run(&["fit", c, "--out", o], PLAIN).ok();
+    }
+    assert_same_files(&reference, &out);
+
+    // A changed config, then the report alone: refused naming the stale file and the stage to
+    // run; a stale figure never survives a rebuilt report.
+    std::fs::write(out.join("report/stale.svg"), "<svg/>").unwrap();
+    let cfg2 = study(dir.path(), "  damping: 0.04\n");
+    run(&["report", s(&cfg2), "--out", o], PLAIN)
+        .fails(1, "tnew.h5 was made from other inputs than");
+    let r = run(&["report", s(&cfg2), "--out", o], PLAIN);
+    assert!(r.stderr.contains("run `slidestack sweep"), "{}", r.stderr);
+    run(&["run", s(&cfg2), "--out", o], PLAIN).ok();
+    assert!(!out.join("report/stale.svg").exists());
+
+    // Unit files left behind by a kill during cleanup are removed by the next sweep.
+    std::fs::create_dir_all(&units).unwrap();
+    std::fs::write(units.join("III_000_000.unit"), "left over").unwrap();
+    let r = run(&["sweep", s(&cfg2), "--out", o], PLAIN).ok();
+    assert!(r.stdout.contains("is up to date"));
+    assert!(!units.exists());
+}
+
+/// A config with one key's line replaced, for the refusal tests.
+fn config_with(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const BASE: &str = "zones: [{ name: III, target: \"is1893:zone=III,soil=I\" }]\n\
+                    motions:\n  seeds:\n    stochastic: { count: 2, seed: 1 }\n";
+
+#[test]
+fn inputs_that_used_to_hang_abort_or_mislead_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("out");
+    let o = s(&out);
+    let at2 = |name: &str, header: &str, values: &str| -> PathBuf {
+        let p = d.join(name);
+        std::fs::write(
+            &p,
+            format!("PEER\nx\nACCELERATION TIME SERIES IN UNITS OF G\n{header}\n{values}\n"),
+        )
+        .unwrap();
+        p
+    };
+    // Records: absurd steps and sample counts, and a 100 kB token.
+    for (header, want) in [
+        (
+            "NPTS= 2, DT= 1e-15 SEC",
+            "time step dt = 1e-15 s is outside",
+        ),
+        (
+            "NPTS= 2, DT= 1e-300 SEC",
+            "time step dt = 1e-300 s is outside",
+        ),
+        (
+            "NPTS= 2, DT= 1e300 SEC",
+            "time step dt = 1e300 s is outside",
+        ),
+        (
+            "NPTS= 1000000000000, DT= .01 SEC",
+            "1000000000000.0 samples: a record may have at most 16777216",
+        ),
+        (
+            "NPTS= 1e30, DT= .01 SEC",
+            "1e30 samples: a record may have at most",
+        ),
+    ] {
+        let p = at2("r.AT2", header, "0.1 0.2");
+        run(&["simulate", "--record", s(&p)], QUICK).fails(2, want);
+    }
+    let token = "x".repeat(100_000);
+    let p = at2("t.AT2", "NPTS= 2, DT= .01 SEC", &format!("0.1 {token}"));
+    let r = run(&["simulate", "--record", s(&p)], QUICK).fails(2, "is not a number");
+    assert!(r.stderr.len() < 300, "{} bytes echoed", r.stderr.len());
+    run(&["simulate", "--record", s(d)], QUICK).fails(2, "Is a directory");
+
+    // Systems: beyond double precision or the integrators' accurate range.
+    for (args, code, want) in [
+        (
+            &["--alpha", "1e17", "--mu", "0.2"][..],
+            2,
+            "must be finite, > 0 and ≤ 10000, got 1e17",
+        ),
+        (
+            &["--alpha", "1e9", "--mu", "0.2"][..],
+            2,
+            "≤ 10000, got 1000000000.0",
+        ),
+        (&["--period", "1e15"][..], 2, "period_s must be within"),
+        (&["--period", "1e6"][..], 2, "period_s must be within"),
+        (
+            &["--period", "-1"][..],
+            2,
+            "period_s must be within 0.000001 … 10000 s, got -1.0",
+        ),
+        (
+            &["--period", "5000"][..],
+            2,
+            "the exact integrator is accurate up to",
+        ),
+        (
+            &[
+                "--integrator",
+                "rk4",
+                "--rk4-substeps",
+                "1",
+                "--period",
+                "0.02",
+            ][..],
+            2,
+            "use at least 2 sub-steps",
+        ),
+        (
+            &["--integrator", "rk4", "--rk4-substeps", "1000000000"][..],
+            2,
+            "rk4 sub-steps per sample must be 1 … 100000",
+        ),
+    ] {
+        let mut a = vec!["simulate"];
+        a.extend_from_slice(args);
+        run(&a, QUICK).fails(code, want);
+    }
+    // Allowed, but near the edge: a warning with the reason, then the answer.
+    let r = run(&["simulate", "--period", "1000", "--json"], QUICK).ok();
+    assert!(r.stderr.contains("energy error may reach"), "{}", r.stderr);
+
+    // Spectra: absurd periods and counts.
+    let rec = fixture("RSN960_NORTHR_LOS270.AT2");
+    for (periods, want) in [
+        ("1e-300", "period 1e-300 s is outside 0.001 … 10000 s"),
+        ("log:0.1:1:10000000", "2 ≤ COUNT ≤ 100000"),
+        ("0:1e12:1e-6", "values; at most 100000"),
+    ] {
+        run(
+            &["spectrum", "--record", s(&rec), "--periods", periods],
+            QUICK,
+        )
+        .fails(2, want);
+    }
+
+    // Configs: every limit refused before any work, naming the file and the key.
+    let grid = |g: &str| format!("{BASE}grid:\n{g}");
+    let cases: Vec<(String, &str)> = vec![
+        (
+            grid(
+                "  period_s: { from: 0.1, to: 1e12, step: 1e-6 }\n  alpha: [[0.5]]\n  mu: [[0.1]]\n",
+            ),
+            "`grid.period_s`: range from 0.1 to 1000000000000 by 0.000001 has",
+        ),
+        (
+            grid(&format!(
+                "  period_s: [1]\n  alpha: [{}]\n  mu: [{}]\n",
+                vec!["[0.1]"; 15].join(", "),
+                vec!["[0.1]"; 15].join(", ")
+            )),
+            "`grid.alpha`: needs one list per block, 1 to 14 blocks",
+        ),
+        (
+            grid(&format!(
+                "  period_s: {{ from: 0.01, to: 10, step: 0.01 }}\n  alpha: [{a}]\n  mu: [{a}]\n",
+                a = vec!["{ from: 0.01, to: 1, step: 0.01 }"; 6].join(", ")
+            )),
+            "case results (cases × motions × zones); at most 50000000",
+        ),
+        (
+            format!("{BASE}  matching: {{ check_periods: 100000000 }}\n"),
+            "matching setting `check_periods` = 100000000: must be 2 … 100000",
+        ),
+        (
+            format!("output_dir: /\n{BASE}"),
+            "`output_dir` `/` is the root of the file system",
+        ),
+        (
+            format!("output_dir: ~/x\n{BASE}"),
+            "`~` is not expanded here",
+        ),
+        (format!("output_dir: \"\"\n{BASE}"), "`output_dir` is empty"),
+        (
+            format!("{BASE}x: {}\n", "[".repeat(5000)),
+            "levels deep; a config nests at most 32",
+        ),
+    ];
+    for (i, (text, want)) in cases.iter().enumerate() {
+        let with_out = if text.starts_with("output_dir") {
+            text.clone()
+        } else {
+            format!("output_dir: {o}\n{text}")
+        };
+        let cfg = config_with(d, &format!("c{i}.yaml"), &with_out);
+        run(&["motions", s(&cfg)], QUICK).fails(2, want);
+    }
+    // A byte-order mark is not a mistake.
+    let cfg = config_with(d, "bom.yaml", &format!("\u{feff}output_dir: {o}\n{BASE}"));
+    let r = run(&["status", s(&cfg)], QUICK).ok();
+    assert!(r.stdout.contains("motions"), "{}", r.stdout);
+    // A directory given as a record file.
+    let cfg = config_with(
+        d,
+        "dir.yaml",
+        &format!(
+            "output_dir: {o}\nzones: [{{ name: III, target: \"is1893:zone=III,soil=I\" }}]\n\
+             motions:\n  seeds:\n    records: {{ files: [{}] }}\n",
+            d.display()
+        ),
+    );
+    run(&["motions", s(&cfg)], QUICK).fails(2, "is a directory, not a record file");
+    // An output directory that cannot be made: refused before any matching.
+    let blocker = d.join("a-file");
+    std::fs::write(&blocker, "").unwrap();
+    let cfg = config_with(
+        d,
+        "unwritable.yaml",
+        &format!("output_dir: {}\n{BASE}", blocker.join("out").display()),
+    );
+    let start = Instant::now();
+    run(&["motions", s(&cfg)], QUICK).fails(1, "cannot create it");
+    assert!(start.elapsed() < Duration::from_secs(2));
+}
+
+#[test]
+fn an_error_and_its_cause_print_once() {
+    let r = run(&["simulate", "--record", "/nonexistent.AT2"], QUICK)
+        .fails(2, "No such file or directory");
+    assert_eq!(r.stderr.lines().count(), 1, "{}", r.stderr);
+}
