@@ -589,7 +589,7 @@ fn inputs_that_used_to_hang_abort_or_mislead_are_refused_at_once() {
         (
             grid(&format!(
                 "  period_s: {{ from: 0.01, to: 10, step: 0.01 }}\n  alpha: [{a}]\n  mu: [{a}]\n",
-                a = vec!["{ from: 0.01, to: 1, step: 0.01 }"; 6].join(", ")
+                a = ["{ from: 0.01, to: 1, step: 0.01 }"; 6].join(", ")
             )),
             "case results (cases × motions × zones); at most 50000000",
         ),

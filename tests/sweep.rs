@@ -19,6 +19,7 @@ fn grid(ratio: f64) -> (Grid, Physics) {
         ],
         mu_static_ratio: ratio,
         damping: 0.05,
+        damping_basis: Default::default(),
     };
     (g.axes(), g.physics())
 }

@@ -16,6 +16,7 @@ use slidestack::dynamics::{
 use slidestack::motion::{self, Record};
 use slidestack::store::write_history;
 use slidestack::study::config::read_yaml_text;
+use slidestack::study::sweep::{DampingBasis, Physics};
 use std::path::PathBuf;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize, Serialize)]
@@ -30,7 +31,8 @@ pub enum Integrator {
 #[derive(Debug, clap::Args)]
 #[command(allow_negative_numbers = true)]
 pub struct Args {
-    /// YAML file with the case (keys: record, period, alpha, mu, mu_static, damping, scale,
+    /// YAML file with the case (keys: record, period, alpha, mu, mu_static, damping,
+    /// damping_basis, scale,
     /// integrator, rk4_substeps, history); flags given on the command line override it.
     #[arg(long)]
     config: Option<PathBuf>,
@@ -49,9 +51,13 @@ pub struct Args {
     /// Static friction coefficients (≥ kinetic) [default: equal to --mu].
     #[arg(long, value_delimiter = ',', num_args = 1..)]
     mu_static: Option<Vec<f64>>,
-    /// Damping ratio of the bare structure [default: 0.05].
+    /// Viscous damping ratio [default: 0.05], of the system --damping-basis names.
     #[arg(long)]
     damping: Option<f64>,
+    /// `rigid`: the damping ratio is that of the structure with its whole stack rigidly attached
+    /// (the study's default); `structure`: of the bare structure [default: rigid].
+    #[arg(long)]
+    damping_basis: Option<DampingBasis>,
     /// Factor applied to the record [default: 1.0].
     #[arg(long)]
     scale: Option<f64>,
@@ -79,6 +85,7 @@ struct CaseFile {
     mu: Option<Vec<f64>>,
     mu_static: Option<Vec<f64>>,
     damping: Option<f64>,
+    damping_basis: Option<DampingBasis>,
     scale: Option<f64>,
     integrator: Option<Integrator>,
     rk4_substeps: Option<usize>,
@@ -104,7 +111,11 @@ struct Output {
     scale: f64,
     period_s: f64,
     period_rigid_s: f64,
+    /// The damping ratio as given, of the system `damping_basis` names.
     damping: f64,
+    damping_basis: DampingBasis,
+    /// The bare structure's damping ratio that gives the same damper.
+    structure_damping: f64,
     alpha: Vec<f64>,
     mu: Vec<f64>,
     mu_static: Vec<f64>,
@@ -136,11 +147,27 @@ pub fn run(args: Args) -> Result<()> {
         }
         None => CaseFile::default(),
     };
+    let basis = args
+        .damping_basis
+        .or(file.damping_basis)
+        .unwrap_or_default();
+    let alpha = args.alpha.or(file.alpha).unwrap_or_else(|| vec![0.5, 0.5]);
+    let physics = Physics {
+        damping: args.damping.or(file.damping).unwrap_or(0.05),
+        basis,
+        mu_static_ratio: 1.0,
+    };
+    let total: f64 = alpha.iter().sum();
+    if total.is_finite() && total <= slidestack::limits::MAX_ALPHA {
+        physics
+            .check(total)
+            .map_err(|why| BadInput(format!("invalid case: {why}")))?;
+    }
     let spec = SystemSpec {
         period_s: args.period.or(file.period).unwrap_or(1.0),
-        damping_ratio: args.damping.or(file.damping).unwrap_or(0.05),
+        damping_ratio: physics.structure_damping(alpha.iter().sum()),
         mass_kg: 1.0,
-        alpha: args.alpha.or(file.alpha).unwrap_or_else(|| vec![0.5, 0.5]),
+        alpha,
         mu: args.mu.or(file.mu).unwrap_or_else(|| vec![0.2, 0.1]),
         mu_static: args.mu_static.or(file.mu_static),
     };
@@ -186,7 +213,9 @@ pub fn run(args: Args) -> Result<()> {
     if let (Some(path), Some(h)) = (&history_path, &response.history) {
         write_history(path, h)?;
     }
-    let out = output(&record, scale, &system, integrator, substeps, &response);
+    let out = output(
+        &record, scale, &physics, &system, integrator, substeps, &response,
+    );
     if args.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
@@ -201,6 +230,7 @@ pub fn run(args: Args) -> Result<()> {
 fn output(
     record: &Record,
     scale: f64,
+    physics: &Physics,
     sys: &System,
     integrator: Integrator,
     substeps: usize,
@@ -214,7 +244,9 @@ fn output(
         scale,
         period_s: sys.period_s(),
         period_rigid_s: sys.period_rigid_s(),
-        damping: sys.damping_ratio(),
+        damping: physics.damping,
+        damping_basis: physics.basis,
+        structure_damping: sys.damping_ratio(),
         alpha: sys.masses()[1..]
             .iter()
             .map(|m| m / sys.mass_kg())
@@ -255,8 +287,12 @@ fn print_table(o: &Output) {
         o.record, o.npts, o.dt_s, o.scale
     );
     println!(
-        "structure         T_p {} s, damping {}, T_rigid {:.4} s",
-        o.period_s, o.damping, o.period_rigid_s
+        "structure         T_p {} s, damping {} ({} basis; bare structure {:.4}), T_rigid {:.4} s",
+        o.period_s,
+        o.damping,
+        o.damping_basis.name(),
+        o.structure_damping,
+        o.period_rigid_s
     );
     println!(
         "stack             alpha [{}], mu [{}], mu_static [{}]",

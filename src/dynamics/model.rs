@@ -113,9 +113,6 @@ impl System {
         if !(STRUCTURE_PERIOD_RANGE_S.0..=STRUCTURE_PERIOD_RANGE_S.1).contains(&period_s) {
             return Err(ModelError::Period(period_s));
         }
-        if !(damping_ratio.is_finite() && (0.0..1.0).contains(&damping_ratio)) {
-            return Err(ModelError::Damping(damping_ratio));
-        }
         if !(mass_kg.is_finite() && mass_kg > 0.0) {
             return Err(ModelError::Mass(mass_kg));
         }
@@ -169,6 +166,9 @@ impl System {
                 s.clone()
             }
         };
+        if !(damping_ratio.is_finite() && (0.0..1.0).contains(&damping_ratio)) {
+            return Err(ModelError::Damping(damping_ratio));
+        }
         let mut masses = Vec::with_capacity(n + 1);
         masses.push(mass_kg);
         masses.extend(alpha.iter().map(|a| a * mass_kg));

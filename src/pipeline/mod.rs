@@ -32,7 +32,7 @@ pub mod tnew;
 use crate::grid::Grid;
 use crate::store::{StoreError, atomic};
 use crate::study::config::{ConfigError, StudyConfig};
-use crate::study::sweep::Physics;
+use crate::study::sweep::{DampingBasis, Physics};
 use lock::{LockError, LockMode, OutputLock};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -300,6 +300,7 @@ impl Study {
         self.cfg.grid.as_ref().map_or(
             Physics {
                 damping: 0.05,
+                basis: DampingBasis::default(),
                 mu_static_ratio: 1.0,
             },
             |g| g.physics(),

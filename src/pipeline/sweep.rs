@@ -16,12 +16,13 @@ use crate::grid::Grid;
 use crate::motion::Record;
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
+use crate::store::h5::Attr;
 use crate::store::motions::read_zone_motions;
 use crate::store::sweep::{SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, unit_path, write_unit};
 use crate::study::config::{Seeds, StudyConfig};
 use crate::study::sweep::{
-    SKIP_RULE_CODES, SKIP_RULE_FLAGS, SweepError, UnitOptions, UnitResult, run_unit,
+    Physics, SKIP_RULE_CODES, SKIP_RULE_FLAGS, SweepError, UnitOptions, UnitResult, run_unit,
 };
 use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
@@ -370,14 +371,15 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
     let me = StageId::Sweep;
     let fp = study.fingerprint(me)?;
     let motions_fp = study.fingerprint(StageId::Motions)?;
+    let physics = study.physics();
     let meta = SweepMeta {
         fingerprint: fp,
         config_sha256: &study.config_sha256,
         motions_fingerprint: motions_fp,
         skip_rule_codes: SKIP_RULE_CODES,
         skip_rule_flags: &SKIP_RULE_FLAGS,
-        mu_static_ratio: study.physics().mu_static_ratio,
-        settings: &[("damping", study.physics().damping)],
+        mu_static_ratio: physics.mu_static_ratio,
+        settings: &physics_attrs(&physics),
     };
     let path = study.path(me.output());
     write_sweep(&path, &meta, grid, &zones)?;
@@ -417,6 +419,14 @@ fn array<T>(
         }
         .into()
     })
+}
+
+/// The physics settings stored as file attributes of `sweep.h5` and `tnew.h5`.
+pub fn physics_attrs(p: &Physics) -> [(&'static str, Attr<'static>); 2] {
+    [
+        ("damping", Attr::F64(p.damping)),
+        ("damping_basis", Attr::Str(p.basis.name())),
+    ]
 }
 
 /// Equal to the bit (NaN fill included).

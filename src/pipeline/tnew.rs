@@ -12,7 +12,9 @@ use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::read_zone_sweep;
 use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, write_tnew};
-use crate::study::tnew::{TNEW_FLAG_CODES, TnewFlag, period_at_displacement};
+use crate::study::tnew::{
+    BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES, TnewFlag, period_at_displacement,
+};
 use ndarray::{ArrayD, Axis};
 use rayon::prelude::*;
 use thiserror::Error;
@@ -101,6 +103,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let mut t_rigid = Vec::with_capacity(cases);
         let mut t_new = Vec::with_capacity(cases);
         let mut flag = Vec::with_capacity(cases);
+        let mut band = Vec::with_capacity(cases);
         for (c, (&us, &slid)) in u_stack.iter().zip(&slides).enumerate() {
             let case = grid.point(c);
             let tr = physics.rigid(case.period_s, case.alpha_total()).period_s;
@@ -112,21 +115,15 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             t_rigid.push(tr);
             t_new.push(tn);
             flag.push(f64::from(f as u8));
+            band.push(Band::of(case.period_s, tr, tn, f) as u8);
         }
         let shaped = |v: Vec<f64>| {
             ArrayD::from_shape_vec(grid.shape(), v).expect("one value per case of the grid")
         };
-        let count = |f: TnewFlag| flag.iter().filter(|&&x| x == f64::from(f as u8)).count();
+        let counts = BandCounts::new(&band, &t_new, &t_rigid);
         s.reporter.info(
             me,
-            &format!(
-                "zone {}: {cases} cases, {} slide; T_new from several crossings: {}, outside the \
-                 spectrum: {}",
-                zc.name,
-                slides.iter().filter(|&&x| x).count(),
-                count(TnewFlag::Several),
-                count(TnewFlag::OutsideRange),
-            ),
+            &format!("zone {}: {cases} cases; {}", zc.name, counts.summary()),
         );
         let vars = TnewVars {
             drr_1: &u_stack / &u_rigid,
@@ -138,6 +135,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             t_new: shaped(t_new),
             slides: shaped(slides.iter().map(|&b| f64::from(u8::from(b))).collect()),
             flag: shaped(flag),
+            band: ArrayD::from_shape_vec(grid.shape(), band).expect("one code per case"),
         };
         zones.push(ZoneTnew {
             name: zc.name.clone(),
@@ -151,8 +149,9 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         fingerprint: study.fingerprint(me)?,
         sweep_fingerprint: study.fingerprint(StageId::Sweep)?,
         flag_codes: TNEW_FLAG_CODES,
+        band_flags: &BAND_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,
-        settings: &[("damping", physics.damping)],
+        settings: &super::sweep::physics_attrs(&physics),
     };
     let path = study.path(me.output());
     write_tnew(&path, &meta, grid, &zones)?;

@@ -43,6 +43,24 @@ pub fn read_attr_f64(obj: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
     obj.attr(name)?.read_scalar::<f64>()
 }
 
+/// A scalar attribute value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Attr<'a> {
+    F64(f64),
+    Str(&'a str),
+}
+
+/// Writes scalar attributes in order.
+pub fn write_attrs(obj: &hdf5::Location, attrs: &[(&str, Attr)]) -> hdf5::Result<()> {
+    for (name, value) in attrs {
+        match value {
+            Attr::F64(v) => attr_f64(obj, name, *v)?,
+            Attr::Str(v) => attr_str(obj, name, v)?,
+        }
+    }
+    Ok(())
+}
+
 /// A small contiguous `f64` dataset of any shape with its units and description.
 pub fn write_small(
     g: &hdf5::Group,

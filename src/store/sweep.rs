@@ -14,8 +14,8 @@
 //! fixed order with their times not tracked, so the same inputs give the same bytes.
 
 use super::h5::{
-    attach_all, attach_scale, attr_f64, attr_str, coordinate, group, open, read_flags,
-    read_strings, read_var, set_scale, write_flags, write_stage_file, write_strings, write_var,
+    Attr, attach_all, attach_scale, attr_str, coordinate, group, open, read_flags, read_strings,
+    read_var, set_scale, write_attrs, write_flags, write_stage_file, write_strings, write_var,
 };
 use super::{H5Context, StoreError};
 use crate::grid::Grid;
@@ -35,7 +35,7 @@ pub struct SweepMeta<'a> {
     /// Static friction = this × kinetic (in the `mu_i` coordinates' description).
     pub mu_static_ratio: f64,
     /// Physics settings that are not coordinates (`damping`, …), as scalar file attributes.
-    pub settings: &'a [(&'a str, f64)],
+    pub settings: &'a [(&'a str, Attr<'a>)],
 }
 
 /// One zone's variables, each shaped `[motion, T_p, alpha…, mu…]` (`slip_peak` with a trailing
@@ -120,9 +120,7 @@ pub fn write_sweep(
             attr_str(f, "config_sha256", meta.config_sha256)?;
             attr_str(f, "motions_fingerprint", meta.motions_fingerprint)?;
             attr_str(f, "skip_rule_codes", meta.skip_rule_codes)?;
-            for (k, v) in meta.settings {
-                attr_f64(f, k, *v)?;
-            }
+            write_attrs(f, meta.settings)?;
             for z in zones {
                 write_zone(f, grid, z, meta)?;
             }

@@ -6,13 +6,13 @@
 //! /zone_<name>/      attrs: target
 //!     T_p, alpha_1 … alpha_n, mu_1 … mu_n                 coordinates (dimension scales)
 //!     u_stack_mean, u_single_mean, u_rigid_mean (m), T_rigid, T_new (s), DRR_1, DRR_2,
-//!     slides (0/1), T_new_flag                            [T_p, alpha_1 … alpha_n, mu_1 … mu_n]
+//!     slides (0/1), T_new_flag, T_new_band (CF flags)     [T_p, alpha_1 … alpha_n, mu_1 … mu_n]
 //!     period_sd (s), sd_mean (m): the zone's mean 5 %-damped displacement spectrum
 //! ```
 
 use super::h5::{
-    attach_all, attach_scale, attr_f64, attr_str, coordinate, group, open, read_var, write_small,
-    write_stage_file, write_var,
+    Attr, attach_all, attach_scale, attr_str, coordinate, group, open, read_var, write_attrs,
+    write_flags, write_small, write_stage_file, write_var,
 };
 use super::sweep::{case_coordinates, read_case_coordinates};
 use super::{H5Context, StoreError};
@@ -32,6 +32,8 @@ pub struct TnewVars {
     pub drr_2: ArrayD<f64>,
     pub slides: ArrayD<f64>,
     pub flag: ArrayD<f64>,
+    /// Where `T_new` lies against `[T_p, T_rigid]` (codes in [`TnewMeta::band_flags`]).
+    pub band: ArrayD<u8>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -51,9 +53,11 @@ pub struct TnewMeta<'a> {
     pub sweep_fingerprint: &'a str,
     /// Long description of the `T_new_flag` codes.
     pub flag_codes: &'a str,
+    /// `(code, word)` pairs of the `T_new_band` codes.
+    pub band_flags: &'a [(u8, &'a str)],
     /// Static friction = this × kinetic.
     pub mu_static_ratio: f64,
-    pub settings: &'a [(&'a str, f64)],
+    pub settings: &'a [(&'a str, Attr<'a>)],
 }
 
 /// Writes `tnew.h5` (checked and atomic).
@@ -70,21 +74,19 @@ pub fn write_tnew(
         |f| {
             attr_str(f, "sweep_fingerprint", meta.sweep_fingerprint)?;
             attr_str(f, "T_new_flag_codes", meta.flag_codes)?;
-            for (k, v) in meta.settings {
-                attr_f64(f, k, *v)?;
-            }
+            write_attrs(f, meta.settings)?;
             for z in zones {
-                write_zone(f, grid, z, meta.mu_static_ratio)?;
+                write_zone(f, grid, z, meta)?;
             }
             Ok(())
         },
     )
 }
 
-fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, mu_static_ratio: f64) -> hdf5::Result<()> {
+fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, meta: &TnewMeta) -> hdf5::Result<()> {
     let g = f.create_group(&format!("zone_{}", z.name))?;
     attr_str(&g, "target", &z.target)?;
-    let scales = case_coordinates(&g, grid, mu_static_ratio)?;
+    let scales = case_coordinates(&g, grid, meta.mu_static_ratio)?;
     let mut chunk = vec![1];
     chunk.extend(grid.case_shape());
     let v = &z.vars;
@@ -148,6 +150,15 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, mu_static_ratio: f64) -
         let ds = write_var(&g, name, data.view(), &chunk, units, long)?;
         attach_all(&ds, &scales)?;
     }
+    let ds = write_flags(
+        &g,
+        "T_new_band",
+        v.band.view(),
+        &chunk,
+        "where T_new lies against [T_p, T_rigid]",
+        meta.band_flags,
+    )?;
+    attach_all(&ds, &scales)?;
     let p = coordinate(
         &g,
         "period_sd",
@@ -186,6 +197,7 @@ pub fn read_zone_tnew(
             drr_2: read_var(&g, "DRR_2")?,
             slides: read_var(&g, "slides")?,
             flag: read_var(&g, "T_new_flag")?,
+            band: super::h5::read_flags(&g, "T_new_band")?,
         };
         Ok((
             grid,

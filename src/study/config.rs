@@ -15,7 +15,7 @@
 //!   set_mean_min: 1.0              # the set's mean spectrum / target must not fall below this
 //! ```
 
-use super::sweep::Physics;
+use super::sweep::{DampingBasis, Physics};
 use crate::grid::Grid;
 use crate::grid::linear_range;
 use crate::limits::{
@@ -90,9 +90,13 @@ pub struct GridConfig {
     /// Static coefficients are `mu_static_ratio·μ_i` (≥ 1; 1: static equals kinetic, the paper).
     #[serde(default = "one")]
     pub mu_static_ratio: f64,
-    /// Damping ratio of the bare structure.
+    /// Viscous damping ratio, of the system `damping_basis` names.
     #[serde(default = "five_percent")]
     pub damping: f64,
+    /// `rigid` (default): `damping` is the ratio of the structure with its whole load rigidly
+    /// attached, one damper for every system; `structure`: of the bare structure.
+    #[serde(default)]
+    pub damping_basis: DampingBasis,
 }
 
 impl GridConfig {
@@ -109,6 +113,7 @@ impl GridConfig {
     pub fn physics(&self) -> Physics {
         Physics {
             damping: self.damping,
+            basis: self.damping_basis,
             mu_static_ratio: self.mu_static_ratio,
         }
     }
@@ -502,5 +507,8 @@ fn validate_grid(g: &GridConfig) -> Result<(), (String, String)> {
             format!("{} must be in [0, 1)", g.damping),
         ));
     }
+    g.physics()
+        .check(heaviest)
+        .map_err(|why| ("grid.damping".to_string(), why))?;
     Ok(())
 }

@@ -19,6 +19,7 @@ use crate::dynamics::{
     ExactOptions, G, Ground, ModelError, Response, SimError, System, SystemSpec, simulate_exact,
 };
 use crate::grid::Grid;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use thiserror::Error;
 
@@ -91,21 +92,84 @@ pub struct UnitOptions {
     pub skip: bool,
 }
 
+/// What the damping ratio `ζ` of the study refers to (docs/model.md, "Damping basis").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DampingBasis {
+    /// `ζ` of the structure with its whole load rigidly attached: one physical
+    /// `c = 2·ζ·sqrt(1+α)·ω_p·m_p` for the stack, the single block and the rigid system, so the
+    /// rigid system is damped at `ζ`, as the 5 %-damped spectrum it is read against (`T_new`
+    /// equals `T_rigid` when nothing slides).
+    #[default]
+    Rigid,
+    /// `ζ` of the bare structure, `c = 2·ζ·ω_p·m_p` (the rigidly loaded system then has
+    /// `ζ/sqrt(1+α)`): the convention of the first versions of the study.
+    Structure,
+}
+
+impl DampingBasis {
+    pub fn name(self) -> &'static str {
+        match self {
+            DampingBasis::Rigid => "rigid",
+            DampingBasis::Structure => "structure",
+        }
+    }
+}
+
+impl std::str::FromStr for DampingBasis {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "rigid" => Ok(DampingBasis::Rigid),
+            "structure" => Ok(DampingBasis::Structure),
+            other => Err(format!(
+                "damping basis `{other}`: expected `rigid` or `structure`"
+            )),
+        }
+    }
+}
+
 /// How a case becomes the study's three systems (NOTES.md, "Derived quantities"): the one source
-/// of the physics for the sweep, the report and `design`.
+/// of the physics for the sweep, the report and `design`. All three share one viscous damper.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Physics {
-    /// Viscous damping ratio `ζ` of the bare structure.
+    /// Viscous damping ratio `ζ`, of the system named by `basis`.
     pub damping: f64,
+    pub basis: DampingBasis,
     /// Static friction coefficients are this × the kinetic ones (≥ 1).
     pub mu_static_ratio: f64,
 }
 
 impl Physics {
+    /// Damping ratio of the bare structure that gives the study's `c` for a stack of total mass
+    /// ratio `alpha_total`.
+    pub fn structure_damping(&self, alpha_total: f64) -> f64 {
+        match self.basis {
+            DampingBasis::Structure => self.damping,
+            DampingBasis::Rigid => self.damping * (1.0 + alpha_total).sqrt(),
+        }
+    }
+
+    /// Refuses a damping that would need a bare-structure ratio of 1 or more (critical damping)
+    /// for a stack of total mass ratio `alpha_total`.
+    pub fn check(&self, alpha_total: f64) -> Result<(), String> {
+        let bare = self.structure_damping(alpha_total);
+        if bare < 1.0 {
+            return Ok(());
+        }
+        Err(format!(
+            "damping {} of the rigidly loaded system needs a bare-structure ratio of {bare:.3} for \
+             α = {alpha_total}; it must stay below 1 (use a smaller damping, or the `structure` \
+             basis)",
+            self.damping
+        ))
+    }
+
     /// The structure with its stack of blocks.
     pub fn stack(&self, period_s: f64, alpha: &[f64], mu: &[f64]) -> SystemSpec {
         let mut spec = SystemSpec::new(period_s, alpha, mu);
-        spec.damping_ratio = self.damping;
+        spec.damping_ratio = self.structure_damping(alpha.iter().sum());
         spec.mu_static = Some(mu.iter().map(|m| m * self.mu_static_ratio).collect());
         spec
     }
@@ -115,9 +179,9 @@ impl Physics {
         self.stack(period_s, &[alpha_total], &[mu_1])
     }
 
-    /// The stack rigidly attached: a linear SDOF (paper Eqs. 10–13).
+    /// The stack rigidly attached: a linear SDOF (paper Eqs. 10–13) with the same damper.
     pub fn rigid(&self, period_s: f64, alpha_total: f64) -> SystemSpec {
-        rigid_spec(period_s, alpha_total, self.damping)
+        rigid_spec(period_s, alpha_total, self.structure_damping(alpha_total))
     }
 }
 

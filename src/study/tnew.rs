@@ -53,6 +53,91 @@ pub const TNEW_FLAG_CODES: &str = "0 one crossing of the mean displacement spect
      crossings, the one nearest T_rigid (log period) taken; 2 the mean displacement lies outside \
      the spectrum's range (T_new NaN); 3 nothing slid, T_new = T_rigid";
 
+/// Where a case's `T_new` lies against its physical band `[T_p, T_rigid]` (paper Section 10:
+/// generally `T_p < T_new < T_rigid`; NOTES.md, "Derived quantities").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Band {
+    /// One crossing, `T_p ≤ T_new ≤ T_rigid`.
+    Band = 0,
+    /// `T_new < T_p`: friction lowered the displacement below the bare structure's.
+    BelowTp = 1,
+    /// `T_new > T_rigid`.
+    AboveTrigid = 2,
+    /// No crossing of the mean displacement spectrum (`T_new` NaN).
+    NoCrossing = 3,
+    /// Inside the band, the nearest of several crossings.
+    SeveralCrossings = 4,
+    /// Nothing slid: `T_new = T_rigid`.
+    NoSlide = 5,
+}
+
+/// `(code, word)` of each [`Band`], for the CF `flag_values`/`flag_meanings` attributes.
+pub const BAND_FLAGS: [(u8, &str); 6] = [
+    (Band::Band as u8, "band"),
+    (Band::BelowTp as u8, "below_T_p"),
+    (Band::AboveTrigid as u8, "above_T_rigid"),
+    (Band::NoCrossing as u8, "no_crossing"),
+    (Band::SeveralCrossings as u8, "several_crossings"),
+    (Band::NoSlide as u8, "no_slide"),
+];
+
+impl Band {
+    /// The category of `T_new` (s) found as `flag` for a structure of periods `t_p_s`,
+    /// `t_rigid_s`; earlier rules win: no slide, no crossing, above, below, several.
+    pub fn of(t_p_s: f64, t_rigid_s: f64, t_new_s: f64, flag: TnewFlag) -> Band {
+        match flag {
+            TnewFlag::NoSlip => Band::NoSlide,
+            TnewFlag::OutsideRange => Band::NoCrossing,
+            _ if t_new_s > t_rigid_s => Band::AboveTrigid,
+            _ if t_new_s < t_p_s => Band::BelowTp,
+            TnewFlag::Several => Band::SeveralCrossings,
+            TnewFlag::Unique => Band::Band,
+        }
+    }
+}
+
+/// How many cases of a zone fall in each [`Band`], and how many sliding cases exceed
+/// `1.005·T_rigid` (the band goal's measure).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BandCounts {
+    /// Indexed by the [`Band`] code.
+    pub counts: [usize; 6],
+    pub above_1_005: usize,
+}
+
+impl BandCounts {
+    pub fn new(band: &[u8], t_new_s: &[f64], t_rigid_s: &[f64]) -> Self {
+        let mut c = Self::default();
+        for ((&b, &tn), &tr) in band.iter().zip(t_new_s).zip(t_rigid_s) {
+            c.counts[b as usize] += 1;
+            if b != Band::NoSlide as u8 && tn > 1.005 * tr {
+                c.above_1_005 += 1;
+            }
+        }
+        c
+    }
+
+    /// Cases in which something slid.
+    pub fn sliding(&self) -> usize {
+        self.counts.iter().sum::<usize>() - self.counts[Band::NoSlide as usize]
+    }
+
+    /// One line: the count of every category.
+    pub fn summary(&self) -> String {
+        let parts: Vec<String> = BAND_FLAGS
+            .iter()
+            .map(|(code, word)| format!("{word} {}", self.counts[*code as usize]))
+            .collect();
+        format!(
+            "{}; {} slide, of which {} have T_new > 1.005·T_rigid",
+            parts.join(", "),
+            self.sliding(),
+            self.above_1_005
+        )
+    }
+}
+
 /// The period at which the piecewise-linear curve `(periods_s, sd_m)` equals `u_m`, by the rule
 /// of the module doc; `periods_s` increasing.
 pub fn period_at_displacement(
@@ -98,6 +183,18 @@ pub fn period_at_displacement(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn band_categories_by_precedence() {
+        let b = |t: f64, f| Band::of(1.0, 1.5, t, f);
+        assert_eq!(b(1.5, TnewFlag::NoSlip), Band::NoSlide);
+        assert_eq!(b(f64::NAN, TnewFlag::OutsideRange), Band::NoCrossing);
+        assert_eq!(b(1.6, TnewFlag::Several), Band::AboveTrigid);
+        assert_eq!(b(0.9, TnewFlag::Unique), Band::BelowTp);
+        assert_eq!(b(1.2, TnewFlag::Several), Band::SeveralCrossings);
+        assert_eq!(b(1.0, TnewFlag::Unique), Band::Band);
+        assert_eq!(b(1.5, TnewFlag::Unique), Band::Band);
+    }
 
     #[test]
     fn hand_cases() {
