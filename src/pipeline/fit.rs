@@ -93,12 +93,14 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                     cv.rmse
                 ),
             );
+            let n = f.params.len();
             forms.push(FormFit {
                 form,
                 coefficients: parameter_names(form, &features)
                     .into_iter()
                     .zip(f.params)
                     .collect(),
+                standard_errors: vec![f64::NAN; n],
                 all_cases: m,
                 cross_validated: cv,
             });
@@ -120,10 +122,16 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 ),
             );
         }
+        let recommended = forms
+            .iter()
+            .max_by(|a, b| a.cross_validated.r2.total_cmp(&b.cross_validated.r2))
+            .map(|f| f.form)
+            .expect("at least one form");
         zones.push(ZoneFit {
             zone: zc.name.clone(),
             cases: data.len(),
             forms,
+            recommended,
             published,
         });
     }

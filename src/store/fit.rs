@@ -21,6 +21,8 @@ pub struct FormFit {
     pub form: Form,
     /// Parameter names and values.
     pub coefficients: Vec<(String, f64)>,
+    /// Standard error of each coefficient, same order (NaN where it cannot be estimated).
+    pub standard_errors: Vec<f64>,
     pub all_cases: Metrics,
     pub cross_validated: Metrics,
 }
@@ -30,8 +32,17 @@ pub struct ZoneFit {
     pub zone: String,
     pub cases: usize,
     pub forms: Vec<FormFit>,
+    /// The form a designer should use for this zone.
+    pub recommended: Form,
     /// The paper's published equation for this zone on our T_new, when it applies.
     pub published: Option<Metrics>,
+}
+
+impl ZoneFit {
+    /// The recommended form's fit.
+    pub fn recommended_fit(&self) -> Option<&FormFit> {
+        self.forms.iter().find(|f| f.form == self.recommended)
+    }
 }
 
 /// Everything the fit stage stores.
@@ -67,6 +78,7 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
             attr_str(f, "features", &r.features.join(", "))?;
             for z in &r.zones {
                 let g = f.create_group(&format!("zone_{}", z.zone))?;
+                attr_str(&g, "recommended_form", z.recommended.name())?;
                 for fr in &z.forms {
                     let sub = g.create_group(fr.form.name())?;
                     let values: Vec<f64> = fr.coefficients.iter().map(|c| c.1).collect();
@@ -79,6 +91,14 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
                         "fitted coefficients",
                     )?;
                     attr_str(&ds, "names", &names.join(", "))?;
+                    let se = write_1d(
+                        &sub,
+                        "standard_errors",
+                        &fr.standard_errors,
+                        "mixed (as the coefficients)",
+                        "standard error of each coefficient, from the Jacobian at the optimum",
+                    )?;
+                    attr_str(&se, "names", &names.join(", "))?;
                     write_metrics(&sub, "", &fr.all_cases)?;
                     write_metrics(&sub, "cv_", &fr.cross_validated)?;
                 }
