@@ -9,6 +9,16 @@
 //! Pure data: no physics, no files. The study's physics settings (damping, static friction)
 //! live in [`crate::study::sweep::Physics`], the file layouts in [`crate::store`].
 
+/// A point outside the grid's range in one of its dimensions.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{dim} = {value} lies outside the grid's {lo} … {hi}")]
+pub struct OutsideGrid {
+    pub dim: String,
+    pub value: f64,
+    pub lo: f64,
+    pub hi: f64,
+}
+
 /// `from, from + step, …` up to `to` (inclusive within 1e-9 of a step), each value rounded to
 /// 12 significant digits so that `0.1 + 2·0.1` reads back as `0.3`; at most `max` values,
 /// counted before anything is allocated. The one expansion of a `{from, to, step}` range, for
@@ -125,9 +135,115 @@ impl Grid {
     }
 }
 
+impl Grid {
+    /// The multilinear interpolation at `point` (`[T_p, α_1 … α_n, μ_1 … μ_n]`, the order of
+    /// [`Grid::shape`]) of `values`, one per case in flat order: in each dimension between the
+    /// two bracketing grid values (exact at grid values; a dimension of one value must be met
+    /// exactly). `Ok(None)` when a corner that carries weight is NaN.
+    pub fn interpolate(&self, values: &[f64], point: &[f64]) -> Result<Option<f64>, OutsideGrid> {
+        let axes: Vec<&[f64]> = std::iter::once(self.periods_s.as_slice())
+            .chain(self.alpha.iter().map(Vec::as_slice))
+            .chain(self.mu.iter().map(Vec::as_slice))
+            .collect();
+        let names = self.dim_names();
+        // Per dimension: the lower index and the weight of the upper one.
+        let mut brackets = Vec::with_capacity(axes.len());
+        for ((axis, &x), dim) in axes.iter().zip(point).zip(&names) {
+            let (lo, hi) = (axis[0], axis[axis.len() - 1]);
+            if !(lo..=hi).contains(&x) {
+                return Err(OutsideGrid {
+                    dim: dim.clone(),
+                    value: x,
+                    lo,
+                    hi,
+                });
+            }
+            let i = axis
+                .partition_point(|&v| v <= x)
+                .clamp(1, axis.len().max(2) - 1)
+                - 1;
+            if axis.len() == 1 {
+                brackets.push((0, 0.0));
+            } else {
+                let w = (x - axis[i]) / (axis[i + 1] - axis[i]);
+                brackets.push((i, w));
+            }
+        }
+        let shape = self.shape();
+        let mut total = 0.0;
+        for corner in 0..1usize << axes.len() {
+            let mut weight = 1.0;
+            let mut flat = 0;
+            for (d, &(i, w)) in brackets.iter().enumerate() {
+                let up = corner >> d & 1 == 1;
+                weight *= if up { w } else { 1.0 - w };
+                flat = flat * shape[d] + i + usize::from(up);
+            }
+            if weight == 0.0 {
+                continue;
+            }
+            let v = values[flat];
+            if v.is_nan() {
+                return Ok(None);
+            }
+            total += weight * v;
+        }
+        Ok(Some(total))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn interpolation_is_exact_for_multilinear_data_and_refuses_outside() {
+        // A multilinear function of the five coordinates is reproduced exactly (to round-off)
+        // anywhere inside; the grid values themselves exactly.
+        let g = Grid {
+            periods_s: vec![0.1, 0.5, 1.0, 2.0],
+            alpha: vec![vec![0.1, 0.5, 1.0], vec![0.5, 1.0]],
+            mu: vec![vec![0.05, 0.3], vec![0.1, 0.2, 0.7]],
+        };
+        let f = |p: &[f64]| {
+            1.0 + 2.0 * p[0] - 0.5 * p[1] + 0.3 * p[2] * p[0] + p[3] * p[4]
+                - 0.7 * p[0] * p[1] * p[4]
+        };
+        let values: Vec<f64> = (0..g.cases())
+            .map(|c| {
+                let case = g.point(c);
+                let mut p = vec![case.period_s];
+                p.extend(&case.alpha);
+                p.extend(&case.mu);
+                f(&p)
+            })
+            .collect();
+        for p in [
+            [0.7, 0.3, 0.75, 0.1, 0.4],
+            [0.1, 0.1, 0.5, 0.05, 0.1],
+            [2.0, 1.0, 1.0, 0.3, 0.7],
+            [1.3, 0.9, 0.6, 0.2, 0.15],
+        ] {
+            let got = g.interpolate(&values, &p).unwrap().unwrap();
+            assert!((got - f(&p)).abs() < 1e-13, "{p:?}: {got} vs {}", f(&p));
+        }
+        let e = g
+            .interpolate(&values, &[2.5, 0.5, 0.5, 0.1, 0.1])
+            .unwrap_err();
+        assert_eq!(e.to_string(), "T_p = 2.5 lies outside the grid's 0.1 … 2");
+        // A NaN corner with weight: no value; with zero weight: ignored.
+        let mut v2 = values.clone();
+        v2[0] = f64::NAN;
+        assert_eq!(
+            g.interpolate(&v2, &[0.12, 0.1, 0.5, 0.05, 0.1]).unwrap(),
+            None
+        );
+        assert!(
+            g.interpolate(&v2, &[0.5, 0.1, 0.5, 0.05, 0.1])
+                .unwrap()
+                .is_some()
+        );
+    }
 
     #[test]
     fn ranges_round_and_refuse_before_allocating() {

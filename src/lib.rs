@@ -8,6 +8,7 @@
 //! * [`limits`]: the limits every input is checked against, with their reasons.
 //! * [`grid`]: the study's case grid (axes and indexing).
 //! * [`study`]: the study's numerics and configuration.
+//! * [`design`]: `T_new` of one structure from a finished study (the designer's query).
 //! * [`pipeline`]: the study's stages as library code: one shape, the output lock, checks.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
 //! * [`accuracy`]: work-precision measures (errors against a reference, observed orders).
@@ -16,6 +17,7 @@
 //! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
 
 pub mod accuracy;
+pub mod design;
 pub mod dynamics;
 pub mod fit;
 pub mod grid;

@@ -37,6 +37,8 @@ enum Command {
     Run(cmd::StudyArgs),
     /// What is on disk for every stage of a study (for people and job scripts).
     Status(cmd::status::Args),
+    /// T_new and the design spectral accelerations of one structure, from a finished study.
+    Design(cmd::design::Args),
     /// Evidence: work-precision of the integrators and the numerical stress suite.
     #[command(subcommand)]
     Bench(cmd::bench::BenchCommand),
@@ -63,6 +65,7 @@ fn main() -> std::process::ExitCode {
         Command::Report(args) => cmd::stage::run(args, StageId::Report),
         Command::Run(args) => cmd::run::run(args),
         Command::Status(args) => cmd::status::run(args),
+        Command::Design(args) => cmd::design::run(args),
         Command::Bench(command) => cmd::bench::run(command),
     };
     match result {

@@ -223,3 +223,25 @@ pub fn read_zone_tnew(
     }
     Ok((grid, z))
 }
+
+/// The zone names of `tnew.h5` (file order) and its number of blocks.
+pub fn zones_and_blocks(path: &Path) -> Result<(Vec<String>, usize), StoreError> {
+    let f = super::h5::open(path)?;
+    let zones: Vec<String> = f
+        .member_names()
+        .at(path)?
+        .into_iter()
+        .filter_map(|n| n.strip_prefix("zone_").map(str::to_string))
+        .collect();
+    let Some(first) = zones.first() else {
+        return Err(StoreError::corrupt(path, "holds no zone"));
+    };
+    let g = group(&f, path, &format!("zone_{first}"))?;
+    let blocks = g
+        .member_names()
+        .at(path)?
+        .iter()
+        .filter(|n| n.starts_with("alpha_"))
+        .count();
+    Ok((zones, blocks))
+}

@@ -1,0 +1,99 @@
+//! `slidestack design --study OUT_DIR --zone III --period 0.7 --alpha 1,1 --mu 0.3,0.1 [--json]`:
+//! `T_new` and the design spectral accelerations of one structure from a finished study
+//! ([`slidestack::design`]).
+
+use super::BadInput;
+use anyhow::Result;
+use slidestack::design::{Answer, Query, design};
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+#[command(allow_negative_numbers = true)]
+pub struct Args {
+    /// Output directory of a finished study (holding tnew.h5 and fit.yaml).
+    #[arg(long)]
+    study: PathBuf,
+    /// Zone (hazard level) of the study, e.g. III.
+    #[arg(long)]
+    zone: String,
+    /// Period of the bare structure T_p, s.
+    #[arg(long)]
+    period: f64,
+    /// Block mass ratios α_i = m_i/m_p, bottom block first.
+    #[arg(long, value_delimiter = ',', num_args = 1.., required = true)]
+    alpha: Vec<f64>,
+    /// Kinetic friction coefficients μ_i, interface 1 (structure–block 1) first.
+    #[arg(long, value_delimiter = ',', num_args = 1.., required = true)]
+    mu: Vec<f64>,
+    /// Outside the study's grid, answer from the fitted form instead of refusing.
+    #[arg(long)]
+    extrapolate: bool,
+    /// Print one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let q = Query {
+        zone: args.zone,
+        period_s: args.period,
+        alpha: args.alpha,
+        mu: args.mu,
+        extrapolate: args.extrapolate,
+    };
+    let a = design(&args.study, &q).map_err(|e| -> anyhow::Error {
+        if e.is_bad_input() {
+            BadInput(e.to_string()).into()
+        } else {
+            e.into()
+        }
+    })?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&a)?);
+    } else {
+        print_table(&a);
+    }
+    Ok(())
+}
+
+fn print_table(a: &Answer) {
+    let t = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.3} s"));
+    let g = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.3} g"));
+    println!(
+        "zone {} ({}): T_p {} s, α {:?}, μ {:?}",
+        a.zone, a.target, a.period_s, a.alpha, a.mu
+    );
+    println!("{:<34}{:>10}{:>12}", "", "period", "Sa");
+    println!(
+        "{:<34}{:>10}{:>12}",
+        "bare structure, T_p",
+        format!("{:.3} s", a.period_s),
+        format!("{:.3} g", a.sa_tp_g)
+    );
+    println!(
+        "{:<34}{:>10}",
+        "stack rigidly attached, T_rigid",
+        format!("{:.3} s", a.t_rigid_s)
+    );
+    println!(
+        "{:<34}{:>10}{:>12}",
+        "T_new, the study's grid",
+        t(a.t_new_grid_s),
+        g(a.sa_new_grid_g)
+    );
+    println!(
+        "{:<34}{:>10}{:>12}",
+        format!("T_new, fitted ({} form)", a.fit_form),
+        t(a.t_new_fit_s),
+        g(a.sa_new_fit_g)
+    );
+    println!(
+        "{:<34}{:>10}{:>12}",
+        "T_new, the paper's Eqs. 16–17",
+        t(a.t_new_paper_s),
+        g(a.sa_new_paper_g)
+    );
+    for n in &a.notes {
+        println!("note: {n}");
+    }
+}

@@ -1,0 +1,221 @@
+//! The designer's entry point: `T_new` of one structure from a finished study.
+//!
+//! For a zone, a structure period `T_p` and a stack (`α_i`, `μ_i`): `T_rigid = T_p·sqrt(1+α)`;
+//! `T_new` by multilinear interpolation in the study's stored grid (`tnew.h5`; outside the grid
+//! only with `extrapolate`, and then from the fit); `T_new` from the zone's recommended fitted
+//! form (`fit.yaml`); `T_new` from the paper's Eqs. 16–17 (zones III and V, two blocks); and
+//! the zone's design spectral acceleration (its target spectrum, `Z·Sa/g` for IS 1893) at `T_p`
+//! and at `T_new`. Reads only verified files of the study directory.
+
+use crate::fit::{Fitted, Sample, paper_equation};
+use crate::grid::OutsideGrid;
+use crate::spectrum::TargetSpectrum;
+use crate::store::StoreError;
+use crate::store::fit::read_fit;
+use crate::store::tnew::{read_zone_tnew, zones_and_blocks};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum DesignError {
+    #[error("{}: no {file} (run the study first: `slidestack run CONFIG --out {}`)", dir.display(), dir.display())]
+    Missing { dir: PathBuf, file: &'static str },
+    #[error("zone `{zone}` is not in the study; it has {known}")]
+    UnknownZone { zone: String, known: String },
+    #[error("--{what} lists {got} values but the study's stacks have {blocks} blocks")]
+    Count {
+        what: &'static str,
+        got: usize,
+        blocks: usize,
+    },
+    #[error("{what} = {value} must be finite and > 0")]
+    Value { what: String, value: f64 },
+    #[error("{0}; add --extrapolate to use the fitted form there")]
+    Outside(OutsideGrid),
+    #[error("{}: belongs to another tnew.h5 than the study's: rerun `slidestack fit`", file.display())]
+    Mismatch { file: PathBuf },
+    #[error("{}: zone {zone}: target `{target}`: {why}", file.display())]
+    Target {
+        file: PathBuf,
+        zone: String,
+        target: String,
+        why: String,
+    },
+    #[error(transparent)]
+    Store(#[from] StoreError),
+}
+
+impl DesignError {
+    /// Whether the question (or a missing study) is at fault rather than the study's files.
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(
+            self,
+            DesignError::Store(_) | DesignError::Mismatch { .. } | DesignError::Target { .. }
+        )
+    }
+}
+
+/// What a designer asks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Query {
+    pub zone: String,
+    /// Period of the bare structure `T_p`, s.
+    pub period_s: f64,
+    /// Block mass ratios, bottom first.
+    pub alpha: Vec<f64>,
+    /// Kinetic friction coefficients, interface 1 first.
+    pub mu: Vec<f64>,
+    /// Outside the grid, answer from the fit instead of refusing.
+    pub extrapolate: bool,
+}
+
+/// The answer (`slidestack design --json` prints it).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Answer {
+    pub zone: String,
+    pub target: String,
+    pub period_s: f64,
+    pub alpha: Vec<f64>,
+    pub mu: Vec<f64>,
+    pub t_rigid_s: f64,
+    /// By multilinear interpolation in the stored grid; `None` outside it, or where a grid
+    /// point it needs has no `T_new`.
+    pub t_new_grid_s: Option<f64>,
+    /// From the zone's recommended fitted form.
+    pub t_new_fit_s: Option<f64>,
+    pub fit_form: String,
+    /// The paper's Eq. 16 (Zone III) or 17 (Zone V), two blocks only.
+    pub t_new_paper_s: Option<f64>,
+    /// Design spectral acceleration of the zone at `T_p`, g.
+    pub sa_tp_g: f64,
+    /// At the grid's `T_new`, else the fit's, g.
+    pub sa_new_g: Option<f64>,
+    /// Design spectral acceleration at each `T_new`, g (`None` where that `T_new` is).
+    pub sa_new_grid_g: Option<f64>,
+    pub sa_new_fit_g: Option<f64>,
+    pub sa_new_paper_g: Option<f64>,
+    /// Anything the designer should know about these numbers.
+    pub notes: Vec<String>,
+}
+
+/// Answers `q` from the finished study in `dir`.
+pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
+    let positive = |what: String, value: f64| {
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(DesignError::Value { what, value })
+        }
+    };
+    positive("--period".into(), q.period_s)?;
+    for (i, &a) in q.alpha.iter().enumerate() {
+        positive(format!("alpha_{}", i + 1), a)?;
+    }
+    for (i, &m) in q.mu.iter().enumerate() {
+        positive(format!("mu_{}", i + 1), m)?;
+    }
+    let tnew = dir.join("tnew.h5");
+    let fit_yaml = dir.join("fit.yaml");
+    let Some(tnew_fp) = crate::store::h5::stored_fingerprint(&tnew)? else {
+        return Err(DesignError::Missing {
+            dir: dir.to_path_buf(),
+            file: "tnew.h5",
+        });
+    };
+    let Some(fit) = read_fit(&fit_yaml)? else {
+        return Err(DesignError::Missing {
+            dir: dir.to_path_buf(),
+            file: "fit.yaml",
+        });
+    };
+    if fit.fingerprint != crate::pipeline::fit::fingerprint(&tnew_fp) {
+        return Err(DesignError::Mismatch { file: fit_yaml });
+    }
+    let (zones, blocks) = zones_and_blocks(&tnew)?;
+    if !zones.contains(&q.zone) {
+        return Err(DesignError::UnknownZone {
+            zone: q.zone.clone(),
+            known: zones.join(", "),
+        });
+    }
+    for (what, got) in [("alpha", q.alpha.len()), ("mu", q.mu.len())] {
+        if got != blocks {
+            return Err(DesignError::Count { what, got, blocks });
+        }
+    }
+    let (grid, t) = read_zone_tnew(&tnew, &q.zone, blocks)?;
+    let target: TargetSpectrum = t
+        .target
+        .parse()
+        .map_err(|e: crate::spectrum::TargetError| DesignError::Target {
+            file: tnew.clone(),
+            zone: q.zone.clone(),
+            target: t.target.clone(),
+            why: e.to_string(),
+        })?;
+    let alpha_total: f64 = q.alpha.iter().sum();
+    let t_rigid_s = q.period_s * (1.0 + alpha_total).sqrt();
+    let mut notes = Vec::new();
+
+    let mut point = vec![q.period_s];
+    point.extend(&q.alpha);
+    point.extend(&q.mu);
+    let values: Vec<f64> = t.vars.t_new.iter().copied().collect();
+    let t_new_grid_s = match grid.interpolate(&values, &point) {
+        Ok(Some(v)) => Some(v),
+        Ok(None) => {
+            notes.push(
+                "a grid point next to this structure has no T_new (no crossing of the mean \
+                 displacement spectrum): no interpolated value"
+                    .into(),
+            );
+            None
+        }
+        Err(outside) if q.extrapolate => {
+            notes.push(format!("{outside}: T_new from the fitted form"));
+            None
+        }
+        Err(outside) => return Err(DesignError::Outside(outside)),
+    };
+
+    let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
+    let recommended = zone_fit.and_then(|z| z.recommended_fit());
+    let t_new_fit_s = recommended.map(|f| {
+        let mut x = vec![q.period_s];
+        x.extend(&q.mu);
+        x.extend(&q.alpha);
+        Fitted {
+            form: f.form,
+            params: f.coefficients.iter().map(|c| c.1).collect(),
+        }
+        .predict(&Sample {
+            x,
+            t_rigid_s,
+            t_new_s: f64::NAN,
+        })
+    });
+    let mut paper_x = vec![q.period_s];
+    paper_x.extend(&q.mu);
+    paper_x.extend(&q.alpha);
+    let t_new_paper_s = paper_equation(&q.zone, &paper_x);
+    let sa = |t: Option<f64>| t.filter(|t| t.is_finite()).map(|t| target.sa_g(t));
+    Ok(Answer {
+        zone: q.zone.clone(),
+        target: target.to_string(),
+        period_s: q.period_s,
+        alpha: q.alpha.clone(),
+        mu: q.mu.clone(),
+        t_rigid_s,
+        t_new_grid_s,
+        t_new_fit_s,
+        fit_form: recommended.map_or_else(String::new, |f| f.form.name().to_string()),
+        t_new_paper_s,
+        sa_tp_g: target.sa_g(q.period_s),
+        sa_new_g: sa(t_new_grid_s.or(t_new_fit_s)),
+        sa_new_grid_g: sa(t_new_grid_s),
+        sa_new_fit_g: sa(t_new_fit_s),
+        sa_new_paper_g: sa(t_new_paper_s),
+        notes,
+    })
+}
