@@ -14,7 +14,8 @@
 //! * [`accuracy`]: work-precision measures (errors against a reference, observed orders).
 //! * [`stress`]: the numerical stress suite: extreme but legal cases and their checks.
 //!
-//! `../shared/reference/NOTES.md` (the reading of the paper this reproduces) is cited as NOTES.md.
+//! `docs/model.md` states the model, the numbers checked by hand and the choices the paper leaves
+//! open; the code cites its sections as `docs/model.md, "<section>"`.
 
 pub mod accuracy;
 pub mod design;

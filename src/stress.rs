@@ -61,7 +61,7 @@
 //!      displacement at the common samples over that body's peak, and of the peak structure
 //!      displacement;
 //!    * closed forms: a zero record gives exactly zero everywhere (tolerance 0); a stack that
-//!      cannot slide is a linear SDOF of mass `m_p(1+α)` (NOTES.md, "Stated special cases"),
+//!      cannot slide is a linear SDOF of mass `m_p(1+α)` (docs/model.md, "Stated special cases"),
 //!      stepped by the φ-function Nigam–Jennings recurrence of [`crate::spectrum::response`],
 //!      which has no cancellation at long periods, and its exact peak; a frictionless stack
 //!      leaves the structure alone and every block at `−∬a_g`; two blocks with `μ_2 = μ_1` are one
@@ -184,7 +184,7 @@ pub enum Reference {
     /// A zero record: every output is exactly zero (tolerance 0).
     Zero,
     /// Nothing may slide: the structure is a linear SDOF of mass `m_p(1+α)` with the bare
-    /// structure's `c` (NOTES.md, "Stated special cases"), stepped by the φ-function
+    /// structure's `c` (docs/model.md, "Stated special cases"), stepped by the φ-function
     /// Nigam–Jennings recurrence of [`crate::spectrum::response`]. Error: displacement at the
     /// samples over the peak, and the peak against [`crate::spectrum::peak_response`]. Zero switches
     /// and zero slip required.

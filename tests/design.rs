@@ -33,7 +33,7 @@ fn worked_example_grid_points_and_refusals() {
     };
 
     // Section 9: T_p 0.7 s, α 1/1, μ 0.3/0.1. Eq. 16 gives 1.138 s and Eq. 17 0.926 s
-    // (NOTES.md, to the printed 3 decimals); IS 1893 hard soil Z·Sa/g in the 1/T branch is
+    // (docs/model.md, to the printed 3 decimals); IS 1893 hard soil Z·Sa/g in the 1/T branch is
     // Z·1/T: 0.16/0.7 = 0.229 g and 0.36/0.7 = 0.514 g, and Z/T at the equations' periods
     // (0.141 g and 0.389 g; the paper prints 0.31 g for Zone V, which its spectrum does not
     // give: docs/model.md). Tolerances: the printed digits for the equations, 1e-12 for the

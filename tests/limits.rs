@@ -1,4 +1,4 @@
-//! Limit cases with closed-form or independent oracles (NOTES.md, "Stated special cases").
+//! Limit cases with closed-form or independent oracles (docs/model.md, "Stated special cases").
 
 #![allow(clippy::needless_range_loop)]
 

@@ -1,4 +1,4 @@
-//! Coulomb-consistent choice of the stick/slip pattern at an instant (NOTES.md, "The physical
+//! Coulomb-consistent choice of the stick/slip pattern at an instant (docs/model.md, "The physical
 //! system").
 //!
 //! At an instant where some interfaces have zero relative velocity, their friction forces `f_i`

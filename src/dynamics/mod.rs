@@ -1,6 +1,6 @@
 //! The structure-and-stack model and its integrators.
 //!
-//! * [`model`]: the validated system (NOTES.md, "The physical system").
+//! * [`model`]: the validated system (docs/model.md, "The physical system").
 //! * [`contact`]: the Coulomb-consistent stick/slip pattern at an instant.
 //! * [`exact`]: the default event-driven integrator, exact for piecewise-linear ground motion.
 //! * [`rk4`]: the paper's fixed-step RK4 with its top-down cluster rule, kept as a reference.

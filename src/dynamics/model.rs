@@ -1,5 +1,5 @@
 //! The physical system: a linear SDOF primary structure (PS) carrying a stack of rigid blocks
-//! with Coulomb friction at every interface (NOTES.md, "The physical system").
+//! with Coulomb friction at every interface (docs/model.md, "The physical system").
 //!
 //! Body 0 is the PS, bodies `1..=n` are the blocks bottom-up; interface `i` lies under block `i`,
 //! so interface 1 is PS–block 1. All displacements are relative to the ground.

@@ -4,7 +4,7 @@
 //! `T_p, μ_1, μ_2, α_1, α_2`).
 //!
 //! * [`Form::Paper`]: the paper's Eqs. 16–17, `T_new = a·x + b·e^{c·x + d} + e`. Only `b·e^d`
-//!   is identifiable (NOTES.md), so it is fitted as `T_new = a·x + B·e^{c·x} + e`: linear in
+//!   is identifiable (docs/model.md), so it is fitted as `T_new = a·x + B·e^{c·x} + e`: linear in
 //!   `(a, B, e)` for fixed `c`, so each cost evaluation solves those by least squares
 //!   (variable projection) and argmin's Nelder–Mead searches `c` alone.
 //! * [`Form::Bounded`]: `T_new = T_p + (T_rigid − T_p)·σ(w·x + w₀)`, `σ` the logistic
@@ -272,7 +272,7 @@ pub fn cross_validate(form: Form, data: &[Sample], k: usize) -> Result<Metrics, 
 }
 
 /// The paper's published design equations (Eqs. 16 for Zone III and 17 for Zone V) at
-/// `x = (T_p, μ_1, μ_2, α_1, α_2)`, as printed (NOTES.md checks the worked example: 1.138 s and
+/// `x = (T_p, μ_1, μ_2, α_1, α_2)`, as printed (docs/model.md checks the worked example: 1.138 s and
 /// 0.926 s).
 pub fn paper_equation(zone: &str, x: &[f64]) -> Option<f64> {
     let (a, b, c, d, e): ([f64; 5], f64, [f64; 5], f64, f64) = match zone {

@@ -6,8 +6,9 @@
 //!
 //! * `is1893:zone=V,soil=I[,scaling=z|z/2][,i=1][,r=1]`: IS 1893 (Part 1):2016, Clause 6.4.2 and
 //!   Fig. 2 (response spectrum method), valued `factor·(I/R)·Sa/g` with `factor` the zone factor
-//!   `Z` of Table 3 or `Z/2`. The paper's targets are `Z·Sa/g` on hard soil (NOTES.md, "Numbers
-//!   checked by hand"), hence the default `scaling=z`; the code's design coefficient `Ah`
+//!   `Z` of Table 3 or `Z/2`. The paper's targets are `Z·Sa/g` on hard soil (docs/model.md,
+//!   "Hazard: numbers checked by hand"), hence the default `scaling=z`; the code's design
+//!   coefficient `Ah`
 //!   is `scaling=z/2` with the building's `I` and `R`.
 //! * `asce7:sds=1.0,sd1=0.6,tl=8`: the ASCE 7-16 §11.4.6 design response spectrum.
 //! * `table:FILE`: two columns `period_s sa_g`, log-log interpolated.
@@ -167,7 +168,7 @@ impl fmt::Display for Soil {
 /// Which multiple of the zone factor scales `Sa/g`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ZoneScaling {
-    /// `Z·Sa/g`: the paper's targets (NOTES.md, "Numbers checked by hand").
+    /// `Z·Sa/g`: the paper's targets (docs/model.md, "Hazard: numbers checked by hand").
     Z,
     /// `(Z/2)·Sa/g`: the design level of IS 1893 (Part 1):2016 Clause 6.4.2, `Ah = (Z/2)(I/R)(Sa/g)`.
     HalfZ,
@@ -820,7 +821,7 @@ mod tests {
 
     #[test]
     fn notes_zone_iii_and_v_hard_soil_at_0_7_s() {
-        // NOTES.md: hard soil, T = 0.7 s is on the 1/T branch (0.40 < 0.7 ≤ 4), Sa/g = 1/0.7 = 1.4286;
+        // docs/model.md: hard soil, T = 0.7 s is on the 1/T branch (0.40 < 0.7 ≤ 4), Sa/g = 1/0.7 = 1.4286;
         // Z·Sa/g = 0.16/0.7 = 0.2286 g (zone III) and 0.36/0.7 = 0.5143 g (zone V).
         let iii = is1893(Zone::III, Soil::I).sa_g(0.7);
         let v = is1893(Zone::V, Soil::I).sa_g(0.7);

@@ -16,7 +16,7 @@ impl NamedCase {
 }
 
 /// Section 7.1, the paper's example of `T_new`: `T_p` = 1 s, α = 0.5/0.5, μ = 0.2/0.1; in
-/// Zone III the mean peak displacement 5.49 cm gives `T_new` = 1.38 s (NOTES.md).
+/// Zone III the mean peak displacement 5.49 cm gives `T_new` = 1.38 s (docs/model.md).
 pub const SECTION_7_1: NamedCase = NamedCase {
     period_s: 1.0,
     alpha: &[0.5, 0.5],

@@ -1,7 +1,7 @@
 //! The sweep's numerics: the grid of cases, the skip rules, and one work unit (one motion, one
 //! structure period, every block and friction combination).
 //!
-//! Three systems per case (NOTES.md, "Derived quantities"): the stack, the single block (the
+//! Three systems per case (docs/model.md, "Derived quantities"): the stack, the single block (the
 //! whole stack as one block on interface 1) and the rigidly attached stack (a linear SDOF of
 //! mass `m_p(1+α)`, `T_rigid = T_p·sqrt(1+α)`, same `c`). What a case does not need is skipped,
 //! exactly:
@@ -13,7 +13,7 @@
 //!   ([`SkipRule::NoSlip`]); likewise the single block when it stays below `μ_s,1·g`;
 //! * when the coefficients never decrease upward and static equals kinetic, no upper interface
 //!   can slip before the one below it, so the stack acts as one block ([`SkipRule::SingleBlock`],
-//!   NOTES.md "Stated special cases").
+//!   docs/model.md "Stated special cases").
 
 use crate::dynamics::{
     ExactOptions, G, Ground, ModelError, Response, SimError, System, SystemSpec, simulate_exact,
@@ -130,7 +130,7 @@ impl std::str::FromStr for DampingBasis {
     }
 }
 
-/// How a case becomes the study's three systems (NOTES.md, "Derived quantities"): the one source
+/// How a case becomes the study's three systems (docs/model.md, "Derived quantities"): the one source
 /// of the physics for the sweep, the report and `design`. All three share one viscous damper.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Physics {

@@ -1,4 +1,4 @@
-//! `T_new` and the displacement response ratios (paper Section 7.1, Eqs. 7–8; NOTES.md "Derived
+//! `T_new` and the displacement response ratios (paper Section 7.1, Eqs. 7–8; docs/model.md "Derived
 //! quantities").
 //!
 //! For one case and one zone: the mean over the motions of the peak structure displacement with
@@ -54,7 +54,7 @@ pub const TNEW_FLAG_CODES: &str = "0 one crossing of the mean displacement spect
      the spectrum's range (T_new NaN); 3 nothing slid, T_new = T_rigid";
 
 /// Where a case's `T_new` lies against its physical band `[T_p, T_rigid]` (paper Section 10:
-/// generally `T_p < T_new < T_rigid`; NOTES.md, "Derived quantities").
+/// generally `T_p < T_new < T_rigid`; docs/model.md, "Derived quantities").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u8)]
 pub enum Band {
@@ -198,7 +198,7 @@ mod tests {
 
     #[test]
     fn hand_cases() {
-        // Sd = 0.1·T on [0.5, 2]: ū = 0.138 m lies at T = 1.38 s (NOTES.md's Section 7.1 number
+        // Sd = 0.1·T on [0.5, 2]: ū = 0.138 m lies at T = 1.38 s (docs/model.md's Section 7.1 number
         // in the 1/T branch, Sd ∝ T), exactly on the straight segment.
         let t = [0.5, 1.0, 1.5, 2.0];
         let sd = [0.05, 0.1, 0.15, 0.2];
