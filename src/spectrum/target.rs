@@ -8,8 +8,7 @@
 //!   Fig. 2 (response spectrum method), valued `factor·(I/R)·Sa/g` with `factor` the zone factor
 //!   `Z` of Table 3 or `Z/2`. The paper's targets are `Z·Sa/g` on hard soil (docs/model.md,
 //!   "Hazard: numbers checked by hand"), hence the default `scaling=z`; the code's design
-//!   coefficient `Ah`
-//!   is `scaling=z/2` with the building's `I` and `R`.
+//!   coefficient `Ah` is `scaling=z/2` with the building's `I` and `R`.
 //! * `asce7:sds=1.0,sd1=0.6,tl=8`: the ASCE 7-16 §11.4.6 design response spectrum.
 //! * `table:FILE`: two columns `period_s sa_g`, log-log interpolated.
 //!
