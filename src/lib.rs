@@ -11,13 +11,10 @@
 //! * [`design`]: `T_new` of one structure from a finished study (the designer's query).
 //! * [`pipeline`]: the study's stages as library code: one shape, the output lock, checks.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
-//! * [`accuracy`]: work-precision measures (errors against a reference, observed orders).
-//! * [`stress`]: the numerical stress suite: extreme but legal cases and their checks.
 //!
 //! `docs/model.md` states the model, the numbers checked by hand and the choices the paper leaves
 //! open; the code cites its sections as `docs/model.md, "<section>"`.
 
-pub mod accuracy;
 pub mod design;
 pub mod dynamics;
 pub mod fit;
@@ -29,5 +26,4 @@ pub mod pipeline;
 pub mod report;
 pub mod spectrum;
 pub mod store;
-pub mod stress;
 pub mod study;

@@ -39,9 +39,6 @@ enum Command {
     Status(cmd::status::Args),
     /// T_new and the design spectral accelerations of one structure, from a finished study.
     Design(cmd::design::Args),
-    /// Evidence: work-precision of the integrators and the numerical stress suite.
-    #[command(subcommand)]
-    Bench(cmd::bench::BenchCommand),
 }
 
 fn main() -> std::process::ExitCode {
@@ -66,7 +63,6 @@ fn main() -> std::process::ExitCode {
         Command::Run(args) => cmd::run::run(args),
         Command::Status(args) => cmd::status::run(args),
         Command::Design(args) => cmd::design::run(args),
-        Command::Bench(command) => cmd::bench::run(command),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

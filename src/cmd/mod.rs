@@ -1,7 +1,6 @@
 //! One module per subcommand: each parses its arguments, calls the library and prints. The
 //! study's stages share [`StudyArgs`], [`CliReporter`] and [`print_outcome`].
 
-pub mod bench;
 pub mod design;
 pub mod matching;
 pub mod run;

@@ -1,6 +1,6 @@
 //! Work-precision measures: how far a method's structure-displacement history is from a
 //! reference, the convergence order it shows as its step shrinks, and the finest setting it needs
-//! to reach a tolerance. Plain functions over slices; `slidestack bench accuracy` runs the
+//! to reach a tolerance. Plain functions over slices; `slidestack-verify accuracy` runs the
 //! integrators, times them and composes these.
 
 use thiserror::Error;

@@ -1,7 +1,7 @@
 //! The case list and the tolerance rules (module doc of [`super`]).
 
 use super::{Expect, GroundMotion, Reference, Scale, StressCase};
-use crate::dynamics::{ExactOptions, G, SystemSpec};
+use slidestack::dynamics::{ExactOptions, G, SystemSpec};
 
 /// Floor of the energy-balance tolerance (see the module doc).
 pub const ENERGY_TOLERANCE_FLOOR: f64 = 1e-9;
@@ -451,7 +451,7 @@ fn limit_cases() -> Vec<StressCase> {
 
 /// The one case built to trip the switch guard: a limit of one switch per sample on a stack
 /// that switches several times within a sample; the run must stop with
-/// [`crate::dynamics::SimError::Zeno`].
+/// [`slidestack::dynamics::SimError::Zeno`].
 fn zeno_case() -> StressCase {
     StressCase {
         expect: Expect::Zeno,

@@ -1,28 +1,8 @@
-//! `slidestack bench …`: the evidence that the tool is fast and accurate, regenerated on demand
-//! (`scripts/evidence` runs every part and collects it under `docs/evidence/`).
-
-pub mod accuracy;
-pub mod stress;
+//! Timing for the evidence: the machine's description, the CPU time of the running thread, and
+//! a batched median per call.
 
 use std::hint::black_box;
 use std::time::Duration;
-
-#[derive(Debug, clap::Subcommand)]
-pub enum BenchCommand {
-    /// Work-precision: error against time of the exact integrator, the paper's RK4 at 1–1000
-    /// sub-steps and (optionally) OpenSees, on real records → accuracy.{md,csv,svg,html}.
-    Accuracy(accuracy::Args),
-    /// Numerical stress suite: extreme but legal cases and their checks → a Markdown report
-    /// (docs/stress.md); fails if a case fails.
-    Stress(stress::Args),
-}
-
-pub fn run(command: BenchCommand) -> anyhow::Result<()> {
-    match command {
-        BenchCommand::Accuracy(args) => accuracy::run(&args),
-        BenchCommand::Stress(args) => stress::run(args),
-    }
-}
 
 /// The machine, for every benchmark header: cores, CPU model, OS and architecture.
 pub fn machine_description() -> String {

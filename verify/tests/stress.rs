@@ -1,8 +1,8 @@
-//! The numerical stress suite (`slidestack::stress`): every case passes every check, the known
+//! The numerical stress suite (`slidestack_verify::stress`): every case passes every check, the known
 //! limit stays within the suite's rules where they claim to hold, and each check can fail.
 
 use slidestack::dynamics::{ExactOptions, G, Ground, System, SystemSpec, simulate_exact};
-use slidestack::stress::{
+use slidestack_verify::stress::{
     Check, Expect, FRICTION_TOLERANCE, GroundMotion, Reference, RunEnd, Scale, StressCase, cases,
     friction_bound_excess, limit_survey, markdown_table, non_finite_count, refine_linear, run,
     run_all,

@@ -1,4 +1,4 @@
-//! `slidestack bench accuracy` end to end on one real record (quick mode): the files it writes,
+//! `slidestack-verify accuracy` end to end on one real record (quick mode): the files it writes,
 //! the exact integrator's self-check, RK4's convergence toward it, and refused input.
 
 use std::path::Path;
@@ -7,10 +7,13 @@ use std::process::Command;
 const RECORD: &str = "tests/fixtures/records/RSN960_NORTHR_LOS270.AT2";
 
 fn bench(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .arg("bench")
+    // From the repository root, where the default records and scripts are.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap();
+    Command::new(env!("CARGO_BIN_EXE_slidestack-verify"))
         .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .current_dir(root)
         .output()
         .unwrap()
 }
@@ -88,7 +91,7 @@ fn accuracy_refuses_missing_inputs_before_any_work() {
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(err.contains("Python no/such/python not found"), "{err}");
     assert!(
-        !err.contains("bench accuracy: RSN"),
+        !err.contains("accuracy: RSN"),
         "ran cases before refusing: {err}"
     );
 }

@@ -1,6 +1,6 @@
 //! The numerical stress suite (issue 5, item 3): the exact integrator on extreme but legal
 //! parameters and ground motions, every run checked against what must hold. [`cases`] lists the
-//! cases, [`run`] runs one, [`markdown_table`] renders the outcomes; `slidestack bench stress`
+//! cases, [`run`] runs one, [`markdown_table`] renders the outcomes; `slidestack-verify stress`
 //! writes them to `docs/stress.md`. [`limit_survey`] measures the exact integrator's known
 //! long-period limit across `T_p` and `α`. Nothing here prints or reads files.
 //!
@@ -12,7 +12,7 @@
 //! * Sampling: `dt` 0.0005–0.05 s (at `T_p` = 0.01 s that is five structural periods per
 //!   sample); records of 6–300 s.
 //! * Ground motions, all built in code ([`GroundMotion`]): a zero record; the built-in stochastic
-//!   generator ([`crate::motion::stochastic`]) with fixed seeds, scaled by 1e-12, by 1e3 or to a
+//!   generator ([`slidestack::motion::stochastic`]) with fixed seeds, scaled by 1e-12, by 1e3 or to a
 //!   peak ground acceleration, 20–300 s long; a ramp to exactly `μ·g` and back (the demand grazes
 //!   the limit); a ramp to exactly `μ·g` held for 99 s (friction balances the ground's push
 //!   exactly, so a loose block coasts); steps (changes over one sample) to a constant and a ±0.4 g
@@ -39,7 +39,7 @@
 //! 4. **Friction bounds** ([`friction_bound_excess`]) at every history row: a stuck interface
 //!    carries at most `μ_s·N`, a slipping one exactly `μ_k·N`. Tolerance [`FRICTION_TOLERANCE`]
 //!    = 1e-9 of the force scale: the integrator lets a stuck force exceed its static limit by
-//!    1e-10 of it before breaking away ([`crate::dynamics::exact::BREAK_TOLERANCE`]), and the
+//!    1e-10 of it before breaking away ([`slidestack::dynamics::exact::BREAK_TOLERANCE`]), and the
 //!    recovered force is a sum of mass × acceleration terms with their round-off. Measured: at
 //!    most 1e-11.
 //! 5. **Energy balance**, [`Response::energy_balance_error_max`] (the largest
@@ -62,7 +62,7 @@
 //!      displacement;
 //!    * closed forms: a zero record gives exactly zero everywhere (tolerance 0); a stack that
 //!      cannot slide is a linear SDOF of mass `m_p(1+α)` (docs/model.md, "Stated special cases"),
-//!      stepped by the φ-function Nigam–Jennings recurrence of [`crate::spectrum::response`],
+//!      stepped by the φ-function Nigam–Jennings recurrence of [`slidestack::spectrum::response`],
 //!      which has no cancellation at long periods, and its exact peak; a frictionless stack
 //!      leaves the structure alone and every block at `−∬a_g`; two blocks with `μ_2 = μ_1` are one
 //!      block on `μ_1` (exact integrator, other cluster layout);
@@ -92,7 +92,7 @@
 //!   balance error of 1.5e-5 on `T_rigid` = 1 s, and on `T_rigid` = 20 s the damping energy comes
 //!   out several times too large (energy balance error 1.1) and the displacement off by 4e-5 of
 //!   its peak. [`limit_survey`] shows this column next to the stochastic ones, unchecked. A
-//!   φ-function form of the closed form (as [`crate::spectrum::response`] uses) would remove it.
+//!   φ-function form of the closed form (as [`slidestack::spectrum::response`] uses) would remove it.
 //! * **Chaos with `μ_s > μ_k`.** The drop from static to kinetic friction at break-away makes
 //!   some stick–slip motions chaotic: on random extreme systems, a relative change of 1e-14 in
 //!   the record changed the response by O(1) (six blocks on `T_p` = 0.036 s with `μ_s` up to 10
@@ -116,11 +116,11 @@ pub use cases::{
 };
 pub use survey::{SurveyPoint, limit_survey, survey_markdown};
 
-use crate::dynamics::{
+use slidestack::dynamics::{
     Contact, ExactOptions, Ground, Response, SimError, System, SystemSpec, simulate_exact,
 };
-use crate::motion::StochasticModel;
-use crate::report::sci;
+use slidestack::motion::StochasticModel;
+use slidestack::report::sci;
 use std::fmt::Write as _;
 
 /// How a case's ground acceleration is built: synthetic signals in code, or the built-in
@@ -185,8 +185,8 @@ pub enum Reference {
     Zero,
     /// Nothing may slide: the structure is a linear SDOF of mass `m_p(1+α)` with the bare
     /// structure's `c` (docs/model.md, "Stated special cases"), stepped by the φ-function
-    /// Nigam–Jennings recurrence of [`crate::spectrum::response`]. Error: displacement at the
-    /// samples over the peak, and the peak against [`crate::spectrum::peak_response`]. Zero switches
+    /// Nigam–Jennings recurrence of [`slidestack::spectrum::response`]. Error: displacement at the
+    /// samples over the peak, and the peak against [`slidestack::spectrum::peak_response`]. Zero switches
     /// and zero slip required.
     RigidSdof { tolerance: f64 },
     /// Every `μ = 0`: the structure responds alone with `T_p`, every block's displacement is
@@ -770,9 +770,9 @@ pub fn markdown_report(outcomes: &[Outcome], survey: &[SurveyPoint]) -> String {
         .count();
     let mut s = String::from("# Numerical stress suite\n\n");
     s.push_str(
-        "This file is generated: `slidestack bench stress --out docs/stress.md` (from a checkout, \
-         `cargo run --release -- bench stress --out docs/stress.md`) reruns every case of \
-         `slidestack::stress` and rewrites it, and `cargo test --release --test stress` runs the \
+        "This file is generated: `slidestack-verify stress --out docs/stress.md` (from a checkout, \
+         `cargo run --release -p slidestack-verify -- stress --out docs/stress.md`) reruns every case of \
+         `slidestack_verify::stress` and rewrites it, and `cargo test --release -p slidestack-verify --test stress` runs the \
          same cases as tests. Each case runs the exact integrator with its full history on \
          extreme but legal parameters and a ground motion built in code (no files), and is \
          checked for: how the run ended (every run is bounded by the integrator's switch guard; \
@@ -780,7 +780,7 @@ pub fn markdown_report(outcomes: &[Outcome], survey: &[SurveyPoint]) -> String {
          Coulomb's law at every history row, the energy balance, and agreement with its \
          references. In each cell the number before the parentheses is measured and the one \
          inside is its tolerance; why each tolerance is what it is, is stated in the module \
-         documentation of `src/stress.rs`. Nothing is timed.\n\n",
+         documentation of `verify/src/stress.rs`. Nothing is timed.\n\n",
     );
     let _ = writeln!(
         s,

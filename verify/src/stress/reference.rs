@@ -3,8 +3,10 @@
 //! a relative error, or why it could not be computed.
 
 use super::{Check, Reference, ReferenceOutcome, Samples, StressCase, options, refine_linear};
-use crate::dynamics::{G, History, Response, System, SystemSpec, simulate_exact, simulate_rk4};
-use crate::spectrum::response::{NjStep, peak_response};
+use slidestack::dynamics::{
+    G, History, Response, System, SystemSpec, simulate_exact, simulate_rk4,
+};
+use slidestack::spectrum::response::{NjStep, peak_response};
 
 pub(super) fn compare(
     case: &StressCase,

@@ -5,7 +5,7 @@
 
 use super::cases::{Ref, case};
 use super::{Check, GroundMotion, Outcome, Scale, run, sci};
-use crate::dynamics::{G, SystemSpec};
+use slidestack::dynamics::{G, SystemSpec};
 use std::fmt::Write as _;
 
 /// Structure periods of the survey, s.
