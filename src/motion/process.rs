@@ -223,6 +223,24 @@ pub fn arias_intensity_mps(accel_g: &[f64], dt_s: f64) -> f64 {
     PI * G / 2.0 * (sum * dt_s / 3.0)
 }
 
+/// Time at which the fraction `p` of a record's Arias intensity has accrued (cumulative
+/// `Σ a_k²·dt`, linear between samples), s.
+pub fn arias_time_s(accel_g: &[f64], dt_s: f64, p: f64) -> f64 {
+    let total: f64 = accel_g.iter().map(|a| a * a).sum();
+    let target = p * total;
+    let mut cum = 0.0;
+    for (k, a) in accel_g.iter().enumerate() {
+        let next = cum + a * a;
+        if next >= target && a * a > 0.0 {
+            // Sample k's energy accrues over (t_{k−1}, t_k].
+            let frac = (target - cum) / (a * a);
+            return ((k as f64 - 1.0) + frac).max(0.0) * dt_s;
+        }
+        cum = next;
+    }
+    accel_g.len().saturating_sub(1) as f64 * dt_s
+}
+
 /// Baseline correction of an acceleration record.
 ///
 /// Textual form ([`FromStr`], [`Display`](fmt::Display)): `none`, `poly:<order>`,
@@ -381,43 +399,6 @@ fn legendre(x: f64, p: &mut [f64], dp: &mut [f64], d2p: &mut [f64]) {
     }
 }
 
-/// Least-squares solution of `A·c ≈ b` by Householder QR; `cols` holds the columns of `A`
-/// (all of `b`'s length, at least as long as there are columns). A column that is zero after the
-/// earlier reflections gets coefficient 0.
-fn least_squares(mut cols: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
-    let m = cols.len();
-    let mut r_diag = vec![0.0; m];
-    for k in 0..m {
-        let (done, rest) = cols.split_at_mut(k + 1);
-        let v = &mut done[k][k..];
-        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if norm == 0.0 {
-            continue;
-        }
-        let alpha = if v[0] > 0.0 { -norm } else { norm };
-        v[0] -= alpha;
-        let vv: f64 = v.iter().map(|x| x * x).sum();
-        r_diag[k] = alpha;
-        let reflect = |y: &mut [f64]| {
-            let f = 2.0 * v.iter().zip(y.iter()).map(|(a, b)| a * b).sum::<f64>() / vv;
-            y.iter_mut().zip(v.iter()).for_each(|(y, v)| *y -= f * v);
-        };
-        for col in rest.iter_mut() {
-            reflect(&mut col[k..]);
-        }
-        reflect(&mut b[k..]);
-    }
-    let mut c = vec![0.0; m];
-    for i in (0..m).rev() {
-        if r_diag[i] == 0.0 {
-            continue;
-        }
-        let s: f64 = (i + 1..m).map(|j| cols[j][i] * c[j]).sum();
-        c[i] = (b[i] - s) / r_diag[i];
-    }
-    c
-}
-
 fn polynomial(accel: &[f64], dt: f64, order: usize) -> Result<Vec<f64>, ProcessError> {
     let n = accel.len();
     let m = order + 1;
@@ -441,7 +422,7 @@ fn polynomial(accel: &[f64], dt: f64, order: usize) -> Result<Vec<f64>, ProcessE
             col[k] = t * t * pj;
         }
     }
-    let c = least_squares(cols, disp);
+    let c = crate::numeric::linalg::least_squares(cols, disp);
     // p(t) = τ²·q(τ): p''(t) = (2q + 4τ·q' + τ²·q'')/T², with d/dτ = 2·d/dx.
     let mut out = Vec::with_capacity(n);
     for (k, &a) in accel.iter().enumerate() {
@@ -456,63 +437,6 @@ fn polynomial(accel: &[f64], dt: f64, order: usize) -> Result<Vec<f64>, ProcessE
         out.push(a - (2.0 * q + 4.0 * t * dq + t * t * d2q) / (duration * duration));
     }
     Ok(out)
-}
-
-/// A second-order (or, with `b2 = a2 = 0`, first-order) digital filter section,
-/// `H(z) = (b0 + b1 z⁻¹ + b2 z⁻²)/(1 + a1 z⁻¹ + a2 z⁻²)`.
-#[derive(Debug, Clone, Copy)]
-struct Biquad {
-    b0: f64,
-    b1: f64,
-    b2: f64,
-    a1: f64,
-    a2: f64,
-}
-
-impl Biquad {
-    /// Filters `x` in place from zero initial state (direct form II transposed).
-    fn run(&self, x: &mut [f64]) {
-        let (mut z1, mut z2) = (0.0, 0.0);
-        for v in x.iter_mut() {
-            let u = *v;
-            let y = self.b0 * u + z1;
-            z1 = self.b1 * u - self.a1 * y + z2;
-            z2 = self.b2 * u - self.a2 * y;
-            *v = y;
-        }
-    }
-}
-
-/// Sections of a digital Butterworth high-pass of `order` poles with its corner at `corner_hz`
-/// for the step `dt`: bilinear transform of the analog prototype with the corner prewarped,
-/// `K = tan(π·fc·dt)`. Each analog pair `s²/(s² + s·ωc/Q + ωc²)`, `1/(2Q) = sin((2k−1)π/(2n))`,
-/// becomes `(1 − z⁻¹)²/((1 + K/Q + K²) + 2(K² − 1)z⁻¹ + (1 − K/Q + K²)z⁻²)`; an odd order adds the
-/// real pole `s/(s + ωc)` → `(1 − z⁻¹)/((1 + K) + (K − 1)z⁻¹)`.
-fn butterworth_high_pass(corner_hz: f64, order: usize, dt: f64) -> Vec<Biquad> {
-    let k = (PI * corner_hz * dt).tan();
-    let mut sections = Vec::with_capacity(order / 2 + 1);
-    for i in 1..=order / 2 {
-        let two_zeta = 2.0 * ((2 * i - 1) as f64 * PI / (2 * order) as f64).sin();
-        let norm = 1.0 / (1.0 + two_zeta * k + k * k);
-        sections.push(Biquad {
-            b0: norm,
-            b1: -2.0 * norm,
-            b2: norm,
-            a1: 2.0 * (k * k - 1.0) * norm,
-            a2: (1.0 - two_zeta * k + k * k) * norm,
-        });
-    }
-    if order % 2 == 1 {
-        let norm = 1.0 / (1.0 + k);
-        sections.push(Biquad {
-            b0: norm,
-            b1: -norm,
-            b2: 0.0,
-            a1: (k - 1.0) * norm,
-            a2: 0.0,
-        });
-    }
-    sections
 }
 
 fn high_pass(
@@ -542,7 +466,7 @@ fn high_pass(
     let n = accel.len();
     let mut x = vec![0.0; n + 2 * pad];
     x[pad..pad + n].copy_from_slice(accel);
-    let sections = butterworth_high_pass(corner_hz, order, dt);
+    let sections = crate::numeric::filter::butterworth_high_pass(corner_hz, order, dt);
     for s in &sections {
         s.run(&mut x);
     }
@@ -1014,7 +938,7 @@ mod tests {
         assert_eq!(best, 0);
         // The single causal pass does shift it, so the check above has teeth.
         let mut causal = x.clone();
-        for s in &butterworth_high_pass(0.5, 4, dt) {
+        for s in &crate::numeric::filter::butterworth_high_pass(0.5, 4, dt) {
             s.run(&mut causal);
         }
         let xcorr_causal = |lag: isize| -> f64 {

@@ -1,5 +1,18 @@
-//! Small numerical pieces shared by the closed-form solutions: complex arithmetic, the
-//! φ-functions of exponential integrators, and a bracketed root finder.
+//! Small numerical kernels, each written once and tested against its own oracle:
+//!
+//! * here: complex arithmetic, the φ-functions of exponential integrators, a bracketed Newton
+//!   root finder;
+//! * [`linalg`]: Cholesky, least squares by Householder QR, the 4×4 matrix exponential;
+//! * [`special`]: `ln Γ`, the regularised incomplete gamma function and its quantile;
+//! * [`rng`]: the seeded generator of the stochastic motions;
+//! * [`filter`]: Butterworth high-pass sections.
+
+pub mod filter;
+pub mod linalg;
+pub mod rng;
+pub mod special;
+
+pub use linalg::cholesky_solve;
 
 /// Complex number `re + i·im`, just what the closed-form integrals need.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,35 +120,6 @@ pub(crate) fn bracketed_root(
         x = next;
     }
     x
-}
-
-/// Solves `A·x = rhs` for a symmetric positive definite `n×n` matrix `a` (row-major; only the
-/// lower triangle is read, and `a` is overwritten by its Cholesky factor), in place of `rhs`.
-/// Pivots are floored at `min_pivot` (> 0) against round-off in nearly singular systems.
-pub(crate) fn cholesky_solve(a: &mut [f64], rhs: &mut [f64], n: usize, min_pivot: f64) {
-    for j in 0..n {
-        let mut s = a[j * n + j];
-        for k in 0..j {
-            s -= a[j * n + k] * a[j * n + k];
-        }
-        let ljj = s.max(min_pivot).sqrt();
-        a[j * n + j] = ljj;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / ljj;
-        }
-    }
-    for i in 0..n {
-        let s = rhs[i] - (0..i).map(|k| a[i * n + k] * rhs[k]).sum::<f64>();
-        rhs[i] = s / a[i * n + i];
-    }
-    for i in (0..n).rev() {
-        let s = rhs[i] - (i + 1..n).map(|k| a[k * n + i] * rhs[k]).sum::<f64>();
-        rhs[i] = s / a[i * n + i];
-    }
 }
 
 #[cfg(test)]
