@@ -6,7 +6,7 @@ mod common;
 use common::{Rng, fixture, real_records};
 use slidestack::motion::process::{BaselineCorrection, drift, refine};
 use slidestack::motion::{
-    ReadOptions, Record, Units, format_at2, read_record, read_record_with, write_at2,
+    ReadOptions, Record, RecordError, Units, checked_at2, format_at2, read_record, read_record_with,
 };
 use std::path::{Path, PathBuf};
 
@@ -215,6 +215,13 @@ fn assert_same_bits(a: &Record, b: &Record) {
     for (k, (x, y)) in a.accel_g.iter().zip(&b.accel_g).enumerate() {
         assert_eq!(x.to_bits(), y.to_bits(), "sample {k}: {x:e} vs {y:e}");
     }
+}
+
+/// `checked_at2` then a checked atomic write, as `slidestack match` writes its records.
+fn write_at2(r: &Record, description: &str, path: &std::path::Path) -> Result<(), RecordError> {
+    let text = checked_at2(r, description, &path.display().to_string())?;
+    slidestack::store::atomic::write_bytes(path, text.as_bytes()).expect("writable temp dir");
+    Ok(())
 }
 
 /// Fixtures written with `write_at2` read back bit-identical, and carry the same digits as the

@@ -13,8 +13,9 @@ use super::RecordArgs;
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use slidestack::motion::matching::{MatchSettings, match_record};
-use slidestack::motion::{Record, write_at2};
+use slidestack::motion::{Record, checked_at2};
 use slidestack::spectrum::TargetSpectrum;
+use slidestack::store::atomic::write_bytes;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -108,7 +109,9 @@ pub fn run(args: Args) -> Result<()> {
                 rec.name,
                 env!("CARGO_PKG_VERSION")
             );
-            write_at2(&matched, &desc, &args.out.join(&name))?;
+            let path = args.out.join(&name);
+            let text = checked_at2(&matched, &desc, &path.display().to_string())?;
+            write_bytes(&path, text.as_bytes())?;
             name
         } else {
             left_out.push(rec.name.clone());

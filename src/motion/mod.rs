@@ -9,7 +9,7 @@ pub mod stochastic;
 
 pub use process::{BaselineCorrection, ProcessError};
 pub use record::{
-    ReadOptions, Record, RecordError, Units, format_at2, read_record, read_record_with, write_at2,
+    ReadOptions, Record, RecordError, Units, checked_at2, format_at2, read_record, read_record_with,
 };
 pub use stochastic::{Envelope, ParameterScatter, StochasticError, StochasticModel};
 

@@ -700,29 +700,20 @@ pub fn format_at2(record: &Record, description: &str) -> String {
     out
 }
 
-/// Writes [`format_at2`] of `record` to `path`, atomically (a temporary renamed over it). Refuses
-/// a step outside the readable range, or a non-finite value, naming the line of the file it
-/// would have gone to.
-pub fn write_at2(record: &Record, description: &str, path: &Path) -> Result<(), RecordError> {
-    let file = path.display().to_string();
-    checked_dt(record.dt_s, &file, 4)?;
+/// [`format_at2`] of `record`, after refusing a step outside the readable range or a
+/// non-finite value, naming the line of the file `file` it would have gone to. Write the text
+/// with [`crate::store::atomic::write_bytes`].
+pub fn checked_at2(record: &Record, description: &str, file: &str) -> Result<String, RecordError> {
+    checked_dt(record.dt_s, file, 4)?;
     if let Some((k, &value)) = record
         .accel_g
         .iter()
         .enumerate()
         .find(|(_, v)| !v.is_finite())
     {
-        return Err(at(&file, 5 + k / 5, Problem::NonFinite { value }));
+        return Err(at(file, 5 + k / 5, Problem::NonFinite { value }));
     }
-    crate::store::atomic::write_bytes(path, format_at2(record, description).as_bytes()).map_err(
-        |e| match e {
-            crate::store::StoreError::Io { source, .. } => RecordError::Io { file, source },
-            other => RecordError::Io {
-                file,
-                source: std::io::Error::other(other.to_string()),
-            },
-        },
-    )
+    Ok(format_at2(record, description))
 }
 
 #[cfg(test)]
