@@ -65,7 +65,15 @@ fn main() -> std::process::ExitCode {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
-            std::process::ExitCode::FAILURE
+            // Motions outside the matching band that the config does not allow: a result, not
+            // a failure of the tool.
+            if e.downcast_ref::<slidestack::study::motions::Unmatched>()
+                .is_some()
+            {
+                std::process::ExitCode::from(2)
+            } else {
+                std::process::ExitCode::FAILURE
+            }
         }
     }
 }

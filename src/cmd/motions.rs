@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use slidestack::store::fingerprint::{file_sha256, fingerprint, sha256_hex};
 use slidestack::store::motions::{StageMeta, read_fingerprint, write_motions};
 use slidestack::study::config::{Seeds, StudyConfig};
-use slidestack::study::motions::{match_zone, seed_records};
+use slidestack::study::motions::{MotionsError, match_zone, seed_records};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -69,8 +69,11 @@ pub fn run(args: Args) -> Result<()> {
     for (i, z) in cfg.zones.iter().enumerate() {
         let target = cfg.target(i)?;
         let start = std::time::Instant::now();
-        let zm = match_zone(&z.name, &target, &seeds, &cfg.motions)
-            .with_context(|| format!("zone {}: matching failed", z.name))?;
+        // Unmatched motions stay their own error: `main` maps it to exit code 2.
+        let zm = match_zone(&z.name, &target, &seeds, &cfg.motions).map_err(|e| match e {
+            MotionsError::Unmatched(u) => anyhow::Error::new(u),
+            e => anyhow::Error::new(e).context(format!("zone {}: matching failed", z.name)),
+        })?;
         println!(
             "motions: zone {}: {} motions kept of {} seeds tried, matched to {} in {:.1} s; set scale {:.4}, \
              mean/target ≥ {:.3} (set_mean_min {}: {}; ASCE 7 90 %: {})",
@@ -85,18 +88,18 @@ pub fn run(args: Args) -> Result<()> {
             if zm.set_mean_ok { "met" } else { "NOT met" },
             if zm.asce7_ok { "met" } else { "NOT met" },
         );
-        for (s, r) in zm.seeds.iter().zip(&zm.reports) {
-            if !r.converged {
+        for (i, (s, r)) in zm.seeds.iter().zip(&zm.reports).enumerate() {
+            if !r.converged && !zm.kept.contains(&i) {
                 eprintln!(
                     "motions: zone {}: {s} left out: worst misfit {:.3} after {} iterations",
                     z.name, r.worst_misfit, r.iterations
                 );
             }
         }
-        if !zm.all_within_band {
+        for u in &zm.unmatched {
             eprintln!(
-                "motions: zone {}: after the set scale {:.4} some motions exceed the upper bound {}",
-                z.name, zm.set_scale, cfg.motions.matching.upper
+                "motions: zone {}: kept, flagged (allow_unmatched): {u}",
+                z.name
             );
         }
         if zm.kept.is_empty() {

@@ -263,6 +263,13 @@ struct SampleStates {
     best_k: [usize; LANES],
 }
 
+thread_local! {
+    /// The state buffers of the last spectrum computed on this thread, reused: every element
+    /// a spectrum reads is written first, so they need no zeroing.
+    static STATES: std::cell::Cell<(Vec<[f64; LANES]>, Vec<[f64; LANES]>)> =
+        const { std::cell::Cell::new((Vec::new(), Vec::new())) };
+}
+
 impl Lanes {
     /// Whether lane `l`, at `(u0, v0)` at the start of an interval with ground acceleration
     /// `ag0 → ag1` and `reach = h·max|a_g|`, can exceed `peak` inside the interval. Two
@@ -373,6 +380,7 @@ impl Lanes {
                 }
             }
         }
+        STATES.set((st.u, st.v));
         peaks
     }
 
@@ -384,8 +392,11 @@ impl Lanes {
         let c = |f: fn(&NjStep) -> f64| self.steps.map(|s| f(&s));
         let (uu, uv, ug0, ug1) = (c(|s| s.uu), c(|s| s.uv), c(|s| s.ug0), c(|s| s.ug1));
         let (vu, vv, vg0, vg1) = (c(|s| s.vu), c(|s| s.vv), c(|s| s.vg0), c(|s| s.vg1));
-        let mut us = vec![[0.0f64; LANES]; accel.len()];
-        let mut vs = vec![[0.0f64; LANES]; accel.len()];
+        let (mut us, mut vs) = STATES.take();
+        us.resize(accel.len(), [0.0; LANES]);
+        vs.resize(accel.len(), [0.0; LANES]);
+        us[0] = [0.0; LANES];
+        vs[0] = [0.0; LANES];
         let (mut u, mut v) = ([0.0f64; LANES], [0.0f64; LANES]);
         let mut best = [0.0f64; LANES];
         let mut best_k = [0.0f64; LANES];
