@@ -264,22 +264,40 @@ pub fn match_zone(
             .zip(&target_psa_g)
             .any(|(a, q)| a * scale / q > settings.upper * (1.0 + 1e-12))
     };
-    // Matched again with half the tolerance: the room the set scale needs.
+    // A motion matched again is aimed at the target after the scale, with half the tolerance
+    // (and fallbacks above half the room to the bound): what the scale may still add when the
+    // set is scaled anew stays inside the band.
     let tight = MatchSettings {
         tolerance: 0.5 * settings.tolerance,
         retry_misfit: 0.5 * settings.tolerance + 0.25 * (settings.upper - 1.0),
         ..settings.clone()
     };
     let mut set_scale = set_scale_of(&matched);
+    let mut rounds = 0;
     for _ in 0..SET_SCALE_ROUNDS {
+        if !kept
+            .iter()
+            .any(|&i| matched[i].report.converged && above(&matched[i], set_scale))
+        {
+            break;
+        }
+        // The first round tightens every motion not yet within half the tolerance (what lowers
+        // the mean and so raises the scale), later ones the motions still pushed out.
+        let first = rounds == 0;
+        rounds += 1;
         let out: Vec<usize> = kept
             .iter()
             .copied()
-            .filter(|&i| matched[i].report.converged && above(&matched[i], set_scale))
+            .filter(|&i| {
+                let m = &matched[i];
+                m.report.converged
+                    && if first {
+                        m.report.worst_misfit > tight.tolerance || above(m, set_scale)
+                    } else {
+                        above(m, set_scale)
+                    }
+            })
             .collect();
-        if out.is_empty() {
-            break;
-        }
         let again = out
             .par_iter()
             .map(|&i| {
