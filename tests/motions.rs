@@ -234,9 +234,7 @@ fn write_config(dir: &std::path::Path, extra: &str) -> std::path::PathBuf {
 #[test]
 fn motions_stage_writes_skips_and_rebuilds() {
     let dir = tempfile::tempdir().unwrap();
-    // Two motions: the set scale can leave one of them outside the band, which is not what
-    // this test is about, so they are allowed (flagged).
-    let cfg = write_config(dir.path(), "  allow_unmatched: true\n");
+    let cfg = write_config(dir.path(), "");
     let cfg_s = cfg.to_str().unwrap();
     let out = run(&["motions", cfg_s]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -304,7 +302,7 @@ fn motions_file_does_not_depend_on_the_thread_count() {
     std::fs::write(
         &cfg,
         "output_dir: unused\nzones: [{ name: V, target: \"is1893:zone=V,soil=I\" }]\n\
-         motions: { seeds: { stochastic: { count: 2, seed: 7, spare: 1 } }, allow_unmatched: true }\n",
+         motions: { seeds: { stochastic: { count: 2, seed: 7, spare: 1 } } }\n",
     )
     .unwrap();
     let mut read = Vec::new();

@@ -97,10 +97,7 @@ pub fn run(args: Args) -> Result<()> {
             }
         }
         for u in &zm.unmatched {
-            eprintln!(
-                "motions: zone {}: kept, flagged (allow_unmatched): {u}",
-                z.name
-            );
+            eprintln!("motions: zone {}: kept, flagged: {u}", z.name);
         }
         if zm.kept.is_empty() {
             bail!("zone {}: no seed met the matching acceptance", z.name);

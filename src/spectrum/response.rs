@@ -263,10 +263,13 @@ struct SampleStates {
     best_k: [usize; LANES],
 }
 
+/// `u` and `v` buffers of [`SampleStates`].
+type StateBuffers = (Vec<[f64; LANES]>, Vec<[f64; LANES]>);
+
 thread_local! {
     /// The state buffers of the last spectrum computed on this thread, reused: every element
     /// a spectrum reads is written first, so they need no zeroing.
-    static STATES: std::cell::Cell<(Vec<[f64; LANES]>, Vec<[f64; LANES]>)> =
+    static STATES: std::cell::Cell<StateBuffers> =
         const { std::cell::Cell::new((Vec::new(), Vec::new())) };
 }
 
@@ -328,19 +331,14 @@ impl Lanes {
     fn peaks_generic(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
         let n = accel.len();
         let st = self.sample_states(accel);
-        let mut peaks = [Peak {
-            sd_m: 0.0,
-            u_m: 0.0,
-            time_s: 0.0,
-        }; LANES];
-        for l in 0..LANES {
+        let mut peaks: [Peak; LANES] = std::array::from_fn(|l| {
             let k = st.best_k[l];
-            peaks[l] = Peak {
+            Peak {
                 sd_m: st.best[l],
                 u_m: st.u[k][l],
                 time_s: k as f64 * self.h,
-            };
-        }
+            }
+        });
         let omega_peak: [f64; LANES] = std::array::from_fn(|l| self.omega[l] * st.best[l]);
         let two_zw = self.omega.map(|w| 2.0 * self.zeta * w);
         let inv_h = 1.0 / self.h;

@@ -9,10 +9,14 @@
 //!
 //! The set's mean spectrum must not fall below `set_mean_min` of the target on the check grid:
 //! when it does, the kept motions are scaled up together by the smallest factor `s` that lifts
-//! it there. A motion that this pushes above the upper bound is matched again, from its matched
-//! form, to the target divided by `s`, so that after the scale it is centred on the target; the
-//! scale is then computed anew, at most [`SET_SCALE_ROUNDS`] times. A motion still outside the
-//! band after that is unmatched too.
+//! it there. When that pushes a motion above the upper bound, every motion not yet within half
+//! the tolerance is matched again, from its matched form, with half the tolerance (a tighter set
+//! needs a smaller scale), those pushed out to the target over `s` so that after the scale they
+//! lie around the target; the scale is then computed anew, and motions still pushed out are
+//! matched again likewise, at most [`SET_SCALE_ROUNDS`] rounds in all. A motion still outside
+//! the band after that (seen with sets of two motions, whose mean can need more scale than any
+//! re-match leaves room for) is kept and flagged: listed in `unmatched`, `all_within_band`
+//! false.
 
 use super::config::{MotionsConfig, Seeds, StudyConfig};
 use crate::motion::matching::{
@@ -273,8 +277,7 @@ pub fn match_zone(
         ..settings.clone()
     };
     let mut set_scale = set_scale_of(&matched);
-    let mut rounds = 0;
-    for _ in 0..SET_SCALE_ROUNDS {
+    for round in 0..SET_SCALE_ROUNDS {
         if !kept
             .iter()
             .any(|&i| matched[i].report.converged && above(&matched[i], set_scale))
@@ -283,8 +286,7 @@ pub fn match_zone(
         }
         // The first round tightens every motion not yet within half the tolerance (what lowers
         // the mean and so raises the scale), later ones the motions still pushed out.
-        let first = rounds == 0;
-        rounds += 1;
+        let first = round == 0;
         let out: Vec<usize> = kept
             .iter()
             .copied()
@@ -349,15 +351,6 @@ pub fn match_zone(
                 after_set_scale: true,
             });
         }
-    }
-    if !pushed_out.is_empty() && !cfg.allow_unmatched {
-        return Err(Unmatched {
-            zone: name.to_string(),
-            lower: settings.lower,
-            upper: settings.upper,
-            records: pushed_out,
-        }
-        .into());
     }
     unmatched.extend(pushed_out);
     let all_within_band = unmatched.is_empty();
