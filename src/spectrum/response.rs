@@ -16,8 +16,8 @@
 //! form (pieces of at most a quarter damped period, where `u̇` has at most one extremum, so no
 //! pair of zeros is missed).
 //!
-//! Four oscillators advance together in lanes so the recurrences overlap in the pipeline, and
-//! groups of four run in parallel.
+//! Eight oscillators advance together in lanes so the recurrences overlap in the pipeline, and
+//! groups of eight run in parallel.
 
 use crate::dynamics::closed_form::{Basis, Osc, Wave};
 use crate::limits::{DT_RANGE_S, MAX_SAMPLES, PERIOD_RANGE_S};
@@ -183,7 +183,7 @@ pub fn response_spectrum(
         validate_oscillator(t, damping)?;
     }
     let reach = reach_per_interval(accel_mps2, dt_s);
-    // Groups of four periods are independent: in parallel, the result does not depend on the
+    // Groups of eight periods are independent: in parallel, the result does not depend on the
     // thread count.
     let groups: Vec<Vec<Peak>> = periods_s
         .par_chunks(LANES)
@@ -223,7 +223,9 @@ pub fn sampled_peak(accel_mps2: &[f64], dt_s: f64, period_s: f64, damping: f64) 
     peak
 }
 
-const LANES: usize = 4;
+/// Oscillators advanced together: eight lanes are two AVX2 (four SSE2) registers, enough
+/// independent recurrences to hide the latency of one step.
+const LANES: usize = 8;
 
 /// `h·max(|a_g,k|, |a_g,k+1|)` per interval: how far `√E` can grow across it, m/s.
 fn reach_per_interval(accel: &[f64], h: f64) -> Vec<f64> {
@@ -233,7 +235,7 @@ fn reach_per_interval(accel: &[f64], h: f64) -> Vec<f64> {
         .collect()
 }
 
-/// Four oscillators of one damping ratio, advanced together.
+/// Oscillators of one damping ratio, advanced together.
 struct Lanes {
     omega: [f64; LANES],
     w2: [f64; LANES],
@@ -261,6 +263,25 @@ struct IntervalLoad {
 /// Relative slack on the bounds against round-off.
 const SLACK: f64 = 1.0 - 1e-10;
 
+/// `(u, v)` of every lane at every sample (m, m/s) and each lane's largest sampled `|u|` with
+/// its first sample.
+struct SampleStates {
+    u: Vec<[f64; LANES]>,
+    v: Vec<[f64; LANES]>,
+    best: [f64; LANES],
+    best_k: [usize; LANES],
+}
+
+/// `u` and `v` buffers of [`SampleStates`].
+type StateBuffers = (Vec<[f64; LANES]>, Vec<[f64; LANES]>);
+
+thread_local! {
+    /// The state buffers of the last spectrum computed on this thread, reused: every element
+    /// a spectrum reads is written first, so they need no zeroing.
+    static STATES: std::cell::Cell<StateBuffers> =
+        const { std::cell::Cell::new((Vec::new(), Vec::new())) };
+}
+
 impl Lanes {
     /// Whether lane `l`, at `(u0, v0)` at the start of an interval with ground acceleration
     /// `ag0 → ag1` and `reach = h·max|a_g|`, can exceed `peak` inside the interval. Two
@@ -285,110 +306,137 @@ impl Lanes {
         !(room > 0.0 && amp2 <= room * room * SLACK)
     }
 
-    /// The exact peaks: first the recurrence over the samples, storing the states and the
-    /// largest sampled `|u|`; then a sweep over the intervals in which only those whose bound
-    /// reaches the running peak are searched exactly. Starting the sweep from the sampled
-    /// peak (a lower bound of the true one, within `1 − cos(π·dt/T)`) keeps the exact search
-    /// to the few intervals around the largest excursions.
+    /// The exact peaks, in two passes over the samples. The first runs the recurrence, stores
+    /// the states and takes the largest sampled `|u|` of each lane (a lower bound of the true
+    /// peak, within `1 − cos(π·dt/T)`). The second keeps, with the energy bound of
+    /// [`Lanes::may_raise`] at that sampled peak (branch-free over the lanes), only the intervals
+    /// that can hold a larger `|u|`: the few around the largest excursions. Those face the end
+    /// tests (an interval can hold a larger `|u|` than its ends only if `u̇` vanishes inside,
+    /// which needs a sign change of `u̇` or of the relative acceleration at its ends, unless it
+    /// is longer than a quarter period) and both bounds at the running peak, and the survivors
+    /// are searched exactly. The energy test at the running peak is implied by the one at the
+    /// sampled peak, so the same intervals are searched as without the prefilter.
+    ///
+    /// Compiled twice: for AVX2 (chosen at run time where the processor has it) and for the
+    /// baseline. Neither contracts a multiply and an add, so both give the same bits.
     fn peaks(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor has AVX2 (checked just above).
+                return unsafe { self.peaks_avx2(accel, reach) };
+            }
+        }
+        self.peaks_generic(accel, reach)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn peaks_avx2(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
+        self.peaks_generic(accel, reach)
+    }
+
+    #[inline(always)]
+    fn peaks_generic(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
         let n = accel.len();
-        let states = self.sample_states(accel);
-        // The sampled peak of each lane and its first sample.
-        let mut best = [(0.0f64, 0usize); LANES];
-        for (l, b) in best.iter_mut().enumerate() {
-            for (k, (u, _)) in states.iter().enumerate() {
-                if u[l].abs() > b.0 {
-                    *b = (u[l].abs(), k);
-                }
-            }
-        }
-        let inv_h = 1.0 / self.h;
-        let mut peaks = [Peak {
-            sd_m: 0.0,
-            u_m: 0.0,
-            time_s: 0.0,
-        }; LANES];
-        for l in 0..LANES {
-            let (sd, k) = best[l];
-            peaks[l] = Peak {
-                sd_m: sd,
-                u_m: states[k].0[l],
+        let st = self.sample_states(accel);
+        let mut peaks: [Peak; LANES] = std::array::from_fn(|l| {
+            let k = st.best_k[l];
+            Peak {
+                sd_m: st.best[l],
+                u_m: st.u[k][l],
                 time_s: k as f64 * self.h,
-            };
-        }
-        // An interval can hold a larger |u| than its ends only if u̇ vanishes inside, which
-        // needs a sign change of u̇, or of the relative acceleration (u̇ then has an extremum and
-        // may cross zero twice), at its ends; unless it is longer than a quarter period, when
-        // those end tests say nothing. Those candidates then face the bounds of `may_raise`.
-        let two_zw = self.omega.map(|w| 2.0 * self.zeta * w);
-        let long = self.quarter.map(|q| self.h > q);
-        let rel_acc = |k: usize, l: usize| {
-            let (u, v) = (states[k].0[l], states[k].1[l]);
-            -accel[k] - self.w2[l] * u - two_zw[l] * v
-        };
-        let mut a0 = [0.0f64; LANES];
-        for (l, a) in a0.iter_mut().enumerate() {
-            *a = rel_acc(0, l);
-        }
-        for k in 0..n - 1 {
-            let ((u0, v0), (u1, v1)) = (states[k], states[k + 1]);
-            let mut a1 = [0.0f64; LANES];
-            let mut candidate = false;
-            for l in 0..LANES {
-                a1[l] = -accel[k + 1] - self.w2[l] * u1[l] - two_zw[l] * v1[l];
-                candidate |= long[l] || v0[l] * v1[l] <= 0.0 || a0[l] * a1[l] <= 0.0;
             }
-            if candidate {
-                let (ag0, ag1) = (accel[k], accel[k + 1]);
-                let load = IntervalLoad {
-                    ag0,
-                    ag1,
-                    slope: (ag0 - ag1) * inv_h,
-                    reach: reach[k],
-                };
-                for l in 0..LANES {
-                    let sign_change = long[l] || v0[l] * v1[l] <= 0.0 || a0[l] * a1[l] <= 0.0;
-                    if sign_change && self.may_raise(l, peaks[l].sd_m, (u0[l], v0[l]), &load) {
-                        self.search(
-                            l,
-                            k,
-                            (u0[l], v0[l]),
-                            (u1[l], v1[l]),
-                            (ag0, ag1),
-                            &mut peaks[l],
-                        );
-                    }
+        });
+        let omega_peak: [f64; LANES] = std::array::from_fn(|l| self.omega[l] * st.best[l]);
+        let two_zw = self.omega.map(|w| 2.0 * self.zeta * w);
+        let inv_h = 1.0 / self.h;
+        for k in 0..n - 1 {
+            let (u0, v0) = (&st.u[k], &st.v[k]);
+            let mut any = false;
+            for l in 0..LANES {
+                let e = self.w2[l] * u0[l] * u0[l] + v0[l] * v0[l];
+                let room = omega_peak[l] - reach[k];
+                any |= !(room > 0.0 && e <= room * room * SLACK);
+            }
+            if !any {
+                continue;
+            }
+            let (u1, v1) = (&st.u[k + 1], &st.v[k + 1]);
+            let (ag0, ag1) = (accel[k], accel[k + 1]);
+            let load = IntervalLoad {
+                ag0,
+                ag1,
+                slope: (ag0 - ag1) * inv_h,
+                reach: reach[k],
+            };
+            for l in 0..LANES {
+                let a0 = -ag0 - self.w2[l] * u0[l] - two_zw[l] * v0[l];
+                let a1 = -ag1 - self.w2[l] * u1[l] - two_zw[l] * v1[l];
+                let sign_change =
+                    self.h > self.quarter[l] || v0[l] * v1[l] <= 0.0 || a0 * a1 <= 0.0;
+                if sign_change && self.may_raise(l, peaks[l].sd_m, (u0[l], v0[l]), &load) {
+                    self.search(
+                        l,
+                        k,
+                        (u0[l], v0[l]),
+                        (u1[l], v1[l]),
+                        (ag0, ag1),
+                        &mut peaks[l],
+                    );
                 }
             }
-            a0 = a1;
         }
+        STATES.set((st.u, st.v));
         peaks
     }
 
-    /// `(u, v)` of every lane at every sample: the recurrence, with the coefficients laid out
-    /// lane by lane so the four updates run side by side.
-    #[inline(never)]
-    fn sample_states(&self, accel: &[f64]) -> Vec<([f64; LANES], [f64; LANES])> {
+    /// The recurrence over the samples, with the coefficients laid out lane by lane so the
+    /// updates of all lanes run side by side, and the largest sampled `|u|` of each lane (its
+    /// first sample on ties).
+    #[inline(always)]
+    fn sample_states(&self, accel: &[f64]) -> SampleStates {
         let c = |f: fn(&NjStep) -> f64| self.steps.map(|s| f(&s));
         let (uu, uv, ug0, ug1) = (c(|s| s.uu), c(|s| s.uv), c(|s| s.ug0), c(|s| s.ug1));
         let (vu, vv, vg0, vg1) = (c(|s| s.vu), c(|s| s.vv), c(|s| s.vg0), c(|s| s.vg1));
-        let mut states = Vec::with_capacity(accel.len());
+        let (mut us, mut vs) = STATES.take();
+        us.resize(accel.len(), [0.0; LANES]);
+        vs.resize(accel.len(), [0.0; LANES]);
+        us[0] = [0.0; LANES];
+        vs[0] = [0.0; LANES];
         let (mut u, mut v) = ([0.0f64; LANES], [0.0f64; LANES]);
-        states.push((u, v));
-        for w in accel.windows(2) {
+        let mut best = [0.0f64; LANES];
+        let mut best_k = [0.0f64; LANES];
+        for (k, ((w, us), vs)) in accel
+            .windows(2)
+            .zip(&mut us[1..])
+            .zip(&mut vs[1..])
+            .enumerate()
+        {
             let (ag0, ag1) = (w[0], w[1]);
+            let kf = (k + 1) as f64;
             for l in 0..LANES {
                 let (u0, v0) = (u[l], v[l]);
                 u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * ag0 + ug1[l] * ag1;
                 v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * ag0 + vg1[l] * ag1;
+                let raised = u[l].abs() > best[l];
+                best[l] = if raised { u[l].abs() } else { best[l] };
+                best_k[l] = if raised { kf } else { best_k[l] };
             }
-            states.push((u, v));
+            *us = u;
+            *vs = v;
         }
-        states
+        SampleStates {
+            u: us,
+            v: vs,
+            best,
+            best_k: best_k.map(|k| k as usize),
+        }
     }
 
     /// Exact search of interval `k` of lane `l` for a `|u|` above `peak`.
     #[cold]
+    #[inline(never)]
     fn search(
         &self,
         l: usize,

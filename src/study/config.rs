@@ -13,6 +13,7 @@
 //!   #   records: { files: [a.AT2, b.AT2], units: g, dt_s: 0.01 }
 //!   matching: { passes: [10, 25, 50] }           # MatchSettings keys, defaults for the rest
 //!   set_mean_min: 1.0              # the set's mean spectrum / target must not fall below this
+//!   allow_unmatched: false         # true: keep motions outside the band, flagged
 //! ```
 
 use super::sweep::{DampingBasis, Physics};
@@ -141,6 +142,10 @@ pub struct MotionsConfig {
     /// (ASCE 7-16 asks 0.9; the study's default is 1.0).
     #[serde(default = "one")]
     pub set_mean_min: f64,
+    /// Keep a motion that does not meet the matching acceptance (or leaves the band once the
+    /// set is scaled), flagged in the report, instead of refusing the stage.
+    #[serde(default)]
+    pub allow_unmatched: bool,
 }
 
 fn one() -> f64 {

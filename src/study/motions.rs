@@ -1,17 +1,32 @@
 //! The motions stage: seed motions (stochastic or records), matched to each zone's target, and
 //! the checks on the set.
 //!
-//! A seed that does not meet the matching acceptance is reported and left out of the zone. The
-//! set's mean spectrum must not fall below `set_mean_min` of the target on the check grid: when
-//! it does, the kept motions are scaled up together by the smallest factor that lifts it there,
-//! and `all_within_band` says whether every motion still meets the upper bound afterwards.
+//! A seed that does not meet the matching acceptance is an [`Unmatched`] result naming it, its
+//! worst check period and ratio and the iterations spent, unless the config says
+//! `allow_unmatched: true`: then it is kept with its misfit and flagged (`converged` false in
+//! its report). Stochastic seeds are matched in order until `count` are accepted, spares
+//! replacing the seeds that are not; only when the spares run out is that unmatched.
+//!
+//! The set's mean spectrum must not fall below `set_mean_min` of the target on the check grid:
+//! when it does, the kept motions are scaled up together by the smallest factor `s` that lifts
+//! it there. When that pushes a motion above the upper bound, every motion not yet within half
+//! the tolerance is matched again, from its matched form, with half the tolerance (a tighter set
+//! needs a smaller scale), those pushed out to the target over `s` so that after the scale they
+//! lie around the target; the scale is then computed anew, and motions still pushed out are
+//! matched again likewise, at most [`SET_SCALE_ROUNDS`] rounds in all. A motion still outside
+//! the band after that (seen with sets of two motions, whose mean can need more scale than any
+//! re-match leaves room for) is kept and flagged: listed in `unmatched`, `all_within_band`
+//! false.
 
 use super::config::{MotionsConfig, Seeds, StudyConfig};
-use crate::motion::matching::{MatchError, MatchReport, match_record};
+use crate::motion::matching::{
+    MatchError, MatchReport, MatchSettings, Matched, match_record, match_record_scaled,
+};
 use crate::motion::stochastic::StochasticError;
 use crate::motion::{Record, RecordError, read_record_with};
 use crate::spectrum::TargetSpectrum;
 use rayon::prelude::*;
+use std::fmt;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -20,6 +35,76 @@ pub enum SeedError {
     Record(#[from] RecordError),
     #[error("stochastic seeds: {0}")]
     Stochastic(#[from] StochasticError),
+}
+
+/// Rounds of re-matching motions that the set scale pushed out of the band.
+pub const SET_SCALE_ROUNDS: usize = 3;
+
+/// One motion that does not meet the acceptance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnmatchedRecord {
+    pub name: String,
+    /// Check period of the largest misfit, s, and spectrum/target there (after the set scale
+    /// when `after_set_scale`).
+    pub worst_period_s: f64,
+    pub worst_ratio: f64,
+    pub iterations: usize,
+    /// Outside the band only once the set scale was applied.
+    pub after_set_scale: bool,
+}
+
+impl fmt::Display for UnmatchedRecord {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}: PSA/target {:.3} at {:.3} s{} after {} iterations",
+            self.name,
+            self.worst_ratio,
+            self.worst_period_s,
+            if self.after_set_scale {
+                " once the set is scaled"
+            } else {
+                ""
+            },
+            self.iterations
+        )
+    }
+}
+
+/// Motions of a zone that do not meet the acceptance `[lower, upper]`, and the config does not
+/// allow them.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub struct Unmatched {
+    pub zone: String,
+    pub lower: f64,
+    pub upper: f64,
+    pub records: Vec<UnmatchedRecord>,
+}
+
+impl fmt::Display for Unmatched {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "zone {}: {} motion(s) not within [{}, {}] of the target at every check period \
+             (set `motions.allow_unmatched: true` to keep them, flagged): ",
+            self.zone,
+            self.records.len(),
+            self.lower,
+            self.upper
+        )?;
+        for (i, r) in self.records.iter().enumerate() {
+            write!(f, "{}{r}", if i > 0 { "; " } else { "" })?;
+        }
+        Ok(())
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum MotionsError {
+    #[error(transparent)]
+    Match(#[from] MatchError),
+    #[error(transparent)]
+    Unmatched(#[from] Unmatched),
 }
 
 /// The seed motions of a study, in configuration order.
@@ -51,7 +136,8 @@ pub struct ZoneMotions {
     /// each.
     pub seeds: Vec<String>,
     pub reports: Vec<MatchReport>,
-    /// Indices (into `seeds`) of the motions kept.
+    /// Indices (into `seeds`) of the motions kept: the accepted ones, and with
+    /// `allow_unmatched` the others needed (their reports say `converged: false`).
     pub kept: Vec<usize>,
     /// The kept motions, after the set scale.
     pub motions: Vec<Record>,
@@ -67,6 +153,30 @@ pub struct ZoneMotions {
     pub asce7_ok: bool,
     /// Every kept motion within `[lower, upper]` after the set scale.
     pub all_within_band: bool,
+    /// The kept motions that are not (flagged; empty unless `allow_unmatched`).
+    pub unmatched: Vec<UnmatchedRecord>,
+}
+
+/// The mean over `psa` (motions × periods) per period.
+fn mean(psa: &[Vec<f64>], periods: usize) -> Vec<f64> {
+    (0..periods)
+        .map(|p| psa.iter().map(|s| s[p]).sum::<f64>() / psa.len().max(1) as f64)
+        .collect()
+}
+
+/// `(index, ratio)` of the largest `|ratio − 1|` of `psa·scale` against `target`.
+fn worst(psa: &[f64], scale: f64, target: &[f64]) -> (usize, f64) {
+    psa.iter()
+        .zip(target)
+        .map(|(a, q)| a * scale / q)
+        .enumerate()
+        .fold((0, 1.0), |w, (i, r)| {
+            if (r - 1.0).abs() > (w.1 - 1.0f64).abs() {
+                (i, r)
+            } else {
+                w
+            }
+        })
 }
 
 /// Matches every seed to `target` (in parallel; the result does not depend on the thread count)
@@ -76,7 +186,7 @@ pub fn match_zone(
     target: &TargetSpectrum,
     seeds: &[Record],
     cfg: &MotionsConfig,
-) -> Result<ZoneMotions, MatchError> {
+) -> Result<ZoneMotions, MotionsError> {
     let settings = &cfg.matching;
     let periods_s = settings.check_grid_s();
     let target_psa_g: Vec<f64> = periods_s.iter().map(|&t| target.sa_g(t)).collect();
@@ -86,12 +196,9 @@ pub fn match_zone(
     };
     // Seeds are matched in order, a batch at a time, until `wanted` are accepted: spares are
     // only matched when needed, and which seeds are tried does not depend on the thread count.
-    let mut matched = Vec::new();
+    let mut matched: Vec<Matched> = Vec::new();
     loop {
-        let accepted = matched
-            .iter()
-            .filter(|m: &&crate::motion::matching::Matched| m.report.converged)
-            .count();
+        let accepted = matched.iter().filter(|m| m.report.converged).count();
         if accepted >= wanted || matched.len() == seeds.len() {
             break;
         }
@@ -104,42 +211,149 @@ pub fn match_zone(
         matched.extend(batch);
     }
     let seeds = &seeds[..matched.len()];
-    let kept: Vec<usize> = (0..seeds.len())
+    let unmatched_record = |i: usize, m: &Matched| UnmatchedRecord {
+        name: seeds[i].name.clone(),
+        worst_period_s: m.report.worst_period_s,
+        worst_ratio: m.report.worst_ratio,
+        iterations: m.report.iterations,
+        after_set_scale: false,
+    };
+    let mut kept: Vec<usize> = (0..seeds.len())
         .filter(|&i| matched[i].report.converged)
         .take(wanted)
         .collect();
+    let mut unmatched: Vec<UnmatchedRecord> = Vec::new();
+    if kept.len() < wanted {
+        let short: Vec<usize> = (0..seeds.len())
+            .filter(|&i| !matched[i].report.converged)
+            .take(wanted - kept.len())
+            .collect();
+        unmatched = short
+            .iter()
+            .map(|&i| unmatched_record(i, &matched[i]))
+            .collect();
+        if !cfg.allow_unmatched {
+            return Err(Unmatched {
+                zone: name.to_string(),
+                lower: settings.lower,
+                upper: settings.upper,
+                records: unmatched,
+            }
+            .into());
+        }
+        kept.extend(short);
+        kept.sort_unstable();
+    }
+
     let n = periods_s.len();
-    let mean = |psa: &[Vec<f64>]| -> Vec<f64> {
-        (0..n)
-            .map(|p| psa.iter().map(|s| s[p]).sum::<f64>() / psa.len().max(1) as f64)
-            .collect()
-    };
-    let mut psa_g: Vec<Vec<f64>> = kept
-        .iter()
-        .map(|&i| matched[i].check_psa_g.clone())
-        .collect();
     let ratio_min = |m: &[f64]| {
         m.iter()
             .zip(&target_psa_g)
             .map(|(a, q)| a / q)
             .fold(f64::INFINITY, f64::min)
     };
-    let before = ratio_min(&mean(&psa_g));
-    let set_scale = if kept.is_empty() {
-        1.0
-    } else {
-        (cfg.set_mean_min / before).max(1.0)
+    let set_scale_of = |matched: &[Matched]| {
+        if kept.is_empty() {
+            return 1.0;
+        }
+        let psa: Vec<Vec<f64>> = kept
+            .iter()
+            .map(|&i| matched[i].check_psa_g.clone())
+            .collect();
+        (cfg.set_mean_min / ratio_min(&mean(&psa, n))).max(1.0)
     };
-    psa_g
-        .iter_mut()
-        .for_each(|s| s.iter_mut().for_each(|v| *v *= set_scale));
-    let mean_psa_g = mean(&psa_g);
-    let mean_ratio_min = ratio_min(&mean_psa_g);
-    let all_within_band = psa_g.iter().all(|s| {
-        s.iter()
+    let above = |m: &Matched, scale: f64| {
+        m.check_psa_g
+            .iter()
             .zip(&target_psa_g)
-            .all(|(a, q)| a / q >= settings.lower && a / q <= settings.upper * (1.0 + 1e-12))
-    });
+            .any(|(a, q)| a * scale / q > settings.upper * (1.0 + 1e-12))
+    };
+    // A motion matched again is aimed at the target after the scale, with half the tolerance
+    // (and fallbacks above half the room to the bound): what the scale may still add when the
+    // set is scaled anew stays inside the band.
+    let tight = MatchSettings {
+        tolerance: 0.5 * settings.tolerance,
+        retry_misfit: 0.5 * settings.tolerance + 0.25 * (settings.upper - 1.0),
+        ..settings.clone()
+    };
+    let mut set_scale = set_scale_of(&matched);
+    for round in 0..SET_SCALE_ROUNDS {
+        if !kept
+            .iter()
+            .any(|&i| matched[i].report.converged && above(&matched[i], set_scale))
+        {
+            break;
+        }
+        // The first round tightens every motion not yet within half the tolerance (what lowers
+        // the mean and so raises the scale), later ones the motions still pushed out.
+        let first = round == 0;
+        let out: Vec<usize> = kept
+            .iter()
+            .copied()
+            .filter(|&i| {
+                let m = &matched[i];
+                m.report.converged
+                    && if first {
+                        m.report.worst_misfit > tight.tolerance || above(m, set_scale)
+                    } else {
+                        above(m, set_scale)
+                    }
+            })
+            .collect();
+        let again = out
+            .par_iter()
+            .map(|&i| {
+                let m = &matched[i];
+                let factor = m.report.target_factor / set_scale;
+                match_record_scaled(&m.accel_g, seeds[i].dt_s, target, factor, &tight)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        for (&i, mut m) in out.iter().zip(again) {
+            let old = &matched[i].report;
+            m.report.scale *= old.scale;
+            m.report.iterations += old.iterations;
+            m.report.attempts += old.attempts;
+            m.report.stalls += old.stalls;
+            m.report.pga_before_g = old.pga_before_g;
+            m.report.arias_ratio *= old.arias_ratio;
+            // Kept only if it still meets the band against its own (scaled) target.
+            if m.report.converged {
+                matched[i] = m;
+            }
+        }
+        set_scale = set_scale_of(&matched);
+    }
+
+    let psa_g: Vec<Vec<f64>> = kept
+        .iter()
+        .map(|&i| {
+            matched[i]
+                .check_psa_g
+                .iter()
+                .map(|v| v * set_scale)
+                .collect()
+        })
+        .collect();
+    let mean_psa_g = mean(&psa_g, n);
+    let mean_ratio_min = ratio_min(&mean_psa_g);
+    let mut pushed_out = Vec::new();
+    for (k, &i) in kept.iter().enumerate() {
+        let in_band = psa_g[k].iter().zip(&target_psa_g).all(|(a, q)| {
+            a / q >= settings.lower * (1.0 - 1e-12) && a / q <= settings.upper * (1.0 + 1e-12)
+        });
+        if !in_band && matched[i].report.converged {
+            let (w, r) = worst(&matched[i].check_psa_g, set_scale, &target_psa_g);
+            pushed_out.push(UnmatchedRecord {
+                name: seeds[i].name.clone(),
+                worst_period_s: periods_s[w],
+                worst_ratio: r,
+                iterations: matched[i].report.iterations,
+                after_set_scale: true,
+            });
+        }
+    }
+    unmatched.extend(pushed_out);
+    let all_within_band = unmatched.is_empty();
     let motions = kept
         .iter()
         .map(|&i| Record {
@@ -163,6 +377,7 @@ pub fn match_zone(
         set_mean_ok: mean_ratio_min >= cfg.set_mean_min * (1.0 - 1e-12),
         asce7_ok: mean_ratio_min >= 0.9,
         all_within_band,
+        unmatched,
         periods_s,
     })
 }
