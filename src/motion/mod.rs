@@ -1,10 +1,11 @@
 //! Ground-motion records: readers and writer ([`record`]), processing ([`process`]), spectral
-//! matching ([`matching`]), built-in stochastic motions ([`stochastic`]) and the built-in default
-//! motion.
+//! matching ([`matching`]) and the matched set ([`set`]), built-in stochastic motions
+//! ([`stochastic`]) and the built-in default motion.
 
 pub mod matching;
 pub mod process;
 pub mod record;
+pub mod set;
 pub mod stochastic;
 
 pub use process::{BaselineCorrection, ProcessError};

@@ -23,7 +23,7 @@ use super::h5::{
 use super::{H5Context, StoreError};
 use crate::motion::Record;
 use crate::motion::matching::MatchReport;
-use crate::study::motions::ZoneMotions;
+use crate::motion::set::ZoneMotions;
 use std::path::Path;
 
 /// Provenance written on the file.
