@@ -59,7 +59,7 @@ fn fit_stage_on_the_quick_study() {
             assert_eq!(f.all_cases.n, z.cases);
             assert_eq!(f.cross_validated.n, z.cases);
             assert!(f.all_cases.r2.is_finite() && f.cross_validated.r2.is_finite());
-            assert!(f.all_cases.rmse >= 0.0 && f.residual_std_s >= 0.0);
+            assert!(f.all_cases.rmse >= 0.0 && f.residual_std >= 0.0);
             assert_eq!(f.cv_solvers.len(), 5);
             assert!(f.solver.relative_offset.is_finite(), "{:?}", f.solver);
             // Corners (2⁵) and the quasi-random points.

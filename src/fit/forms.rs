@@ -75,17 +75,36 @@ impl Form {
         matches!(self, Form::Bounded | Form::Damped)
     }
 
+    /// What the least squares minimise, for people.
+    pub fn objective(self) -> &'static str {
+        match self {
+            Form::Paper | Form::Bounded => "sum of squared errors of T_new (s²)",
+            Form::Damped => "sum of squared errors of T_new/T_p (weights 1/T_p)",
+        }
+    }
+
+    /// The weight of a case of bare period `t_p_s` in the least squares: 1, or `1/T_p` for
+    /// [`Form::Damped`] (errors of `T_new/T_p`).
+    pub fn weight(self, t_p_s: f64) -> f64 {
+        match self {
+            Form::Paper | Form::Bounded => 1.0,
+            Form::Damped => 1.0 / t_p_s,
+        }
+    }
+
     /// Parameters for `k` features.
     pub fn parameter_count(self, k: usize) -> usize {
         match self {
-            Form::Paper | Form::Damped => 2 * k + 2,
+            Form::Paper => 2 * k + 2,
             Form::Bounded => k + 1,
+            Form::Damped => 2 * k + 4,
         }
     }
 
     /// Names of the parameters, in [`crate::fit::Fitted::params`] order: paper
     /// `a_1 … a_k, c_1 … c_k, B, e`; bounded `w_1 … w_k, w_0`; damped
-    /// `w_1 … w_k, w_0, v_1 … v_k, v_0` (weights of `ln x`).
+    /// `w_ln_1 … w_ln_k, w_ln_T_p_sq, w_0, v_ln_1 … v_ln_k, v_ln_T_p_sq, v_0` (weights of `ln x`
+    /// and of `(ln T_p)²`).
     pub fn parameter_names(self, features: &[String]) -> Vec<String> {
         let each = |prefix: &str, log: bool| -> Vec<String> {
             features
@@ -112,27 +131,26 @@ impl Form {
                 v
             }
             Form::Damped => {
+                let square = format!("ln_{}_sq", features.first().map_or("T_p", |f| f));
                 let mut v = each("w", true);
-                v.push("w_0".into());
+                v.extend([format!("w_{square}"), "w_0".into()]);
                 v.extend(each("v", true));
-                v.push("v_0".into());
+                v.extend([format!("v_{square}"), "v_0".into()]);
                 v
             }
         }
     }
 
-    /// Whether the form's regressors are the logarithms of the features.
-    fn logarithmic(self) -> bool {
-        matches!(self, Form::Damped)
-    }
-
-    /// The regressors of the linear predictors for features `x`: `x` itself, or `ln x`
-    /// ([`Form::Damped`]; NaN or −∞ where a feature is not positive).
+    /// The regressors of the linear predictors for features `x`: `x` itself, or
+    /// `(ln x, (ln T_p)²)` for [`Form::Damped`] (NaN or −∞ where a feature is not positive).
     pub fn regressors(self, x: &[f64]) -> Vec<f64> {
-        if self.logarithmic() {
-            x.iter().map(|v| v.ln()).collect()
-        } else {
-            x.to_vec()
+        match self {
+            Form::Paper | Form::Bounded => x.to_vec(),
+            Form::Damped => {
+                let mut z: Vec<f64> = x.iter().map(|v| v.ln()).collect();
+                z.push(z[0] * z[0]);
+                z
+            }
         }
     }
 
@@ -198,9 +216,9 @@ impl Form {
         self.evaluate(p, &self.regressors(&s.x), s.t_p_s(), s.t_rigid_s, None)
     }
 
-    /// Where the solver starts, for `k` features (each start is run, the best kept; see
-    /// `docs/fit.md`). The paper form's starts are completed from the data by
-    /// [`crate::fit::problem`] (its linear parameters by least squares).
+    /// Where the solver starts, for `k` features (each start is probed, the best run to
+    /// convergence; see `docs/fit.md`). The paper form's linear parameters are then filled in
+    /// by least squares.
     pub fn starts(self, k: usize) -> Vec<Vec<f64>> {
         match self {
             // Exponent weights only (`c`, all features alike); the rest is filled in.
@@ -228,9 +246,9 @@ impl Form {
             ]
             .iter()
             .map(|&(w0, v0)| {
-                let mut p = vec![0.0; 2 * k + 2];
-                p[k] = w0;
-                p[2 * k + 1] = v0;
+                let mut p = vec![0.0; 2 * k + 4];
+                p[k + 1] = w0;
+                p[2 * k + 3] = v0;
                 p
             })
             .collect(),

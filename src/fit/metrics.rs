@@ -6,7 +6,9 @@ use super::{FitError, Fitted, Sample};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-/// Goodness of fit (paper Table 3). `rmse`, `mae` in s, `mse` in s².
+/// Goodness of fit (paper Table 3). `rmse`, `mae` in s, `mse` in s²; the relative errors are
+/// fractions of the computed `T_new` (not in Table 3: they show how a form does at short
+/// periods, where errors of a few hundredths of a second are large).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     pub r2: f64,
@@ -15,6 +17,16 @@ pub struct Metrics {
     pub mse: f64,
     pub mae: f64,
     pub n: usize,
+    /// Root mean square of `(predicted − observed)/observed`.
+    #[serde(default = "nan")]
+    pub relative_rmse: f64,
+    /// Largest `|predicted − observed|/observed`.
+    #[serde(default = "nan")]
+    pub max_relative_error: f64,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 impl Default for Metrics {
@@ -26,6 +38,8 @@ impl Default for Metrics {
             mse: f64::NAN,
             mae: f64::NAN,
             n: 0,
+            relative_rmse: f64::NAN,
+            max_relative_error: f64::NAN,
         }
     }
 }
@@ -37,7 +51,11 @@ pub fn metrics(observed: &[f64], predicted: &[f64]) -> Metrics {
     let mo = observed.iter().sum::<f64>() / n;
     let mp = predicted.iter().sum::<f64>() / n;
     let (mut ss_res, mut ss_tot, mut abs, mut cov, mut vp) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut ss_rel, mut max_rel) = (0.0, 0.0f64);
     for (o, p) in observed.iter().zip(predicted) {
+        let rel = (p - o) / o;
+        ss_rel += rel * rel;
+        max_rel = max_rel.max(rel.abs());
         ss_res += (o - p).powi(2);
         ss_tot += (o - mo).powi(2);
         abs += (o - p).abs();
@@ -52,6 +70,8 @@ pub fn metrics(observed: &[f64], predicted: &[f64]) -> Metrics {
         mse,
         mae: abs / n,
         n: observed.len(),
+        relative_rmse: (ss_rel / n).sqrt(),
+        max_relative_error: max_rel,
     }
 }
 
@@ -66,8 +86,9 @@ pub const SINGULAR_CONDITION: f64 = 1e10;
 pub struct Uncertainty {
     /// `√diag(s²·(JᵀJ)⁻¹)`, same units as the parameters; NaN where `JᵀJ` is singular.
     pub standard_errors: Vec<f64>,
-    /// `s = √(SSE/(n − p))`, s.
-    pub residual_std_s: f64,
+    /// `s = √(SSE/(n − p))` of the (weighted) residuals: s, or a fraction of `T_p` for a form
+    /// fitted to `T_new/T_p`.
+    pub residual_std: f64,
     /// Condition number of the Jacobian with its columns scaled to unit norm (∞ when a column
     /// is zero).
     pub condition_number: f64,
@@ -84,7 +105,7 @@ pub fn standard_errors(j: &DMatrix<f64>, sse: f64) -> Uncertainty {
     let norms: Vec<f64> = (0..p).map(|c| j.column(c).norm()).collect();
     let nan = |cond: f64| Uncertainty {
         standard_errors: vec![f64::NAN; p],
-        residual_std_s: s2.sqrt(),
+        residual_std: s2.sqrt(),
         condition_number: cond,
     };
     if norms.iter().any(|v| !(v.is_finite() && *v > 0.0)) || dof == 0 {
@@ -110,12 +131,13 @@ pub fn standard_errors(j: &DMatrix<f64>, sse: f64) -> Uncertainty {
         .collect();
     Uncertainty {
         standard_errors,
-        residual_std_s: s2.sqrt(),
+        residual_std: s2.sqrt(),
         condition_number: cond,
     }
 }
 
-/// The uncertainty of `fitted` on `data` (the Jacobian at its parameters).
+/// The uncertainty of `fitted` on `data` (the Jacobian of the weighted residuals at its
+/// parameters: for weights `1/T_p` the covariance of a fit whose errors scale with `T_p`).
 pub fn uncertainty(fitted: &Fitted, data: &[Sample]) -> Result<Uncertainty, FitError> {
     let problem = Problem::new(fitted.form, data)?;
     let j = problem.jacobian(&fitted.params);
@@ -135,6 +157,9 @@ mod tests {
         // Pearson r of (1,2,3) and (1,2,4): Σ products of deviations 3, sums of squares 2 and
         // 14/3 → 3/sqrt(2·14/3).
         assert!((m.r - 3.0 / (2.0f64 * 14.0 / 3.0).sqrt()).abs() < 1e-15);
+        // Relative errors 0, 0, 1/3.
+        assert!((m.max_relative_error - 1.0 / 3.0).abs() < 1e-15);
+        assert!((m.relative_rmse - (1.0f64 / 27.0).sqrt()).abs() < 1e-15);
     }
 
     #[test]
@@ -164,7 +189,7 @@ mod tests {
         let se_b = s / sxx.sqrt();
         assert!((u.standard_errors[0] / se_a - 1.0).abs() < 1e-12, "{u:?}");
         assert!((u.standard_errors[1] / se_b - 1.0).abs() < 1e-12, "{u:?}");
-        assert!((u.residual_std_s / s - 1.0).abs() < 1e-14);
+        assert!((u.residual_std / s - 1.0).abs() < 1e-14);
     }
 
     #[test]

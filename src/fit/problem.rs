@@ -1,6 +1,7 @@
-//! One form against one data set as a nonlinear least-squares problem: residuals
-//! `r_i = T_new,i(p) − T_new,i` (s), their sum of squares, the Jacobian `J = ∂r/∂p` from the
-//! form's analytic derivatives, and the Gauss–Newton normal equations `Jᵀr`, `JᵀJ`.
+//! One form against one data set as a nonlinear least-squares problem: weighted residuals
+//! `r_i = w_i·(T_new,i(p) − T_new,i)` (`w_i` of [`Form::weight`]: 1, or `1/T_p` for a fit of
+//! `T_new/T_p`), their sum of squares, the Jacobian `J = ∂r/∂p` from the form's analytic
+//! derivatives, and the Gauss–Newton normal equations `Jᵀr`, `JᵀJ`.
 //!
 //! The argmin adapter ([`Scaled`]) poses it in scaled parameters `q_j = d_j·p_j`, `d_j` the
 //! root mean square of Jacobian column `j` at the start: a unit step in any `q_j` then moves the
@@ -19,12 +20,16 @@ pub(crate) struct Problem {
     pub k: usize,
     /// Parameters.
     pub m: usize,
-    /// Regressors, `n × k` row-major ([`Form::regressors`]).
+    /// Regressors per case ([`Form::regressors`]).
+    width: usize,
+    /// Regressors, `n × width` row-major.
     z: Vec<f64>,
     t_p_s: Vec<f64>,
     t_rigid_s: Vec<f64>,
     /// Computed `T_new`, s.
     y: Vec<f64>,
+    /// Weight of each case ([`Form::weight`]).
+    w: Vec<f64>,
 }
 
 /// `Jᵀr`, `JᵀJ` (`m × m`, row-major) and the sum of squared residuals (s²) at one point.
@@ -47,7 +52,8 @@ impl Problem {
                 needed: 3 * m.max(1),
             });
         }
-        let mut z = Vec::with_capacity(data.len() * k);
+        let width = form.regressors(&data[0].x).len();
+        let mut z = Vec::with_capacity(data.len() * width);
         for s in data {
             if s.x.len() != k {
                 return Err(FitError::Features {
@@ -72,10 +78,12 @@ impl Problem {
             form,
             k,
             m,
+            width,
             z,
             t_p_s: data.iter().map(Sample::t_p_s).collect(),
             t_rigid_s: data.iter().map(|s| s.t_rigid_s).collect(),
             y: data.iter().map(|s| s.t_new_s).collect(),
+            w: data.iter().map(|s| form.weight(s.t_p_s())).collect(),
         })
     }
 
@@ -85,17 +93,34 @@ impl Problem {
     }
 
     fn row(&self, i: usize) -> &[f64] {
-        &self.z[i * self.k..(i + 1) * self.k]
+        &self.z[i * self.width..(i + 1) * self.width]
     }
 
-    /// Residual of case `i`, s; with `grad`, its row of the Jacobian.
+    /// Weighted residual of case `i`; with `grad`, its row of the Jacobian.
     fn residual(&self, p: &[f64], i: usize, grad: Option<&mut [f64]>) -> f64 {
-        self.form
-            .evaluate(p, self.row(i), self.t_p_s[i], self.t_rigid_s[i], grad)
-            - self.y[i]
+        let w = self.w[i];
+        match grad {
+            Some(g) => {
+                let t = self.form.evaluate(
+                    p,
+                    self.row(i),
+                    self.t_p_s[i],
+                    self.t_rigid_s[i],
+                    Some(&mut *g),
+                );
+                g.iter_mut().for_each(|v| *v *= w);
+                w * (t - self.y[i])
+            }
+            None => {
+                w * (self
+                    .form
+                    .evaluate(p, self.row(i), self.t_p_s[i], self.t_rigid_s[i], None)
+                    - self.y[i])
+            }
+        }
     }
 
-    /// Sum of squared residuals, s² (`+∞` when not finite).
+    /// Sum of squared weighted residuals (`+∞` when not finite).
     pub fn sse(&self, p: &[f64]) -> f64 {
         let s: f64 = (0..self.n())
             .map(|i| self.residual(p, i, None).powi(2))
@@ -146,10 +171,16 @@ impl Problem {
         (j, r)
     }
 
-    /// A sum of squares at or below this is an exact fit: residuals of 1e-12 of the data's root
-    /// mean square, a few hundred ulps of each `T_new`.
+    /// A sum of squares at or below this is an exact fit: weighted residuals of 1e-12 of the
+    /// weighted data's root mean square, a few hundred ulps of each `T_new`.
     pub fn round_off_sse(&self) -> f64 {
-        let mean_square = self.y.iter().map(|v| v * v).sum::<f64>() / self.n() as f64;
+        let mean_square = self
+            .y
+            .iter()
+            .zip(&self.w)
+            .map(|(y, w)| (w * y).powi(2))
+            .sum::<f64>()
+            / self.n() as f64;
         self.n() as f64 * 1e-24 * mean_square
     }
 
@@ -170,15 +201,16 @@ impl Problem {
         let cols = k + 2;
         let a = DMatrix::from_fn(self.n(), cols, |i, j| {
             let z = self.row(i);
-            if j < k {
+            let v = if j < k {
                 z[j]
             } else if j == k {
                 z.iter().zip(c).map(|(x, w)| x * w).sum::<f64>().exp()
             } else {
                 1.0
-            }
+            };
+            v * self.w[i]
         });
-        let y = DVector::from_column_slice(&self.y);
+        let y = DVector::from_iterator(self.n(), self.y.iter().zip(&self.w).map(|(y, w)| y * w));
         let theta = a
             .svd(true, true)
             .solve(&y, 1e-12)

@@ -255,6 +255,13 @@ pub(crate) fn solve(
     let mut best: Option<(Vec<f64>, f64, bool)> = None;
     let mut iterations = 0;
     for start in starts {
+        if start.len() != problem.m {
+            return Err(FitError::Solver(format!(
+                "a start has {} parameters, the form {}",
+                start.len(),
+                problem.m
+            )));
+        }
         let p0 = problem.complete_start(start);
         let (p, sse, it, converged) = trust_region(problem, &p0, PROBE_ITERATIONS)?;
         iterations += it;

@@ -90,7 +90,8 @@ fn assess(
         all_cases: metrics(&observed, &predicted),
         cross_validated: cv.metrics,
         equation: form.equation().to_string(),
-        residual_std_s: u.residual_std_s,
+        objective: form.objective().to_string(),
+        residual_std: u.residual_std,
         condition_number: u.condition_number,
         solver: all.solver,
         cv_solvers: cv.solvers,
@@ -188,13 +189,16 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             s.reporter.info(
                 me,
                 &format!(
-                    "zone {zone}: {:<7} R² {:.4}  R {:.4}  RMSE {:.4} s  MAE {:.4} s   \
-                     ({FOLDS}-fold CV: R² {:.4}, RMSE {:.4} s)   {} {}   box {}",
+                    "zone {zone}: {:<7} R² {:.4}  R {:.4}  RMSE {:.4} s  MAE {:.4} s  relative \
+                     RMS {:.3}, max {:.2}   ({FOLDS}-fold CV: R² {:.4}, RMSE {:.4} s)   {} {}   \
+                     box {}",
                     f.form.name(),
                     m.r2,
                     m.r,
                     m.rmse,
                     m.mae,
+                    m.relative_rmse,
+                    m.max_relative_error,
                     cv.r2,
                     cv.rmse,
                     match f.solver.method {

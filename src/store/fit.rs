@@ -6,9 +6,11 @@
 //! fit.h5:  /  attrs: contents, slidestack_version, fingerprint, features
 //!          /zone_<name>                       attrs: recommended_form, recommendation
 //!          /zone_<name>/<form>                attrs: equation, r2, r, rmse_s, mse_s2, mae_s, n,
+//!                                                     relative_rmse, max_relative_error,
 //!                                                     cv_r2, cv_r, …, solver, converged,
 //!                                                     iterations, relative_offset,
-//!                                                     residual_std_s, condition_number,
+//!                                                     objective, residual_std,
+//!                                                     condition_number,
 //!                                                     box_passed, box_points,
 //!                                                     box_min_t_new_over_t_p,
 //!                                                     box_max_t_new_over_t_rigid
@@ -37,9 +39,13 @@ pub struct FormFit {
     /// The equation, for people ([`Form::equation`]).
     #[serde(default)]
     pub equation: String,
-    /// `s = √(SSE/(n − p))`, s.
+    /// What the least squares minimise ([`Form::objective`]).
     #[serde(default)]
-    pub residual_std_s: f64,
+    pub objective: String,
+    /// `s = √(SSE/(n − p))` of the residuals the fit minimised: s, or a fraction of `T_p` for a
+    /// form fitted to `T_new/T_p`.
+    #[serde(default)]
+    pub residual_std: f64,
     /// Condition number of the column-scaled Jacobian at the optimum (standard errors are NaN
     /// above [`crate::fit::metrics::SINGULAR_CONDITION`]).
     #[serde(default)]
@@ -108,6 +114,8 @@ fn write_metrics(g: &hdf5::Location, prefix: &str, m: &Metrics) -> hdf5::Result<
         ("mse_s2", m.mse),
         ("mae_s", m.mae),
         ("n", m.n as f64),
+        ("relative_rmse", m.relative_rmse),
+        ("max_relative_error", m.max_relative_error),
     ] {
         attr_f64(g, &format!("{prefix}{k}"), v)?;
     }
@@ -129,6 +137,7 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
                 for fr in &z.forms {
                     let sub = g.create_group(fr.form.name())?;
                     attr_str(&sub, "equation", &fr.equation)?;
+                    attr_str(&sub, "objective", &fr.objective)?;
                     attr_str(
                         &sub,
                         "solver",
@@ -142,7 +151,7 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
                         ("converged", f64::from(u8::from(fr.solver.converged))),
                         ("iterations", fr.solver.iterations as f64),
                         ("relative_offset", fr.solver.relative_offset),
-                        ("residual_std_s", fr.residual_std_s),
+                        ("residual_std", fr.residual_std),
                         ("condition_number", fr.condition_number),
                         ("box_passed", f64::from(u8::from(b.passed))),
                         ("box_points", b.points as f64),
