@@ -12,11 +12,17 @@
 //!   period and the rigidly attached one (the limits `μ → 0` and `μ → ∞`), so it cannot
 //!   represent `T_new < T_p`, which friction damping produces (2,940 of the 7,156 sliding cases
 //!   of Zone V on the paper grid).
-//! * [`Form::Damped`]: `T_new = T_p·(1 − ½·σ(v·ln x + v₀)) + (T_rigid − T_p)·σ(w·ln x + w₀)`:
-//!   the bounded form on the logarithms of the features, less a friction-damping term that can
-//!   take up to half of `T_p` away. For every input and any parameters
-//!   `½·T_p ≤ T_new ≤ T_rigid` (strictly inside in exact arithmetic): bounded by construction. `docs/fit.md` tells why this form and
-//!   these features, with the numbers measured on the paper grid.
+//! * [`Form::Damped`]: `T_new = T_p·(1 − ½·σ(v·z + v₀)) + (T_rigid − T_p)·σ(w·z + w₀)` with
+//!   regressors `z = (ln x, (ln T_p)²)`: the bounded form on the logarithms of the features,
+//!   less a friction-damping term that can take up to half of `T_p` away; the square of
+//!   `ln T_p` lets either term rise and fall with the period (the damping is strongest near the
+//!   spectrum's corner period). For every input and any parameters `½·T_p ≤ T_new ≤ T_rigid`
+//!   (strictly inside in exact arithmetic): bounded by construction. It is fitted to the
+//!   elongation ratio `T_new/T_p` (least squares weighted by `1/T_p`, [`Form::weight`]), so a
+//!   short-period structure counts as much as a long-period one.
+//!
+//! `docs/fit.md` tells why this form, these features and this objective, with the numbers
+//! measured on the paper grid.
 
 use super::Sample;
 use serde::{Deserialize, Serialize};
@@ -65,7 +71,10 @@ impl Form {
         match self {
             Form::Paper => "T_new = a·x + B·exp(c·x) + e  (paper Eqs. 16–17 with B = b·e^d)",
             Form::Bounded => "T_new = T_p + (T_rigid − T_p)·σ(w·x + w_0)",
-            Form::Damped => "T_new = T_p·(1 − σ(v·ln x + v_0)/2) + (T_rigid − T_p)·σ(w·ln x + w_0)",
+            Form::Damped => {
+                "T_new = T_p·(1 − σ(v·z + v_0)/2) + (T_rigid − T_p)·σ(w·z + w_0), \
+                 z = (ln x, (ln T_p)²)"
+            }
         }
     }
 

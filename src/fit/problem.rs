@@ -357,6 +357,60 @@ mod tests {
     use super::*;
 
     #[test]
+    fn weighted_jacobian_and_normal_equations_match_differences() {
+        // The problem's Jacobian (weighted residuals, weights 1/T_p for the damped form)
+        // against central differences of its residuals (h = 1e-6·max(1, |p_j|), tolerance as
+        // in tests/fit.rs: 1e-7·(1 + |J|)); and Jᵀr, JᵀJ, SSE against sums over the rows.
+        let mut data = Vec::new();
+        for (i, tp) in [0.15, 0.4, 0.9, 1.3, 1.7].iter().enumerate() {
+            for (j, mu) in [0.05, 0.3, 0.6].iter().enumerate() {
+                for a in [0.1, 0.45, 0.8] {
+                    data.push(Sample {
+                        x: vec![*tp, *mu, 0.2 + 0.1 * j as f64, a, 0.5],
+                        t_rigid_s: tp * (1.5f64 + a).sqrt(),
+                        t_new_s: tp * (1.0 + 0.05 * (i + j) as f64),
+                    });
+                }
+            }
+        }
+        for form in Form::ALL {
+            let problem = Problem::new(form, &data).unwrap();
+            let p: Vec<f64> = (0..problem.m).map(|j| 0.3 - 0.07 * j as f64).collect();
+            let (jac, r) = problem.jacobian_and_residuals(&p);
+            for c in 0..problem.m {
+                let h = 1e-6 * p[c].abs().max(1.0);
+                let (mut up, mut down) = (p.clone(), p.clone());
+                up[c] += h;
+                down[c] -= h;
+                let (ru, rd) = (
+                    problem.jacobian_and_residuals(&up).1,
+                    problem.jacobian_and_residuals(&down).1,
+                );
+                for i in 0..problem.n() {
+                    let fd = (ru[i] - rd[i]) / (2.0 * h);
+                    assert!(
+                        (jac[(i, c)] - fd).abs() <= 1e-7 * (1.0 + jac[(i, c)].abs()),
+                        "{form:?} case {i} parameter {c}: {} vs {fd}",
+                        jac[(i, c)]
+                    );
+                }
+            }
+            let ne = problem.normal_equations(&p);
+            let sse: f64 = r.iter().map(|v| v * v).sum();
+            assert!((ne.sse - sse).abs() <= 1e-13 * sse);
+            assert!((problem.sse(&p) - sse).abs() <= 1e-13 * sse);
+            for a in 0..problem.m {
+                let g: f64 = (0..problem.n()).map(|i| jac[(i, a)] * r[i]).sum();
+                assert!((ne.gradient[a] - g).abs() <= 1e-12 * (1.0 + g.abs()));
+                for b in 0..problem.m {
+                    let h: f64 = (0..problem.n()).map(|i| jac[(i, a)] * jac[(i, b)]).sum();
+                    assert!((ne.jtj[a * problem.m + b] - h).abs() <= 1e-12 * (1.0 + h.abs()));
+                }
+            }
+        }
+    }
+
+    #[test]
     fn relative_offset_of_a_straight_line() {
         // For linear least squares y ≈ a + b·x the Gauss–Newton step is exact, so at any
         // (a₀, b₀) the decrement is SSE(a₀, b₀) − SSE(â, b̂), with (â, b̂) the textbook closed
