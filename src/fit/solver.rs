@@ -37,7 +37,7 @@ pub const RELATIVE_OFFSET_TOLERANCE: f64 = 1e-4;
 /// Trust-region iterations of each start's probe.
 pub const PROBE_ITERATIONS: u64 = 30;
 
-/// Trust-region iterations per start, at most.
+/// Trust-region iterations of the best start's run to convergence, at most.
 pub const MAX_ITERATIONS: u64 = 400;
 
 /// Iterations without a decrease of the cost after which the trust region stops.
@@ -61,7 +61,8 @@ pub enum Method {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct SolverReport {
     pub method: Method,
-    /// Trust region: the cosine test passed; Nelder–Mead: it stopped on its own tolerance.
+    /// Trust region: the relative-offset test (or the exact-fit test) passed; Nelder–Mead: it
+    /// stopped on its own tolerance.
     pub converged: bool,
     /// Starts tried (trust region from each).
     pub starts: usize,
@@ -157,7 +158,7 @@ where
 }
 
 /// One trust-region run from `p0` (natural parameters): the best point, its sum of squares,
-/// the iterations and whether the cosine test passed.
+/// the iterations and whether it converged.
 fn trust_region(
     problem: &Problem,
     p0: &[f64],
@@ -177,15 +178,6 @@ fn trust_region(
         Some(TerminationReason::SolverConverged)
     );
     let iterations = result.state.get_iter();
-    if std::env::var_os("FIT_TRACE").is_some() {
-        eprintln!(
-            "TR {:?} it {} cost {} reason {:?}",
-            problem.form,
-            iterations,
-            result.state.get_best_cost(),
-            result.state.get_termination_reason()
-        );
-    }
     let q = result
         .state
         .get_best_param()
