@@ -422,7 +422,7 @@ fn polynomial(accel: &[f64], dt: f64, order: usize) -> Result<Vec<f64>, ProcessE
             col[k] = t * t * pj;
         }
     }
-    let c = crate::numeric::linalg::least_squares(cols, disp);
+    let c = crate::numeric::linalg::least_squares(&cols, &disp);
     // p(t) = τ²·q(τ): p''(t) = (2q + 4τ·q' + τ²·q'')/T², with d/dτ = 2·d/dx.
     let mut out = Vec::with_capacity(n);
     for (k, &a) in accel.iter().enumerate() {

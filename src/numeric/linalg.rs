@@ -1,4 +1,4 @@
-//! Small dense linear algebra: each kernel once.
+//! Small dense linear algebra: each kernel once (least squares through `nalgebra`'s SVD).
 
 /// Solves `A·x = rhs` for a symmetric positive definite `n×n` matrix `a` (row-major; only the
 /// lower triangle is read, and `a` is overwritten by its Cholesky factor), in place of `rhs`.
@@ -29,41 +29,19 @@ pub fn cholesky_solve(a: &mut [f64], rhs: &mut [f64], n: usize, min_pivot: f64) 
     }
 }
 
-/// Least-squares solution of `A·c ≈ b` by Householder QR; `cols` holds the columns of `A`
-/// (all of `b`'s length, at least as long as there are columns). A column that is zero after the
-/// earlier reflections gets coefficient 0.
-pub fn least_squares(mut cols: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
+/// Least-squares solution of `A·c ≈ b` (minimum norm where `A` is rank-deficient), by the
+/// SVD of `nalgebra`, singular values below `1e-12` of the largest dropped; `cols` holds the
+/// columns of `A`, each of `b`'s length. The one least-squares solver of the project.
+pub fn least_squares(cols: &[Vec<f64>], b: &[f64]) -> Vec<f64> {
     let m = cols.len();
-    let mut r_diag = vec![0.0; m];
-    for k in 0..m {
-        let (done, rest) = cols.split_at_mut(k + 1);
-        let v = &mut done[k][k..];
-        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if norm == 0.0 {
-            continue;
-        }
-        let alpha = if v[0] > 0.0 { -norm } else { norm };
-        v[0] -= alpha;
-        let vv: f64 = v.iter().map(|x| x * x).sum();
-        r_diag[k] = alpha;
-        let reflect = |y: &mut [f64]| {
-            let f = 2.0 * v.iter().zip(y.iter()).map(|(a, b)| a * b).sum::<f64>() / vv;
-            y.iter_mut().zip(v.iter()).for_each(|(y, v)| *y -= f * v);
-        };
-        for col in rest.iter_mut() {
-            reflect(&mut col[k..]);
-        }
-        reflect(&mut b[k..]);
-    }
-    let mut c = vec![0.0; m];
-    for i in (0..m).rev() {
-        if r_diag[i] == 0.0 {
-            continue;
-        }
-        let s: f64 = (i + 1..m).map(|j| cols[j][i] * c[j]).sum();
-        c[i] = (b[i] - s) / r_diag[i];
-    }
-    c
+    let n = b.len();
+    let a = nalgebra::DMatrix::from_fn(n, m, |i, j| cols[j][i]);
+    let svd = a.svd(true, true);
+    let cutoff = 1e-12 * svd.singular_values.max();
+    let y = nalgebra::DVector::from_column_slice(b);
+    svd.solve(&y, cutoff)
+        .map(|c| c.iter().copied().collect())
+        .unwrap_or_else(|_| vec![0.0; m])
 }
 
 pub type Mat4 = [[f64; 4]; 4];
@@ -136,16 +114,16 @@ mod tests {
             .map(|j| t.iter().map(|x| x.powi(j)).collect())
             .collect();
         let y: Vec<f64> = t.iter().map(|x| 1.0 - 2.0 * x + 0.5 * x * x).collect();
-        let c = least_squares(cols.clone(), y.clone());
+        let c = least_squares(&cols, &y);
         for (got, want) in c.iter().zip([1.0, -2.0, 0.5]) {
             assert!((got - want).abs() < 1e-13, "{c:?}");
         }
         let r: Vec<f64> = t.iter().map(|x| (x - 0.5).powi(3)).collect();
-        let c_r = least_squares(cols.clone(), r.clone());
+        let c_r = least_squares(&cols, &r);
         let resid: Vec<f64> = (0..t.len())
             .map(|k| r[k] - (0..3).map(|j| c_r[j] * cols[j][k]).sum::<f64>())
             .collect();
-        let c0 = least_squares(cols, resid);
+        let c0 = least_squares(&cols, &resid);
         assert!(c0.iter().all(|v| v.abs() < 1e-14), "{c0:?}");
     }
 

@@ -1,18 +1,29 @@
-//! The fit stage: per zone, the design equation for `T_new` in two forms ([`crate::fit`]): the
-//! paper's (Eqs. 16–17, `b·e^d` reparameterised) and a bounded logistic form between `T_p` and
-//! `T_rigid`. Every case with a finite `T_new` enters. For each form: coefficients and R², R,
-//! RMSE, MSE, MAE on all cases and 5-fold cross-validated; and the paper's own published
-//! Eqs. 16–17 on our `T_new` (zones named III and V, two blocks) → `fit.h5` and `fit.yaml`
-//! (layout in [`crate::store::fit`]).
+//! The fit stage: per zone, the design equation for `T_new` in every form of
+//! [`crate::fit::Form`] (the paper's Eqs. 16–17 shape, the bounded logistic form, and the
+//! damped form that can go below `T_p`). Every case with a finite `T_new` enters. For each form:
+//! coefficients with standard errors; R², R, RMSE, MSE, MAE on all cases and
+//! [`FOLDS`]-fold cross-validated; which solver converged; and the box check (finite and inside
+//! `[½·T_p, 1.5·T_rigid]` on a box [`BOX_MARGIN`] beyond the grid). The recommended form is the
+//! best cross-validated R² among the forms that pass the box check. Also the paper's own
+//! published Eqs. 16–17 on our `T_new` (zones named III and V, two blocks) → `fit.h5` and
+//! `fit.yaml` (layout in [`crate::store::fit`]). `docs/fit.md` explains the forms.
 //!
-//! Fingerprint: T_new's, and the number of folds.
+//! Forms and folds are fitted in parallel, each fit sequentially: the results do not depend on
+//! the thread count.
+//!
+//! Fingerprint: T_new's, the forms, the number of folds and the box.
 
 use super::{Outcome, PipelineError, Session, StageId};
-use crate::fit::{FitError, Form, cross_validate, fit, metrics, paper_equation};
+use crate::fit::extrapolation::{BOX_MARGIN, BOX_POINTS};
+use crate::fit::{
+    DesignBox, FitError, Form, Sample, check_box, cross_validate, fit, metrics, paper_equation,
+    uncertainty,
+};
 use crate::store::fingerprint::fingerprint as hash_parts;
-use crate::store::fit::{FitReport, FormFit, ZoneFit, write_fit};
+use crate::store::fit::{FitReport, FormFit, NotFitted, ZoneFit, write_fit};
 use crate::store::tnew::read_zone_tnew;
 use crate::study::tnew::samples;
+use rayon::prelude::*;
 use thiserror::Error;
 
 /// Folds of the cross-validation.
@@ -26,32 +37,104 @@ pub enum FitStageError {
         form: &'static str,
         source: FitError,
     },
+    #[error("zone {zone}: no form could be fitted ({reasons})")]
+    NoForm { zone: String, reasons: String },
 }
 
 /// The fingerprint `fit.h5` and `fit.yaml` must carry.
 pub fn fingerprint(tnew_fingerprint: &str) -> String {
-    hash_parts(&[tnew_fingerprint, &format!("folds={FOLDS}")])
+    let forms: Vec<&str> = Form::ALL.iter().map(|f| f.name()).collect();
+    hash_parts(&[
+        tnew_fingerprint,
+        &format!("folds={FOLDS}"),
+        &format!("forms={}", forms.join(",")),
+        &format!("box={BOX_MARGIN},{BOX_POINTS}"),
+    ])
 }
 
 /// Names of a form's parameters, in [`crate::fit::Fitted::params`] order.
 pub fn parameter_names(form: Form, features: &[String]) -> Vec<String> {
-    match form {
-        Form::Paper => features
-            .iter()
-            .map(|f| format!("a_{f}"))
-            .chain(features.iter().map(|f| format!("c_{f}")))
-            .chain(["B (= b·e^d)".to_string(), "e".to_string()])
+    form.parameter_names(features)
+}
+
+/// One form on one zone's data: fitted, cross-validated, its uncertainty and its box check;
+/// `Ok(Err(_))` when the form does not apply to the data.
+fn assess(
+    form: Form,
+    data: &[Sample],
+    features: &[String],
+    bx: &DesignBox,
+) -> Result<Result<FormFit, NotFitted>, FitError> {
+    let (all, cv) = rayon::join(|| fit(form, data), || cross_validate(form, data, FOLDS));
+    let (all, cv) = match (all, cv) {
+        (Err(e @ (FitError::NotApplicable { .. } | FitError::TooFew { .. })), _) => {
+            return Ok(Err(NotFitted {
+                form,
+                reason: e.to_string(),
+            }));
+        }
+        (all, cv) => (all?, cv?),
+    };
+    let observed: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
+    let predicted: Vec<f64> = data.iter().map(|s| all.fitted.predict(s)).collect();
+    let u = uncertainty(&all.fitted, data)?;
+    let box_check = check_box(&all.fitted, bx, BOX_POINTS, BOX_MARGIN);
+    Ok(Ok(FormFit {
+        form,
+        coefficients: form
+            .parameter_names(features)
+            .into_iter()
+            .zip(all.fitted.params.iter().copied())
             .collect(),
-        Form::Bounded => features
-            .iter()
-            .map(|f| format!("w_{f}"))
-            .chain(["w_0".to_string()])
-            .collect(),
+        standard_errors: u.standard_errors,
+        all_cases: metrics(&observed, &predicted),
+        cross_validated: cv.metrics,
+        equation: form.equation().to_string(),
+        objective: form.objective().to_string(),
+        residual_std: u.residual_std,
+        condition_number: u.condition_number,
+        solver: all.solver,
+        cv_solvers: cv.solvers,
+        box_check,
+    }))
+}
+
+/// The recommended form and why: the best cross-validated R² among the forms that pass the box
+/// check, else the best overall.
+fn recommend(forms: &[FormFit]) -> (Form, String) {
+    fn best<'a>(it: impl Iterator<Item = &'a FormFit>) -> Option<&'a FormFit> {
+        it.max_by(|a, b| a.cross_validated.r2.total_cmp(&b.cross_validated.r2))
+    }
+    let passing = forms.iter().filter(|f| f.box_check.passed).count();
+    if let Some(f) = best(forms.iter().filter(|f| f.box_check.passed)) {
+        (
+            f.form,
+            format!(
+                "best cross-validated R² ({:.4}) of the {passing} of {} forms that stay finite \
+                 and inside [0.5·T_p, 1.5·T_rigid] on the box {:.0} % beyond the grid",
+                f.cross_validated.r2,
+                forms.len(),
+                100.0 * BOX_MARGIN
+            ),
+        )
+    } else {
+        let f = best(forms.iter()).expect("at least one form");
+        (
+            f.form,
+            format!(
+                "no form stays finite and inside [0.5·T_p, 1.5·T_rigid] on the box {:.0} % \
+                 beyond the grid; this is the best cross-validated R² ({:.4}) overall: do not \
+                 use it outside the grid",
+                100.0 * BOX_MARGIN,
+                f.cross_validated.r2
+            ),
+        )
     }
 }
 
 /// Builds `fit.h5` and `fit.yaml`.
 pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+    let start = std::time::Instant::now();
     let study = &s.study;
     let me = StageId::Fit;
     let grid = study.grid(me)?;
@@ -60,88 +143,155 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let mut features = vec!["T_p".to_string()];
     features.extend((1..=n).map(|i| format!("mu_{i}")));
     features.extend((1..=n).map(|i| format!("alpha_{i}")));
-    let mut zones = Vec::new();
+    let range = |v: &[f64]| {
+        v.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(*x), hi.max(*x))
+            })
+    };
+    let mut ranges = vec![range(&grid.periods_s)];
+    ranges.extend(grid.mu.iter().map(|v| range(v)));
+    ranges.extend(grid.alpha.iter().map(|v| range(v)));
+    let bx = DesignBox::beyond(&ranges, BOX_MARGIN);
+    let mut zone_data = Vec::new();
     for zc in &study.cfg.zones {
         let (_, t) = read_zone_tnew(&tnew_path, &zc.name, n)?;
         let t_rigid: Vec<f64> = t.vars.t_rigid.iter().copied().collect();
         let t_new: Vec<f64> = t.vars.t_new.iter().copied().collect();
-        let data = samples(grid, &t_rigid, &t_new);
-        let observed: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
-        let mut forms = Vec::new();
-        for form in [Form::Paper, Form::Bounded] {
-            let err = |source| FitStageError::Fit {
-                zone: zc.name.clone(),
+        zone_data.push((zc.name.clone(), samples(grid, &t_rigid, &t_new)));
+    }
+    let jobs: Vec<(usize, Form)> = (0..zone_data.len())
+        .flat_map(|z| Form::ALL.map(|f| (z, f)))
+        .collect();
+    let results: Vec<_> = jobs
+        .par_iter()
+        .map(|&(z, form)| {
+            assess(form, &zone_data[z].1, &features, &bx).map_err(|source| FitStageError::Fit {
+                zone: zone_data[z].0.clone(),
                 form: form.name(),
                 source,
-            };
-            let f = fit(form, &data).map_err(err)?;
-            let pred: Vec<f64> = data.iter().map(|s| f.predict(s)).collect();
-            let cv = cross_validate(form, &data, FOLDS).map_err(err)?;
-            let m = metrics(&observed, &pred);
+            })
+        })
+        .collect();
+    let mut results = results.into_iter();
+    let mut zones = Vec::new();
+    for (zone, data) in &zone_data {
+        let mut forms = Vec::new();
+        let mut not_fitted = Vec::new();
+        for _ in Form::ALL {
+            match results.next().expect("one result per job")? {
+                Ok(f) => forms.push(f),
+                Err(nf) => not_fitted.push(nf),
+            }
+        }
+        for f in &forms {
+            let (m, cv, b) = (&f.all_cases, &f.cross_validated, &f.box_check);
             s.reporter.info(
                 me,
                 &format!(
-                    "zone {}: {:<7} R² {:.3}  R {:.3}  RMSE {:.3} s  MAE {:.3} s   ({FOLDS}-fold CV: \
-                     R² {:.3}, RMSE {:.3} s)",
-                    zc.name,
-                    form.name(),
+                    "zone {zone}: {:<7} R² {:.4}  R {:.4}  RMSE {:.4} s  MAE {:.4} s  relative \
+                     RMS {:.3}, max {:.2}   ({FOLDS}-fold CV: R² {:.4}, RMSE {:.4} s)   {} {}   \
+                     box {}",
+                    f.form.name(),
                     m.r2,
                     m.r,
                     m.rmse,
                     m.mae,
+                    m.relative_rmse,
+                    m.max_relative_error,
                     cv.r2,
-                    cv.rmse
+                    cv.rmse,
+                    match f.solver.method {
+                        crate::fit::Method::TrustRegion => "trust region",
+                        crate::fit::Method::NelderMead => "Nelder–Mead fallback",
+                    },
+                    if f.solver.converged {
+                        "converged"
+                    } else {
+                        "NOT converged"
+                    },
+                    if b.passed {
+                        format!(
+                            "passed (T_new/T_p ≥ {:.3}, T_new/T_rigid ≤ {:.3})",
+                            b.min_t_new_over_t_p, b.max_t_new_over_t_rigid
+                        )
+                    } else {
+                        format!(
+                            "FAILED at {} of {} points ({} not finite)",
+                            b.outside + b.non_finite,
+                            b.points,
+                            b.non_finite
+                        )
+                    }
                 ),
             );
-            let n = f.params.len();
-            forms.push(FormFit {
-                form,
-                coefficients: parameter_names(form, &features)
-                    .into_iter()
-                    .zip(f.params)
-                    .collect(),
-                standard_errors: vec![f64::NAN; n],
-                all_cases: m,
-                cross_validated: cv,
-            });
         }
-        let published: Option<Vec<f64>> = data
-            .iter()
-            .map(|s| paper_equation(&zc.name, &s.x))
-            .collect();
+        for nf in &not_fitted {
+            s.reporter.warn(
+                me,
+                &format!("zone {zone}: {} form: {}", nf.form.name(), nf.reason),
+            );
+        }
+        if forms.is_empty() {
+            return Err(FitStageError::NoForm {
+                zone: zone.clone(),
+                reasons: not_fitted
+                    .iter()
+                    .map(|n| n.reason.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            }
+            .into());
+        }
+        let observed: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
+        let published: Option<Vec<f64>> = data.iter().map(|s| paper_equation(zone, &s.x)).collect();
         let published = published.map(|p| metrics(&observed, &p));
         if let Some(m) = &published {
             s.reporter.info(
                 me,
                 &format!(
-                    "zone {}: published Eq. {} on our T_new: R² {:.3}  RMSE {:.3} s",
-                    zc.name,
-                    if zc.name == "III" { 16 } else { 17 },
+                    "zone {zone}: published Eq. {} on our T_new: R² {:.4}  RMSE {:.4} s",
+                    if zone == "III" { 16 } else { 17 },
                     m.r2,
                     m.rmse
                 ),
             );
         }
-        let recommended = forms
-            .iter()
-            .max_by(|a, b| a.cross_validated.r2.total_cmp(&b.cross_validated.r2))
-            .map(|f| f.form)
-            .expect("at least one form");
+        let (recommended, recommendation) = recommend(&forms);
+        s.reporter.info(
+            me,
+            &format!(
+                "zone {zone}: recommended {}: {recommendation}",
+                recommended.name()
+            ),
+        );
         zones.push(ZoneFit {
-            zone: zc.name.clone(),
+            zone: zone.clone(),
             cases: data.len(),
             forms,
             recommended,
             published,
+            recommendation,
+            not_fitted,
         });
     }
     let report = FitReport {
         slidestack_version: env!("CARGO_PKG_VERSION").to_string(),
         fingerprint: study.fingerprint(me)?.to_string(),
         features,
+        folds: FOLDS,
         zones,
     };
     let (h5, yaml) = (study.path(me.output()), study.path("fit.yaml"));
     write_fit(&h5, &yaml, &report)?;
+    s.reporter.info(
+        me,
+        &format!(
+            "{} zones × {} forms, {FOLDS}-fold cross-validated, in {:.1} s",
+            report.zones.len(),
+            Form::ALL.len(),
+            start.elapsed().as_secs_f64()
+        ),
+    );
     Ok(Outcome::Wrote(vec![h5, yaml]))
 }

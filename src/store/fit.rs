@@ -4,14 +4,24 @@
 //!
 //! ```text
 //! fit.h5:  /  attrs: contents, slidestack_version, fingerprint, features
-//!          /zone_<name>/<form>/coefficients   attrs: names, r2, r, rmse_s, mse_s2, mae_s, n,
-//!                                                     cv_r2, cv_r, …
+//!          /zone_<name>                       attrs: recommended_form, recommendation
+//!          /zone_<name>/<form>                attrs: equation, r2, r, rmse_s, mse_s2, mae_s, n,
+//!                                                     relative_rmse, max_relative_error,
+//!                                                     cv_r2, cv_r, …, solver, converged,
+//!                                                     iterations, relative_offset,
+//!                                                     objective, residual_std,
+//!                                                     condition_number,
+//!                                                     box_passed, box_points,
+//!                                                     box_min_t_new_over_t_p,
+//!                                                     box_max_t_new_over_t_rigid
+//!          /zone_<name>/<form>/coefficients   attrs: names
+//!          /zone_<name>/<form>/standard_errors attrs: names
 //!          /zone_<name>/published             attrs: r2, r, rmse_s, mse_s2, mae_s, n
 //! ```
 
 use super::h5::{attr_f64, attr_str, write_1d, write_stage_file};
 use super::{StoreError, checksum};
-use crate::fit::{Form, Metrics};
+use crate::fit::{BoxCheck, Form, Method, Metrics, SolverReport};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -21,10 +31,42 @@ pub struct FormFit {
     pub form: Form,
     /// Parameter names and values.
     pub coefficients: Vec<(String, f64)>,
-    /// Standard error of each coefficient, same order (NaN where it cannot be estimated).
+    /// Standard error of each coefficient, same order: `√diag(s²·(JᵀJ)⁻¹)` from the Jacobian
+    /// at the optimum, `s² = SSE/(n − p)`; NaN where `JᵀJ` is singular.
     pub standard_errors: Vec<f64>,
     pub all_cases: Metrics,
     pub cross_validated: Metrics,
+    /// The equation, for people ([`Form::equation`]).
+    #[serde(default)]
+    pub equation: String,
+    /// What the least squares minimise ([`Form::objective`]).
+    #[serde(default)]
+    pub objective: String,
+    /// `s = √(SSE/(n − p))` of the residuals the fit minimised: s, or a fraction of `T_p` for a
+    /// form fitted to `T_new/T_p`.
+    #[serde(default)]
+    pub residual_std: f64,
+    /// Condition number of the column-scaled Jacobian at the optimum (standard errors are NaN
+    /// above [`crate::fit::metrics::SINGULAR_CONDITION`]).
+    #[serde(default)]
+    pub condition_number: f64,
+    /// How the solver went on all cases.
+    #[serde(default)]
+    pub solver: SolverReport,
+    /// How it went on each cross-validation fold.
+    #[serde(default)]
+    pub cv_solvers: Vec<SolverReport>,
+    /// Whether the fitted form stays finite and inside `[½·T_p, 1.5·T_rigid]` on the box
+    /// beyond the grid.
+    #[serde(default)]
+    pub box_check: BoxCheck,
+}
+
+/// A form the stage did not fit, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NotFitted {
+    pub form: Form,
+    pub reason: String,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -32,10 +74,17 @@ pub struct ZoneFit {
     pub zone: String,
     pub cases: usize,
     pub forms: Vec<FormFit>,
-    /// The form a designer should use for this zone.
+    /// The form a designer should use for this zone: the best cross-validated R² among the
+    /// forms that pass the box check, else the best overall (see `recommendation`).
     pub recommended: Form,
     /// The paper's published equation for this zone on our T_new, when it applies.
     pub published: Option<Metrics>,
+    /// Why `recommended` was chosen.
+    #[serde(default)]
+    pub recommendation: String,
+    /// Forms that could not be fitted to this zone's data.
+    #[serde(default)]
+    pub not_fitted: Vec<NotFitted>,
 }
 
 impl ZoneFit {
@@ -51,6 +100,9 @@ pub struct FitReport {
     pub slidestack_version: String,
     pub fingerprint: String,
     pub features: Vec<String>,
+    /// Folds of the cross-validation.
+    #[serde(default)]
+    pub folds: usize,
     pub zones: Vec<ZoneFit>,
 }
 
@@ -62,6 +114,8 @@ fn write_metrics(g: &hdf5::Location, prefix: &str, m: &Metrics) -> hdf5::Result<
         ("mse_s2", m.mse),
         ("mae_s", m.mae),
         ("n", m.n as f64),
+        ("relative_rmse", m.relative_rmse),
+        ("max_relative_error", m.max_relative_error),
     ] {
         attr_f64(g, &format!("{prefix}{k}"), v)?;
     }
@@ -79,8 +133,33 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
             for z in &r.zones {
                 let g = f.create_group(&format!("zone_{}", z.zone))?;
                 attr_str(&g, "recommended_form", z.recommended.name())?;
+                attr_str(&g, "recommendation", &z.recommendation)?;
                 for fr in &z.forms {
                     let sub = g.create_group(fr.form.name())?;
+                    attr_str(&sub, "equation", &fr.equation)?;
+                    attr_str(&sub, "objective", &fr.objective)?;
+                    attr_str(
+                        &sub,
+                        "solver",
+                        match fr.solver.method {
+                            Method::TrustRegion => "trust-region",
+                            Method::NelderMead => "nelder-mead",
+                        },
+                    )?;
+                    let b = &fr.box_check;
+                    for (k, v) in [
+                        ("converged", f64::from(u8::from(fr.solver.converged))),
+                        ("iterations", fr.solver.iterations as f64),
+                        ("relative_offset", fr.solver.relative_offset),
+                        ("residual_std", fr.residual_std),
+                        ("condition_number", fr.condition_number),
+                        ("box_passed", f64::from(u8::from(b.passed))),
+                        ("box_points", b.points as f64),
+                        ("box_min_t_new_over_t_p", b.min_t_new_over_t_p),
+                        ("box_max_t_new_over_t_rigid", b.max_t_new_over_t_rigid),
+                    ] {
+                        attr_f64(&sub, k, v)?;
+                    }
                     let values: Vec<f64> = fr.coefficients.iter().map(|c| c.1).collect();
                     let names: Vec<String> = fr.coefficients.iter().map(|c| c.0.clone()).collect();
                     let ds = write_1d(
