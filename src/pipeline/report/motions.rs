@@ -8,11 +8,12 @@ use plotters::style::RGBColor;
 pub(super) fn motions_section(inp: &Inputs, files: &mut Files) -> Result<Section, ReportError> {
     let m = &inp.study.cfg.motions.matching;
     let (lo, hi) = (m.lower, m.upper);
+    let damping = format!("{} %", 100.0 * m.damping);
     let mut body = para(&format!(
-        "Figs 4–5 of the paper: the 5 %-damped target spectrum of each zone (IS 1893:2016, hard \
-         soil, scaled by Z), the mean spectrum of the zone's matched motions, and the matching \
-         band {lo}–{hi} × target; every motion in grey. The right panel shows mean / target: \
-         ASCE 7-16 asks that it not fall below 0.9."
+        "Figs 4–5 of the paper: the {damping}-damped target spectrum of each zone (the paper's: \
+         IS 1893:2016, hard soil, Z·Sa/g), the mean spectrum of the zone's matched motions, and \
+         the matching band {lo}–{hi} × target; every motion in grey. The right panel shows mean \
+         / target: ASCE 7-16 asks that it not fall below 0.9."
     ));
     for z in &inp.zones {
         let s = &z.spectra;
@@ -69,7 +70,7 @@ pub(super) fn motions_section(inp: &Inputs, files: &mut Files) -> Result<Section
         let x = || Axis::new("period T (s)");
         let mut fig = Figure::grid(
             format!(
-                "Zone {}: 5 %-damped spectra of the matched motions (Figs 4–5)",
+                "Zone {}: {damping}-damped spectra of the matched motions (Figs 4–5)",
                 z.name
             ),
             vec![
@@ -94,9 +95,10 @@ pub(super) fn motions_section(inp: &Inputs, files: &mut Files) -> Result<Section
             &format!("spectra_{}.svg", z.name),
             &fig,
             &format!(
-                "Zone {}: target, mean of the {} matched motions and the matching band (paper \
-                 Figs 4–5).",
+                "Zone {}: target ({}), mean of the {} matched motions and the matching band \
+                 (paper Figs 4–5).",
                 z.name,
+                z.tnew.target,
                 z.motions.len()
             ),
         )?;
