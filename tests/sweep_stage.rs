@@ -219,8 +219,8 @@ fn run_does_the_whole_quick_study_and_ends_with_the_report_path() {
         "spectra_III.svg",
         "history_V.svg",
         "tnew_III.svg",
-        "fit_V.svg",
-        "Table 3-like",
+        "residuals_V.svg",
+        "Table 3",
     ] {
         assert!(html.contains(part), "{part}");
     }

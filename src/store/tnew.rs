@@ -245,3 +245,26 @@ pub fn zones_and_blocks(path: &Path) -> Result<(Vec<String>, usize), StoreError>
         .count();
     Ok((zones, blocks))
 }
+
+/// The CF `flag_values`/`flag_meanings` of zone `zone`'s `T_new_band`: `(code, word)` pairs.
+pub fn read_band_flags(path: &Path, zone: &str) -> Result<Vec<(u8, String)>, StoreError> {
+    let f = open(path)?;
+    let g = group(&f, path, &format!("zone_{zone}"))?;
+    let read = || -> hdf5::Result<Vec<(u8, String)>> {
+        let ds = g.dataset("T_new_band")?;
+        let values = ds.attr("flag_values")?.read_raw::<u8>()?;
+        let words = super::h5::read_attr_str(&ds, "flag_meanings").unwrap_or_default();
+        Ok(values
+            .into_iter()
+            .zip(words.split_whitespace().map(str::to_string))
+            .collect())
+    };
+    let flags = read().at(path)?;
+    if flags.is_empty() {
+        return Err(StoreError::corrupt(
+            path,
+            format!("zone_{zone}/T_new_band has no flag_values/flag_meanings"),
+        ));
+    }
+    Ok(flags)
+}

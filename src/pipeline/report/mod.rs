@@ -1,0 +1,305 @@
+//! The report stage: `OUT/report/index.html` with SVG figures beside it, side by side with the
+//! paper where the paper has a number:
+//!
+//! * the matched motions (Figs 4–5): target, mean and matching band, every motion faint;
+//! * the Section 7.1 case: displacement histories of the stack, the single block and the rigid
+//!   system; the construction of `T_new` on the mean displacement spectrum (Fig. 12); the
+//!   energy partition (input, kinetic, strain, damping, friction per interface);
+//! * Table 2 (stack against single block) next to the paper's;
+//! * `DRR_1`, `DRR_2` (Figs 10–11) and `T_new` (Figs 16–17) against `T_p`, panels over the mass
+//!   ratios, a subset of friction pairs drawn out over every pair in grey;
+//! * the band counts of `T_new`, Table 3 next to the paper's, the recommended form's
+//!   coefficients with their standard errors, and the residuals of every fitted form.
+//!
+//! Panels and lines are picked from the grid's own axes, so any grid (other block counts
+//! included) gives a report. Every simulation uses the study's physics
+//! ([`crate::study::sweep::Physics`]). The directory is replaced as a whole
+//! ([`crate::store::report`]).
+//!
+//! Fingerprint: the fit's and the motions' (which carry everything upstream), and the report's
+//! own version.
+
+mod cases;
+mod fit;
+mod grid;
+mod motions;
+mod runs;
+mod select;
+mod text;
+
+use super::{Outcome, PipelineError, Session, StageId, Study};
+use crate::dynamics::{ModelError, SimError};
+use crate::grid::Grid;
+use crate::motion::Record;
+use crate::report::chart::{self, ChartError, Figure};
+use crate::report::page::{Section, document, figure, list, para, table_with_id};
+use crate::store::StoreError;
+use crate::store::fingerprint::fingerprint as hash_parts;
+use crate::store::fit::{FitReport, ZoneFit, read_fit};
+use crate::store::motions::{ZoneSpectra, read_zone_spectra};
+use crate::store::report::write_report_dir;
+use crate::store::tnew::{ZoneTnew, read_band_flags, read_zone_tnew};
+use crate::study::cases::{PAPER_SECTION_7_1, PAPER_TABLE_2, PAPER_TABLE_3, SECTION_7_1, TABLE_2};
+use crate::study::sweep::Physics;
+use cases::{section71_section, table2_section};
+use fit::fit_section;
+use grid::{drr_section, tnew_section};
+use motions::motions_section;
+use runs::{CaseRun, System3, section71_tnew};
+use select::Selection;
+use text::{fixed, joined, num};
+use thiserror::Error;
+
+/// Changes when the report's contents change.
+const REPORT_VERSION: &str = "report-2";
+
+#[derive(Debug, Error)]
+pub enum ReportError {
+    #[error("the report's case {case}: {source}")]
+    Model { case: String, source: ModelError },
+    #[error("the report's case {case} under {motion}: {source}")]
+    Simulation {
+        case: String,
+        motion: String,
+        source: SimError,
+    },
+    #[error("zone {zone} has no motions")]
+    NoMotions { zone: String },
+    #[error(transparent)]
+    Chart(#[from] ChartError),
+}
+
+/// The fingerprint the report must carry.
+pub fn fingerprint(fit_fingerprint: &str, motions_fingerprint: &str) -> String {
+    hash_parts(&[fit_fingerprint, motions_fingerprint, REPORT_VERSION])
+}
+
+/// One zone's inputs.
+struct Zone {
+    name: String,
+    motions: Vec<Record>,
+    spectra: ZoneSpectra,
+    tnew: ZoneTnew,
+    band_flags: Vec<(u8, String)>,
+    fit: ZoneFit,
+    section71: CaseRun,
+    table2: CaseRun,
+}
+
+impl Zone {
+    /// Column `case` of a `[T_p, case…]` variable: one value per `T_p`.
+    fn column(&self, v: &ndarray::ArrayD<f64>, per: usize, case: usize) -> Vec<f64> {
+        v.iter().skip(case).step_by(per).copied().collect()
+    }
+}
+
+/// Everything the report is made of: the study and each zone's data.
+struct Inputs<'a> {
+    study: &'a Study,
+    grid: &'a Grid,
+    physics: Physics,
+    fit: FitReport,
+    zones: Vec<Zone>,
+}
+
+impl<'a> Inputs<'a> {
+    fn load(study: &'a Study) -> Result<Self, PipelineError> {
+        let grid = study.grid(StageId::Report)?;
+        let physics = study.physics();
+        let motions = super::sweep::load_motions(study)?;
+        let (mh5, th5, fyaml) = (
+            study.path("motions.h5"),
+            study.path("tnew.h5"),
+            study.path("fit.yaml"),
+        );
+        let fit = read_fit(&fyaml)?.ok_or_else(|| StoreError::corrupt(&fyaml, "is missing"))?;
+        let n = grid.blocks();
+        let mut zones = Vec::new();
+        for (zc, motions) in study.cfg.zones.iter().zip(motions) {
+            if motions.is_empty() {
+                return Err(ReportError::NoMotions {
+                    zone: zc.name.clone(),
+                }
+                .into());
+            }
+            let (axes, tnew) = read_zone_tnew(&th5, &zc.name, n)?;
+            if axes != *grid {
+                return Err(StoreError::corrupt(
+                    &th5,
+                    format!("zone_{}: its grid differs from the config's", zc.name),
+                )
+                .into());
+            }
+            let zf = fit
+                .zones
+                .iter()
+                .find(|f| f.zone == zc.name)
+                .cloned()
+                .ok_or_else(|| StoreError::corrupt(&fyaml, format!("has no zone {}", zc.name)))?;
+            zones.push(Zone {
+                name: zc.name.clone(),
+                spectra: read_zone_spectra(&mh5, &zc.name)?,
+                band_flags: read_band_flags(&th5, &zc.name)?,
+                section71: CaseRun::new(&physics, &SECTION_7_1, n, &motions)?,
+                table2: CaseRun::new(&physics, &TABLE_2, n, &motions)?,
+                motions,
+                tnew,
+                fit: zf,
+            });
+        }
+        Ok(Self {
+            study,
+            grid,
+            physics,
+            fit,
+            zones,
+        })
+    }
+}
+
+/// The report's files as they are made.
+#[derive(Default)]
+struct Files {
+    files: Vec<(String, Vec<u8>)>,
+}
+
+impl Files {
+    /// Renders `fig` as `name` and returns its HTML figure with `caption`.
+    fn figure(&mut self, name: &str, fig: &Figure, caption: &str) -> Result<String, ReportError> {
+        let svg = chart::render(fig)?;
+        self.files.push((name.to_string(), svg.into_bytes()));
+        Ok(figure(name, caption))
+    }
+}
+
+fn summary(inp: &Inputs) -> String {
+    let study = inp.study;
+    let g = inp.grid;
+    let ph = &inp.physics;
+    let mut rows = Vec::new();
+    for z in &inp.zones {
+        let (u, _, tn, _) = section71_tnew(z, ph);
+        let p71 = (PAPER_SECTION_7_1.0 == z.name).then_some(PAPER_SECTION_7_1);
+        rows.push(vec![
+            "Section 7.1 case: T_new (s)".into(),
+            z.name.clone(),
+            p71.map_or("–".into(), |p| format!("{:.2}", p.2)),
+            fixed(tn, 3),
+        ]);
+        rows.push(vec![
+            "Section 7.1 case: mean peak displacement (cm)".into(),
+            z.name.clone(),
+            p71.map_or("–".into(), |p| format!("{:.2}", p.1 * 100.0)),
+            format!("{:.2}", u * 100.0),
+        ]);
+        let c = &z.table2;
+        let red = 100.0 * (1.0 - c.mean_peak(System3::Stack) / c.mean_peak(System3::Single));
+        let p2 = PAPER_TABLE_2.iter().find(|p| p.0 == z.name);
+        rows.push(vec![
+            "Table 2 case: reduction of the peak by the stack (%)".into(),
+            z.name.clone(),
+            p2.map_or("–".into(), |p| {
+                format!("{:.2}", 100.0 * (1.0 - p.2 / p.1))
+            }),
+            format!("{red:.1}"),
+        ]);
+        let p3 = PAPER_TABLE_3.iter().find(|p| p.0 == z.name);
+        if let Some(ff) = z.fit.recommended_fit() {
+            rows.push(vec![
+                format!("design equation R² (ours: {} form)", ff.form.name()),
+                z.name.clone(),
+                p3.map_or("–".into(), |p| format!("{:.3}", p.1[0])),
+                format!("{:.3}", ff.all_cases.r2),
+            ]);
+        }
+    }
+    let motions: Vec<String> = inp
+        .zones
+        .iter()
+        .map(|z| format!("{} in Zone {}", z.motions.len(), z.name))
+        .collect();
+    let facts = vec![
+        // Not the output directory: a study's report is the same wherever it is written.
+        format!("Config {}.", study.config_path.display()),
+        format!("Matched motions: {}.", motions.join(", ")),
+        format!(
+            "Grid: T_p {} to {} s ({} values); {}; {}; {} cases per zone.",
+            num(g.periods_s[0]),
+            num(g.periods_s[g.periods_s.len() - 1]),
+            g.periods_s.len(),
+            g.alpha
+                .iter()
+                .enumerate()
+                .map(|(i, a)| format!("α_{} ∈ {{{}}}", i + 1, joined(a)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            g.mu.iter()
+                .enumerate()
+                .map(|(i, a)| format!("μ_{} ∈ {{{}}}", i + 1, joined(a)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            g.cases()
+        ),
+        format!(
+            "Physics: viscous damping ζ = {} of the {} basis (one damper for the stack, single \
+             block and rigid systems); static friction = {} × kinetic.",
+            ph.damping,
+            ph.basis.name(),
+            ph.mu_static_ratio
+        ),
+    ];
+    list(&facts)
+        + &para("The paper's numbers next to ours (details in the sections below):")
+        + &table_with_id("summary", &["quantity", "zone", "paper", "ours"], &rows)
+}
+
+fn not_shown() -> Section {
+    Section::new(
+        "not-shown",
+        "Not reproduced here",
+        list(&[
+            "Figs 1–3 (the model's sketches) and Figs 6–8 (the ABAQUS validation): the solver is \
+             checked against independent references instead (docs/accuracy)."
+                .into(),
+            "Fig. 9 (histories of the Table 2 case under record #11): the paper's records are not \
+             available; the histories shown are the Section 7.1 case's."
+                .into(),
+            "Figs 13–15 (the OLE validation of the T_new method against reference [12]).".into(),
+            "Table 1 (the paper's PEER NGA records): this study's motions come from its config."
+                .into(),
+        ]),
+    )
+}
+
+/// Builds the report.
+pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+    let study = &s.study;
+    let inp = Inputs::load(study)?;
+    let sel = Selection::new(inp.grid);
+    let mut files = Files::default();
+    let sections = vec![
+        motions_section(&inp, &mut files)?,
+        section71_section(&inp, &mut files)?,
+        table2_section(&inp),
+        drr_section(&inp, &sel, &mut files)?,
+        tnew_section(&inp, &sel, &mut files)?,
+        fit_section(&inp, &mut files)?,
+        not_shown(),
+    ];
+    let html = document(
+        &format!(
+            "slidestack report: {}",
+            study.config_path.file_name().map_or_else(
+                || study.config_path.display().to_string(),
+                |f| { f.to_string_lossy().into_owned() }
+            )
+        ),
+        &summary(&inp),
+        &sections,
+    );
+    let mut out = files.files;
+    out.push(("index.html".into(), html.into_bytes()));
+    let dir = study.path("report");
+    write_report_dir(&dir, study.fingerprint(StageId::Report)?, &out)?;
+    Ok(Outcome::Wrote(vec![dir.join("index.html")]))
+}

@@ -1,0 +1,337 @@
+//! The report of `configs/quick.yaml` (the README's first command) as a reader gets it: every
+//! SVG rendered by a real renderer and not blank where its data should be, legends beside the
+//! plots, the page referencing only files of the report directory, the numbers of Tables 2 and 3
+//! and of the band counts those of the files (and of the paper), and the same bytes on a rerun.
+//!
+//! The renderer is resvg: a pure-Rust SVG renderer (no system library, no browser), the one with
+//! the most complete SVG conformance suite, rendering into a pixel buffer the test can read.
+//! Set `SLIDESTACK_REPORT_PNG=DIR` to keep every figure as a PNG in `DIR` for looking at.
+
+use resvg::{tiny_skia, usvg};
+use slidestack::dynamics::{ExactOptions, Ground, System, simulate_exact};
+use slidestack::pipeline::Study;
+use slidestack::report::chart::areas;
+use slidestack::store::fit::read_fit;
+use slidestack::store::motions::read_zone_motions;
+use slidestack::store::tnew::read_zone_tnew;
+use slidestack::study::cases::{PAPER_TABLE_2, PAPER_TABLE_3, TABLE_2};
+use slidestack::study::tnew::{BAND_FLAGS, BandCounts};
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::Command;
+
+fn slidestack(args: &[&str]) {
+    let o = Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// The `<td>` texts of each row of the table with `id`.
+fn table(doc: &roxmltree::Document, id: &str) -> Vec<Vec<String>> {
+    let t = doc
+        .descendants()
+        .find(|n| n.has_tag_name("table") && n.attribute("id") == Some(id))
+        .unwrap_or_else(|| panic!("no table `{id}`"));
+    t.children()
+        .filter(|n| n.has_tag_name("tr"))
+        .map(|tr| {
+            tr.children()
+                .filter(|n| n.has_tag_name("td"))
+                .map(|td| {
+                    td.descendants()
+                        .filter(|d| d.is_text())
+                        .filter_map(|d| d.text())
+                        .collect()
+                })
+                .collect::<Vec<String>>()
+        })
+        .filter(|r| !r.is_empty())
+        .collect()
+}
+
+fn header(doc: &roxmltree::Document, id: &str) -> Vec<String> {
+    let t = doc
+        .descendants()
+        .find(|n| n.has_tag_name("table") && n.attribute("id") == Some(id))
+        .unwrap();
+    t.descendants()
+        .filter(|n| n.has_tag_name("th"))
+        .map(|th| th.text().unwrap_or_default().to_string())
+        .collect()
+}
+
+fn close(shown: &str, want: f64, tol: f64, what: &str) {
+    let v: f64 = shown
+        .parse()
+        .unwrap_or_else(|_| panic!("{what}: `{shown}` is not a number"));
+    assert!(
+        (v - want).abs() <= tol,
+        "{what}: shown {shown}, file {want}"
+    );
+}
+
+/// Renders `svg` and checks that every plot area has drawn pixels and no legend overlaps one.
+fn check_figure(name: &str, svg: &str, opt: &usvg::Options, png_dir: Option<&Path>) {
+    let tree = usvg::Tree::from_str(svg, opt).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let size = tree.size().to_int_size();
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height()).unwrap();
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
+    if let Some(dir) = png_dir {
+        pixmap
+            .save_png(dir.join(name).with_extension("png"))
+            .unwrap();
+    }
+    let list = areas(svg);
+    let plots: Vec<[i32; 4]> = list
+        .iter()
+        .filter(|(k, _)| k == "plot")
+        .map(|a| a.1)
+        .collect();
+    assert!(!plots.is_empty(), "{name}: no plot area listed");
+    let w = size.width() as i32;
+    for p in &plots {
+        // Inside the axes (3 px in), pixels darker than the light grid lines (235) are data.
+        let mut drawn = 0;
+        for y in p[1] + 3..p[3] - 3 {
+            for x in p[0] + 3..p[2] - 3 {
+                let px = pixmap.pixels()[(y * w + x) as usize].demultiply();
+                if px.red().min(px.green()).min(px.blue()) < 225 {
+                    drawn += 1;
+                }
+            }
+        }
+        assert!(
+            drawn >= 30,
+            "{name}: plot area {p:?} is blank ({drawn} pixels)"
+        );
+    }
+    for (_, l) in list.iter().filter(|(k, _)| k == "legend") {
+        for p in &plots {
+            let apart = l[0] >= p[2] || l[2] <= p[0] || l[1] >= p[3] || l[3] <= p[1];
+            assert!(apart, "{name}: legend {l:?} overlaps plot area {p:?}");
+        }
+    }
+}
+
+#[test]
+fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
+    let out = dir.path().join("quick");
+    let (c, o) = (cfg.to_str().unwrap(), out.to_str().unwrap());
+    slidestack(&["run", c, "--out", o]);
+    let report = out.join("report");
+    let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+    let doc = roxmltree::Document::parse_with_options(
+        &html,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .expect("index.html is well-formed");
+
+    // The page references only files of the report directory (and its own anchors), every one
+    // listed in the manifest; every figure in the directory is shown.
+    let manifest = std::fs::read_to_string(report.join("MANIFEST.sha256")).unwrap();
+    let listed: Vec<&str> = manifest
+        .lines()
+        .filter_map(|l| l.split_once("  ").map(|p| p.1))
+        .collect();
+    let ids: Vec<&str> = doc
+        .descendants()
+        .filter_map(|n| n.attribute("id"))
+        .collect();
+    let mut shown = Vec::new();
+    for n in doc.descendants() {
+        for attr in ["src", "href"] {
+            let Some(v) = n.attribute(attr) else { continue };
+            if let Some(anchor) = v.strip_prefix('#') {
+                assert!(ids.contains(&anchor), "no element with id `{anchor}`");
+                continue;
+            }
+            assert!(
+                !v.contains(':') && !v.contains('/') && !v.contains('\\'),
+                "`{v}` is not a file of the report directory"
+            );
+            assert!(report.join(v).is_file(), "`{v}` does not exist");
+            assert!(listed.contains(&v), "`{v}` is not in the manifest");
+            shown.push(v.to_string());
+        }
+    }
+    let mut svgs: Vec<String> = std::fs::read_dir(&report)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".svg"))
+        .collect();
+    svgs.sort();
+    for s in &svgs {
+        assert!(shown.contains(s), "{s} is not shown on the page");
+    }
+    for want in [
+        "spectra_III.svg",
+        "history_V.svg",
+        "tnew_construction_III.svg",
+        "energy.svg",
+        "drr_V.svg",
+        "tnew_III.svg",
+        "residuals_V.svg",
+    ] {
+        assert!(svgs.iter().any(|s| s == want), "{want} missing: {svgs:?}");
+    }
+
+    // Every figure rendered, with data in each plot area and its legend beside them.
+    let png_dir = std::env::var_os("SLIDESTACK_REPORT_PNG").map(std::path::PathBuf::from);
+    if let Some(d) = &png_dir {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    let mut opt = usvg::Options::default();
+    // Text only where the machine has fonts: the checks do not depend on it. The figures ask for
+    // the generic `sans-serif`, which fontdb maps to Arial unless told otherwise.
+    let db = opt.fontdb_mut();
+    db.load_system_fonts();
+    let family = db
+        .faces()
+        .flat_map(|f| f.families.iter().map(|(name, _)| name.clone()))
+        .find(|name| name == "DejaVu Sans")
+        .or_else(|| {
+            db.faces()
+                .next()
+                .and_then(|f| f.families.first().map(|n| n.0.clone()))
+        });
+    if let Some(f) = family {
+        db.set_sans_serif_family(f);
+    }
+    for s in &svgs {
+        let text = std::fs::read_to_string(report.join(s)).unwrap();
+        check_figure(s, &text, &opt, png_dir.as_deref());
+    }
+
+    // Table 3: the paper's rows are the paper's, ours are fit.yaml's.
+    let fit = read_fit(&out.join("fit.yaml")).unwrap().unwrap();
+    let rows = table(&doc, "table3");
+    let mut seen = 0;
+    for z in &fit.zones {
+        let zrows: Vec<&Vec<String>> = rows.iter().filter(|r| r[0] == z.zone).collect();
+        if let Some((_, p)) = PAPER_TABLE_3.iter().find(|p| p.0 == z.zone) {
+            let r = zrows.iter().find(|r| r[1] == "paper Table 3").unwrap();
+            for (k, v) in p.iter().enumerate() {
+                close(&r[2 + k], *v, 5e-4, "paper Table 3");
+            }
+        }
+        for ff in &z.forms {
+            let name = format!("{} form", ff.form.name());
+            let r = zrows
+                .iter()
+                .find(|r| r[1].starts_with(&name))
+                .unwrap_or_else(|| panic!("zone {}: no row for the {name}", z.zone));
+            let (m, cv) = (&ff.all_cases, &ff.cross_validated);
+            for (k, v) in [m.r2, m.r, m.rmse, m.mse, m.mae, cv.r2, cv.rmse]
+                .iter()
+                .enumerate()
+            {
+                close(&r[2 + k], *v, 5e-4, &format!("zone {} {name}", z.zone));
+            }
+            assert_eq!(r[1].ends_with("recommended"), ff.form == z.recommended);
+            seen += 1;
+        }
+        if let Some(m) = &z.published {
+            let r = zrows
+                .iter()
+                .find(|r| r[1].starts_with("paper's equation"))
+                .unwrap();
+            for (k, v) in [m.r2, m.r, m.rmse, m.mse, m.mae].iter().enumerate() {
+                close(&r[2 + k], *v, 5e-4, "published equation");
+            }
+        }
+    }
+    assert!(seen >= 2);
+
+    // Table 2: the paper's columns are the paper's; ours are the means over the motions of
+    // motions.h5, simulated here again with the study's physics.
+    let study = Study::load(&cfg, Some(out.clone())).unwrap();
+    let physics = study.physics();
+    let (alpha, mu) = TABLE_2.for_blocks(2);
+    let rows = table(&doc, "table2");
+    for zc in &study.cfg.zones {
+        let r = rows.iter().find(|r| r[0] == zc.name).unwrap();
+        let motions = read_zone_motions(&out.join("motions.h5"), &zc.name).unwrap();
+        let peak = |spec: slidestack::dynamics::SystemSpec| -> f64 {
+            let sys = System::new(&spec).unwrap();
+            motions
+                .iter()
+                .map(|m| {
+                    let a = m.accel_mps2(1.0);
+                    let g = Ground {
+                        dt_s: m.dt_s,
+                        accel_mps2: &a,
+                    };
+                    simulate_exact(&sys, &g, &ExactOptions::default())
+                        .unwrap()
+                        .peak_displacement_m
+                })
+                .sum::<f64>()
+                / motions.len() as f64
+        };
+        let single = peak(physics.single(TABLE_2.period_s, TABLE_2.alpha_total(), mu[0]));
+        let stack = peak(physics.stack(TABLE_2.period_s, &alpha, &mu));
+        close(&r[1], single, 5e-5, "Table 2 single block");
+        close(&r[2], stack, 5e-5, "Table 2 stack");
+        close(
+            &r[3],
+            100.0 * (1.0 - stack / single),
+            0.05,
+            "Table 2 reduction",
+        );
+        let p = PAPER_TABLE_2.iter().find(|p| p.0 == zc.name).unwrap();
+        close(&r[5], p.1, 5e-4, "paper Table 2 single block");
+        close(&r[6], p.2, 5e-4, "paper Table 2 stack");
+    }
+
+    // The band counts are tnew.h5's.
+    let head = header(&doc, "bands");
+    let rows = table(&doc, "bands");
+    for zc in &study.cfg.zones {
+        let (_, t) = read_zone_tnew(&out.join("tnew.h5"), &zc.name, 2).unwrap();
+        let band: Vec<u8> = t.vars.band.iter().copied().collect();
+        let tn: Vec<f64> = t.vars.t_new.iter().copied().collect();
+        let tr: Vec<f64> = t.vars.t_rigid.iter().copied().collect();
+        let counts = BandCounts::new(&band, &tn, &tr);
+        let r = rows.iter().find(|r| r[0] == zc.name).unwrap();
+        let col = |name: &str| head.iter().position(|h| h == name).unwrap();
+        for (code, word) in BAND_FLAGS {
+            assert_eq!(
+                r[col(word)],
+                counts.counts[code as usize].to_string(),
+                "{word}"
+            );
+        }
+        assert_eq!(r[col("sliding cases")], counts.sliding().to_string());
+        assert_eq!(
+            r[col("T_new > 1.005·T_rigid (sliding)")],
+            counts.above_1_005.to_string()
+        );
+    }
+
+    // The same bytes when the report is made again.
+    let before: BTreeMap<String, Vec<u8>> = std::fs::read_dir(&report)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    slidestack(&["report", c, "--out", o, "--force"]);
+    for (name, bytes) in &before {
+        assert!(
+            std::fs::read(report.join(name)).unwrap() == *bytes,
+            "{name} differs on a rerun"
+        );
+    }
+}
