@@ -493,6 +493,60 @@ mod tests {
     }
 
     #[test]
+    fn refuses_impossible_yielding_naming_it() {
+        let s = System::new(&SystemSpec::new(1.0, &[0.5, 0.5], &[0.2, 0.1])).unwrap();
+        let msg = |y: Yielding| s.clone().with_yielding(y).unwrap_err().to_string();
+        assert!(msg(Yielding::epp(0.0)).contains("C_y"));
+        assert!(msg(Yielding::epp(f64::NAN)).contains("C_y"));
+        assert!(msg(Yielding::bilinear(0.1, 1.0)).contains("r = 1 is the elastic"));
+        assert!(msg(Yielding::bilinear(0.1, -0.1)).contains("post-yield stiffness ratio r"));
+        // ζ = 0.05: ζ/√r ≥ 1 below r = 0.0025, ≥ 0.9 below r = 0.003086.
+        let over = msg(Yielding::bilinear(0.1, 0.002));
+        assert!(
+            over.contains("r = 0.002") && over.contains("overdamped"),
+            "{over}"
+        );
+        assert!(over.contains("r >= 0.0031"), "{over}");
+        let near = msg(Yielding::bilinear(0.1, 0.003));
+        assert!(near.contains("nearly critically damped"), "{near}");
+        assert!(
+            s.clone()
+                .with_yielding(Yielding::bilinear(0.1, 0.0031))
+                .is_ok()
+        );
+        assert!(s.clone().with_yielding(Yielding::epp(0.1)).is_ok());
+        // Without damping any r is underdamped.
+        let mut spec = SystemSpec::new(1.0, &[], &[]);
+        spec.damping_ratio = 0.0;
+        let bare = System::new(&spec).unwrap();
+        assert!(bare.with_yielding(Yielding::bilinear(0.1, 1e-9)).is_ok());
+    }
+
+    #[test]
+    fn yield_displacement_and_the_bounding_lines() {
+        // T_p = 1 s: k = 4π² m_p; C_y = 0.1: u_y = 0.1·g/(4π²) = 0.0248405 m.
+        let s = System::new(&SystemSpec::new(1.0, &[], &[]))
+            .unwrap()
+            .with_yielding(Yielding::bilinear(0.1, 0.1))
+            .unwrap();
+        let h = *s.hysteresis().unwrap();
+        let uy = 0.1 * G / (4.0 * std::f64::consts::PI.powi(2));
+        assert!((h.yield_displacement_m - uy).abs() < 1e-15);
+        assert!((s.yield_displacement_m().unwrap() - uy).abs() < 1e-15);
+        let y = Yielding::from_yield_displacement(1.0, uy, 0.1);
+        assert!((y.strength_ratio - 0.1).abs() < 1e-15);
+        // The clamped elastic line: elastic inside ±u_y from the origin, on the bounding lines
+        // beyond, and continuous.
+        let fy = h.yield_force_n;
+        assert!((h.force_n(0.5 * uy, 0.0, 0.0) - 0.5 * fy).abs() < 1e-12);
+        assert!((h.force_n(uy, 0.0, 0.0) - fy).abs() < 1e-12);
+        let f3 = h.force_n(3.0 * uy, 0.0, 0.0);
+        assert!((f3 - (fy + 0.1 * h.stiffness * 2.0 * uy)).abs() < 1e-12);
+        assert!((h.force_n(-3.0 * uy, 0.0, 0.0) + f3).abs() < 1e-12);
+        assert!((h.recoverable_energy(fy) - 0.5 * fy * uy).abs() < 1e-15);
+    }
+
+    #[test]
     fn derived_quantities() {
         let s = System::new(&SystemSpec::new(1.0, &[0.5, 0.5], &[0.2, 0.1])).unwrap();
         assert!((s.period_rigid_s() - 2f64.sqrt()).abs() < 1e-15);
