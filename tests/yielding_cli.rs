@@ -134,3 +134,77 @@ fn simulate_refuses_yielding_flags_that_do_not_fit() {
         assert!(err.contains(needle), "{all:?}: {err}");
     }
 }
+
+#[test]
+fn spectrum_ductility_reports_strengths_and_refuses_bad_targets() {
+    let rec = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/records/RSN960_NORTHR_LOS270.AT2"
+    );
+    let v = json(&[
+        "spectrum",
+        "--record",
+        rec,
+        "--periods",
+        "0.2,1",
+        "--ductility",
+        "1,4",
+        "--json",
+    ]);
+    let arr = v.as_array().unwrap();
+    assert_eq!(arr.len(), 2);
+    for s in arr {
+        let mu = s["ductility"].as_f64().unwrap();
+        let cy = s["strength_ratio"].as_array().unwrap();
+        let ce = s["elastic_strength_ratio"].as_array().unwrap();
+        let ry = s["reduction_factor"].as_array().unwrap();
+        assert_eq!(cy.len(), 2);
+        for i in 0..2 {
+            let (cy, ce, ry) = (
+                cy[i].as_f64().unwrap(),
+                ce[i].as_f64().unwrap(),
+                ry[i].as_f64().unwrap(),
+            );
+            assert!((ry - ce / cy).abs() < 1e-12 * ry);
+            if mu == 1.0 {
+                assert_eq!(ry, 1.0);
+            } else {
+                assert!(ry > 1.0);
+            }
+            let reached = s["ductility_reached"][i].as_f64().unwrap();
+            assert!((reached - mu).abs() < 1e-8 * mu);
+        }
+    }
+    let csv = run(&[
+        "spectrum",
+        "--record",
+        rec,
+        "--periods",
+        "0.5",
+        "--ductility",
+        "2",
+        "--csv",
+    ]);
+    let text = String::from_utf8_lossy(&csv.stdout);
+    assert!(text.starts_with("record,damping,ductility,post_yield_ratio,period_s,strength_ratio,"));
+    assert_eq!(text.lines().count(), 2);
+    for (args, needle) in [
+        (
+            vec!["--ductility", "0.5"],
+            "target ductility must be within 1",
+        ),
+        (
+            vec!["--ductility", "2", "--post-yield-ratio", "0.0001"],
+            "overdamped",
+        ),
+    ] {
+        let mut all = vec!["spectrum", "--record", rec, "--periods", "0.5"];
+        all.extend(args);
+        let out = run(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{all:?}: {err}");
+        assert!(err.contains(needle), "{all:?}: {err}");
+    }
+    let out = run(&["spectrum", "--record", rec, "--post-yield-ratio", "0.1"]);
+    assert_eq!(out.status.code(), Some(2));
+}
