@@ -777,3 +777,133 @@ fn stack_on_yielding_structure_matches_regularised_friction() {
         assert!(extra < 1e-4, "{extra:e}");
     }
 }
+
+/// Record (index into the real records, `usize::MAX` for a zero record), `T_p`, scale, `α`,
+/// `μ`, bare-structure `ζ`, model.
+type EdgeCase = (usize, f64, f64, Vec<f64>, Vec<f64>, f64, Yielding);
+
+/// Extreme but legal yielding systems: strengths from 1e-6 (yield displacement below a
+/// micrometre at 1 s, ductilities 4e5–1.4e6) to barely reached, `r` at the edge of the damping
+/// limit (`ζ/√r` = 0.88), `r = 0` without damping (a cubic plastic branch), periods 0.01
+/// to 20 s, stacks of five blocks and friction that falls upward, a zero record and a record
+/// scaled by 10. Each run must end (the integrator's switch guard), give finite output and
+/// close the energy balance to `max(1e-9, 2e-13·N²)` of the running input, `N` the samples per
+/// longest period (`T_rigid`, or `T_rigid/√r` on the post-yield branch): the stress suite's
+/// tolerance for the known long-period cancellation of `dynamics::exact` (verify/src/stress.rs;
+/// measured here 2e-10 at 20 s and 5e-10 at `r` = 0.0032, `T_rigid/√r` = 18 s), and an exact
+/// peak never below a sampled one.
+#[test]
+fn yielding_edge_cases_are_finite_balanced_and_terminate() {
+    let recs = real_records();
+    let zero = vec![0.0; 500];
+    let cases: Vec<EdgeCase> = vec![
+        (0, 1.0, 1.0, vec![], vec![], 0.05, Yielding::epp(1e-6)),
+        (
+            1,
+            0.5,
+            1.0,
+            vec![0.5, 0.5],
+            vec![0.1, 0.05],
+            0.05,
+            Yielding::bilinear(1e-6, 0.5),
+        ),
+        (2, 1.0, 1.0, vec![], vec![], 0.0, Yielding::epp(0.05)),
+        (
+            0,
+            0.01,
+            1.0,
+            vec![1.0],
+            vec![0.1],
+            0.05,
+            Yielding::bilinear(0.5, 0.1),
+        ),
+        (
+            1,
+            20.0,
+            1.0,
+            vec![0.2],
+            vec![0.05],
+            0.05,
+            Yielding::epp(0.0005),
+        ),
+        // ζ_p/√r = 0.88: just inside the limit.
+        (
+            2,
+            1.0,
+            1.0,
+            vec![],
+            vec![],
+            0.05,
+            Yielding::bilinear(0.05, 0.0032),
+        ),
+        (
+            0,
+            0.7,
+            10.0,
+            vec![0.2, 0.3, 0.1, 0.5, 0.2],
+            vec![0.3, 0.2, 0.15, 0.1, 0.05],
+            0.05,
+            Yielding::bilinear(0.3, 0.02),
+        ),
+        (
+            usize::MAX,
+            1.0,
+            1.0,
+            vec![0.5],
+            vec![0.1],
+            0.05,
+            Yielding::epp(0.1),
+        ),
+    ];
+    for (ri, tp, scale, alpha, mu, zeta, y) in cases {
+        let (accel, dt) = if ri == usize::MAX {
+            (zero.clone(), 0.01)
+        } else {
+            (recs[ri].accel_mps2(scale), recs[ri].dt_s)
+        };
+        let ground = Ground {
+            dt_s: dt,
+            accel_mps2: &accel,
+        };
+        let mut spec = SystemSpec::new(tp, &alpha, &mu);
+        spec.damping_ratio = zeta;
+        let sys = System::new(&spec).unwrap().with_yielding(y).unwrap();
+        let t0 = std::time::Instant::now();
+        let r =
+            simulate_exact(&sys, &ground, &HIST).unwrap_or_else(|e| panic!("T={tp} {y:?}: {e}"));
+        let h = r.history.as_ref().unwrap();
+        assert!(
+            h.displacement_m
+                .iter()
+                .chain(&h.velocity_mps)
+                .chain(&h.abs_accel_mps2)
+                .all(|x| x.is_finite())
+        );
+        let r_post = y.post_yield_ratio;
+        let longest = sys.period_rigid_s() / if r_post > 0.0 { r_post.sqrt() } else { 1.0 };
+        let steps = longest / dt;
+        let tol = (2e-13 * steps * steps).max(1e-9);
+        let u = column(&h.displacement_m, h.bodies, 0);
+        let sampled = u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        eprintln!(
+            "T={tp} x{scale} n={} {y:?}: ductility {:.3e}, {} yield events, {} switches, \
+             balance {:.1e}, {:?}",
+            alpha.len(),
+            r.ductility.unwrap(),
+            r.yield_events,
+            r.switches,
+            r.energy_balance_error_max,
+            t0.elapsed()
+        );
+        assert!(
+            r.energy_balance_error_max < tol,
+            "{:e}",
+            r.energy_balance_error_max
+        );
+        assert!(r.peak_displacement_m >= sampled);
+        if ri == usize::MAX {
+            assert_eq!(r.peak_displacement_m, 0.0);
+            assert_eq!(r.yield_events, 0);
+        }
+    }
+}
