@@ -338,7 +338,7 @@ pub struct DecayPiece {
     /// `u(h)`, `u̇(h)`.
     pub u: f64,
     pub v: f64,
-    /// `∫₀^h u dτ` and `∫₀^h u̇² dτ`.
+    /// `∫₀^h u dτ` and `∫₀^h u̇² dτ` (NaN unless asked for).
     pub int_u: f64,
     pub int_v2: f64,
 }
@@ -349,8 +349,14 @@ pub struct DecayPiece {
 /// (exact to round-off: the integrand is a quartic plus terms in `e^{−aτ}` with `2a·h ≤ 2`,
 /// whose 16th derivative bounds the error below `1e-18·h·max u̇²`). The same motion as the
 /// structure wave of `r = 0` (`Exact::structure_wave`), without its terms of order `p₀/a²`
-/// that cancel when `a·h` is small.
-pub fn decay_piece(decay: f64, p0: f64, p1: f64, u0: f64, v0: f64, h: f64) -> DecayPiece {
+/// that cancel when `a·h` is small. `square`: whether to compute `∫u̇²` (eight evaluations).
+pub fn decay_piece(
+    decay: f64,
+    (p0, p1): (f64, f64),
+    (u0, v0): (f64, f64),
+    h: f64,
+    square: bool,
+) -> DecayPiece {
     debug_assert!(decay * h <= 1.0);
     let vel = |t: f64| {
         let x = -decay * t;
@@ -363,10 +369,14 @@ pub fn decay_piece(decay: f64, p0: f64, p1: f64, u0: f64, v0: f64, h: f64) -> De
         phi_small(3, x),
         phi_small(4, x),
     );
-    let int_v2 = h * GAUSS8
-        .iter()
-        .map(|&(node, weight)| weight * vel(node * h).powi(2))
-        .sum::<f64>();
+    let int_v2 = if square {
+        h * GAUSS8
+            .iter()
+            .map(|&(node, weight)| weight * vel(node * h).powi(2))
+            .sum::<f64>()
+    } else {
+        f64::NAN
+    };
     DecayPiece {
         u: u0 + h * (v0 * f1 + h * (p0 * f2 + h * p1 * f3)),
         v: vel(h),
@@ -498,7 +508,9 @@ mod tests {
         // a·h is not small) and Simpson's rule on the wave.
         let (p0, p1, u0, v0) = (-2.5, 40.0, 0.03, -0.4);
         for (a, h) in [(0.9, 1.0), (50.0, 0.02), (5.0, 0.1), (0.0, 0.01)] {
-            let d = decay_piece(a, p0, p1, u0, v0, h);
+            let d = decay_piece(a, (p0, p1), (u0, v0), h, true);
+            let e = decay_piece(a, (p0, p1), (u0, v0), h, false);
+            assert!(e.int_v2.is_nan() && (e.u, e.v, e.int_u) == (d.u, d.v, d.int_u));
             let osc = Osc {
                 decay: a,
                 omega: 0.0,

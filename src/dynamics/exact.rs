@@ -181,7 +181,11 @@ impl Spring {
                 k_post: 0.0,
                 intercept: 0.0,
                 u_y: 0.0,
-                branch: Branch::Plastic(0),
+                branch: Branch::Elastic {
+                    offset: 0.0,
+                    lo: f64::NEG_INFINITY,
+                    hi: f64::INFINITY,
+                },
             };
         };
         Self {
@@ -772,11 +776,10 @@ impl<'s, const Y: bool> Exact<'s, Y> {
         let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
         Some(decay_piece(
             cl.osc.decay,
-            self.plastic_load(cl, f_top0, ga),
-            -slope,
-            self.x[0],
-            self.v[0],
+            (self.plastic_load(cl, f_top0, ga), -slope),
+            (self.x[0], self.v[0]),
             b.tau,
+            self.opts.energy_balance,
         ))
     }
 
