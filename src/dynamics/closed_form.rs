@@ -476,6 +476,39 @@ mod tests {
     }
 
     #[test]
+    fn bounds_hold_without_oscillation() {
+        // `Osc { decay: a, omega: 0 }` (a branch without stiffness): the wave's exponential is
+        // `c·e^{−aτ}` and each derivative multiplies it by `−a`, so `natural() = a` and the
+        // amplitude bounds of `deriv_abs_bound` must hold; checked against dense samples of the
+        // derivative waves, with a polynomial part of the size the r = 0 branch gives.
+        for decay in [0.0, 0.4, 25.0] {
+            let osc = Osc { decay, omega: 0.0 };
+            assert_eq!(osc.natural(), decay);
+            let g = Wave {
+                p: [3.0, -40.0, 2.5, 0.0],
+                c: -2.9,
+                d: 0.0,
+            };
+            let amps = Osc::amplitudes(osc.natural(), g.amplitude());
+            let (t0, t1) = (0.003, 0.02);
+            let exp_t0 = (-decay * t0).exp();
+            let mut dk = g;
+            for (k, amp) in amps.iter().enumerate() {
+                let bound = g.deriv_abs_bound(k, t1, exp_t0, *amp);
+                for i in 0..=1000 {
+                    let t = t0 + (t1 - t0) * i as f64 / 1000.0;
+                    let v = dk.eval(&Basis::at(osc, t)).abs();
+                    assert!(
+                        v <= bound * (1.0 + 1e-15),
+                        "a={decay} k={k} t={t}: {v} > {bound}"
+                    );
+                }
+                dk = dk.deriv(osc);
+            }
+        }
+    }
+
+    #[test]
     fn square_integral_without_stiffness_matches_numerics() {
         // Independent oracle: composite Simpson on the wave evaluated through `Basis`. Decay
         // rates on both sides of the series/asymptotic switch (a·h = 20) and zero.
