@@ -49,6 +49,32 @@ pub const MAX_ALPHA: f64 = 1e4;
 /// never slides, which any `μ` of a few tens already gives.
 pub const MAX_MU: f64 = 1e3;
 
+/// Yield strength ratio `C_y = F_y/(m_p·g)` of a yielding structure. Below `1e-6` the
+/// structure is a mass on a damper whose yield displacement (`C_y·g/ω_p²`, under a micrometre at
+/// `T_p = 1 s`) makes the ductility a ratio of round-off; above `1e6` (a million g) nothing a
+/// record can do reaches the yield force, and the value is a unit mistake rather than a design.
+pub const STRENGTH_RATIO_RANGE: (f64, f64) = (1e-6, 1e6);
+
+/// Largest damping ratio of the post-yield branch, `ζ_p/√r` with `ζ_p` the bare structure's
+/// ratio and `r > 0` the post-yield stiffness ratio (at its largest when every block slides).
+/// The exact integrator writes a branch's free motion as `e^{−aτ}(c·cos ωτ + d·sin ωτ)`: an
+/// overdamped branch has no such form (it would need hyperbolic functions; refused), and near
+/// critical damping `ω → 0` makes `d ∝ 1/ω`, so the bounds of the certified search loosen by
+/// that factor. `0.9` keeps the loss below a factor `1/sqrt(1 − 0.9²) ≈ 2.3`.
+/// `r = 0` (elastic–perfectly plastic) has its own exact form and is always allowed.
+pub const MAX_POST_YIELD_DAMPING: f64 = 0.9;
+
+/// Largest target ductility of a constant-ductility spectrum. The strength search scans down
+/// from the elastic strength in steps of [`DUCTILITY_SCAN_STEP`], about `ln(μ)/0.02` runs; 100
+/// is far beyond any structure's capacity (Chopra's spectra stop at 8).
+pub const MAX_TARGET_DUCTILITY: f64 = 100.0;
+
+/// Ratio of successive strengths `f̄_y = C_y/C_e` in the downward scan of a constant-ductility
+/// spectrum (`src/spectrum/ductility.rs`): the largest strength with the target ductility is
+/// found to within this step before bisection refines it; a root inside an excursion of
+/// `μ(f̄_y)` narrower than 2 % of `f̄_y` can be missed.
+pub const DUCTILITY_SCAN_STEP: f64 = 0.98;
+
 /// Largest `T_rigid/dt` the exact integrator runs: its structure cluster is written as a
 /// particular plus a homogeneous solution whose terms cancel when `ω·dt` is small, so the energy
 /// error grows like `3e-15·(T_rigid/dt)²` (module doc of `dynamics::exact`): about `1e-3` here.

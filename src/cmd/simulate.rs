@@ -4,14 +4,16 @@
 //! built-in Northridge record when absent) and the case from flags or a YAML file (`--config`,
 //! keys as the long flags with `_` for `-`; flags override it). Prints the peaks, slips, switch
 //! count and energy terms as a table or, with `--json`, one JSON object on stdout. Writes the full
-//! time history when `--history OUT.h5|OUT.csv` is given.
+//! time history when `--history OUT.h5|OUT.csv` is given. `--structure epp|bilinear` makes the
+//! structure yield (docs/model.md, "Yielding structure") and adds its ductility, residual
+//! displacement and hysteretic energy.
 
 use super::BadInput;
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 use serde::{Deserialize, Serialize};
 use slidestack::dynamics::{
-    ExactOptions, G, Ground, Response, System, SystemSpec, simulate_exact, simulate_rk4,
+    ExactOptions, G, Ground, Response, System, SystemSpec, Yielding, simulate_exact, simulate_rk4,
 };
 use slidestack::motion::{self, Record};
 use slidestack::store::write_history;
@@ -28,12 +30,24 @@ pub enum Integrator {
     Rk4,
 }
 
+/// The structure's restoring force (docs/model.md, "Yielding structure").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StructureKind {
+    /// Linear, the paper's structure.
+    Elastic,
+    /// Elastic–perfectly plastic (needs --yield-strength-ratio).
+    Epp,
+    /// Bilinear with kinematic hardening (needs --yield-strength-ratio and --post-yield-ratio).
+    Bilinear,
+}
+
 #[derive(Debug, clap::Args)]
 #[command(allow_negative_numbers = true)]
 pub struct Args {
     /// YAML file with the case (keys: record, period, alpha, mu, mu_static, damping,
-    /// damping_basis, scale,
-    /// integrator, rk4_substeps, history); flags given on the command line override it.
+    /// damping_basis, scale, integrator, rk4_substeps, history, structure,
+    /// yield_strength_ratio, post_yield_ratio); flags given on the command line override it.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Ground-motion record: PEER .AT2 or two-column time/acceleration text, values in g.
@@ -67,6 +81,16 @@ pub struct Args {
     /// RK4 sub-steps per record interval [default: 10].
     #[arg(long)]
     rk4_substeps: Option<usize>,
+    /// Restoring force of the structure [default: elastic].
+    #[arg(long, value_enum)]
+    structure: Option<StructureKind>,
+    /// Yield strength ratio C_y = F_y/(m_p·g) of an epp or bilinear structure (m_p the bare
+    /// structure's mass).
+    #[arg(long)]
+    yield_strength_ratio: Option<f64>,
+    /// Post-yield stiffness over elastic stiffness r (0 ≤ r < 1) of a bilinear structure.
+    #[arg(long)]
+    post_yield_ratio: Option<f64>,
     /// Write the time history to this .h5 or .csv file.
     #[arg(long)]
     history: Option<PathBuf>,
@@ -90,6 +114,9 @@ struct CaseFile {
     integrator: Option<Integrator>,
     rk4_substeps: Option<usize>,
     history: Option<PathBuf>,
+    structure: Option<StructureKind>,
+    yield_strength_ratio: Option<f64>,
+    post_yield_ratio: Option<f64>,
 }
 
 #[derive(Debug, Serialize)]
@@ -100,6 +127,8 @@ struct EnergyJson {
     damping: f64,
     friction: f64,
     friction_per_interface: Vec<f64>,
+    /// `∫F_s du − F_s²/(2k)` of a yielding structure; 0 when elastic.
+    hysteretic: f64,
 }
 
 /// The `--json` contract (README): field names are relied on by users and checks.
@@ -121,6 +150,10 @@ struct Output {
     mu_static: Vec<f64>,
     integrator: Integrator,
     rk4_substeps: Option<usize>,
+    structure: StructureKind,
+    yield_strength_ratio: Option<f64>,
+    post_yield_ratio: Option<f64>,
+    yield_displacement_m: Option<f64>,
     peak_displacement_m: f64,
     peak_displacement_time_s: f64,
     peak_abs_accel_g: Vec<f64>,
@@ -128,6 +161,12 @@ struct Output {
     residual_slip_m: Vec<f64>,
     slip_time_s: Vec<f64>,
     switches: u64,
+    /// Peak displacement over the yield displacement; null when elastic.
+    ductility: Option<f64>,
+    /// Structure displacement at the end of the record, m.
+    residual_displacement_m: f64,
+    /// Yield and unloading events (or, with rk4, changes of branch between sub-steps).
+    yield_events: u64,
     energy: EnergyJson,
     energy_balance_error: f64,
     energy_balance_error_max: f64,
@@ -184,7 +223,21 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(p) = &history_path {
         slidestack::store::HistoryFormat::from_path(p)?;
     }
-    let system = System::new(&spec).map_err(|e| BadInput(format!("invalid case: {e}")))?;
+    let structure = args
+        .structure
+        .or(file.structure)
+        .unwrap_or(StructureKind::Elastic);
+    let yielding = yielding(
+        structure,
+        args.yield_strength_ratio.or(file.yield_strength_ratio),
+        args.post_yield_ratio.or(file.post_yield_ratio),
+    )?;
+    let mut system = System::new(&spec).map_err(|e| BadInput(format!("invalid case: {e}")))?;
+    if let Some(y) = yielding {
+        system = system
+            .with_yielding(y)
+            .map_err(|e| BadInput(format!("invalid case: {e}")))?;
+    }
     let record: Record = match args.record.or(file.record) {
         Some(path) => motion::read_record(&path)?,
         None => motion::builtin(),
@@ -214,7 +267,7 @@ pub fn run(args: Args) -> Result<()> {
         write_history(path, h)?;
     }
     let out = output(
-        &record, scale, &physics, &system, integrator, substeps, &response,
+        &record, scale, &physics, &system, structure, integrator, substeps, &response,
     );
     if args.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
@@ -227,16 +280,59 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
+/// The yielding model the flags ask for; `None` for the elastic structure. Each flag is
+/// refused where it does not apply, and required where it does.
+fn yielding(
+    structure: StructureKind,
+    strength: Option<f64>,
+    r: Option<f64>,
+) -> Result<Option<Yielding>, BadInput> {
+    match (structure, strength, r) {
+        (StructureKind::Elastic, None, None) => Ok(None),
+        (StructureKind::Elastic, _, _) => Err(BadInput(
+            "--yield-strength-ratio and --post-yield-ratio apply only to --structure epp or \
+             bilinear"
+                .into(),
+        )),
+        (_, None, _) => Err(BadInput(format!(
+            "--structure {} needs --yield-strength-ratio (C_y = F_y/(m_p·g))",
+            structure.name()
+        ))),
+        (StructureKind::Epp, Some(c), None) => Ok(Some(Yielding::epp(c))),
+        (StructureKind::Epp, Some(_), Some(r)) => Err(BadInput(format!(
+            "--structure epp has no post-yield stiffness (r = 0), got --post-yield-ratio {r}; \
+             use --structure bilinear"
+        ))),
+        (StructureKind::Bilinear, Some(_), None) => Err(BadInput(
+            "--structure bilinear needs --post-yield-ratio (r, 0 ≤ r < 1)".into(),
+        )),
+        (StructureKind::Bilinear, Some(c), Some(r)) => Ok(Some(Yielding::bilinear(c, r))),
+    }
+}
+
+impl StructureKind {
+    fn name(self) -> &'static str {
+        match self {
+            StructureKind::Elastic => "elastic",
+            StructureKind::Epp => "epp",
+            StructureKind::Bilinear => "bilinear",
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn output(
     record: &Record,
     scale: f64,
     physics: &Physics,
     sys: &System,
+    structure: StructureKind,
     integrator: Integrator,
     substeps: usize,
     r: &Response,
 ) -> Output {
     let e = &r.energy;
+    let hyst = sys.hysteresis();
     Output {
         record: record.name.clone(),
         dt_s: record.dt_s,
@@ -255,6 +351,10 @@ fn output(
         mu_static: sys.mu_static().to_vec(),
         integrator,
         rk4_substeps: (integrator == Integrator::Rk4).then_some(substeps),
+        structure,
+        yield_strength_ratio: hyst.map(|h| h.strength_ratio),
+        post_yield_ratio: hyst.map(|h| h.post_yield_ratio),
+        yield_displacement_m: hyst.map(|h| h.yield_displacement_m),
         peak_displacement_m: r.peak_displacement_m,
         peak_displacement_time_s: r.peak_displacement_time_s,
         peak_abs_accel_g: r.peak_abs_accel_mps2.iter().map(|a| a / G).collect(),
@@ -262,6 +362,9 @@ fn output(
         residual_slip_m: r.residual_slip_m.clone(),
         slip_time_s: r.slip_time_s.clone(),
         switches: r.switches,
+        ductility: r.ductility,
+        residual_displacement_m: r.residual_displacement_m,
+        yield_events: r.yield_events,
         energy: EnergyJson {
             input: e.input,
             kinetic: e.kinetic,
@@ -269,6 +372,7 @@ fn output(
             damping: e.damping,
             friction: e.friction,
             friction_per_interface: e.friction_per_interface.clone(),
+            hysteretic: e.hysteretic,
         },
         energy_balance_error: e.balance_error(),
         energy_balance_error_max: r.energy_balance_error_max,
@@ -305,6 +409,16 @@ fn print_table(o: &Output) {
         None => "exact".to_string(),
     };
     println!("integrator        {integ}");
+    if let (Some(c), Some(r), Some(uy)) = (
+        o.yield_strength_ratio,
+        o.post_yield_ratio,
+        o.yield_displacement_m,
+    ) {
+        println!(
+            "yielding          {}: C_y {c}, r {r}, u_y {uy:.6} m",
+            o.structure.name()
+        );
+    }
     println!(
         "peak displacement {:.6} m at {:.4} s",
         o.peak_displacement_m, o.peak_displacement_time_s
@@ -317,11 +431,20 @@ fn print_table(o: &Output) {
     println!("residual slip     [{}] m", list(&o.residual_slip_m, 5));
     println!("slipping time     [{}] s", list(&o.slip_time_s, 3));
     println!("switches          {}", o.switches);
+    if let Some(mu) = o.ductility {
+        println!(
+            "ductility         {mu:.4} ({} yield/unloading events), residual displacement {:.6} m",
+            o.yield_events, o.residual_displacement_m
+        );
+    }
     let e = &o.energy;
     println!(
         "energy (J/kg)     input {:.6}, kinetic {:.6}, strain {:.6}, damping {:.6}, friction {:.6}",
         e.input, e.kinetic, e.strain, e.damping, e.friction
     );
+    if o.ductility.is_some() {
+        println!("                  hysteretic {:.6}", e.hysteretic);
+    }
     println!(
         "energy balance    |residual|/input = {:.2e}",
         o.energy_balance_error

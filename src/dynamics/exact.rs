@@ -41,7 +41,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::closed_form::{
-    Basis, Osc, PieceIntegrals, Wave, hermite_range, integral_of_square_with,
+    Basis, DecayPiece, Osc, PieceIntegrals, Wave, decay_piece, hermite_range,
+    integral_of_square_decay, integral_of_square_with,
 };
 use super::contact::{Contact, ContactSelector};
 use super::model::System;
@@ -73,7 +74,9 @@ impl Default for ExactOptions {
     }
 }
 
-/// Runs the exact integrator over the whole record.
+/// Runs the exact integrator over the whole record. A yielding structure
+/// ([`System::with_yielding`]) runs a separate instance of the integrator; the linear one is
+/// compiled without any of its branches.
 pub fn simulate_exact(
     sys: &System,
     ground: &Ground,
@@ -81,12 +84,18 @@ pub fn simulate_exact(
 ) -> Result<Response, SimError> {
     ground.validate()?;
     super::check_accuracy(sys, ground)?;
-    let r = Exact::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?;
+    let r = if sys.hysteresis().is_some() {
+        Exact::<true>::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?
+    } else {
+        Exact::<false>::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?
+    };
     r.check_finite()?;
     Ok(r)
 }
 
-/// Coefficients of the structure's cluster when its top body is `e0`.
+/// Coefficients of the structure's cluster when its top body is `e0`. With a post-yield
+/// stiffness of zero (`omega2 = 0`) the free motion is `1` and `e^{−(c/M)τ}`: `osc` is then
+/// `{ decay: c/M, omega: 0 }`, whose wave `c·e^{−aτ}` is that exponential.
 #[derive(Debug, Clone, Copy)]
 struct Cluster0 {
     mass: f64,
@@ -99,12 +108,143 @@ struct Cluster0 {
     integrals_dt: PieceIntegrals,
 }
 
+impl Cluster0 {
+    /// The cluster of mass `mass` (kg) on a spring of stiffness `stiffness` (N/m, `≥ 0`) and
+    /// the damper `damping` (N·s/m), with its sample-interval basis for `dt` (s).
+    fn new(mass: f64, stiffness: f64, damping: f64, dt: f64) -> Self {
+        let omega2 = stiffness / mass;
+        let osc = if omega2 == 0.0 {
+            Osc {
+                decay: damping / mass,
+                omega: 0.0,
+            }
+        } else {
+            let decay = damping / (2.0 * mass);
+            Osc {
+                decay,
+                omega: (omega2 - decay * decay).sqrt(),
+            }
+        };
+        let basis_dt = Basis::at(osc, dt);
+        Cluster0 {
+            mass,
+            osc,
+            omega2,
+            natural: osc.natural(),
+            basis_dt,
+            integrals_dt: PieceIntegrals::new(osc, &basis_dt),
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum EventKind {
     /// Slipping interface (0-based) whose relative velocity reaches zero.
     SlipStop(usize),
     /// Stuck interface (0-based) whose required force leaves the static limit.
     Break(usize),
+    /// The structure's displacement reaches the end of its elastic range on side ±1.
+    Yield(i8),
+    /// The structure's velocity reverses in a plastic branch.
+    Unload,
+}
+
+/// Branch of a yielding structure's restoring force `F = k_b·u + f_off`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Branch {
+    /// `k_b = k`, within `lo ≤ u ≤ hi` (m).
+    Elastic { offset: f64, lo: f64, hi: f64 },
+    /// On the bounding line of side `dir`: `k_b = r·k`, `f_off = dir·(1 − r)·F_y`; lasts while
+    /// `dir·u̇ ≥ 0`.
+    Plastic(i8),
+}
+
+/// The yielding structure's spring and its current branch (docs/model.md, "Yielding
+/// structure"); all zero for the linear structure, which never reads it.
+#[derive(Debug, Clone, Copy)]
+struct Spring {
+    /// Elastic stiffness `k` and post-yield stiffness `r·k`, N/m.
+    k: f64,
+    k_post: f64,
+    /// `(1 − r)·F_y`, N.
+    intercept: f64,
+    /// Yield displacement `u_y`, m.
+    u_y: f64,
+    branch: Branch,
+}
+
+impl Spring {
+    fn new(sys: &System) -> Self {
+        let Some(h) = sys.hysteresis() else {
+            return Self {
+                k: 0.0,
+                k_post: 0.0,
+                intercept: 0.0,
+                u_y: 0.0,
+                branch: Branch::Elastic {
+                    offset: 0.0,
+                    lo: f64::NEG_INFINITY,
+                    hi: f64::INFINITY,
+                },
+            };
+        };
+        Self {
+            k: h.stiffness,
+            k_post: h.post_yield_ratio * h.stiffness,
+            intercept: h.intercept_n(),
+            u_y: h.yield_displacement_m,
+            branch: Branch::Elastic {
+                offset: 0.0,
+                lo: -h.yield_displacement_m,
+                hi: h.yield_displacement_m,
+            },
+        }
+    }
+
+    fn plastic(&self) -> bool {
+        matches!(self.branch, Branch::Plastic(_))
+    }
+
+    /// `(k_b, f_off)` of the current branch, N/m and N.
+    #[inline]
+    fn line(&self) -> (f64, f64) {
+        match self.branch {
+            Branch::Elastic { offset, .. } => (self.k, offset),
+            Branch::Plastic(dir) => (self.k_post, f64::from(dir) * self.intercept),
+        }
+    }
+
+    /// Restoring force at `u` (m) on the current branch, N.
+    #[inline]
+    fn force(&self, u: f64) -> f64 {
+        let (kb, off) = self.line();
+        kb * u + off
+    }
+
+    /// Leaves the plastic branch at `u` (m): the new elastic line passes through the bounding
+    /// line's point at `u`, and the elastic range ends exactly at `u` on the side just left, so
+    /// the yield event of that side starts at zero.
+    fn unload(&mut self, u: f64) {
+        let Branch::Plastic(dir) = self.branch else {
+            return;
+        };
+        let f = self.k_post * u + f64::from(dir) * self.intercept;
+        let offset = f - self.k * u;
+        let width = 2.0 * self.u_y;
+        self.branch = if dir > 0 {
+            Branch::Elastic {
+                offset,
+                lo: u - width,
+                hi: u,
+            }
+        } else {
+            Branch::Elastic {
+                offset,
+                lo: u,
+                hi: u + width,
+            }
+        };
+    }
 }
 
 /// A function of the piece's local time with its derivative and the oscillation amplitudes of
@@ -203,12 +343,19 @@ struct Event {
     g: Tracked,
 }
 
-struct Exact<'s> {
+/// The integrator; `Y` is whether the structure yields (its spring and plastic clusters are read
+/// only then).
+struct Exact<'s, const Y: bool> {
     sys: &'s System,
     dt: f64,
     opts: ExactOptions,
     n: usize,
     cluster0: Vec<Cluster0>,
+    /// The structure's cluster on the post-yield stiffness, by top body (empty unless `Y`).
+    cluster_plastic: Vec<Cluster0>,
+    spring: Spring,
+    /// `∫F_s du` so far, J (only with `Y`; the linear structure's is `½k·u²`).
+    spring_work: f64,
     /// `mass_prefix[j] = Σ_{i<j} m_i`.
     mass_prefix: Vec<f64>,
     lim_s: Vec<f64>,
@@ -238,7 +385,7 @@ struct Exact<'s> {
     energy: Energy,
 }
 
-impl<'s> Exact<'s> {
+impl<'s, const Y: bool> Exact<'s, Y> {
     fn new(sys: &'s System, dt: f64, opts: ExactOptions) -> Self {
         let n = sys.blocks();
         let m = sys.masses();
@@ -249,25 +396,16 @@ impl<'s> Exact<'s> {
         let k = sys.stiffness();
         let c = sys.damping();
         let cluster0 = (0..=n)
-            .map(|e0| {
-                let mass = mass_prefix[e0 + 1];
-                let omega2 = k / mass;
-                let decay = c / (2.0 * mass);
-                let osc = Osc {
-                    decay,
-                    omega: (omega2 - decay * decay).sqrt(),
-                };
-                let basis_dt = Basis::at(osc, dt);
-                Cluster0 {
-                    mass,
-                    osc,
-                    omega2,
-                    natural: osc.natural(),
-                    basis_dt,
-                    integrals_dt: PieceIntegrals::new(osc, &basis_dt),
-                }
-            })
+            .map(|e0| Cluster0::new(mass_prefix[e0 + 1], k, c, dt))
             .collect();
+        let spring = Spring::new(sys);
+        let cluster_plastic = if Y {
+            (0..=n)
+                .map(|e0| Cluster0::new(mass_prefix[e0 + 1], spring.k_post, c, dt))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let lim_s = (1..=n).map(|i| sys.static_limit(i)).collect();
         let lim_k = (1..=n).map(|i| sys.kinetic_limit(i)).collect();
         let contacts: Vec<Contact> = sys
@@ -294,6 +432,9 @@ impl<'s> Exact<'s> {
             opts,
             n,
             cluster0,
+            cluster_plastic,
+            spring,
+            spring_work: 0.0,
             mass_prefix,
             lim_s,
             lim_k,
@@ -349,15 +490,19 @@ impl<'s> Exact<'s> {
                 let h = self.dt - tau;
                 let osc = self.osc();
                 let basis_h = if tau == 0.0 {
-                    self.cluster0[self.top[0]].basis_dt
+                    self.cl().basis_dt
                 } else {
                     Basis::at(osc, h)
                 };
                 // Both break events at once: A₀ certified inside its bounds over the piece.
                 let breaks_clear = self.breaks_clear(&basis_h);
+                // Both yield events at once: u certified inside the elastic range.
+                let yields_clear = Y && self.yields_clear(&basis_h);
                 let mut first: Option<(f64, usize)> = None;
                 for (e, ev) in self.events.iter().enumerate() {
-                    if breaks_clear && matches!(ev.kind, EventKind::Break(_)) {
+                    if breaks_clear && matches!(ev.kind, EventKind::Break(_))
+                        || yields_clear && matches!(ev.kind, EventKind::Yield(_))
+                    {
                         continue;
                     }
                     let limit = first.map_or(h, |f| f.0);
@@ -396,12 +541,16 @@ impl<'s> Exact<'s> {
             }
             let t1 = (k + 1) as f64 * self.dt;
             if self.opts.energy_balance {
-                let (kinetic, strain) = Energy::state_terms(
+                let (kinetic, mut strain) = Energy::state_terms(
                     self.sys.masses(),
                     &self.v,
                     self.sys.stiffness(),
                     self.x[0],
                 );
+                if Y {
+                    // Recoverable plus hysteretic: all the spring's work so far.
+                    strain = self.spring_work;
+                }
                 input_peak = input_peak.max(self.energy.input.abs());
                 if input_peak > 0.0 {
                     let err = self.energy.residual_with(kinetic, strain).abs() / input_peak;
@@ -421,8 +570,27 @@ impl<'s> Exact<'s> {
         self.finish(history)
     }
 
+    /// The structure's cluster on its current branch.
+    #[inline]
+    fn cl(&self) -> &Cluster0 {
+        if Y && self.spring.plastic() {
+            &self.cluster_plastic[self.top[0]]
+        } else {
+            &self.cluster0[self.top[0]]
+        }
+    }
+
     fn osc(&self) -> Osc {
-        self.cluster0[self.top[0]].osc
+        self.cl().osc
+    }
+
+    /// The structure's restoring force at its current displacement, N.
+    fn restoring_force(&self) -> f64 {
+        if Y {
+            self.spring.force(self.x[0])
+        } else {
+            self.sys.stiffness() * self.x[0]
+        }
     }
 
     /// External forces at the current state and the Coulomb-consistent mode.
@@ -432,7 +600,7 @@ impl<'s> Exact<'s> {
         for j in 0..=self.n {
             self.external[j] = -m[j] * ga;
         }
-        self.external[0] -= self.sys.damping() * self.v[0] + self.sys.stiffness() * self.x[0];
+        self.external[0] -= self.sys.damping() * self.v[0] + self.restoring_force();
         self.selector.select(
             m,
             &self.external,
@@ -457,7 +625,7 @@ impl<'s> Exact<'s> {
             self.top[nc - 1] = j;
         }
         let e0 = self.top[0];
-        let cl = self.cluster0[e0];
+        let cl = *self.cl();
         let f_top0 = if e0 < n { self.force[e0] } else { 0.0 };
         let osc = cl.osc;
         self.disp[0] = self.structure_wave(&cl, f_top0, ga, slope);
@@ -507,13 +675,75 @@ impl<'s> Exact<'s> {
                 g: Tracked::new(g, osc, cl.natural),
             });
         }
+        if Y {
+            self.push_structure_events(osc, cl.natural);
+        }
+    }
+
+    /// The yielding structure's switching functions: in the elastic branch `hi − u ≥ 0` and
+    /// `u − lo ≥ 0`; in a plastic branch `dir·u̇ ≥ 0`. Their values at `τ = 0` are set from the
+    /// state (as the slip events' are), exactly: right after an unloading the yield function of
+    /// the side just left starts at exactly 0, and its slope from the state's velocity, whose
+    /// sign the event made certain (the wave's own slope there can differ by round-off and
+    /// would yield again at once).
+    fn push_structure_events(&mut self, osc: Osc, natural: f64) {
+        let (x0, v0) = (self.x[0], self.v[0]);
+        match self.spring.branch {
+            Branch::Elastic { lo, hi, .. } => {
+                for (dir, sign, value) in [(1, -1.0, hi - x0), (-1, 1.0, x0 - lo)] {
+                    let mut g = self.u0.affine(sign, 0.0);
+                    g.f.p[0] = value - g.f.c;
+                    g.d1.p[0] = sign * v0 - g.d1.c;
+                    self.events.push(Event {
+                        kind: EventKind::Yield(dir),
+                        g,
+                    });
+                }
+            }
+            Branch::Plastic(dir) => {
+                let sgn = f64::from(dir);
+                let mut g = Tracked::new(self.vel[0].scale(sgn), osc, natural);
+                g.f.p[0] = sgn * v0 - g.f.c;
+                self.events.push(Event {
+                    kind: EventKind::Unload,
+                    g,
+                });
+            }
+        }
     }
 
     /// The structure cluster's displacement over a piece from the current state:
-    /// `ü + 2aü + ω²u = p0 + p1·τ` (Nigam–Jennings, the constant friction from above added).
+    /// `ü + 2aü + ω²u = p0 + p1·τ` (Nigam–Jennings, the constant friction from above added; for
+    /// a yielding structure, the branch's constant force `f_off` too). On a branch without
+    /// stiffness (`r = 0`): `ü + a·u̇ = p0 + p1·τ`, `a = c/M`, whose velocity is
+    /// `A + Bτ + (v₀ − A)·e^{−aτ}` with `B = p1/a`, `A = (p0 − B)/a`; without damping either,
+    /// a cubic.
     fn structure_wave(&self, cl: &Cluster0, f_top0: f64, ga: f64, slope: f64) -> Wave {
-        let p0 = -f_top0 / cl.mass - ga;
+        let p0 = if Y {
+            self.plastic_load(cl, f_top0, ga)
+        } else {
+            -f_top0 / cl.mass - ga
+        };
         let p1 = -slope;
+        if Y && cl.omega2 == 0.0 {
+            let (x0, v0) = (self.x[0], self.v[0]);
+            let a = cl.osc.decay;
+            if a == 0.0 {
+                return Wave {
+                    p: [x0, v0, 0.5 * p0, p1 / 6.0],
+                    c: 0.0,
+                    d: 0.0,
+                };
+            }
+            let big_b = p1 / a;
+            let big_a = (p0 - big_b) / a;
+            let c = -(v0 - big_a) / a;
+            return Wave {
+                p: [x0 - c, big_a, 0.5 * big_b, 0.0],
+                c,
+                d: 0.0,
+            };
+        }
         let b = p1 / cl.omega2;
         let a = (p0 - 2.0 * cl.osc.decay * b) / cl.omega2;
         let c = self.x[0] - a;
@@ -525,6 +755,34 @@ impl<'s> Exact<'s> {
         }
     }
 
+    /// `p₀` of [`Exact::structure_wave`] for a yielding structure: `−(f_top0 + f_off)/M − a_g`,
+    /// m/s².
+    fn plastic_load(&self, cl: &Cluster0, f_top0: f64, ga: f64) -> f64 {
+        -(f_top0 + self.spring.line().1) / cl.mass - ga
+    }
+
+    /// The structure cluster's piece ending at `b` in the cancellation-free form of
+    /// [`decay_piece`], when the branch has no stiffness (`r = 0`) and `a·h ≤ 1` (beyond, the
+    /// wave's terms of order `p₀/a²` no longer exceed its values); `None` otherwise.
+    fn stable_decay_piece(&self, ga: f64, slope: f64, b: &Basis) -> Option<DecayPiece> {
+        if !Y {
+            return None;
+        }
+        let cl = self.cl();
+        if cl.omega2 != 0.0 || cl.osc.decay * b.tau > 1.0 {
+            return None;
+        }
+        let e0 = self.top[0];
+        let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
+        Some(decay_piece(
+            cl.osc.decay,
+            (self.plastic_load(cl, f_top0, ga), -slope),
+            (self.x[0], self.v[0]),
+            b.tau,
+            self.opts.energy_balance,
+        ))
+    }
+
     /// A whole sample interval on which, with every interface stuck, nothing can happen: the
     /// acceleration stays inside its break bounds and neither the displacement nor the
     /// acceleration can exceed its peak so far, each certified by the curvature bound on the
@@ -534,7 +792,7 @@ impl<'s> Exact<'s> {
     fn quiet_interval(&mut self, ga: f64, slope: f64) -> bool {
         let n = self.n;
         // The cluster arrays are those of the current mode (built at the last piece).
-        if self.top[0] != n {
+        if self.top[0] != n || (Y && self.spring.plastic()) {
             return false;
         }
         let cl = self.cluster0[n];
@@ -546,9 +804,17 @@ impl<'s> Exact<'s> {
         if u_lo.abs().max(u_hi.abs()) + curv_u > self.out.peak_displacement_m {
             return false;
         }
+        if Y && let Branch::Elastic { lo, hi, .. } = self.spring.branch
+            && (u_lo.min(u_hi) - curv_u < lo || u_lo.max(u_hi) + curv_u > hi)
+        {
+            return false;
+        }
         let vel = u.deriv(cl.osc);
         let (c_m, k_m) = (self.sys.damping() / cl.mass, self.sys.stiffness() / cl.mass);
-        let acc = vel.combine(-c_m, &u, -k_m);
+        let mut acc = vel.combine(-c_m, &u, -k_m);
+        if Y {
+            acc = acc.plus_constant(-self.spring.line().1 / cl.mass);
+        }
         let (a_lo, a_hi) = (acc.p[0] + acc.c, acc.eval(&b));
         let amp_acc2 = cl.natural * cl.natural * acc.amplitude();
         let curv_a = acc.deriv_abs_bound(2, h, 1.0, amp_acc2) * h * h / 8.0;
@@ -616,11 +882,31 @@ impl<'s> Exact<'s> {
             .range_within((&n0.0, n0.1, n0.2), (&n1.0, n1.1, n1.2), lo, hi)
     }
 
-    /// Absolute acceleration of the structure's cluster: `(F − c·u̇ − k·u)/M`.
+    /// Whether a yielding structure in its elastic branch stays inside its elastic range over
+    /// the piece ending at `b` (the test both yield events' searches start with, done once).
+    fn yields_clear(&self, b: &Basis) -> bool {
+        let Branch::Elastic { lo, hi, .. } = self.spring.branch else {
+            return false;
+        };
+        let (n0, n1) = (self.u0.node(Basis::ZERO), self.u0.node(*b));
+        // The state, not the wave, at τ = 0: the events are anchored to it.
+        let x0 = self.x[0];
+        self.u0
+            .range_within((&n0.0, x0, n0.2), (&n1.0, n1.1, n1.2), lo, hi)
+    }
+
+    /// Absolute acceleration of the structure's cluster: `(F − c·u̇ − k·u)/M`, or with a
+    /// yielding structure `(F − c·u̇ − k_b·u − f_off)/M`.
     fn accel0_wave(&self) -> Wave {
         let e0 = self.top[0];
         let mass = self.cluster0[e0].mass;
         let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
+        if Y {
+            let (kb, off) = self.spring.line();
+            return self.vel[0]
+                .combine(-self.sys.damping() / mass, &self.disp[0], -kb / mass)
+                .plus_constant(-(f_top0 + off) / mass);
+        }
         self.vel[0]
             .combine(
                 -self.sys.damping() / mass,
@@ -665,12 +951,14 @@ impl<'s> Exact<'s> {
     /// clusters' waves are those of the piece).
     fn settle(&mut self, ga: f64, slope: f64, b: &Basis) {
         let osc = self.osc();
-        let e0 = self.top[0];
         let end = b.tau;
         // Energy: input −Σ M_c∫a_g·v_c, damping ∫c·u̇².
         let nc = self.cluster_of[self.n] + 1;
+        // A plastic piece without stiffness: the structure cluster's state and integrals from
+        // the cancellation-free form (always `None` for the linear structure).
+        let stable = self.stable_decay_piece(ga, slope, b);
         if self.opts.energy_balance {
-            let cl = &self.cluster0[e0];
+            let cl = *self.cl();
             let pi = if *b == cl.basis_dt {
                 cl.integrals_dt
             } else {
@@ -680,15 +968,33 @@ impl<'s> Exact<'s> {
             for cidx in 0..nc {
                 let mass =
                     self.mass_prefix[self.top[cidx] + 1] - self.mass_prefix[self.bottom[cidx]];
-                let w = &self.disp[cidx];
-                let x0 = w.p[0] + w.c;
-                let x1 = w.eval(b);
-                let int_av = ga * (x1 - x0) + slope * (end * x1 - w.integral_with(b, &pi));
+                let int_av = match stable {
+                    Some(d) if cidx == 0 => ga * (d.u - self.x[0]) + slope * (end * d.u - d.int_u),
+                    _ => {
+                        let w = &self.disp[cidx];
+                        let x0 = w.p[0] + w.c;
+                        let x1 = w.eval(b);
+                        ga * (x1 - x0) + slope * (end * x1 - w.integral_with(b, &pi))
+                    }
+                };
                 input -= mass * int_av;
             }
             self.energy.input += input;
-            self.energy.damping +=
-                self.sys.damping() * integral_of_square_with(&self.vel[0], b, &pi);
+            self.energy.damping += self.sys.damping()
+                * match stable {
+                    Some(d) => d.int_v2,
+                    None if Y && cl.omega2 == 0.0 => {
+                        integral_of_square_decay(&self.vel[0], osc.decay, end)
+                    }
+                    None => integral_of_square_with(&self.vel[0], b, &pi),
+                };
+        }
+        if Y {
+            // ∫F_s du over the piece, F_s = k_b·u + f_off on one branch.
+            let (kb, off) = self.spring.line();
+            let u0 = self.x[0];
+            let u1 = stable.map_or_else(|| self.disp[0].eval(b), |d| d.u);
+            self.spring_work += (u1 - u0) * (0.5 * kb * (u1 + u0) + off);
         }
         // New state of every body; offsets within a cluster are constant.
         for i in 0..self.n {
@@ -696,8 +1002,10 @@ impl<'s> Exact<'s> {
         }
         for cidx in 0..nc {
             let bj = self.bottom[cidx];
-            let xb = self.disp[cidx].eval(b);
-            let vb = self.vel[cidx].eval(b);
+            let (xb, vb) = match stable {
+                Some(d) if cidx == 0 => (d.u, d.v),
+                _ => (self.disp[cidx].eval(b), self.vel[cidx].eval(b)),
+            };
             for j in (bj..=self.top[cidx]).rev() {
                 self.x[j] = xb + (self.x[j] - self.x[bj]);
                 self.v[j] = vb;
@@ -717,8 +1025,31 @@ impl<'s> Exact<'s> {
         }
     }
 
-    /// Applies a switch at the current state and chooses the next mode.
+    /// Applies a switch at the current state and chooses the next mode. A yield or an
+    /// unloading changes only the structure's branch: its force is continuous there, so the
+    /// contact forces and the stick/slip mode stay as they are.
     fn switch(&mut self, kind: EventKind, ga: f64) -> Result<(), SimError> {
+        match kind {
+            EventKind::Yield(dir) => {
+                self.spring.branch = Branch::Plastic(dir);
+                self.out.yield_events += 1;
+                return Ok(());
+            }
+            EventKind::Unload => {
+                if let Branch::Plastic(dir) = self.spring.branch
+                    && f64::from(dir) * self.v[0] > 0.0
+                {
+                    // The event certified the reversal on the wave; the state's velocity (of
+                    // the cancellation-free form when r = 0) is zero up to a round-off residue,
+                    // here of the old sign, which would yield again at once: it is zero.
+                    self.v[..=self.top[0]].fill(0.0);
+                }
+                self.spring.unload(self.x[0]);
+                self.out.yield_events += 1;
+                return Ok(());
+            }
+            EventKind::SlipStop(_) | EventKind::Break(_) => {}
+        }
         self.before.copy_from_slice(&self.contacts);
         // Every slipping interface whose relative velocity has reached or crossed zero sticks
         // momentarily; each group of bodies so joined takes its momentum-weighted velocity.
@@ -787,6 +1118,11 @@ impl<'s> Exact<'s> {
 
     fn fill_state_energy(&self, e: &mut Energy) {
         e.set_state(self.sys.masses(), &self.v, self.sys.stiffness(), self.x[0]);
+        if Y {
+            let f = self.spring.force(self.x[0]);
+            e.strain = f * f / (2.0 * self.spring.k);
+            e.hysteretic = self.spring_work - e.strain;
+        }
     }
 
     /// Appends the current state as a history row (mode of the piece ending here).
@@ -798,8 +1134,7 @@ impl<'s> Exact<'s> {
         let e0 = self.top[0];
         let mass = self.cluster0[e0].mass;
         let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
-        let a0 =
-            (-f_top0 - self.sys.damping() * self.v[0] - self.sys.stiffness() * self.x[0]) / mass;
+        let a0 = (-f_top0 - self.sys.damping() * self.v[0] - self.restoring_force()) / mass;
         for j in 0..=self.n {
             h.abs_accel_mps2.push(if j <= e0 {
                 a0
@@ -821,6 +1156,10 @@ impl<'s> Exact<'s> {
         }
         for i in 0..self.n {
             self.out.residual_slip_m[i] = self.x[i + 1] - self.x[i];
+        }
+        self.out.residual_displacement_m = self.x[0];
+        if Y {
+            self.out.ductility = Some(self.out.peak_displacement_m / self.spring.u_y);
         }
         self.out.energy = e;
         self.out.history = history;

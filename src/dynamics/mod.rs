@@ -6,6 +6,38 @@
 //! * [`rk4`]: the paper's fixed-step RK4 with its top-down cluster rule, kept as a reference.
 //!
 //! Nothing here reads files or configurations: inputs are slices and small structs.
+//!
+//! # A yielding structure
+//!
+//! [`System::with_yielding`] turns the linear structure into an elastic–perfectly-plastic or
+//! bilinear one ([`Yielding`]; docs/model.md, "Yielding structure"). Both integrators take it;
+//! the [`Response`] then carries [`Response::ductility`] (`u_m/u_y`),
+//! [`Response::residual_displacement_m`] and [`Energy::hysteretic`]. A study stage (incremental
+//! dynamic analysis) builds the system once per case and scales the record per intensity into a
+//! reused buffer:
+//!
+//! ```
+//! use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, Yielding, simulate_exact};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let spec = SystemSpec::new(1.0, &[0.5, 0.5], &[0.2, 0.1]);
+//! let sys = System::new(&spec)?.with_yielding(Yielding::bilinear(0.15, 0.05))?;
+//! let opts = ExactOptions { energy_balance: false, ..ExactOptions::default() };
+//! let record: Vec<f64> = (0..2000).map(|k| (0.02 * k as f64).sin()).collect(); // m/s²
+//! let mut accel = Vec::with_capacity(record.len());
+//! for lambda in [0.5, 1.0, 2.0] {
+//!     accel.clear();
+//!     accel.extend(record.iter().map(|a| lambda * a));
+//!     let r = simulate_exact(&sys, &Ground { dt_s: 0.01, accel_mps2: &accel }, &opts)?;
+//!     let (mu, drift) = (r.ductility.unwrap(), r.residual_displacement_m);
+//!     assert!(mu > 0.0 && drift.is_finite() && r.peak_slip_m.len() == 2);
+//! }
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! The residual drift is the displacement at the record's end (pad the record with zeros to
+//! read it at rest); `yield_events == 0` means the structure stayed elastic. Neither model has
+//! negative stiffness, so a collapse criterion must be a ductility or drift cap.
 
 pub mod closed_form;
 pub mod contact;
@@ -16,7 +48,7 @@ pub mod rk4;
 
 pub use contact::{Contact, ContactSelector};
 pub use exact::{ExactOptions, simulate_exact};
-pub use model::{G, ModelError, System, SystemSpec};
+pub use model::{G, Hysteresis, ModelError, System, SystemSpec, Yielding};
 pub use response::{Energy, History, Response};
 pub use rk4::simulate_rk4;
 
@@ -78,6 +110,18 @@ pub enum SimError {
         dt_s: f64,
         ratio: f64,
     },
+    #[error(
+        "the post-yield period T_rigid/√r = {period_s} s (r = {r}) is {ratio:.3e} record steps \
+         (dt = {dt_s} s); the exact integrator is accurate up to {MAX_RIGID_PERIOD_STEPS:e} steps \
+         (its energy error grows like 3e-15·(T/dt)²): use a larger r, r = 0 (elastic–perfectly \
+         plastic, which has no such limit), or a coarser record"
+    )]
+    PostYieldBeyondAccuracy {
+        period_s: f64,
+        r: f64,
+        dt_s: f64,
+        ratio: f64,
+    },
     #[error("the response is not finite (the integration diverged)")]
     Diverged,
     #[error(transparent)]
@@ -124,7 +168,9 @@ impl Ground<'_> {
 }
 
 /// Refuses a system the exact integrator cannot run accurately on this record (limit in
-/// [`crate::limits::MAX_RIGID_PERIOD_STEPS`]).
+/// [`crate::limits::MAX_RIGID_PERIOD_STEPS`]). A yielding structure with `r > 0` has a longer
+/// period on its post-yield branch, `T_rigid/√r`, held to the same limit; with `r = 0` the
+/// plastic branch has its own cancellation-free form (`closed_form::decay_piece`).
 pub fn check_accuracy(sys: &System, ground: &Ground) -> Result<(), SimError> {
     let t_rigid_s = sys.period_rigid_s();
     let ratio = t_rigid_s / ground.dt_s;
@@ -135,7 +181,24 @@ pub fn check_accuracy(sys: &System, ground: &Ground) -> Result<(), SimError> {
             ratio,
         });
     }
+    if let Some(period_s) = post_yield_period_s(sys) {
+        let ratio = period_s / ground.dt_s;
+        if ratio > MAX_RIGID_PERIOD_STEPS {
+            return Err(SimError::PostYieldBeyondAccuracy {
+                period_s,
+                r: sys.hysteresis().map_or(0.0, |h| h.post_yield_ratio),
+                dt_s: ground.dt_s,
+                ratio,
+            });
+        }
+    }
     Ok(())
+}
+
+/// `T_rigid/√r`, s, of a yielding structure with `r > 0`: its longest post-yield period.
+fn post_yield_period_s(sys: &System) -> Option<f64> {
+    let r = sys.hysteresis()?.post_yield_ratio;
+    (r > 0.0).then(|| sys.period_rigid_s() / r.sqrt())
 }
 
 /// What a user should know before trusting a run that is allowed but near the edge of what the
@@ -150,6 +213,17 @@ pub fn accuracy_warnings(sys: &System, ground: &Ground) -> Vec<String> {
              error may reach {:.0e} of the input (it grows like 3e-15·(T_rigid/dt)²)",
             3e-15 * ratio * ratio
         ));
+    }
+    if let Some(period_s) = post_yield_period_s(sys) {
+        let ratio = period_s / ground.dt_s;
+        if ratio > WARN_RIGID_PERIOD_STEPS {
+            out.push(format!(
+                "the post-yield period T_rigid/√r = {period_s} s is {ratio:.2e} record steps: the \
+                 exact integrator's energy error may reach {:.0e} of the input (it grows like \
+                 3e-15·(T/dt)²)",
+                3e-15 * ratio * ratio
+            ));
+        }
     }
     let duration = ground.duration_s();
     if t_rigid_s > 10.0 * duration {

@@ -3,8 +3,13 @@
 //!
 //! Body 0 is the PS, bodies `1..=n` are the blocks bottom-up; interface `i` lies under block `i`,
 //! so interface 1 is PS–block 1. All displacements are relative to the ground.
+//!
+//! The PS is linear unless [`System::with_yielding`] gives it a bilinear restoring force
+//! (docs/model.md, "Yielding structure").
 
-use crate::limits::{MAX_ALPHA, MAX_MU, STRUCTURE_PERIOD_RANGE_S};
+use crate::limits::{
+    MAX_ALPHA, MAX_MU, MAX_POST_YIELD_DAMPING, STRENGTH_RATIO_RANGE, STRUCTURE_PERIOD_RANGE_S,
+};
 use thiserror::Error;
 
 /// Standard gravity, m/s².
@@ -48,6 +53,113 @@ pub enum ModelError {
         got: usize,
         expected: usize,
     },
+    #[error(
+        "yield strength ratio C_y = F_y/(m_p·g) must be within {lo} … {hi}, got {0:?}",
+        lo = STRENGTH_RATIO_RANGE.0,
+        hi = STRENGTH_RATIO_RANGE.1
+    )]
+    StrengthRatio(f64),
+    #[error(
+        "post-yield stiffness ratio r must be finite, >= 0 and < 1 (r = 1 is the elastic \
+         structure), got {0:?}"
+    )]
+    PostYieldRatio(f64),
+    #[error(
+        "post-yield stiffness ratio r = {r} makes the post-yield branch {what} (damping ratio \
+         ζ/√r = {zeta_post:.3} with the bare structure's ζ = {zeta:.4}; at most \
+         {MAX_POST_YIELD_DAMPING} is supported): use r = 0 (elastic–perfectly plastic) or \
+         r >= {r_min:.4}"
+    )]
+    PostYieldOverdamped {
+        r: f64,
+        zeta: f64,
+        zeta_post: f64,
+        r_min: f64,
+        what: &'static str,
+    },
+}
+
+/// A yielding primary structure as a user states it (docs/model.md, "Yielding structure"):
+/// bilinear with kinematic hardening, elastic stiffness `k`, yield force `F_y`, post-yield
+/// stiffness `r·k`; `r = 0` is elastic–perfectly plastic (EPP). [`System::with_yielding`]
+/// validates it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Yielding {
+    /// Yield strength ratio `C_y = F_y/(m_p·g)`, `m_p` the bare structure's mass (Chopra,
+    /// *Dynamics of Structures*, Section 7.1: the yield pseudo-acceleration `A_y/g`).
+    pub strength_ratio: f64,
+    /// Post-yield stiffness ratio `r`, `0 ≤ r < 1`.
+    pub post_yield_ratio: f64,
+}
+
+impl Yielding {
+    /// Elastic–perfectly plastic with `C_y = F_y/(m_p·g)`.
+    pub fn epp(strength_ratio: f64) -> Self {
+        Self {
+            strength_ratio,
+            post_yield_ratio: 0.0,
+        }
+    }
+
+    /// Bilinear with kinematic hardening: `C_y = F_y/(m_p·g)`, post-yield stiffness ratio `r`.
+    pub fn bilinear(strength_ratio: f64, post_yield_ratio: f64) -> Self {
+        Self {
+            strength_ratio,
+            post_yield_ratio,
+        }
+    }
+
+    /// From the yield displacement `u_y` (m) of a structure of period `T_p` (s):
+    /// `C_y = ω_p²·u_y/g`.
+    pub fn from_yield_displacement(period_s: f64, yield_displacement_m: f64, r: f64) -> Self {
+        let omega = std::f64::consts::TAU / period_s;
+        Self::bilinear(omega * omega * yield_displacement_m / G, r)
+    }
+}
+
+/// The validated bilinear restoring force of a yielding structure, with its derived constants.
+///
+/// For a given history the force lies between the two bounding lines
+/// `F = r·k·u ± (1 − r)·F_y` (kinematic hardening: they do not move); between them it follows an
+/// elastic line of slope `k`. Elastic range: `2·u_y` wide.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hysteresis {
+    /// `C_y = F_y/(m_p·g)`.
+    pub strength_ratio: f64,
+    /// `r`, post-yield over elastic stiffness.
+    pub post_yield_ratio: f64,
+    /// Elastic stiffness `k`, N/m.
+    pub stiffness: f64,
+    /// `F_y = C_y·m_p·g`, N.
+    pub yield_force_n: f64,
+    /// `u_y = F_y/k`, m.
+    pub yield_displacement_m: f64,
+}
+
+impl Hysteresis {
+    /// `(1 − r)·F_y`, N: the bounding lines' intercept.
+    pub fn intercept_n(&self) -> f64 {
+        (1.0 - self.post_yield_ratio) * self.yield_force_n
+    }
+
+    /// Force on the bounding line of side `dir` (±1) at `u` (m): `r·k·u + dir·(1 − r)·F_y`, N.
+    pub fn bound_n(&self, u: f64, dir: f64) -> f64 {
+        self.post_yield_ratio * self.stiffness * u + dir * self.intercept_n()
+    }
+
+    /// The restoring force at `u` (m) of a structure whose last elastic line passes through
+    /// `(anchor_u, anchor_f)` (m, N): that line clamped between the bounding lines. Used by the
+    /// fixed-step RK4 (`rk4.rs`); the exact integrator follows the branches as events instead.
+    pub fn force_n(&self, u: f64, anchor_u: f64, anchor_f: f64) -> f64 {
+        let trial = anchor_f + self.stiffness * (u - anchor_u);
+        trial.clamp(self.bound_n(u, -1.0), self.bound_n(u, 1.0))
+    }
+
+    /// Recoverable strain energy at force `f` (N): `f²/(2k)`, J (released by elastic unloading
+    /// to zero force).
+    pub fn recoverable_energy(&self, f: f64) -> f64 {
+        f * f / (2.0 * self.stiffness)
+    }
 }
 
 /// A validated structure-and-stack system. Construct with [`System::new`].
@@ -66,6 +178,8 @@ pub struct System {
     normal: Vec<f64>,
     stiffness: f64,
     damping: f64,
+    /// The bilinear restoring force; `None` for the linear structure.
+    hysteresis: Option<Hysteresis>,
 }
 
 /// What a user states about a system; [`System::new`] validates it.
@@ -191,7 +305,53 @@ impl System {
             normal,
             stiffness,
             damping,
+            hysteresis: None,
         })
+    }
+
+    /// The same system on a yielding structure (docs/model.md, "Yielding structure"). Refuses a
+    /// strength outside [`STRENGTH_RATIO_RANGE`], `r` outside `[0, 1)`, and an `r > 0` whose
+    /// post-yield branch is overdamped or nearly so (see [`MAX_POST_YIELD_DAMPING`]): the
+    /// bare structure alone (every block sliding) is the lightest cluster and so the most
+    /// damped, with `ζ/√r`.
+    pub fn with_yielding(mut self, y: Yielding) -> Result<Self, ModelError> {
+        let Yielding {
+            strength_ratio,
+            post_yield_ratio: r,
+        } = y;
+        if !(STRENGTH_RATIO_RANGE.0..=STRENGTH_RATIO_RANGE.1).contains(&strength_ratio) {
+            return Err(ModelError::StrengthRatio(strength_ratio));
+        }
+        if !(r.is_finite() && (0.0..1.0).contains(&r)) {
+            return Err(ModelError::PostYieldRatio(r));
+        }
+        let zeta = self.damping_ratio;
+        if r > 0.0 && zeta > 0.0 {
+            let zeta_post = zeta / r.sqrt();
+            if zeta_post > MAX_POST_YIELD_DAMPING {
+                let r_min = (zeta / MAX_POST_YIELD_DAMPING).powi(2);
+                return Err(ModelError::PostYieldOverdamped {
+                    r,
+                    zeta,
+                    zeta_post,
+                    r_min: r_min * (1.0 + 1e-12),
+                    what: if zeta_post >= 1.0 {
+                        "overdamped"
+                    } else {
+                        "nearly critically damped"
+                    },
+                });
+            }
+        }
+        let yield_force_n = strength_ratio * self.mass_kg * G;
+        self.hysteresis = Some(Hysteresis {
+            strength_ratio,
+            post_yield_ratio: r,
+            stiffness: self.stiffness,
+            yield_force_n,
+            yield_displacement_m: yield_force_n / self.stiffness,
+        });
+        Ok(self)
     }
 
     /// Number of blocks `n`.
@@ -233,6 +393,14 @@ impl System {
     /// Viscous damping coefficient `c`, N·s/m (set from the bare structure).
     pub fn damping(&self) -> f64 {
         self.damping
+    }
+    /// The bilinear restoring force of a yielding structure; `None` when linear.
+    pub fn hysteresis(&self) -> Option<&Hysteresis> {
+        self.hysteresis.as_ref()
+    }
+    /// Yield displacement `u_y = F_y/k`, m; `None` when linear.
+    pub fn yield_displacement_m(&self) -> Option<f64> {
+        self.hysteresis.map(|h| h.yield_displacement_m)
     }
     /// Total block mass ratio `α = Σα_i`.
     pub fn alpha_total(&self) -> f64 {
@@ -322,6 +490,60 @@ mod tests {
             let msg = System::new(&spec).unwrap_err().to_string();
             assert!(msg.contains(needle), "{msg:?} should name {needle:?}");
         }
+    }
+
+    #[test]
+    fn refuses_impossible_yielding_naming_it() {
+        let s = System::new(&SystemSpec::new(1.0, &[0.5, 0.5], &[0.2, 0.1])).unwrap();
+        let msg = |y: Yielding| s.clone().with_yielding(y).unwrap_err().to_string();
+        assert!(msg(Yielding::epp(0.0)).contains("C_y"));
+        assert!(msg(Yielding::epp(f64::NAN)).contains("C_y"));
+        assert!(msg(Yielding::bilinear(0.1, 1.0)).contains("r = 1 is the elastic"));
+        assert!(msg(Yielding::bilinear(0.1, -0.1)).contains("post-yield stiffness ratio r"));
+        // ζ = 0.05: ζ/√r ≥ 1 below r = 0.0025, ≥ 0.9 below r = 0.003086.
+        let over = msg(Yielding::bilinear(0.1, 0.002));
+        assert!(
+            over.contains("r = 0.002") && over.contains("overdamped"),
+            "{over}"
+        );
+        assert!(over.contains("r >= 0.0031"), "{over}");
+        let near = msg(Yielding::bilinear(0.1, 0.003));
+        assert!(near.contains("nearly critically damped"), "{near}");
+        assert!(
+            s.clone()
+                .with_yielding(Yielding::bilinear(0.1, 0.0031))
+                .is_ok()
+        );
+        assert!(s.clone().with_yielding(Yielding::epp(0.1)).is_ok());
+        // Without damping any r is underdamped.
+        let mut spec = SystemSpec::new(1.0, &[], &[]);
+        spec.damping_ratio = 0.0;
+        let bare = System::new(&spec).unwrap();
+        assert!(bare.with_yielding(Yielding::bilinear(0.1, 1e-9)).is_ok());
+    }
+
+    #[test]
+    fn yield_displacement_and_the_bounding_lines() {
+        // T_p = 1 s: k = 4π² m_p; C_y = 0.1: u_y = 0.1·g/(4π²) = 0.0248405 m.
+        let s = System::new(&SystemSpec::new(1.0, &[], &[]))
+            .unwrap()
+            .with_yielding(Yielding::bilinear(0.1, 0.1))
+            .unwrap();
+        let h = *s.hysteresis().unwrap();
+        let uy = 0.1 * G / (4.0 * std::f64::consts::PI.powi(2));
+        assert!((h.yield_displacement_m - uy).abs() < 1e-15);
+        assert!((s.yield_displacement_m().unwrap() - uy).abs() < 1e-15);
+        let y = Yielding::from_yield_displacement(1.0, uy, 0.1);
+        assert!((y.strength_ratio - 0.1).abs() < 1e-15);
+        // The clamped elastic line: elastic inside ±u_y from the origin, on the bounding lines
+        // beyond, and continuous.
+        let fy = h.yield_force_n;
+        assert!((h.force_n(0.5 * uy, 0.0, 0.0) - 0.5 * fy).abs() < 1e-12);
+        assert!((h.force_n(uy, 0.0, 0.0) - fy).abs() < 1e-12);
+        let f3 = h.force_n(3.0 * uy, 0.0, 0.0);
+        assert!((f3 - (fy + 0.1 * h.stiffness * 2.0 * uy)).abs() < 1e-12);
+        assert!((h.force_n(-3.0 * uy, 0.0, 0.0) + f3).abs() < 1e-12);
+        assert!((h.recoverable_energy(fy) - 0.5 * fy * uy).abs() < 1e-15);
     }
 
     #[test]

@@ -5,22 +5,26 @@ use serde::Serialize;
 
 /// Energy terms per kg of structure mass, J/kg, in the relative-motion formulation: the input
 /// energy is the work of the effective earthquake forces `−m_j·a_g` on the relative velocities.
-/// `input = kinetic + strain + damping + friction` up to `residual`.
+/// `input = kinetic + strain + damping + friction + hysteretic` up to `residual`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Energy {
     pub input: f64,
     pub kinetic: f64,
+    /// Recoverable strain energy `F_s²/(2k)` (for the linear structure `½k·u²`).
     pub strain: f64,
     pub damping: f64,
     pub friction: f64,
     /// Friction dissipation per interface, interface 1 first.
     pub friction_per_interface: Vec<f64>,
+    /// A yielding structure's hysteretic energy `∫F_s du − F_s²/(2k)` (docs/model.md,
+    /// "Yielding structure"); 0 for the linear structure.
+    pub hysteretic: f64,
 }
 
 impl Energy {
-    /// `input − (kinetic + strain + damping + friction)`.
+    /// `input − (kinetic + strain + damping + friction + hysteretic)`.
     pub fn residual(&self) -> f64 {
-        self.residual_with(self.kinetic, self.strain)
+        self.residual_with(self.kinetic, self.strain + self.hysteretic)
     }
 
     /// Sets the kinetic (`½Σm_j·v_j²`) and strain (`½k·u₀²`) terms from a state: masses and
@@ -40,7 +44,8 @@ impl Energy {
         (kinetic, 0.5 * stiffness * u0 * u0)
     }
 
-    /// [`Energy::residual`] with the kinetic and strain terms given instead of stored.
+    /// [`Energy::residual`] with the kinetic and strain terms given instead of stored (`strain`
+    /// standing for all the spring's work, `strain + hysteretic`).
     pub fn residual_with(&self, kinetic: f64, strain: f64) -> f64 {
         self.input - (kinetic + strain + self.damping + self.friction)
     }
@@ -54,6 +59,7 @@ impl Energy {
             &mut self.strain,
             &mut self.damping,
             &mut self.friction,
+            &mut self.hysteretic,
         ]
         .into_iter()
         .chain(self.friction_per_interface.iter_mut())
@@ -68,7 +74,7 @@ impl Energy {
         let scale = self
             .input
             .abs()
-            .max(self.kinetic + self.strain + self.damping + self.friction);
+            .max(self.kinetic + self.strain + self.damping + self.friction + self.hysteretic);
         if scale == 0.0 {
             0.0
         } else {
@@ -130,6 +136,15 @@ pub struct Response {
     pub slip_time_s: Vec<f64>,
     /// Number of interface state changes.
     pub switches: u64,
+    /// Structure displacement relative to the ground at the end of the record, m (a yielding
+    /// structure's residual drift once the record has let it come to rest: pad a record with
+    /// zeros for that).
+    pub residual_displacement_m: f64,
+    /// Peak displacement over the yield displacement, `u_m/u_y` (Chopra, Section 7.2); `None`
+    /// for the linear structure.
+    pub ductility: Option<f64>,
+    /// Number of yield and unloading events of a yielding structure.
+    pub yield_events: u64,
     /// Energy terms at the end of the record, J per kg of structure mass.
     pub energy: Energy,
     /// Largest `|residual(t)| / max_{s≤t} input(s)` over the record samples.
@@ -143,13 +158,14 @@ impl Response {
     pub fn check_finite(&self) -> Result<(), super::SimError> {
         let e = &self.energy;
         let finite = self.peak_displacement_m.is_finite()
+            && self.residual_displacement_m.is_finite()
             && self
                 .peak_abs_accel_mps2
                 .iter()
                 .chain(&self.peak_slip_m)
                 .chain(&self.residual_slip_m)
                 .all(|v| v.is_finite())
-            && [e.kinetic, e.strain, e.friction]
+            && [e.kinetic, e.strain, e.friction, e.hysteretic]
                 .iter()
                 .all(|v| v.is_finite());
         if finite {

@@ -17,12 +17,18 @@
 //!
 //! Switches are resolved only to within a sub-step, so the method converges at first order in
 //! `h` on records that slide, whatever RK4's order on smooth pieces.
+//!
+//! A yielding structure (docs/model.md, "Yielding structure") is the textbook return mapping:
+//! within a sub-step its force is the last elastic line clamped between the bounding lines
+//! ([`Hysteresis::force_n`]), and at the end of the sub-step the line is moved to pass through the
+//! new state. The spring's work `∫F_s·u̇` is integrated with the other energy rates. Yield and
+//! unloading are resolved only to within a sub-step too.
 
 // Parallel per-body and per-interface arrays read best with index loops.
 #![allow(clippy::needless_range_loop)]
 
 use super::contact::Contact;
-use super::model::System;
+use super::model::{Hysteresis, System};
 use super::response::{Energy, History, Response};
 use super::{Ground, SimError};
 use crate::limits::{MAX_RK4_SUBSTEPS, RK4_MAX_OMEGA_STEP};
@@ -69,6 +75,13 @@ struct Rk4<'s> {
     x: Vec<f64>,
     v: Vec<f64>,
     energy: Energy,
+    hysteresis: Option<Hysteresis>,
+    /// A point `(u, F)` (m, N) of the yielding structure's current elastic line.
+    anchor: (f64, f64),
+    /// `∫F_s du` so far, J (yielding structure only).
+    spring_work: f64,
+    /// Whether the last sub-step ended on a bounding line.
+    plastic: bool,
 }
 
 impl<'s> Rk4<'s> {
@@ -99,6 +112,19 @@ impl<'s> Rk4<'s> {
                 friction_per_interface: vec![0.0; n],
                 ..Energy::default()
             },
+            hysteresis: sys.hysteresis().copied(),
+            anchor: (0.0, 0.0),
+            spring_work: 0.0,
+            plastic: false,
+        }
+    }
+
+    /// The structure's restoring force at displacement `u`, N.
+    #[inline]
+    fn restoring(&self, u: f64) -> f64 {
+        match &self.hysteresis {
+            Some(h) => h.force_n(u, self.anchor.0, self.anchor.1),
+            None => self.sys.stiffness() * u,
         }
     }
 
@@ -113,7 +139,7 @@ impl<'s> Rk4<'s> {
         let above = if hi < self.n { self.force[hi] } else { 0.0 };
         let mut f = below - above;
         if lo == 0 {
-            f -= self.sys.damping() * v0 + self.sys.stiffness() * x0;
+            f -= self.sys.damping() * v0 + self.restoring(x0);
         }
         f / self.mass(lo, hi)
     }
@@ -201,12 +227,16 @@ impl<'s> Rk4<'s> {
         }
     }
 
-    /// Energy rates `[input, damping, friction_1..n]` at a state.
-    fn rates(&self, v: &[f64], ag: f64, out: &mut [f64]) {
+    /// Energy rates `[input, damping, friction_1..n]` at a state, and with a yielding structure
+    /// the spring's power `F_s·u̇` last.
+    fn rates(&self, x: &[f64], v: &[f64], ag: f64, out: &mut [f64]) {
         out[0] = -ag * self.masses.iter().zip(v).map(|(m, v)| m * v).sum::<f64>();
         out[1] = self.sys.damping() * v[0] * v[0];
         for i in 0..self.n {
             out[2 + i] = -self.force[i] * (v[i + 1] - v[i]);
+        }
+        if self.hysteresis.is_some() {
+            out[2 + self.n] = self.restoring(x[0]) * v[0];
         }
     }
 
@@ -225,7 +255,7 @@ impl<'s> Rk4<'s> {
             ..Response::default()
         };
         let mut history = want_history.then(|| History::with_capacity(steps + 1, nb));
-        let nr = 2 + n;
+        let nr = 2 + n + usize::from(self.hysteresis.is_some());
         let mut kx = vec![vec![0.0; nb]; 4];
         let mut kv = vec![vec![0.0; nb]; 4];
         let mut ke = vec![vec![0.0; nr]; 4];
@@ -286,7 +316,7 @@ impl<'s> Rk4<'s> {
                                 out.peak_abs_accel_mps2[j].max(abs[j].abs());
                         }
                     }
-                    self.rates(&vs, ag, &mut ke[st]);
+                    self.rates(&xs, &vs, ag, &mut ke[st]);
                 }
                 for j in 0..nb {
                     self.x[j] += h / 6.0 * (kx[0][j] + 2.0 * kx[1][j] + 2.0 * kx[2][j] + kx[3][j]);
@@ -300,6 +330,17 @@ impl<'s> Rk4<'s> {
                     let w = de(2 + i);
                     self.energy.friction_per_interface[i] += w;
                     self.energy.friction += w;
+                }
+                if self.hysteresis.is_some() {
+                    self.spring_work += de(2 + n);
+                    let u = self.x[0];
+                    let f = self.restoring(u);
+                    let plastic = f != self.anchor.1 + self.sys.stiffness() * (u - self.anchor.0);
+                    if plastic != self.plastic {
+                        out.yield_events += 1;
+                        self.plastic = plastic;
+                    }
+                    self.anchor = (u, f);
                 }
                 // Interfaces whose relative velocity changed sign are at rest next sub-step.
                 for i in 0..n {
@@ -345,6 +386,10 @@ impl<'s> Rk4<'s> {
         for i in 0..n {
             out.residual_slip_m[i] = self.x[i + 1] - self.x[i];
         }
+        out.residual_displacement_m = self.x[0];
+        if let Some(h) = &self.hysteresis {
+            out.ductility = Some(out.peak_displacement_m / h.yield_displacement_m);
+        }
         out.switches = switches;
         out.energy = e;
         out.history = history;
@@ -353,6 +398,10 @@ impl<'s> Rk4<'s> {
 
     fn fill_state_energy(&self, e: &mut Energy) {
         e.set_state(self.sys.masses(), &self.v, self.sys.stiffness(), self.x[0]);
+        if let Some(h) = &self.hysteresis {
+            e.strain = h.recoverable_energy(self.restoring(self.x[0]));
+            e.hysteretic = self.spring_work - e.strain;
+        }
     }
 }
 
