@@ -4,7 +4,7 @@
 //! * `problem`: one form against one data set as nonlinear least squares;
 //! * [`solver`]: the machinery, argmin's trust region on the Gauss–Newton model from several
 //!   starts, Nelder–Mead as a fallback;
-//! * [`metrics`]: goodness of fit and the parameters' standard errors;
+//! * [`mod@metrics`]: goodness of fit and the parameters' standard errors;
 //! * [`extrapolation`]: the check that a fitted form stays physical beyond the grid;
 //! * [`published`]: the paper's own Eqs. 16–17.
 //!

@@ -8,7 +8,7 @@
 //! L-BFGS. The trust region uses the curvature `JᵀJ` that a least-squares problem gives for
 //! free and is the Levenberg–Marquardt idea in trust-region form; L-BFGS would learn that
 //! curvature from gradients. argmin's trust region has no stopping rule of its own (it runs to
-//! its iteration limit), so [`GaussNewtonTrustRegion`] wraps it with two: converged when the
+//! its iteration limit), so `GaussNewtonTrustRegion` wraps it with two: converged when the
 //! Bates–Watts relative offset is below [`RELATIVE_OFFSET_TOLERANCE`] (the Gauss–Newton step
 //! that remains, against the radius of the parameters' statistical uncertainty: free of their
 //! scales and conditioning, unlike a gradient norm), stalled when the cost has not decreased

@@ -903,7 +903,7 @@ fn attempt(
 ///
 /// The first attempt follows the settings; while the best motion's worst misfit on the check
 /// grid exceeds `retry_misfit` (and `fallback` is on), the record is matched again from its
-/// pre-scaled start by the next strategy of [`Strategy::ladder`], and the best of all attempts
+/// pre-scaled start by the next strategy of `Strategy::ladder`, and the best of all attempts
 /// is kept.
 pub fn match_record(
     accel_g: &[f64],

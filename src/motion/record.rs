@@ -674,7 +674,7 @@ fn at2_number(v: f64) -> String {
 /// Values are written like PEER's `%15.7E` when eight significant digits hold them exactly, and
 /// with up to 17 (Rust's shortest round-trip digits) otherwise; `DT` is written in Rust's shortest
 /// round-trip form. So [`parse_at2`] gives back the same `dt_s` and `accel_g` bit for bit (for
-/// finite values; [`write_at2`] refuses others), and a record read from a PEER file is written
+/// finite values; [`checked_at2`] refuses others), and a record read from a PEER file is written
 /// back with the same digits.
 pub fn format_at2(record: &Record, description: &str) -> String {
     let description: String = description

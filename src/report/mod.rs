@@ -1,8 +1,8 @@
 //! Figures (SVG, with plotters) and HTML pages of reports. Knows nothing of how the numbers were
 //! computed: every function takes plain series, tables and text, and returns text.
 //!
-//! * [`chart`]: panels, series, legends outside the plot areas; [`chart::render`] a figure.
-//! * [`page`]: tables, figures and sections of an HTML page.
+//! * [`mod@chart`]: panels, series, legends outside the plot areas; [`chart::render`] a figure.
+//! * [`mod@page`]: tables, figures and sections of an HTML page.
 
 pub mod chart;
 pub mod page;
