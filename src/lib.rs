@@ -8,6 +8,7 @@
 //! * [`limits`]: the limits every input is checked against, with their reasons.
 //! * [`grid`]: the study's case grid (axes and indexing).
 //! * [`study`]: the study's numerics and configuration.
+//! * [`simulation`]: one case under one ground motion (`slidestack simulate`).
 //! * [`design`]: `T_new` of one structure from a finished study (the designer's query).
 //! * [`pipeline`]: the study's stages as library code: one shape, the output lock, checks.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
@@ -24,6 +25,7 @@ pub mod motion;
 mod numeric;
 pub mod pipeline;
 pub mod report;
+pub mod simulation;
 pub mod spectrum;
 pub mod store;
 pub mod study;

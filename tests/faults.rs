@@ -321,6 +321,31 @@ fn a_full_disk_fails_naming_the_file_keeps_everything_and_a_rerun_is_clean() {
     )
     .fails(1, "h.csv: cannot write: File too large");
     assert!(!h.exists());
+
+    // A spectrum table on a full disk: an error naming the file, and the old table kept whole.
+    let table = dir.path().join("spectrum.csv");
+    std::fs::write(&table, "an earlier table\n").unwrap();
+    run(
+        &[
+            "spectrum",
+            "--record",
+            s(&fixture("RSN960_NORTHR_LOS270.AT2")),
+            "--periods",
+            "log:0.05:5:400",
+            "--csv",
+            "--out",
+            s(&table),
+        ],
+        Opts {
+            file_size_limit: Some(2_000),
+            guard: QUICK.guard,
+        },
+    )
+    .fails(1, "spectrum.csv: cannot write: File too large");
+    assert_eq!(
+        std::fs::read_to_string(&table).unwrap(),
+        "an earlier table\n"
+    );
 }
 
 #[test]

@@ -146,8 +146,7 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     let summary_path = args.out.join("summary.csv");
-    std::fs::write(&summary_path, summary)
-        .with_context(|| format!("cannot write {}", summary_path.display()))?;
+    slidestack::store::atomic::write_bytes(&summary_path, summary.as_bytes())?;
     if !left_out.is_empty() {
         bail!(
             "{} of {} records did not meet the acceptance (every check period within [{}, {}] of \

@@ -114,6 +114,8 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
             || c.is::<slidestack::dynamics::ModelError>()
             || c.downcast_ref::<slidestack::dynamics::SimError>()
                 .is_some_and(slidestack::dynamics::SimError::is_bad_input)
+            || c.downcast_ref::<slidestack::simulation::CaseError>()
+                .is_some_and(slidestack::simulation::CaseError::is_bad_input)
             || c.is::<BadInput>()
     });
     if bad_input { 2 } else { 1 }

@@ -132,12 +132,7 @@ pub fn run(args: Args) -> Result<()> {
             }
         }
     }
-    match &args.out {
-        Some(path) => std::fs::write(path, text)
-            .with_context(|| format!("cannot write {}", path.display()))?,
-        None => std::io::stdout().lock().write_all(text.as_bytes())?,
-    }
-    Ok(())
+    write_out(args.out.as_deref(), &text)
 }
 
 /// One record, damping ratio and target ductility (the `--ductility --json` contract).
@@ -244,12 +239,7 @@ fn run_ductility(args: &Args, periods: &[f64]) -> Result<()> {
             }
         }
     }
-    match &args.out {
-        Some(path) => std::fs::write(path, text)
-            .with_context(|| format!("cannot write {}", path.display()))?,
-        None => std::io::stdout().lock().write_all(text.as_bytes())?,
-    }
-    Ok(())
+    write_out(args.out.as_deref(), &text)
 }
 
 /// A refused target, period or oscillator is the user's (exit code 2); a failed run is not.
@@ -264,4 +254,13 @@ fn ductility_error(e: DuctilityError, record: &str) -> anyhow::Error {
     } else {
         anyhow::Error::from(e).context(format!("{record}: constant-ductility spectrum failed"))
     }
+}
+
+/// `text` to `out` (written atomically and checked, `store::atomic`), or to standard output.
+fn write_out(out: Option<&std::path::Path>, text: &str) -> Result<()> {
+    match out {
+        Some(path) => slidestack::store::atomic::write_bytes(path, text.as_bytes())?,
+        None => std::io::stdout().lock().write_all(text.as_bytes())?,
+    }
+    Ok(())
 }
