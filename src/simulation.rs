@@ -6,7 +6,7 @@
 //! is docs/model.md, "Yielding structure".
 
 use crate::dynamics::{
-    ExactOptions, G, Ground, History, Response, SimError, System, SystemSpec, Yielding,
+    Energy, ExactOptions, G, Ground, History, Response, SimError, System, SystemSpec, Yielding,
     simulate_exact, simulate_rk4,
 };
 use crate::motion::{self, Record, RecordError};
@@ -319,32 +319,11 @@ impl Case {
             ductility: r.ductility,
             residual_displacement_m: r.residual_displacement_m,
             yield_events: r.yield_events,
-            energy: EnergySummary {
-                input: e.input,
-                kinetic: e.kinetic,
-                strain: e.strain,
-                damping: e.damping,
-                friction: e.friction,
-                friction_per_interface: e.friction_per_interface.clone(),
-                hysteretic: e.hysteretic,
-            },
+            energy: e.clone(),
             energy_balance_error: e.balance_error(),
             energy_balance_error_max: r.energy_balance_error_max,
         }
     }
-}
-
-/// Energy terms per unit structure mass, J/kg (docs/model.md, "Yielding structure").
-#[derive(Debug, Clone, Serialize)]
-pub struct EnergySummary {
-    pub input: f64,
-    pub kinetic: f64,
-    pub strain: f64,
-    pub damping: f64,
-    pub friction: f64,
-    pub friction_per_interface: Vec<f64>,
-    /// `∫F_s du − F_s²/(2k)` of a yielding structure; 0 when elastic.
-    pub hysteretic: f64,
 }
 
 /// What one simulation gives: the `simulate --json` contract (README); field names are relied
@@ -385,7 +364,8 @@ pub struct Summary {
     pub residual_displacement_m: f64,
     /// Yield and unloading events (or, with rk4, changes of branch between sub-steps).
     pub yield_events: u64,
-    pub energy: EnergySummary,
+    /// Energy terms per unit structure mass, J/kg, at the end of the record.
+    pub energy: Energy,
     pub energy_balance_error: f64,
     pub energy_balance_error_max: f64,
 }

@@ -24,7 +24,8 @@ use super::FitError;
 use super::problem::{Problem, Scaled, relative_offset};
 use argmin::core::{
     CostFunction, Error as ArgminError, Executor, Gradient, Hessian, IterState, KV,
-    Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus,
+    OptimizationResult, Problem as ArgminProblem, Solver, State, TerminationReason,
+    TerminationStatus,
 };
 use argmin::solver::neldermead::NelderMead;
 use argmin::solver::trustregion::{Steihaug, TrustRegion};
@@ -173,24 +174,7 @@ fn trust_region(
         .timer(false)
         .run()
         .map_err(solver_error)?;
-    let converged = matches!(
-        result.state.get_termination_reason(),
-        Some(TerminationReason::SolverConverged)
-    );
-    let iterations = result.state.get_iter();
-    let q = result
-        .state
-        .get_best_param()
-        .cloned()
-        .ok_or_else(|| FitError::Solver("trust region: no best parameters".into()))?;
-    let p = result.problem.problem.as_ref().map_or_else(
-        || {
-            Err(FitError::Solver(
-                "trust region: problem not returned".into(),
-            ))
-        },
-        |s| Ok(s.to_p(&q)),
-    )?;
+    let (p, iterations, converged) = outcome(result, "trust region")?;
     let sse = problem.sse(&p);
     Ok((p, sse, iterations, converged))
 }
@@ -216,6 +200,19 @@ fn nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), F
         .timer(false)
         .run()
         .map_err(solver_error)?;
+    outcome(result, "Nelder–Mead")
+}
+
+/// A run of an argmin solver `S` on the scaled problem, as the executor returns it.
+type Finished<'a, S, G, J, H, R> =
+    OptimizationResult<Scaled<'a>, S, IterState<Vec<f64>, G, J, H, R, f64>>;
+
+/// A finished run's best point in natural parameters, its iterations and whether the solver
+/// converged (rather than stopped at its limit or stalled).
+fn outcome<S, G, J, H, R>(
+    result: Finished<S, G, J, H, R>,
+    method: &str,
+) -> Result<(Vec<f64>, u64, bool), FitError> {
     let converged = matches!(
         result.state.get_termination_reason(),
         Some(TerminationReason::SolverConverged)
@@ -224,12 +221,13 @@ fn nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), F
     let q = result
         .state
         .get_best_param()
-        .cloned()
-        .ok_or_else(|| FitError::Solver("Nelder–Mead: no best parameters".into()))?;
-    let p = result.problem.problem.as_ref().map_or_else(
-        || Err(FitError::Solver("Nelder–Mead: problem not returned".into())),
-        |s| Ok(s.to_p(&q)),
-    )?;
+        .ok_or_else(|| FitError::Solver(format!("{method}: no best parameters")))?;
+    let p = result
+        .problem
+        .problem
+        .as_ref()
+        .map(|s| s.to_p(q))
+        .ok_or_else(|| FitError::Solver(format!("{method}: problem not returned")))?;
     Ok((p, iterations, converged))
 }
 

@@ -9,6 +9,25 @@ use crate::report::page::{Section, para, table_with_id};
 use crate::study::tnew::BandCounts;
 use plotters::style::RGBColor;
 
+/// One faint line per friction pair of a panel (`column` gives a pair's values over `T_p`),
+/// `label` on the first for the legend.
+fn every_pair(
+    sel: &Selection,
+    tp: &[f64],
+    label: String,
+    column: impl Fn(&[usize]) -> Vec<f64>,
+) -> Vec<Series> {
+    let mut series: Vec<Series> = sel
+        .all_mu
+        .iter()
+        .map(|m| Series::faint(tp.to_vec(), column(m)))
+        .collect();
+    if let Some(first) = series.first_mut() {
+        first.label = label;
+    }
+    series
+}
+
 pub(super) fn drr_section(
     inp: &Inputs,
     sel: &Selection,
@@ -28,15 +47,12 @@ pub(super) fn drr_section(
         let v = &z.tnew.vars;
         let mut panels = Vec::new();
         for (p, a) in sel.panels.iter().enumerate() {
-            let mut series = Vec::new();
-            for (k, m) in sel.all_mu.iter().enumerate() {
-                let mut s =
-                    Series::faint(tp.clone(), z.column(&v.drr_1, per, case_index(grid, a, m)));
-                if k == 0 {
-                    s.label = format!("DRR_1, each of the {} friction pairs", sel.all_mu.len());
-                }
-                series.push(s);
-            }
+            let mut series = every_pair(
+                sel,
+                tp,
+                format!("DRR_1, each of the {} friction pairs", sel.all_mu.len()),
+                |m| z.column(&v.drr_1, per, case_index(grid, a, m)),
+            );
             let mut drawn_mu1 = Vec::new();
             let mut drr2 = Vec::new();
             for (m, colour, stroke) in &sel.lines {
@@ -152,15 +168,12 @@ pub(super) fn tnew_section(
         let v = &z.tnew.vars;
         let mut panels = Vec::new();
         for (p, a) in sel.panels.iter().enumerate() {
-            let mut series = Vec::new();
-            for (k, m) in sel.all_mu.iter().enumerate() {
-                let mut s =
-                    Series::faint(tp.clone(), z.column(&v.t_new, per, case_index(grid, a, m)));
-                if k == 0 {
-                    s.label = format!("each of the {} friction pairs", sel.all_mu.len());
-                }
-                series.push(s);
-            }
+            let mut series = every_pair(
+                sel,
+                tp,
+                format!("each of the {} friction pairs", sel.all_mu.len()),
+                |m| z.column(&v.t_new, per, case_index(grid, a, m)),
+            );
             // The limits under the data.
             let c0 = case_index(grid, a, &sel.all_mu[0]);
             series.push(
