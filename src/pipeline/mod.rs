@@ -5,6 +5,8 @@
 //! config ─► motions ─► motions.h5 ─► sweep ─► sweep.h5 ─► tnew ─► tnew.h5 ─► fit ─► fit.h5, fit.yaml
 //!                          │                                  ▲                       │
 //!                          └──────────────────────────────────┴──────── report ◄──────┘
+//!                          │
+//!                          └─► ida ─► ida.h5   (a yielding structure, with an `ida:` section)
 //! ```
 //!
 //! Every stage ([`StageId`]) has the same shape: the upstream stages it reads, the fingerprint
@@ -23,6 +25,7 @@
 //! [`Reporter`].
 
 pub mod fit;
+pub mod ida;
 pub mod lock;
 pub mod motions;
 pub mod report;
@@ -32,7 +35,7 @@ pub mod tnew;
 use crate::grid::Grid;
 use crate::store::{StoreError, atomic};
 use crate::study::config::{ConfigError, StudyConfig};
-use crate::study::sweep::{DampingBasis, Physics};
+use crate::study::sweep::Physics;
 use lock::{LockError, LockMode, OutputLock};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -45,15 +48,18 @@ pub enum StageId {
     Tnew,
     Fit,
     Report,
+    /// Incremental dynamic analysis of a yielding structure (only with an `ida:` section).
+    Ida,
 }
 
 impl StageId {
-    pub const ALL: [StageId; 5] = [
+    pub const ALL: [StageId; 6] = [
         StageId::Motions,
         StageId::Sweep,
         StageId::Tnew,
         StageId::Fit,
         StageId::Report,
+        StageId::Ida,
     ];
 
     /// The subcommand's name.
@@ -64,6 +70,7 @@ impl StageId {
             StageId::Tnew => "tnew",
             StageId::Fit => "fit",
             StageId::Report => "report",
+            StageId::Ida => "ida",
         }
     }
 
@@ -76,6 +83,7 @@ impl StageId {
             StageId::Tnew => "tnew.h5",
             StageId::Fit => "fit.h5",
             StageId::Report => "report/index.html",
+            StageId::Ida => "ida.h5",
         }
     }
 
@@ -87,6 +95,7 @@ impl StageId {
             StageId::Tnew => &[StageId::Motions, StageId::Sweep],
             StageId::Fit => &[StageId::Tnew],
             StageId::Report => &[StageId::Motions, StageId::Tnew, StageId::Fit],
+            StageId::Ida => &[StageId::Motions],
         }
     }
 }
@@ -126,6 +135,8 @@ pub enum PipelineError {
     Fit(#[from] fit::FitStageError),
     #[error(transparent)]
     Report(#[from] report::ReportError),
+    #[error(transparent)]
+    Ida(#[from] ida::IdaStageError),
 }
 
 impl PipelineError {
@@ -134,7 +145,8 @@ impl PipelineError {
         match self {
             PipelineError::Config(_)
             | PipelineError::BadInput { .. }
-            | PipelineError::NoGrid { .. } => true,
+            | PipelineError::NoGrid { .. }
+            | PipelineError::Ida(ida::IdaStageError::NoSection { .. }) => true,
             PipelineError::Sweep(e) => e.is_bad_input(),
             PipelineError::Motions(motions::MotionsError::Unmatched(_)) => true,
             _ => false,
@@ -203,6 +215,8 @@ struct Fingerprints {
     motions: String,
     /// `None` without a `grid` section.
     rest: Option<[String; 4]>,
+    /// `None` without an `ida` section.
+    ida: Option<String>,
 }
 
 /// A loaded, validated study: its config, output directory, grid and expected fingerprints.
@@ -275,6 +289,7 @@ impl Study {
             }
             None => None,
         };
+        let ida = ida::fingerprint(&cfg, &motions_fp);
         Ok(Self {
             config_path: config.to_path_buf(),
             config_sha256: crate::store::fingerprint::sha256_hex(&bytes),
@@ -284,8 +299,18 @@ impl Study {
             fingerprints: Fingerprints {
                 motions: motions_fp,
                 rest,
+                ida,
             },
         })
+    }
+
+    /// Whether the config gives `stage` what it needs (`grid`, `ida` sections).
+    pub fn configured(&self, stage: StageId) -> bool {
+        match stage {
+            StageId::Motions => true,
+            StageId::Ida => self.cfg.ida.is_some(),
+            _ => self.grid.is_some(),
+        }
     }
 
     /// The grid, or an error naming the stage that needs it.
@@ -298,14 +323,7 @@ impl Study {
 
     /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`).
     pub fn physics(&self) -> Physics {
-        self.cfg.grid.as_ref().map_or(
-            Physics {
-                damping: 0.05,
-                basis: DampingBasis::default(),
-                mu_static_ratio: 1.0,
-            },
-            |g| g.physics(),
-        )
+        self.cfg.physics()
     }
 
     /// A file of the output directory.
@@ -317,6 +335,14 @@ impl Study {
     pub fn fingerprint(&self, stage: StageId) -> Result<&str, PipelineError> {
         if stage == StageId::Motions {
             return Ok(&self.fingerprints.motions);
+        }
+        if stage == StageId::Ida {
+            return self.fingerprints.ida.as_deref().ok_or_else(|| {
+                ida::IdaStageError::NoSection {
+                    config: self.config_path.clone(),
+                }
+                .into()
+            });
         }
         let rest = self
             .fingerprints
@@ -331,7 +357,7 @@ impl Study {
             StageId::Tnew => &rest[1],
             StageId::Fit => &rest[2],
             StageId::Report => &rest[3],
-            StageId::Motions => unreachable!("handled above"),
+            StageId::Motions | StageId::Ida => unreachable!("handled above"),
         })
     }
 
@@ -465,6 +491,7 @@ pub enum Outcome {
 
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
 pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
+    s.study.fingerprint(stage)?;
     for &up in stage.upstream() {
         s.study.require(up)?;
     }
@@ -487,17 +514,21 @@ pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcom
         StageId::Tnew => tnew::build(s),
         StageId::Fit => fit::build(s),
         StageId::Report => report::build(s),
+        StageId::Ida => ida::build(s),
     }
 }
 
-/// Every stage in order, each skipped when up to date, telling `done` what each did and how
-/// long it took, s.
+/// Every stage in order (`ida` only with an `ida:` section), each skipped when up to date,
+/// telling `done` what each did and how long it took, s.
 pub fn run_all(
     s: &Session,
     opts: StageOptions,
     mut done: impl FnMut(StageId, &Outcome, f64),
 ) -> Result<(), PipelineError> {
     for stage in StageId::ALL {
+        if stage == StageId::Ida && !s.study.configured(stage) {
+            continue;
+        }
         let start = std::time::Instant::now();
         let outcome = execute(s, stage, opts)?;
         done(stage, &outcome, start.elapsed().as_secs_f64());
@@ -522,7 +553,7 @@ pub struct Status {
 pub fn status(study: &Study) -> Result<Status, PipelineError> {
     let mut stages = Vec::new();
     for stage in StageId::ALL {
-        if stage != StageId::Motions && study.grid.is_none() {
+        if !study.configured(stage) {
             continue;
         }
         stages.push((stage, study.state(stage)?));
