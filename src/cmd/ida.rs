@@ -55,7 +55,7 @@ pub fn run(args: Args) -> Result<()> {
     );
     for m in ida::median_ductility(&session.study)? {
         println!(
-            "{:<5} case {:>3} (T_p {} s, α {:?}, μ {:?}) at {:.2} × {:.3} g: stack {:.3}, rigid {:.3} ({:+.1} %)",
+            "{:<5} case {:>3} (T_p {} s, α {:?}, μ {:?}) at {:.2} × {:.3} g: stack {:.3}, rigid {:.3} ({:+.1} %); largest slip {:.4} m",
             m.zone,
             m.case,
             m.period_s,
@@ -65,7 +65,8 @@ pub fn run(args: Args) -> Result<()> {
             m.target_sa_g,
             m.stack,
             m.rigid,
-            100.0 * (m.stack / m.rigid - 1.0)
+            100.0 * (m.stack / m.rigid - 1.0),
+            m.stack_max_slip_m
         );
     }
     if let Some(path) = &args.figure {

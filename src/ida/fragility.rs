@@ -30,7 +30,9 @@ pub enum FitStatus {
     NoExceedance = 1,
     /// Every run of every stripe exceeds: `θ` is below the data.
     AllExceed = 2,
-    /// `β` on the edge of [`BETA_RANGE`] or a singular information matrix: no interval.
+    /// `β` on the edge of [`BETA_RANGE`], fewer than two stripes with some but not all runs
+    /// exceeding (`(θ, β)` then lie on a ridge of equal likelihood), or a singular information
+    /// matrix: the estimates are kept, without intervals.
     Degenerate = 3,
 }
 
@@ -206,7 +208,12 @@ pub fn fit_lognormal(sa_g: &[f64], trials: &[u32], exceed: &[u32]) -> Fragility 
         status: FitStatus::Degenerate,
         ..nan
     };
-    if on_edge || !(h[0][0] < 0.0 && det > 0.0) {
+    let partial = exceed
+        .iter()
+        .zip(trials)
+        .filter(|&(z, n)| *z > 0 && z < n)
+        .count();
+    if on_edge || partial < 2 || !(h[0][0] < 0.0 && det > 0.0) {
         return fit;
     }
     // Covariance = (−H)⁻¹.
@@ -366,5 +373,9 @@ mod tests {
             fit_lognormal(&x, &[3, 3], &[0, 3]).status,
             FitStatus::Degenerate
         );
+        // One stripe between none and all: a ridge, no interval.
+        let f = fit_lognormal(&[0.5, 1.0, 1.5], &[10; 3], &[0, 4, 10]);
+        assert_eq!(f.status, FitStatus::Degenerate);
+        assert!(f.theta_ci_sa_g.0.is_nan() && f.theta_sa_g > 0.5 && f.theta_sa_g < 1.5);
     }
 }

@@ -1,5 +1,6 @@
 //! Special functions of the gamma family, for the stochastic motions' Arias-intensity envelope
-//! (a gamma-shaped Husid curve).
+//! (a gamma-shaped Husid curve), and the normal distribution function through them (the IDA
+//! fragility fits).
 //!
 //! Kept here rather than taken from `statrs` (measured in `docs/ARCHITECTURE.md`, "Our own
 //! numerics and the crates we measured"): `statrs` agrees with `ln Γ` and `P(a, x)` to 1e-14, but

@@ -417,6 +417,8 @@ pub struct MedianDuctility {
     pub target_sa_g: f64,
     pub stack: f64,
     pub rigid: f64,
+    /// The stack's largest peak slip at any interface in any run of the case, m.
+    pub stack_max_slip_m: f64,
 }
 
 /// Multiples of the zone's target at which [`median_ductility`] compares the systems.
@@ -459,6 +461,15 @@ pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineE
             };
             let (stack, rigid) = (curve(0), curve(1));
             let target_sa_g = target.sa_g(axes.case_period_s[c]);
+            let n = axes.case_alpha[c].len();
+            let stack_max_slip_m = z
+                .vars
+                .run_demand
+                .slice(ndarray::s![0, .., c, .., 2..2 + n])
+                .iter()
+                .copied()
+                .filter(|v| !v.is_nan())
+                .fold(0.0, f64::max);
             for factor in TARGET_FACTORS {
                 let at = factor * target_sa_g;
                 rows.push(MedianDuctility {
@@ -471,6 +482,7 @@ pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineE
                     target_sa_g,
                     stack: interpolate(&axes.sa_grid_g, &stack, at),
                     rigid: interpolate(&axes.sa_grid_g, &rigid, at),
+                    stack_max_slip_m,
                 });
             }
         }
