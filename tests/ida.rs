@@ -236,3 +236,33 @@ fn hunt_and_fill_on_a_bare_bilinear_sdof_matches_its_homogeneous_twin() {
     let at = |l: f64| run(c_y, l).ductility.unwrap();
     assert!(at(lo) < cap && at(hi) >= cap, "{lo} {hi}");
 }
+
+/// With an `ida:` section beside a grid, `run` builds `ida.h5` before the report, and the report
+/// shows the curves and the fits; without an up-to-date `ida.h5` the report is refused.
+#[test]
+fn the_report_shows_the_ida_section_and_needs_ida_h5() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let grid = std::fs::read_to_string(root.join("configs/quick.yaml")).unwrap();
+    let ida = std::fs::read_to_string(quick()).unwrap();
+    let cfg = dir.path().join("both.yaml");
+    std::fs::write(&cfg, grid + &ida[ida.find("\nida:").unwrap()..]).unwrap();
+    let out = dir.path().join("out");
+    let o = ok(slidestack(&["run", s(&cfg), "--out", s(&out)], "2"));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("ida 0.") || text.contains("ida 1."), "{text}");
+    let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    for needle in ["ida-fragility", "ida-median", "ida.svg", "fitted"] {
+        assert!(html.contains(needle), "{needle}");
+    }
+    let svg = std::fs::read_to_string(out.join("report/ida.svg")).unwrap();
+    roxmltree::Document::parse(&svg).unwrap();
+    std::fs::remove_file(out.join("ida.h5")).unwrap();
+    let o = slidestack(&["report", s(&cfg), "--out", s(&out), "--force"], "1");
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("ida.h5 is missing") && err.contains("slidestack ida"),
+        "{err}"
+    );
+}

@@ -1,4 +1,5 @@
-//! `slidestack run CONFIG`: every stage in order (motions → sweep → tnew → fit → report), each
+//! `slidestack run CONFIG`: every stage in order (motions → sweep → tnew → fit → ida with an
+//! `ida:` section → report), each
 //! skipped when its output is up to date, under one lock of the output directory; prints the
 //! time of each and ends with the report's path.
 

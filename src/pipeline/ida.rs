@@ -490,11 +490,20 @@ pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineE
     Ok(rows)
 }
 
-/// SVG of the first case's ductility against intensity, one panel per zone: every record's
-/// curve (faint) and the 16–50–84 % fractiles of the stack and of the rigidly attached load.
-/// Collapsed values (`+∞`) are drawn at the collapse ductility.
+/// SVG of [`figure_of`].
 pub fn figure(study: &Study) -> Result<String, PipelineError> {
-    use crate::report::chart::{Axis, Figure, Panel, Series, Stroke, render};
+    let fig = figure_of(study)?;
+    crate::report::chart::render(&fig).map_err(|e| {
+        let path = study.path(StageId::Ida.output());
+        PipelineError::Store(crate::store::StoreError::corrupt(&path, e.to_string()))
+    })
+}
+
+/// The first case's ductility against intensity, one panel per zone: every record's curve
+/// (faint) and the 16–50–84 % fractiles of the stack and of the rigidly attached load.
+/// Collapsed values (`+∞`) are drawn at the collapse ductility.
+pub fn figure_of(study: &Study) -> Result<crate::report::chart::Figure, PipelineError> {
+    use crate::report::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Ida)?;
     let cfg = study
         .cfg
@@ -553,11 +562,9 @@ pub fn figure(study: &Study) -> Result<String, PipelineError> {
             series,
         ));
     }
-    let fig = Figure::grid(
+    Ok(Figure::grid(
         "IDA curves: sliding stack vs rigidly attached load",
         panels,
         1,
-    );
-    render(&fig)
-        .map_err(|e| PipelineError::Store(crate::store::StoreError::corrupt(&path, e.to_string())))
+    ))
 }

@@ -5,8 +5,10 @@
 //! config ─► motions ─► motions.h5 ─► sweep ─► sweep.h5 ─► tnew ─► tnew.h5 ─► fit ─► fit.h5, fit.yaml
 //!                          │                                  ▲                       │
 //!                          └──────────────────────────────────┴──────── report ◄──────┘
-//!                          │
-//!                          └─► ida ─► ida.h5   (a yielding structure, with an `ida:` section)
+//!                          │                                                           ▲
+//!                          └─► ida ─► ida.h5 ──────────────────────────────────────────┘
+//!                              (with an `ida:` section: a yielding structure; the report then
+//!                               shows it and requires it)
 //! ```
 //!
 //! Every stage ([`StageId`]) has the same shape: the upstream stages it reads, the fingerprint
@@ -47,9 +49,9 @@ pub enum StageId {
     Sweep,
     Tnew,
     Fit,
-    Report,
     /// Incremental dynamic analysis of a yielding structure (only with an `ida:` section).
     Ida,
+    Report,
 }
 
 impl StageId {
@@ -58,8 +60,8 @@ impl StageId {
         StageId::Sweep,
         StageId::Tnew,
         StageId::Fit,
-        StageId::Report,
         StageId::Ida,
+        StageId::Report,
     ];
 
     /// The subcommand's name.
@@ -87,7 +89,8 @@ impl StageId {
         }
     }
 
-    /// The stages whose files this one reads.
+    /// The stages whose files this one reads (the report also reads `ida.h5` when the config
+    /// has an `ida:` section; [`execute`] requires it then).
     pub fn upstream(self) -> &'static [StageId] {
         match self {
             StageId::Motions => &[],
@@ -279,17 +282,17 @@ impl Study {
         };
         let grid = cfg.grid.as_ref().map(|g| g.axes());
         let motions_fp = motions::fingerprint(&cfg)?;
+        let ida = ida::fingerprint(&cfg, &motions_fp);
         let rest = match &cfg.grid {
             Some(_) => {
                 let sweep = sweep::fingerprint(&cfg, &motions_fp);
                 let tnew = tnew::fingerprint(&sweep);
                 let fit = fit::fingerprint(&tnew);
-                let report = report::fingerprint(&fit, &motions_fp);
+                let report = report::fingerprint(&fit, &motions_fp, ida.as_deref());
                 Some([sweep, tnew, fit, report])
             }
             None => None,
         };
-        let ida = ida::fingerprint(&cfg, &motions_fp);
         Ok(Self {
             config_path: config.to_path_buf(),
             config_sha256: crate::store::fingerprint::sha256_hex(&bytes),
@@ -391,7 +394,11 @@ impl Study {
             return Ok(());
         }
         let mut first = stage;
-        for earlier in StageId::ALL.into_iter().take_while(|&s| s != stage) {
+        for earlier in StageId::ALL
+            .into_iter()
+            .take_while(|&s| s != stage)
+            .filter(|&s| self.configured(s))
+        {
             if self.state(earlier)? != StageState::UpToDate {
                 first = earlier;
                 break;
@@ -494,6 +501,9 @@ pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcom
     s.study.fingerprint(stage)?;
     for &up in stage.upstream() {
         s.study.require(up)?;
+    }
+    if stage == StageId::Report && s.study.configured(StageId::Ida) {
+        s.study.require(StageId::Ida)?;
     }
     let path = s.study.path(stage.output());
     if !opts.force {
