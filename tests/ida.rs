@@ -1,7 +1,8 @@
 //! The IDA stage end to end on `configs/ida-quick.yaml`: it runs, a rerun is skipped, a
-//! `kill -9` then a rerun gives the same bytes, so does one thread against two; bad `ida:` keys
-//! are refused before any work. And hunt & fill on a bare bilinear SDOF, whose response is
-//! homogeneous in the intensity (docs/model.md, "For a study stage").
+//! `kill -9` then a rerun gives the same bytes, so does one thread against two, xarray reads the
+//! labelled dimensions; bad `ida:` keys are refused before any work; the report shows the IDA
+//! and needs `ida.h5`. And hunt & fill on a bare bilinear SDOF, whose response is homogeneous in
+//! the intensity (docs/model.md, "For a study stage").
 
 mod common;
 
@@ -104,6 +105,32 @@ fn the_stage_runs_skips_resumes_after_a_kill_and_ignores_the_thread_count() {
     copy_motions(&out, &one);
     ok(slidestack(&["ida", s(&cfg), "--out", s(&one)], "1"));
     assert_eq!(std::fs::read(one.join("ida.h5")).unwrap(), want);
+
+    // xarray opens a zone with its named dimensions (scripts/install-deps.sh --test).
+    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".venv-test/bin/python");
+    assert!(
+        python.exists(),
+        "{} is missing: run scripts/install-deps.sh --test",
+        python.display()
+    );
+    let script = "import sys, xarray as xr\n\
+        ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_III')\n\
+        print(list(ds['fractile_curve'].dims), list(ds['theta'].dims), list(ds['run_demand'].dims))\n\
+        print(ds['Sa'].attrs['units'], [str(v) for v in ds['demand'].values[:2]], [str(v) for v in ds['system'].values])\n";
+    let o = ok(Command::new(python)
+        .args(["-c", script, s(&out.join("ida.h5"))])
+        .output()
+        .unwrap());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        text.lines().collect::<Vec<_>>(),
+        [
+            "['system', 'case', 'fractile', 'Sa', 'demand'] ['system', 'case', 'limit_state'] \
+             ['system', 'record', 'case', 'run', 'demand']",
+            "g ['ductility', 'residual_drift_m'] ['stack', 'rigid']",
+        ],
+        "{text}"
+    );
 }
 
 #[test]
