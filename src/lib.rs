@@ -7,6 +7,7 @@
 //! * [`report`]: SVG figures and the HTML report.
 //! * [`limits`]: the limits every input is checked against, with their reasons.
 //! * [`grid`]: the study's case grid (axes and indexing).
+//! * [`ida`]: incremental dynamic analysis kernels: hunt & fill, fractiles, fragility fits.
 //! * [`study`]: the study's numerics and configuration.
 //! * [`simulation`]: one case under one ground motion (`slidestack simulate`).
 //! * [`design`]: `T_new` of one structure from a finished study (the designer's query).
@@ -20,6 +21,7 @@ pub mod design;
 pub mod dynamics;
 pub mod fit;
 pub mod grid;
+pub mod ida;
 pub mod limits;
 pub mod motion;
 mod numeric;

@@ -75,6 +75,26 @@ pub const MAX_TARGET_DUCTILITY: f64 = 100.0;
 /// `μ(f̄_y)` narrower than 2 % of `f̄_y` can be missed.
 pub const DUCTILITY_SCAN_STEP: f64 = 0.98;
 
+/// Runs of one incremental dynamic analysis trace (hunt, bracket and fill together; the hunt's
+/// count follows from `cap_sa_g`, `first_sa_g` and the step increment). Every run is a full
+/// simulation of the record; a few tens trace a curve (Vamvatsikos & Cornell 2002 use 12), and
+/// ten times that bounds a config's mistake (a first step of 1e-9 g) instead of running for days.
+pub const MAX_IDA_TRACE_RUNS: usize = 200;
+
+/// Cases of an IDA section: each is traced under every motion of every zone, twice (the stack
+/// and the rigidly attached load).
+pub const MAX_IDA_CASES: usize = 1_000;
+
+/// Intensities of the common IDA grid (curves, fractiles, fragility stripes): stored arrays
+/// are `records × cases × intensities × demands`, and a grid finer than the traced runs adds
+/// only interpolated points.
+pub const MAX_IDA_GRID_POINTS: usize = 1_000;
+
+/// Zeros appended to every record so the residual drift is read near rest, s: each second is
+/// simulated in every run; ten minutes is far beyond any free-vibration decay of a damped
+/// structure.
+pub const MAX_IDA_PAD_S: f64 = 600.0;
+
 /// Largest `T_rigid/dt` the exact integrator runs: its structure cluster is written as a
 /// particular plus a homogeneous solution whose terms cancel when `ω·dt` is small, so the energy
 /// error grows like `3e-15·(T_rigid/dt)²` (module doc of `dynamics::exact`): about `1e-3` here.

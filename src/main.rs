@@ -33,7 +33,10 @@ enum Command {
     Fit(cmd::StudyArgs),
     /// Study stage 5: figures and tables → report/index.html.
     Report(cmd::StudyArgs),
-    /// The whole study: motions, sweep, tnew, fit, report (each skipped when up to date).
+    /// Incremental dynamic analysis of a yielding structure (the `ida:` section) → ida.h5.
+    Ida(cmd::ida::Args),
+    /// The whole study: motions, sweep, tnew, fit, report, and ida with an `ida:` section (each
+    /// skipped when up to date).
     Run(cmd::StudyArgs),
     /// What is on disk for every stage of a study (for people and job scripts).
     Status(cmd::status::Args),
@@ -60,6 +63,7 @@ fn main() -> std::process::ExitCode {
         Command::Tnew(args) => cmd::stage::run(args, StageId::Tnew),
         Command::Fit(args) => cmd::stage::run(args, StageId::Fit),
         Command::Report(args) => cmd::stage::run(args, StageId::Report),
+        Command::Ida(args) => cmd::ida::run(args),
         Command::Run(args) => cmd::run::run(args),
         Command::Status(args) => cmd::status::run(args),
         Command::Design(args) => cmd::design::run(args),

@@ -2,6 +2,7 @@
 //! study's stages share [`StudyArgs`], [`CliReporter`] and [`print_outcome`].
 
 pub mod design;
+pub mod ida;
 pub mod matching;
 pub mod run;
 pub mod simulate;

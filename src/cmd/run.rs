@@ -1,6 +1,6 @@
-//! `slidestack run CONFIG`: every stage in order (motions → sweep → tnew → fit → report), each
-//! skipped when its output is up to date, under one lock of the output directory; prints the
-//! time of each and ends with the report's path.
+//! `slidestack run CONFIG`: every stage in order (motions → sweep → tnew → fit → ida with an
+//! `ida:` section → report), each skipped when its output is up to date, under one lock of the
+//! output directory; prints the time of each and ends with the report's path.
 
 use super::{CliReporter, StudyArgs, print_outcome};
 use anyhow::Result;

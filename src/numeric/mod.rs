@@ -3,7 +3,8 @@
 //! * here: complex arithmetic, the φ-functions of exponential integrators, a bracketed Newton
 //!   root finder;
 //! * [`linalg`]: Cholesky, least squares by Householder QR, the 4×4 matrix exponential;
-//! * [`special`]: `ln Γ`, the regularised incomplete gamma function and its quantile;
+//! * [`special`]: `ln Γ`, the regularised incomplete gamma functions and the gamma quantile,
+//!   the normal distribution function;
 //! * [`rng`]: the seeded generator of the stochastic motions;
 //! * [`filter`]: Butterworth high-pass sections.
 

@@ -5,6 +5,10 @@
 //! config ─► motions ─► motions.h5 ─► sweep ─► sweep.h5 ─► tnew ─► tnew.h5 ─► fit ─► fit.h5, fit.yaml
 //!                          │                                  ▲                       │
 //!                          └──────────────────────────────────┴──────── report ◄──────┘
+//!                          │                                                           ▲
+//!                          └─► ida ─► ida.h5 ──────────────────────────────────────────┘
+//!                              (with an `ida:` section: a yielding structure; the report then
+//!                               shows it and requires it)
 //! ```
 //!
 //! Every stage ([`StageId`]) has the same shape: the upstream stages it reads, the fingerprint
@@ -23,6 +27,7 @@
 //! [`Reporter`].
 
 pub mod fit;
+pub mod ida;
 pub mod lock;
 pub mod motions;
 pub mod report;
@@ -32,7 +37,7 @@ pub mod tnew;
 use crate::grid::Grid;
 use crate::store::{StoreError, atomic};
 use crate::study::config::{ConfigError, StudyConfig};
-use crate::study::sweep::{DampingBasis, Physics};
+use crate::study::sweep::Physics;
 use lock::{LockError, LockMode, OutputLock};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -44,15 +49,18 @@ pub enum StageId {
     Sweep,
     Tnew,
     Fit,
+    /// Incremental dynamic analysis of a yielding structure (only with an `ida:` section).
+    Ida,
     Report,
 }
 
 impl StageId {
-    pub const ALL: [StageId; 5] = [
+    pub const ALL: [StageId; 6] = [
         StageId::Motions,
         StageId::Sweep,
         StageId::Tnew,
         StageId::Fit,
+        StageId::Ida,
         StageId::Report,
     ];
 
@@ -64,6 +72,7 @@ impl StageId {
             StageId::Tnew => "tnew",
             StageId::Fit => "fit",
             StageId::Report => "report",
+            StageId::Ida => "ida",
         }
     }
 
@@ -76,10 +85,12 @@ impl StageId {
             StageId::Tnew => "tnew.h5",
             StageId::Fit => "fit.h5",
             StageId::Report => "report/index.html",
+            StageId::Ida => "ida.h5",
         }
     }
 
-    /// The stages whose files this one reads.
+    /// The stages whose files this one reads (the report also reads `ida.h5` when the config
+    /// has an `ida:` section; [`execute`] requires it then).
     pub fn upstream(self) -> &'static [StageId] {
         match self {
             StageId::Motions => &[],
@@ -87,6 +98,7 @@ impl StageId {
             StageId::Tnew => &[StageId::Motions, StageId::Sweep],
             StageId::Fit => &[StageId::Tnew],
             StageId::Report => &[StageId::Motions, StageId::Tnew, StageId::Fit],
+            StageId::Ida => &[StageId::Motions],
         }
     }
 }
@@ -126,6 +138,8 @@ pub enum PipelineError {
     Fit(#[from] fit::FitStageError),
     #[error(transparent)]
     Report(#[from] report::ReportError),
+    #[error(transparent)]
+    Ida(#[from] ida::IdaStageError),
 }
 
 impl PipelineError {
@@ -134,7 +148,8 @@ impl PipelineError {
         match self {
             PipelineError::Config(_)
             | PipelineError::BadInput { .. }
-            | PipelineError::NoGrid { .. } => true,
+            | PipelineError::NoGrid { .. }
+            | PipelineError::Ida(ida::IdaStageError::NoSection { .. }) => true,
             PipelineError::Sweep(e) => e.is_bad_input(),
             PipelineError::Motions(motions::MotionsError::Unmatched(_)) => true,
             _ => false,
@@ -203,6 +218,8 @@ struct Fingerprints {
     motions: String,
     /// `None` without a `grid` section.
     rest: Option<[String; 4]>,
+    /// `None` without an `ida` section.
+    ida: Option<String>,
 }
 
 /// A loaded, validated study: its config, output directory, grid and expected fingerprints.
@@ -265,12 +282,13 @@ impl Study {
         };
         let grid = cfg.grid.as_ref().map(|g| g.axes());
         let motions_fp = motions::fingerprint(&cfg)?;
+        let ida = ida::fingerprint(&cfg, &motions_fp);
         let rest = match &cfg.grid {
             Some(_) => {
                 let sweep = sweep::fingerprint(&cfg, &motions_fp);
                 let tnew = tnew::fingerprint(&sweep);
                 let fit = fit::fingerprint(&tnew);
-                let report = report::fingerprint(&fit, &motions_fp);
+                let report = report::fingerprint(&fit, &motions_fp, ida.as_deref());
                 Some([sweep, tnew, fit, report])
             }
             None => None,
@@ -284,8 +302,18 @@ impl Study {
             fingerprints: Fingerprints {
                 motions: motions_fp,
                 rest,
+                ida,
             },
         })
+    }
+
+    /// Whether the config gives `stage` what it needs (`grid`, `ida` sections).
+    pub fn configured(&self, stage: StageId) -> bool {
+        match stage {
+            StageId::Motions => true,
+            StageId::Ida => self.cfg.ida.is_some(),
+            _ => self.grid.is_some(),
+        }
     }
 
     /// The grid, or an error naming the stage that needs it.
@@ -298,14 +326,7 @@ impl Study {
 
     /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`).
     pub fn physics(&self) -> Physics {
-        self.cfg.grid.as_ref().map_or(
-            Physics {
-                damping: 0.05,
-                basis: DampingBasis::default(),
-                mu_static_ratio: 1.0,
-            },
-            |g| g.physics(),
-        )
+        self.cfg.physics()
     }
 
     /// A file of the output directory.
@@ -317,6 +338,14 @@ impl Study {
     pub fn fingerprint(&self, stage: StageId) -> Result<&str, PipelineError> {
         if stage == StageId::Motions {
             return Ok(&self.fingerprints.motions);
+        }
+        if stage == StageId::Ida {
+            return self.fingerprints.ida.as_deref().ok_or_else(|| {
+                ida::IdaStageError::NoSection {
+                    config: self.config_path.clone(),
+                }
+                .into()
+            });
         }
         let rest = self
             .fingerprints
@@ -331,7 +360,7 @@ impl Study {
             StageId::Tnew => &rest[1],
             StageId::Fit => &rest[2],
             StageId::Report => &rest[3],
-            StageId::Motions => unreachable!("handled above"),
+            StageId::Motions | StageId::Ida => unreachable!("handled above"),
         })
     }
 
@@ -365,7 +394,11 @@ impl Study {
             return Ok(());
         }
         let mut first = stage;
-        for earlier in StageId::ALL.into_iter().take_while(|&s| s != stage) {
+        for earlier in StageId::ALL
+            .into_iter()
+            .take_while(|&s| s != stage)
+            .filter(|&s| self.configured(s))
+        {
             if self.state(earlier)? != StageState::UpToDate {
                 first = earlier;
                 break;
@@ -465,8 +498,12 @@ pub enum Outcome {
 
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
 pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
+    s.study.fingerprint(stage)?;
     for &up in stage.upstream() {
         s.study.require(up)?;
+    }
+    if stage == StageId::Report && s.study.configured(StageId::Ida) {
+        s.study.require(StageId::Ida)?;
     }
     let path = s.study.path(stage.output());
     if !opts.force {
@@ -487,17 +524,21 @@ pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcom
         StageId::Tnew => tnew::build(s),
         StageId::Fit => fit::build(s),
         StageId::Report => report::build(s),
+        StageId::Ida => ida::build(s),
     }
 }
 
-/// Every stage in order, each skipped when up to date, telling `done` what each did and how
-/// long it took, s.
+/// Every stage in order (`ida` only with an `ida:` section), each skipped when up to date,
+/// telling `done` what each did and how long it took, s.
 pub fn run_all(
     s: &Session,
     opts: StageOptions,
     mut done: impl FnMut(StageId, &Outcome, f64),
 ) -> Result<(), PipelineError> {
     for stage in StageId::ALL {
+        if stage == StageId::Ida && !s.study.configured(stage) {
+            continue;
+        }
         let start = std::time::Instant::now();
         let outcome = execute(s, stage, opts)?;
         done(stage, &outcome, start.elapsed().as_secs_f64());
@@ -522,7 +563,7 @@ pub struct Status {
 pub fn status(study: &Study) -> Result<Status, PipelineError> {
     let mut stages = Vec::new();
     for stage in StageId::ALL {
-        if stage != StageId::Motions && study.grid.is_none() {
+        if !study.configured(stage) {
             continue;
         }
         stages.push((stage, study.state(stage)?));

@@ -6,7 +6,7 @@
 //! * [`h5`]: HDF5 helpers: labelled variables with checksummed chunks, dimension scales, the
 //!   stage-file envelope (fingerprint, checksum sidecar, verification).
 //! * [`units`]: the sweep's per-unit files (identity, checksum) for resuming and sharding.
-//! * [`motions`], [`sweep`], [`tnew`], [`fit`]: the stage files.
+//! * [`motions`], [`sweep`], [`tnew`], [`fit`], [`ida`]: the stage files.
 //! * [`history`]: one simulation's time history.
 //! * [`fingerprint`]: SHA-256 of inputs, for up-to-date checks.
 
@@ -16,6 +16,7 @@ pub mod fingerprint;
 pub mod fit;
 pub mod h5;
 pub mod history;
+pub mod ida;
 pub mod motions;
 pub mod report;
 pub mod sweep;

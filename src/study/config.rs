@@ -16,6 +16,7 @@
 //!   allow_unmatched: false         # true: keep motions outside the band, flagged
 //! ```
 
+use super::ida::IdaConfig;
 use super::sweep::{DampingBasis, Physics};
 use crate::grid::Grid;
 use crate::grid::linear_range;
@@ -40,6 +41,9 @@ pub struct StudyConfig {
     /// The parameter grid of the sweep; required by `sweep` and later stages.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grid: Option<GridConfig>,
+    /// Incremental dynamic analysis of a yielding structure; required by `ida`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ida: Option<IdaConfig>,
 }
 
 /// A list of values, or an inclusive range `{ from, to, step }`.
@@ -344,6 +348,13 @@ impl StudyConfig {
                 );
             }
         }
+        if let Some(ida) = &self.ida {
+            let physics = self.physics();
+            let targets: Vec<_> = (0..self.zones.len())
+                .filter_map(|i| Some((self.zones[i].name.clone(), self.target(i).ok()?)))
+                .collect();
+            ida.validate(&physics, &targets)?;
+        }
         let seeds = &self.motions.seeds;
         if seeds.stochastic.is_some() == seeds.records.is_some() {
             return err(
@@ -407,6 +418,19 @@ impl StudyConfig {
             }
         }
         Ok(())
+    }
+
+    /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`; the defaults without a
+    /// grid).
+    pub fn physics(&self) -> Physics {
+        self.grid.as_ref().map_or(
+            Physics {
+                damping: 0.05,
+                basis: DampingBasis::default(),
+                mu_static_ratio: 1.0,
+            },
+            GridConfig::physics,
+        )
     }
 
     /// The grid, or an error naming the missing section.

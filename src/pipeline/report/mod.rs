@@ -9,19 +9,22 @@
 //! * `DRR_1`, `DRR_2` (Figs 10–11) and `T_new` (Figs 16–17) against `T_p`, panels over the mass
 //!   ratios, a subset of friction pairs drawn out over every pair in grey;
 //! * the band counts of `T_new`, Table 3 next to the paper's, the recommended form's
-//!   coefficients with their standard errors, and the residuals of every fitted form.
+//!   coefficients with their standard errors, and the residuals of every fitted form;
+//! * with an `ida:` section: the first IDA case's curves, the fragility fits and the median
+//!   ductility of the stack against the rigidly attached load (from `ida.h5`).
 //!
 //! Panels and lines are picked from the grid's own axes, so any grid (other block counts
 //! included) gives a report. Every simulation uses the study's physics
 //! ([`crate::study::sweep::Physics`]). The directory is replaced as a whole
 //! ([`crate::store::report`]).
 //!
-//! Fingerprint: the fit's and the motions' (which carry everything upstream), and the report's
-//! own version.
+//! Fingerprint: the fit's and the motions' (which carry everything upstream), `ida.h5`'s with an
+//! `ida:` section, and the report's own version.
 
 mod cases;
 mod fit;
 mod grid;
+mod ida;
 mod motions;
 mod runs;
 mod select;
@@ -69,9 +72,17 @@ pub enum ReportError {
     Chart(#[from] ChartError),
 }
 
-/// The fingerprint the report must carry.
-pub fn fingerprint(fit_fingerprint: &str, motions_fingerprint: &str) -> String {
-    hash_parts(&[fit_fingerprint, motions_fingerprint, REPORT_VERSION])
+/// The fingerprint the report must carry; with an `ida:` section, `ida.h5`'s too (the report
+/// then shows it).
+pub fn fingerprint(
+    fit_fingerprint: &str,
+    motions_fingerprint: &str,
+    ida_fingerprint: Option<&str>,
+) -> String {
+    match ida_fingerprint {
+        None => hash_parts(&[fit_fingerprint, motions_fingerprint, REPORT_VERSION]),
+        Some(ida) => hash_parts(&[fit_fingerprint, motions_fingerprint, REPORT_VERSION, ida]),
+    }
 }
 
 /// One zone's inputs.
@@ -284,8 +295,12 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         drr_section(&inp, &sel, &mut files)?,
         tnew_section(&inp, &sel, &mut files)?,
         fit_section(&inp, &mut files)?,
-        not_shown(),
     ];
+    let mut sections = sections;
+    if study.configured(StageId::Ida) {
+        sections.push(ida::ida_section(study, &mut files)?);
+    }
+    sections.push(not_shown());
     let html = document(
         &format!(
             "slidestack report: {}",

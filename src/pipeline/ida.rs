@@ -1,0 +1,570 @@
+//! The IDA stage: every case of the `ida:` section under every matched motion, on a yielding
+//! structure, traced by hunt & fill → `ida.h5` (layout in [`crate::store::ida`]; the numerics of
+//! one unit in [`crate::study::ida`], the kernels in [`crate::ida`]).
+//!
+//! Work units (one zone, one motion, one case; both systems) run in parallel and are collected
+//! in their fixed order, so the file's bytes do not depend on the thread count. The file is
+//! written once, atomically, at the end: a run killed before that leaves nothing but a temporary
+//! (removed by the next session) and the rerun computes everything again (the quick config takes
+//! seconds).
+//!
+//! Fingerprint: the `zones` section, the physics of the grid, the `ida` section and the
+//! motions' fingerprint.
+
+use super::{Outcome, PipelineError, Session, StageId, Study};
+use crate::ida::curve::{fractile, on_grid};
+use crate::ida::fragility::{FIT_STATUS_FLAGS, FitStatus, fit_lognormal};
+use crate::ida::trace::Trace;
+use crate::store::fingerprint::fingerprint as hash_parts;
+use crate::store::h5::Attr;
+use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
+use crate::study::config::StudyConfig;
+use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
+use ndarray::{ArrayD, IxDyn};
+use rayon::prelude::*;
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// The fractiles of the summary curves (Vamvatsikos & Cornell 2002, Section 6).
+pub const FRACTILES: [f64; 3] = [0.16, 0.5, 0.84];
+
+#[derive(Debug, Error)]
+pub enum IdaStageError {
+    #[error("{}: the `ida` stage needs an `ida` section", config.display())]
+    NoSection { config: PathBuf },
+    #[error("zone {zone}, motion {motion}, case {case} ({system}): {why}")]
+    Simulation {
+        zone: String,
+        motion: String,
+        case: usize,
+        system: &'static str,
+        why: String,
+    },
+}
+
+/// The fingerprint `ida.h5` must carry, `None` without an `ida` section.
+pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<String> {
+    let ida = cfg.ida.as_ref()?;
+    let p = cfg.physics();
+    let section = serde_json::json!({
+        "zones": cfg.zones, "ida": ida, "solver": "exact",
+        "physics": { "damping": p.damping, "basis": p.basis, "mu_static_ratio": p.mu_static_ratio },
+    });
+    Some(hash_parts(&[&section.to_string(), motions_fingerprint]))
+}
+
+/// One unit's result.
+struct UnitOut {
+    record_sa_g: f64,
+    traces: Vec<Trace<RunDemand>>,
+}
+
+/// Builds `ida.h5`.
+pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+    let study = &s.study;
+    let me = StageId::Ida;
+    let cfg = study
+        .cfg
+        .ida
+        .as_ref()
+        .ok_or_else(|| IdaStageError::NoSection {
+            config: study.config_path.clone(),
+        })?;
+    let fp = study.fingerprint(me)?;
+    let motions = super::sweep::load_motions(study)?;
+    let physics = study.physics();
+    let targets: Vec<_> = (0..study.cfg.zones.len())
+        .map(|i| study.cfg.target(i))
+        .collect::<Result<_, _>>()
+        .map_err(|e| PipelineError::BadInput {
+            file: study.config_path.clone(),
+            why: e.to_string(),
+        })?;
+    let units: Vec<(usize, usize, usize)> = motions
+        .iter()
+        .enumerate()
+        .flat_map(|(z, ms)| {
+            (0..ms.len()).flat_map(move |m| (0..cfg.cases.len()).map(move |c| (z, m, c)))
+        })
+        .collect();
+    s.reporter.info(
+        me,
+        &format!(
+            "{} traces ({} motions over {} zones × {} cases × {} systems), at most {} runs each",
+            units.len() * SYSTEMS.len(),
+            motions.iter().map(Vec::len).sum::<usize>(),
+            motions.len(),
+            cfg.cases.len(),
+            SYSTEMS.len(),
+            cfg.tracing.max_runs()
+        ),
+    );
+    let start = std::time::Instant::now();
+    let bar = s.reporter.progress(me, units.len() as u64);
+    let outs: Vec<UnitOut> = units
+        .par_iter()
+        .map(|&(z, m, c)| -> Result<UnitOut, PipelineError> {
+            let rec = &motions[z][m];
+            let case = &cfg.cases[c];
+            let fail = |system: &'static str, why: String| IdaStageError::Simulation {
+                zone: study.cfg.zones[z].name.clone(),
+                motion: rec.name.clone(),
+                case: c,
+                system,
+                why,
+            };
+            let accel = rec.accel_mps2(1.0);
+            let record_sa_g = sa_g(&accel, rec.dt_s, case.period_s)
+                .map_err(|e| fail(SYSTEMS[0], e.to_string()))?;
+            let padded = padded(&accel, rec.dt_s, cfg.pad_s);
+            let c_y = cfg.strength_ratio(&targets[z], case);
+            let systems = cfg
+                .systems(&physics, case, c_y)
+                .map_err(|e| fail(SYSTEMS[0], e.to_string()))?;
+            let traces = systems
+                .iter()
+                .zip(SYSTEMS)
+                .map(|(sys, name)| {
+                    trace_system(cfg, sys, &padded, rec.dt_s, record_sa_g)
+                        .map_err(|e| fail(name, e.to_string()))
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            bar.inc();
+            Ok(UnitOut {
+                record_sa_g,
+                traces,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    bar.finish();
+    let runs: usize = outs
+        .iter()
+        .flat_map(|o| o.traces.iter().map(|t| t.runs.len()))
+        .sum();
+    let secs = start.elapsed().as_secs_f64();
+    s.reporter.info(
+        me,
+        &format!(
+            "{runs} runs in {secs:.1} s ({:.0} runs/s, {} threads)",
+            runs as f64 / secs.max(1e-9),
+            rayon::current_num_threads()
+        ),
+    );
+    let axes = IdaAxes {
+        systems: SYSTEMS.iter().map(|s| s.to_string()).collect(),
+        case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
+        case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
+        case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
+        runs: cfg.tracing.max_runs(),
+        sa_grid_g: cfg.grid_sa_g(),
+        demands: cfg.demand_names(),
+        limit_states: cfg.limit_states.iter().map(|l| l.name.clone()).collect(),
+        limit_state_definitions: cfg.limit_states.iter().map(|l| l.definition()).collect(),
+        fractiles: FRACTILES.to_vec(),
+    };
+    let mut zones = Vec::new();
+    let mut at = 0;
+    for (z, zc) in study.cfg.zones.iter().enumerate() {
+        let count = motions[z].len() * cfg.cases.len();
+        let slice = &outs[at..at + count];
+        at += count;
+        let c_y: Vec<f64> = cfg
+            .cases
+            .iter()
+            .map(|c| cfg.strength_ratio(&targets[z], c))
+            .collect();
+        zones.push(ZoneIda {
+            name: zc.name.clone(),
+            target: zc.target.clone(),
+            records: motions[z].iter().map(|m| m.name.clone()).collect(),
+            vars: zone_vars(cfg, &axes, motions[z].len(), slice, c_y),
+        });
+    }
+    let c_y_rule = match (&cfg.structure.c_y, &cfg.structure.design) {
+        (Some(c), _) => format!("C_y = {c}"),
+        (None, Some(d)) => format!(
+            "C_y = (Z/2)(I/R)(Sa/g)(T_p) of the zone's IS 1893 target, I = {}, R = {}",
+            d.importance, d.response_reduction
+        ),
+        (None, None) => String::new(),
+    };
+    let t = &cfg.tracing;
+    let mut settings: Vec<(&str, Attr)> = super::sweep::physics_attrs(&physics).to_vec();
+    settings.extend([
+        ("mu_static_ratio", Attr::F64(physics.mu_static_ratio)),
+        ("c_y_rule", Attr::Str(&c_y_rule)),
+        (
+            "post_yield_ratio",
+            Attr::F64(cfg.structure.post_yield_ratio),
+        ),
+        ("collapse_ductility", Attr::F64(cfg.collapse_ductility)),
+        ("slip_limit_m", Attr::F64(cfg.slip_limit_m)),
+        ("pad_s", Attr::F64(cfg.pad_s)),
+        ("first_sa_g", Attr::F64(t.first_sa_g)),
+        ("step_increment_sa_g", Attr::F64(t.step_increment_sa_g)),
+        ("bracket_runs", Attr::F64(t.bracket_runs as f64)),
+        ("fill_runs", Attr::F64(t.fill_runs as f64)),
+        ("cap_sa_g", Attr::F64(t.cap_sa_g)),
+        (
+            "intensity_measure",
+            Attr::Str("Sa(T_p, 5 %) of the scaled motion, T_p the bare structure's period, g"),
+        ),
+        (
+            "fragility_method",
+            Attr::Str(
+                "lognormal, maximum likelihood on multiple stripes (Baker 2015) read off the IDA \
+                 curves at every grid intensity; 95 % Wald intervals from the observed \
+                 information (stripes treated as independent)",
+            ),
+        ),
+    ]);
+    let meta = IdaMeta {
+        fingerprint: fp,
+        motions_fingerprint: study.fingerprint(StageId::Motions)?,
+        config_sha256: &study.config_sha256,
+        fit_flags: &FIT_STATUS_FLAGS,
+        settings: &settings,
+    };
+    let path = study.path(me.output());
+    write_ida(&path, &meta, &axes, &zones)?;
+    s.reporter.info(me, &format!("verified {}", path.display()));
+    Ok(Outcome::Wrote(vec![path]))
+}
+
+fn array<T: Clone>(shape: &[usize], fill: T) -> ArrayD<T> {
+    ArrayD::from_elem(IxDyn(shape), fill)
+}
+
+/// One zone's variables from its units (record-major, then case).
+fn zone_vars(
+    cfg: &IdaConfig,
+    axes: &IdaAxes,
+    records: usize,
+    units: &[UnitOut],
+    c_y: Vec<f64>,
+) -> IdaVars {
+    let (ns, nc, nr) = (SYSTEMS.len(), cfg.cases.len(), axes.runs);
+    let (nd, ng, nl) = (
+        axes.demands.len(),
+        axes.sa_grid_g.len(),
+        cfg.limit_states.len(),
+    );
+    let grid = &axes.sa_grid_g;
+    let mut v = IdaVars {
+        c_y: ArrayD::from_shape_vec(IxDyn(&[nc]), c_y).expect("one per case"),
+        record_sa_g: array(&[records, nc], f64::NAN),
+        run_sa_g: array(&[ns, records, nc, nr], f64::NAN),
+        run_demand: array(&[ns, records, nc, nr, nd], f64::NAN),
+        run_collapsed: array(&[ns, records, nc, nr], 255u8),
+        run_slip_exceeded: array(&[ns, records, nc, nr], 255u8),
+        collapse_sa_g: array(&[ns, records, nc], f64::NAN),
+        curve: array(&[ns, records, nc, ng, nd], f64::NAN),
+        fractile_curve: array(&[ns, nc, FRACTILES.len(), ng, nd], f64::NAN),
+        exceed_fraction: array(&[ns, nc, nl, ng], f64::NAN),
+        fragility_curve: array(&[ns, nc, nl, ng], f64::NAN),
+        theta_sa_g: array(&[ns, nc, nl], f64::NAN),
+        beta: array(&[ns, nc, nl], f64::NAN),
+        theta_ci_low_sa_g: array(&[ns, nc, nl], f64::NAN),
+        theta_ci_high_sa_g: array(&[ns, nc, nl], f64::NAN),
+        beta_ci_low: array(&[ns, nc, nl], f64::NAN),
+        beta_ci_high: array(&[ns, nc, nl], f64::NAN),
+        fit_status: array(&[ns, nc, nl], 255u8),
+    };
+    for (u, out) in units.iter().enumerate() {
+        let (r, c) = (u / nc, u % nc);
+        v.record_sa_g[[r, c]] = out.record_sa_g;
+        for (s, t) in out.traces.iter().enumerate() {
+            for (k, run) in t.runs.iter().enumerate() {
+                v.run_sa_g[[s, r, c, k]] = run.sa_g;
+                v.run_collapsed[[s, r, c, k]] = u8::from(run.collapsed);
+                v.run_slip_exceeded[[s, r, c, k]] = u8::from(run.demand.slip_exceeded);
+                for (d, x) in run.demand.values.iter().enumerate() {
+                    v.run_demand[[s, r, c, k, d]] = *x;
+                }
+            }
+            if let Some((_, hi)) = t.capacity_sa_g() {
+                v.collapse_sa_g[[s, r, c]] = hi;
+            }
+            let sa: Vec<f64> = t.runs.iter().map(|x| x.sa_g).collect();
+            let collapsed: Vec<bool> = t.runs.iter().map(|x| x.collapsed).collect();
+            for d in 0..nd {
+                let demand: Vec<f64> = t.runs.iter().map(|x| x.demand.values[d]).collect();
+                for (j, y) in on_grid(&sa, &demand, &collapsed, grid)
+                    .into_iter()
+                    .enumerate()
+                {
+                    v.curve[[s, r, c, j, d]] = y;
+                }
+            }
+        }
+    }
+    let n = cfg.blocks();
+    for s in 0..ns {
+        for c in 0..nc {
+            for j in 0..ng {
+                for d in 0..nd {
+                    let vals: Vec<f64> = (0..records).map(|r| v.curve[[s, r, c, j, d]]).collect();
+                    for (q, &p) in FRACTILES.iter().enumerate() {
+                        v.fractile_curve[[s, c, q, j, d]] = fractile(&vals, p);
+                    }
+                }
+            }
+            for (l, ls) in cfg.limit_states.iter().enumerate() {
+                let (mut x, mut trials, mut exceed) = (Vec::new(), Vec::new(), Vec::new());
+                for (j, &sa) in grid.iter().enumerate() {
+                    let (mut nj, mut zj) = (0u32, 0u32);
+                    for r in 0..records {
+                        let value = match (ls.ductility, ls.slip_m) {
+                            (Some(_), _) => v.curve[[s, r, c, j, 0]],
+                            _ => (0..n)
+                                .map(|i| v.curve[[s, r, c, j, 2 + i]])
+                                .fold(f64::NEG_INFINITY, f64::max),
+                        };
+                        if value.is_nan() {
+                            continue;
+                        }
+                        let threshold = ls.ductility.or(ls.slip_m).unwrap_or(f64::INFINITY);
+                        nj += 1;
+                        zj += u32::from(value >= threshold);
+                    }
+                    if nj > 0 {
+                        v.exceed_fraction[[s, c, l, j]] = zj as f64 / nj as f64;
+                        x.push(sa);
+                        trials.push(nj);
+                        exceed.push(zj);
+                    }
+                }
+                let f = fit_lognormal(&x, &trials, &exceed);
+                let at = [s, c, l];
+                v.theta_sa_g[at] = f.theta_sa_g;
+                v.beta[at] = f.beta;
+                v.theta_ci_low_sa_g[at] = f.theta_ci_sa_g.0;
+                v.theta_ci_high_sa_g[at] = f.theta_ci_sa_g.1;
+                v.beta_ci_low[at] = f.beta_ci.0;
+                v.beta_ci_high[at] = f.beta_ci.1;
+                v.fit_status[at] = f.status as u8;
+                if matches!(f.status, FitStatus::Fitted | FitStatus::Degenerate) {
+                    for (j, &sa) in grid.iter().enumerate() {
+                        v.fragility_curve[[s, c, l, j]] = f.probability(sa);
+                    }
+                }
+            }
+        }
+    }
+    v
+}
+
+/// One row of the fragility table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FragilityRow {
+    pub zone: String,
+    pub case: usize,
+    pub system: String,
+    pub limit_state: String,
+    pub theta_sa_g: f64,
+    pub theta_ci_sa_g: (f64, f64),
+    pub beta: f64,
+    pub beta_ci: (f64, f64),
+    /// The fit's status word.
+    pub status: &'static str,
+}
+
+/// Every fit of `ida.h5` (which must be up to date), zone, case, system, limit state in order.
+pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError> {
+    study.require(StageId::Ida)?;
+    let path = study.path(StageId::Ida.output());
+    let mut rows = Vec::new();
+    for zone in &study.cfg.zones {
+        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+        let v = &z.vars;
+        for c in 0..axes.case_period_s.len() {
+            for (s, system) in axes.systems.iter().enumerate() {
+                for (l, limit) in axes.limit_states.iter().enumerate() {
+                    let at = [s, c, l];
+                    let code = v.fit_status[at];
+                    rows.push(FragilityRow {
+                        zone: zone.name.clone(),
+                        case: c,
+                        system: system.clone(),
+                        limit_state: limit.clone(),
+                        theta_sa_g: v.theta_sa_g[at],
+                        theta_ci_sa_g: (v.theta_ci_low_sa_g[at], v.theta_ci_high_sa_g[at]),
+                        beta: v.beta[at],
+                        beta_ci: (v.beta_ci_low[at], v.beta_ci_high[at]),
+                        status: FIT_STATUS_FLAGS
+                            .iter()
+                            .find(|f| f.0 == code)
+                            .map_or("unknown", |f| f.1),
+                    });
+                }
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// The median ductility of the stack and of the rigidly attached load at one intensity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MedianDuctility {
+    pub zone: String,
+    pub case: usize,
+    pub period_s: f64,
+    pub alpha: Vec<f64>,
+    pub mu: Vec<f64>,
+    /// The intensity is `factor × target_sa_g`.
+    pub factor: f64,
+    /// The zone's target `Sa(T_p)`, g: the level the motions are matched to.
+    pub target_sa_g: f64,
+    pub stack: f64,
+    pub rigid: f64,
+    /// The stack's largest peak slip at any interface in any run of the case, m.
+    pub stack_max_slip_m: f64,
+}
+
+/// Multiples of the zone's target at which [`median_ductility`] compares the systems.
+pub const TARGET_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
+
+/// `y` on the grid `x` at `at`, linearly (`+∞` where either neighbour is; NaN outside).
+fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
+    let j = x.partition_point(|&v| v < at);
+    if j == x.len() {
+        return f64::NAN;
+    }
+    if x[j] == at || j == 0 {
+        return if x[j] == at { y[j] } else { f64::NAN };
+    }
+    let w = (at - x[j - 1]) / (x[j] - x[j - 1]);
+    if y[j - 1].is_infinite() || y[j].is_infinite() {
+        return f64::INFINITY;
+    }
+    y[j - 1] + w * (y[j] - y[j - 1])
+}
+
+/// The median ductility of both systems at [`TARGET_FACTORS`] × the zone's target `Sa(T_p)`,
+/// read off the median curves of `ida.h5` (NaN above the grid).
+pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineError> {
+    study.require(StageId::Ida)?;
+    let path = study.path(StageId::Ida.output());
+    let mut rows = Vec::new();
+    for (zi, zone) in study.cfg.zones.iter().enumerate() {
+        let target = study.cfg.target(zi).map_err(|e| PipelineError::BadInput {
+            file: study.config_path.clone(),
+            why: e.to_string(),
+        })?;
+        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+        let median = FRACTILES.iter().position(|&p| p == 0.5).unwrap_or(1);
+        for c in 0..axes.case_period_s.len() {
+            let curve = |s: usize| -> Vec<f64> {
+                (0..axes.sa_grid_g.len())
+                    .map(|j| z.vars.fractile_curve[[s, c, median, j, 0]])
+                    .collect()
+            };
+            let (stack, rigid) = (curve(0), curve(1));
+            let target_sa_g = target.sa_g(axes.case_period_s[c]);
+            let n = axes.case_alpha[c].len();
+            let stack_max_slip_m = z
+                .vars
+                .run_demand
+                .slice(ndarray::s![0, .., c, .., 2..2 + n])
+                .iter()
+                .copied()
+                .filter(|v| !v.is_nan())
+                .fold(0.0, f64::max);
+            for factor in TARGET_FACTORS {
+                let at = factor * target_sa_g;
+                rows.push(MedianDuctility {
+                    zone: zone.name.clone(),
+                    case: c,
+                    period_s: axes.case_period_s[c],
+                    alpha: axes.case_alpha[c].clone(),
+                    mu: axes.case_mu[c].clone(),
+                    factor,
+                    target_sa_g,
+                    stack: interpolate(&axes.sa_grid_g, &stack, at),
+                    rigid: interpolate(&axes.sa_grid_g, &rigid, at),
+                    stack_max_slip_m,
+                });
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// SVG of [`figure_of`].
+pub fn figure(study: &Study) -> Result<String, PipelineError> {
+    let fig = figure_of(study)?;
+    crate::report::chart::render(&fig).map_err(|e| {
+        let path = study.path(StageId::Ida.output());
+        PipelineError::Store(crate::store::StoreError::corrupt(&path, e.to_string()))
+    })
+}
+
+/// The first case's ductility against intensity, one panel per zone: every record's curve
+/// (faint) and the 16–50–84 % fractiles of the stack and of the rigidly attached load.
+/// Collapsed values (`+∞`) are drawn at the collapse ductility.
+pub fn figure_of(study: &Study) -> Result<crate::report::chart::Figure, PipelineError> {
+    use crate::report::chart::{Axis, Figure, Panel, Series, Stroke};
+    study.require(StageId::Ida)?;
+    let cfg = study
+        .cfg
+        .ida
+        .as_ref()
+        .ok_or_else(|| IdaStageError::NoSection {
+            config: study.config_path.clone(),
+        })?;
+    let cap = cfg.collapse_ductility;
+    let clip = |v: f64| if v.is_infinite() { cap } else { v };
+    let path = study.path(StageId::Ida.output());
+    let mut panels = Vec::new();
+    for zone in &study.cfg.zones {
+        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+        let x = axes.sa_grid_g.clone();
+        let mut series = Vec::new();
+        for s in 0..axes.systems.len() {
+            for r in 0..z.records.len() {
+                let y: Vec<f64> = (0..x.len())
+                    .map(|j| clip(z.vars.curve[[s, r, 0, j, 0]]))
+                    .collect();
+                series.push(Series::faint(x.clone(), y));
+            }
+        }
+        for (s, name) in axes.systems.iter().enumerate() {
+            let q = |k: usize| -> Vec<f64> {
+                (0..x.len())
+                    .map(|j| clip(z.vars.fractile_curve[[s, 0, k, j, 0]]))
+                    .collect()
+            };
+            series.push(Series::band(
+                format!("{name}: 16–84 %"),
+                x.clone(),
+                q(0),
+                q(2),
+            ));
+            let line = Series::line(format!("{name}: median"), x.clone(), q(1));
+            series.push(if s == 0 {
+                line
+            } else {
+                line.stroke(Stroke::Dashed, 2)
+            });
+        }
+        let a = &axes;
+        panels.push(Panel::xy(
+            format!(
+                "zone {}: T_p = {} s, α = {:?}, μ = {:?}, C_y = {:.3}",
+                zone.name,
+                a.case_period_s[0],
+                a.case_alpha[0],
+                a.case_mu[0],
+                z.vars.c_y[[0]]
+            ),
+            Axis::new("Sa(T_p, 5 %), g"),
+            Axis::new("ductility u_m/u_y").range(0.0, cap),
+            series,
+        ));
+    }
+    Ok(Figure::grid(
+        "IDA curves: sliding stack vs rigidly attached load",
+        panels,
+        1,
+    ))
+}

@@ -1,0 +1,468 @@
+//! `ida.h5`, the incremental dynamic analysis stage's file.
+//!
+//! ```text
+//! /                  attrs: contents, slidestack_version, fingerprint, motions_fingerprint,
+//!                           config_sha256, + the writer's settings (tracing, structure, fit)
+//! /zone_<name>/      attrs: target
+//!     system, record, demand, limit_state (strings), case, block, run, Sa (g), fractile
+//!                                                    coordinates (dimension scales)
+//!     case_T_p (s) [case]; case_alpha, case_mu [case, block]; c_y [case]
+//!     limit_state_definition [limit_state]
+//!     record_Sa (g) [record, case]: Sa(T_p, 5 %) of the unscaled motion
+//!     run_Sa (g) [system, record, case, run]; run_demand [system, record, case, run, demand];
+//!     run_collapsed, run_slip_exceeded (CF flags) [system, record, case, run]
+//!     collapse_Sa (g) [system, record, case]: lowest collapsing intensity (NaN: none)
+//!     curve [system, record, case, Sa, demand]
+//!     fractile_curve [system, case, fractile, Sa, demand]
+//!     exceed_fraction, fragility_curve [system, case, limit_state, Sa]
+//!     theta (g), beta, theta_ci_low, theta_ci_high (g), beta_ci_low, beta_ci_high,
+//!     fit_status (CF flags) [system, case, limit_state]
+//! ```
+//! Runs a trace did not make are NaN (255 for the flags). Variables are chunked per system,
+//! deflate+shuffle compressed, Fletcher32-checksummed, written in a fixed order with object
+//! times not tracked, so the same inputs give the same bytes.
+
+use super::h5::{
+    Attr, attach_scale, attr_str, coordinate, group, open, read_flags, read_strings, read_var,
+    set_scale, write_attrs, write_flags, write_stage_file, write_strings, write_var,
+};
+use super::{H5Context, StoreError};
+use ndarray::ArrayD;
+use std::path::Path;
+
+/// The axes every zone shares.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IdaAxes {
+    pub systems: Vec<String>,
+    pub case_period_s: Vec<f64>,
+    /// `[case][block]`.
+    pub case_alpha: Vec<Vec<f64>>,
+    pub case_mu: Vec<Vec<f64>>,
+    pub runs: usize,
+    pub sa_grid_g: Vec<f64>,
+    pub demands: Vec<String>,
+    pub limit_states: Vec<String>,
+    pub limit_state_definitions: Vec<String>,
+    pub fractiles: Vec<f64>,
+}
+
+/// One zone's variables (shapes in the module doc).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IdaVars {
+    pub c_y: ArrayD<f64>,
+    pub record_sa_g: ArrayD<f64>,
+    pub run_sa_g: ArrayD<f64>,
+    pub run_demand: ArrayD<f64>,
+    pub run_collapsed: ArrayD<u8>,
+    pub run_slip_exceeded: ArrayD<u8>,
+    pub collapse_sa_g: ArrayD<f64>,
+    pub curve: ArrayD<f64>,
+    pub fractile_curve: ArrayD<f64>,
+    pub exceed_fraction: ArrayD<f64>,
+    pub fragility_curve: ArrayD<f64>,
+    pub theta_sa_g: ArrayD<f64>,
+    pub beta: ArrayD<f64>,
+    pub theta_ci_low_sa_g: ArrayD<f64>,
+    pub theta_ci_high_sa_g: ArrayD<f64>,
+    pub beta_ci_low: ArrayD<f64>,
+    pub beta_ci_high: ArrayD<f64>,
+    pub fit_status: ArrayD<u8>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct ZoneIda {
+    pub name: String,
+    pub target: String,
+    pub records: Vec<String>,
+    pub vars: IdaVars,
+}
+
+/// Provenance written on `ida.h5`.
+#[derive(Debug, Clone)]
+pub struct IdaMeta<'a> {
+    pub fingerprint: &'a str,
+    pub motions_fingerprint: &'a str,
+    pub config_sha256: &'a str,
+    /// `(code, word)` pairs of `fit_status`.
+    pub fit_flags: &'a [(u8, &'a str)],
+    pub settings: &'a [(&'a str, Attr<'a>)],
+}
+
+const YES_NO: [(u8, &str); 2] = [(0, "no"), (1, "yes")];
+
+/// Writes `ida.h5` (checked and atomic).
+pub fn write_ida(
+    path: &Path,
+    meta: &IdaMeta,
+    axes: &IdaAxes,
+    zones: &[ZoneIda],
+) -> Result<(), StoreError> {
+    write_stage_file(
+        path,
+        "slidestack ida stage: incremental dynamic analysis of a yielding structure with its \
+         stack, IDA curves, fractiles and fragility functions",
+        meta.fingerprint,
+        |f| {
+            attr_str(f, "motions_fingerprint", meta.motions_fingerprint)?;
+            attr_str(f, "config_sha256", meta.config_sha256)?;
+            write_attrs(f, meta.settings)?;
+            for z in zones {
+                write_zone(f, axes, z, meta)?;
+            }
+            Ok(())
+        },
+    )
+}
+
+fn strings_scale(
+    g: &hdf5::Group,
+    name: &str,
+    v: &[String],
+    long: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = write_strings(g, name, v, long)?;
+    set_scale(&ds, name)?;
+    Ok(ds)
+}
+
+fn indices(n: usize) -> Vec<f64> {
+    (0..n).map(|i| i as f64).collect()
+}
+
+/// One chunk per leading index (per system where there is one).
+fn chunk_of(shape: &[usize]) -> Vec<usize> {
+    let mut c = shape.to_vec();
+    if c.len() > 1 {
+        c[0] = 1;
+    }
+    c
+}
+
+fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hdf5::Result<()> {
+    let g = f.create_group(&format!("zone_{}", z.name))?;
+    attr_str(&g, "target", &z.target)?;
+    let system = strings_scale(
+        &g,
+        "system",
+        &axes.systems,
+        "stack: the sliding stack; rigid: the same load rigidly attached",
+    )?;
+    let record = strings_scale(
+        &g,
+        "record",
+        &z.records,
+        "ground motion (matched, see motions.h5)",
+    )?;
+    let case = coordinate(
+        &g,
+        "case",
+        &indices(axes.case_period_s.len()),
+        "1",
+        "case index (ida.cases of the config)",
+    )?;
+    let block = coordinate(
+        &g,
+        "block",
+        &indices(axes.case_alpha.first().map_or(0, Vec::len)),
+        "1",
+        "block (0 = bottom) or interface under it",
+    )?;
+    let run = coordinate(
+        &g,
+        "run",
+        &indices(axes.runs),
+        "1",
+        "run of a trace, in the order made (hunt, bracket, fill)",
+    )?;
+    let sa = coordinate(
+        &g,
+        "Sa",
+        &axes.sa_grid_g,
+        "g",
+        "Sa(T_p, 5 %) of the scaled motion: the common intensity grid",
+    )?;
+    let demand = strings_scale(
+        &g,
+        "demand",
+        &axes.demands,
+        "engineering demand (units in the name; ductility = u_m/u_y)",
+    )?;
+    let limit = strings_scale(
+        &g,
+        "limit_state",
+        &axes.limit_states,
+        "limit state of the fragility fits",
+    )?;
+    let fractile = coordinate(
+        &g,
+        "fractile",
+        &axes.fractiles,
+        "1",
+        "fractile over the records",
+    )?;
+    let ds = write_strings(
+        &g,
+        "limit_state_definition",
+        &axes.limit_state_definitions,
+        "exceeded when (a collapse exceeds every limit state)",
+    )?;
+    attach_scale(&ds, &limit, 0)?;
+    let v = &z.vars;
+    let put = |name: &str,
+               data: &ArrayD<f64>,
+               dims: &[&hdf5::Dataset],
+               units: &str,
+               long: &str|
+     -> hdf5::Result<()> {
+        let ds = write_var(&g, name, data.view(), &chunk_of(data.shape()), units, long)?;
+        for (i, d) in dims.iter().enumerate() {
+            attach_scale(&ds, d, i)?;
+        }
+        Ok(())
+    };
+    let shape = (
+        axes.case_alpha.len(),
+        axes.case_alpha.first().map_or(0, Vec::len),
+    );
+    let alpha = ndarray::Array2::from_shape_fn(shape, |(c, b)| axes.case_alpha[c][b]).into_dyn();
+    let mu = ndarray::Array2::from_shape_fn(shape, |(c, b)| axes.case_mu[c][b]).into_dyn();
+    let periods = ndarray::Array1::from(axes.case_period_s.clone()).into_dyn();
+    put(
+        "case_T_p",
+        &periods,
+        &[&case],
+        "s",
+        "period of the bare structure",
+    )?;
+    put(
+        "case_alpha",
+        &alpha,
+        &[&case, &block],
+        "1",
+        "mass ratio m_i/m_p of each block",
+    )?;
+    put(
+        "case_mu",
+        &mu,
+        &[&case, &block],
+        "1",
+        "kinetic friction coefficient of the interface under each block",
+    )?;
+    put(
+        "c_y",
+        &v.c_y,
+        &[&case],
+        "1",
+        "yield strength ratio F_y/(m_p g) of the structure",
+    )?;
+    put(
+        "record_Sa",
+        &v.record_sa_g,
+        &[&record, &case],
+        "g",
+        "Sa(T_p, 5 %) of the unscaled motion",
+    )?;
+    let sys_run = [&system, &record, &case, &run];
+    put(
+        "run_Sa",
+        &v.run_sa_g,
+        &sys_run,
+        "g",
+        "intensity of each traced run",
+    )?;
+    put(
+        "run_demand",
+        &v.run_demand,
+        &[&system, &record, &case, &run, &demand],
+        "demand",
+        "demands of each traced run (units in the demand names)",
+    )?;
+    for (name, data, long) in [
+        (
+            "run_collapsed",
+            &v.run_collapsed,
+            "the run reached the collapse ductility",
+        ),
+        (
+            "run_slip_exceeded",
+            &v.run_slip_exceeded,
+            "some block's peak slip reached slip_limit_m",
+        ),
+    ] {
+        let ds = write_flags(
+            &g,
+            name,
+            data.view(),
+            &chunk_of(data.shape()),
+            long,
+            &YES_NO,
+        )?;
+        for (i, d) in sys_run.iter().enumerate() {
+            attach_scale(&ds, d, i)?;
+        }
+    }
+    put(
+        "collapse_Sa",
+        &v.collapse_sa_g,
+        &[&system, &record, &case],
+        "g",
+        "lowest collapsing intensity of the trace (NaN: no collapse up to the cap)",
+    )?;
+    put(
+        "curve",
+        &v.curve,
+        &[&system, &record, &case, &sa, &demand],
+        "demand",
+        "IDA curve on the common grid (linear between runs; +inf from the collapse on; NaN above the last run)",
+    )?;
+    put(
+        "fractile_curve",
+        &v.fractile_curve,
+        &[&system, &case, &fractile, &sa, &demand],
+        "demand",
+        "fractiles of the curves over the records (type 7; collapsed records count as +inf)",
+    )?;
+    let fr = [&system, &case, &limit, &sa];
+    put(
+        "exceed_fraction",
+        &v.exceed_fraction,
+        &fr,
+        "1",
+        "fraction of the records whose curve exceeds the limit state (the stripe data of the fit)",
+    )?;
+    put(
+        "fragility_curve",
+        &v.fragility_curve,
+        &fr,
+        "1",
+        "fitted lognormal fragility Phi(ln(Sa/theta)/beta)",
+    )?;
+    let fit = [&system, &case, &limit];
+    for (name, data, units, long) in [
+        (
+            "theta",
+            &v.theta_sa_g,
+            "g",
+            "median capacity theta (maximum likelihood, multiple stripes, Baker 2015)",
+        ),
+        ("beta", &v.beta, "1", "logarithmic standard deviation beta"),
+        (
+            "theta_ci_low",
+            &v.theta_ci_low_sa_g,
+            "g",
+            "95 % Wald interval of theta, observed information, lower end",
+        ),
+        (
+            "theta_ci_high",
+            &v.theta_ci_high_sa_g,
+            "g",
+            "95 % Wald interval of theta, upper end",
+        ),
+        (
+            "beta_ci_low",
+            &v.beta_ci_low,
+            "1",
+            "95 % Wald interval of beta (on ln beta), lower end",
+        ),
+        (
+            "beta_ci_high",
+            &v.beta_ci_high,
+            "1",
+            "95 % Wald interval of beta, upper end",
+        ),
+    ] {
+        put(name, data, &fit, units, long)?;
+    }
+    let ds = write_flags(
+        &g,
+        "fit_status",
+        v.fit_status.view(),
+        &chunk_of(v.fit_status.shape()),
+        "how the fragility fit ended",
+        meta.fit_flags,
+    )?;
+    for (i, d) in fit.iter().enumerate() {
+        attach_scale(&ds, d, i)?;
+    }
+    Ok(())
+}
+
+/// Zone `zone` of `ida.h5` with the axes stored with it.
+pub fn read_zone_ida(path: &Path, zone: &str) -> Result<(IdaAxes, ZoneIda), StoreError> {
+    let f = open(path)?;
+    let g = group(&f, path, &format!("zone_{zone}"))?;
+    let read = || -> hdf5::Result<(IdaAxes, ZoneIda)> {
+        let rows = |name: &str| -> hdf5::Result<Vec<Vec<f64>>> {
+            let a = read_var(&g, name)?;
+            Ok(a.outer_iter()
+                .map(|r| r.iter().copied().collect())
+                .collect())
+        };
+        let axes = IdaAxes {
+            systems: read_strings(&g, "system")?,
+            case_period_s: g.dataset("case_T_p")?.read_raw()?,
+            case_alpha: rows("case_alpha")?,
+            case_mu: rows("case_mu")?,
+            runs: g.dataset("run")?.size(),
+            sa_grid_g: g.dataset("Sa")?.read_raw()?,
+            demands: read_strings(&g, "demand")?,
+            limit_states: read_strings(&g, "limit_state")?,
+            limit_state_definitions: read_strings(&g, "limit_state_definition")?,
+            fractiles: g.dataset("fractile")?.read_raw()?,
+        };
+        let vars = IdaVars {
+            c_y: read_var(&g, "c_y")?,
+            record_sa_g: read_var(&g, "record_Sa")?,
+            run_sa_g: read_var(&g, "run_Sa")?,
+            run_demand: read_var(&g, "run_demand")?,
+            run_collapsed: read_flags(&g, "run_collapsed")?,
+            run_slip_exceeded: read_flags(&g, "run_slip_exceeded")?,
+            collapse_sa_g: read_var(&g, "collapse_Sa")?,
+            curve: read_var(&g, "curve")?,
+            fractile_curve: read_var(&g, "fractile_curve")?,
+            exceed_fraction: read_var(&g, "exceed_fraction")?,
+            fragility_curve: read_var(&g, "fragility_curve")?,
+            theta_sa_g: read_var(&g, "theta")?,
+            beta: read_var(&g, "beta")?,
+            theta_ci_low_sa_g: read_var(&g, "theta_ci_low")?,
+            theta_ci_high_sa_g: read_var(&g, "theta_ci_high")?,
+            beta_ci_low: read_var(&g, "beta_ci_low")?,
+            beta_ci_high: read_var(&g, "beta_ci_high")?,
+            fit_status: read_flags(&g, "fit_status")?,
+        };
+        let z = ZoneIda {
+            name: zone.to_string(),
+            target: super::h5::read_attr_str(&g, "target").unwrap_or_default(),
+            records: read_strings(&g, "record")?,
+            vars,
+        };
+        Ok((axes, z))
+    };
+    let (axes, z) = read().at(path)?;
+    let want = [
+        axes.systems.len(),
+        z.records.len(),
+        axes.case_period_s.len(),
+        axes.runs,
+    ];
+    if z.vars.run_sa_g.shape() != want {
+        return Err(StoreError::corrupt(
+            path,
+            format!(
+                "zone_{zone}: run_Sa has shape {:?} where its coordinates give {want:?}",
+                z.vars.run_sa_g.shape()
+            ),
+        ));
+    }
+    Ok((axes, z))
+}
+
+/// The zone names of `ida.h5`, in file order.
+pub fn zones(path: &Path) -> Result<Vec<String>, StoreError> {
+    let f = open(path)?;
+    Ok(f.member_names()
+        .at(path)?
+        .into_iter()
+        .filter_map(|n| n.strip_prefix("zone_").map(str::to_string))
+        .collect())
+}

@@ -1,0 +1,447 @@
+//! The IDA stage's numerics (docs/model.md, "Incremental dynamic analysis"): the `ida:` section
+//! of a study, the two systems of a case on a yielding structure, and one work unit (one motion,
+//! one case) traced by hunt & fill ([`crate::ida::trace`]).
+//!
+//! Per case two systems share the structure (its `k`, `c` and yield force `F_y`): the sliding
+//! stack, and the same load rigidly attached (a bilinear SDOF of mass `m_p(1+α)`, so its
+//! strength ratio on the total mass is `C_y/(1+α)`, docs/model.md "Yielding structure"). Both
+//! are traced in `Sa(T_p, 5 %)` of the record, `T_p` the bare structure's period, so their
+//! curves share one intensity axis. No skip rule is used: a stack that never slides is the
+//! rigid system only while the structure stays elastic.
+
+use super::sweep::Physics;
+use crate::dynamics::{ExactOptions, G, Ground, SimError, System, Yielding, simulate_exact};
+use crate::ida::trace::{HuntFill, Trace, hunt_fill};
+use crate::limits::{
+    MAX_ALPHA, MAX_BLOCKS, MAX_IDA_CASES, MAX_IDA_GRID_POINTS, MAX_IDA_PAD_S, MAX_IDA_TRACE_RUNS,
+    MAX_MU, MAX_TARGET_DUCTILITY, PERIOD_RANGE_S, STRENGTH_RATIO_RANGE,
+};
+use crate::spectrum::TargetSpectrum;
+use crate::spectrum::target::ZoneScaling;
+use serde::{Deserialize, Serialize};
+
+/// The `ida:` section of a study file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IdaConfig {
+    pub structure: StructureConfig,
+    /// The cases traced, each under every motion of every zone.
+    pub cases: Vec<CaseConfig>,
+    /// Hunt & fill (Vamvatsikos & Cornell 2002), intensities `Sa(T_p, 5 %)` in g.
+    pub tracing: HuntFill,
+    /// The common intensity grid: `grid_points` equal steps from 0 to `tracing.cap_sa_g`
+    /// (zero excluded).
+    pub grid_points: usize,
+    /// A run with a ductility at or above this counts as collapse (the model has no negative
+    /// stiffness, so no dynamic instability ends a curve by itself).
+    pub collapse_ductility: f64,
+    /// A block "falls off" when its peak slip relative to what it sits on reaches this, m.
+    pub slip_limit_m: f64,
+    pub limit_states: Vec<LimitState>,
+    /// Zeros appended to every record so the residual drift is read near rest, s.
+    #[serde(default)]
+    pub pad_s: f64,
+}
+
+/// The yielding structure: a strength stated directly or from the IS 1893 design force.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StructureConfig {
+    /// Yield strength ratio `C_y = F_y/(m_p·g)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub c_y: Option<f64>,
+    /// `C_y = (Z/2)·(I/R)·(Sa/g)(T_p)` of the zone's IS 1893 target (Clause 6.4.2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub design: Option<DesignStrength>,
+    /// Post-yield stiffness ratio `r`.
+    pub post_yield_ratio: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DesignStrength {
+    /// Importance factor `I` (IS 1893 Table 8).
+    pub importance: f64,
+    /// Response reduction factor `R` (IS 1893 Table 9).
+    pub response_reduction: f64,
+}
+
+/// One case: the bare structure's period and the stack (bottom first).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseConfig {
+    pub period_s: f64,
+    pub alpha: Vec<f64>,
+    /// Kinetic friction per interface (static = `grid.mu_static_ratio` × kinetic).
+    pub mu: Vec<f64>,
+}
+
+/// A limit state for the fragility fits: exactly one of the two thresholds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitState {
+    pub name: String,
+    /// Exceeded when the ductility reaches this (or the run collapses).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ductility: Option<f64>,
+    /// Exceeded when some interface's peak slip reaches this, m (or the run collapses).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slip_m: Option<f64>,
+}
+
+impl LimitState {
+    /// `ductility >= 2` or `slip_m >= 0.3`.
+    pub fn definition(&self) -> String {
+        match (self.ductility, self.slip_m) {
+            (Some(d), _) => format!("ductility >= {d}"),
+            (None, Some(s)) => format!("peak slip >= {s} m"),
+            (None, None) => String::new(),
+        }
+    }
+}
+
+/// The two systems of a case (module doc), in stored order.
+pub const SYSTEMS: [&str; 2] = ["stack", "rigid"];
+
+impl IdaConfig {
+    /// The common intensity grid, g.
+    pub fn grid_sa_g(&self) -> Vec<f64> {
+        let n = self.grid_points;
+        (1..=n)
+            .map(|k| self.tracing.cap_sa_g * k as f64 / n as f64)
+            .collect()
+    }
+
+    /// Blocks per case (validated equal for every case).
+    pub fn blocks(&self) -> usize {
+        self.cases.first().map_or(0, |c| c.alpha.len())
+    }
+
+    /// Names of the demands of every run, in stored order.
+    pub fn demand_names(&self) -> Vec<String> {
+        let n = self.blocks();
+        let mut v = vec!["ductility".to_string(), "residual_drift_m".to_string()];
+        v.extend((1..=n).map(|i| format!("peak_slip_{i}_m")));
+        v.extend((1..=n).map(|i| format!("residual_slip_{i}_m")));
+        v
+    }
+
+    /// `C_y` of `case` in the zone with target `target` (validated: IS 1893 when `design`).
+    pub fn strength_ratio(&self, target: &TargetSpectrum, case: &CaseConfig) -> f64 {
+        match (&self.structure.c_y, &self.structure.design, target) {
+            (Some(c), _, _) => *c,
+            (None, Some(d), TargetSpectrum::Is1893 { zone, soil, .. }) => TargetSpectrum::Is1893 {
+                zone: *zone,
+                soil: *soil,
+                scaling: ZoneScaling::HalfZ,
+                importance: d.importance,
+                response_reduction: d.response_reduction,
+            }
+            .sa_g(case.period_s),
+            _ => f64::NAN,
+        }
+    }
+
+    /// The stack and the rigidly attached load of `case` on the yielding structure, in the order
+    /// of [`SYSTEMS`].
+    pub fn systems(
+        &self,
+        physics: &Physics,
+        case: &CaseConfig,
+        c_y: f64,
+    ) -> Result<[System; 2], crate::dynamics::ModelError> {
+        let r = self.structure.post_yield_ratio;
+        let total: f64 = case.alpha.iter().sum();
+        let stack = physics.stack(case.period_s, &case.alpha, &case.mu);
+        let rigid = physics.rigid(case.period_s, total);
+        Ok([
+            System::new(&stack)?.with_yielding(Yielding::bilinear(c_y, r))?,
+            System::new(&rigid)?.with_yielding(Yielding::bilinear(c_y / (1.0 + total), r))?,
+        ])
+    }
+
+    /// Every check that needs no record; `Err((key, why))` with keys under `ida.`.
+    /// `targets` are the zones' target spectra (the design strength needs IS 1893 ones).
+    pub fn validate(
+        &self,
+        physics: &Physics,
+        targets: &[(String, TargetSpectrum)],
+    ) -> Result<(), (String, String)> {
+        let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
+        let s = &self.structure;
+        match (s.c_y, &s.design) {
+            (Some(_), Some(_)) | (None, None) => {
+                return err("structure", "give exactly one of `c_y` and `design`".into());
+            }
+            (Some(c), None) if !(STRENGTH_RATIO_RANGE.0..=STRENGTH_RATIO_RANGE.1).contains(&c) => {
+                return err(
+                    "structure.c_y",
+                    format!(
+                        "{c} must be in [{:e}, {:e}]",
+                        STRENGTH_RATIO_RANGE.0, STRENGTH_RATIO_RANGE.1
+                    ),
+                );
+            }
+            (None, Some(d)) => {
+                for (k, v) in [
+                    ("importance", d.importance),
+                    ("response_reduction", d.response_reduction),
+                ] {
+                    if !(v.is_finite() && v > 0.0 && v <= 100.0) {
+                        return err(
+                            &format!("structure.design.{k}"),
+                            format!("{v} must be in (0, 100]"),
+                        );
+                    }
+                }
+                if let Some((name, _)) = targets
+                    .iter()
+                    .find(|(_, t)| !matches!(t, TargetSpectrum::Is1893 { .. }))
+                {
+                    return err(
+                        "structure.design",
+                        format!("zone {name}: its target is not an IS 1893 spectrum; give `c_y`"),
+                    );
+                }
+            }
+            _ => {}
+        }
+        let r = s.post_yield_ratio;
+        if !(r.is_finite() && (0.0..1.0).contains(&r)) {
+            return err(
+                "structure.post_yield_ratio",
+                format!("{r} must be in [0, 1)"),
+            );
+        }
+        if self.cases.is_empty() || self.cases.len() > MAX_IDA_CASES {
+            return err(
+                "cases",
+                format!("{} cases; needs 1 to {MAX_IDA_CASES}", self.cases.len()),
+            );
+        }
+        let n = self.blocks();
+        for (i, c) in self.cases.iter().enumerate() {
+            let key = |k: &str| format!("cases[{i}].{k}");
+            if !(c.period_s.is_finite()
+                && c.period_s >= PERIOD_RANGE_S.0
+                && c.period_s <= PERIOD_RANGE_S.1)
+            {
+                return err(
+                    &key("period_s"),
+                    format!(
+                        "{} must be in [{}, {}]",
+                        c.period_s, PERIOD_RANGE_S.0, PERIOD_RANGE_S.1
+                    ),
+                );
+            }
+            if c.alpha.is_empty() || c.alpha.len() > MAX_BLOCKS || c.alpha.len() != n {
+                return err(
+                    &key("alpha"),
+                    format!(
+                        "{} blocks: every case needs the same number, 1 to {MAX_BLOCKS} ({n} in the first)",
+                        c.alpha.len()
+                    ),
+                );
+            }
+            if c.mu.len() != n {
+                return err(&key("mu"), format!("needs one value per interface ({n})"));
+            }
+            let total: f64 = c.alpha.iter().sum();
+            if c.alpha.iter().any(|a| !(a.is_finite() && *a > 0.0)) || total > MAX_ALPHA {
+                return err(
+                    &key("alpha"),
+                    format!("values must be > 0 with a sum ≤ {MAX_ALPHA}"),
+                );
+            }
+            if c.mu
+                .iter()
+                .any(|m| !(m.is_finite() && (0.0..=MAX_MU).contains(m)))
+            {
+                return err(&key("mu"), format!("values must be in [0, {MAX_MU}]"));
+            }
+            physics
+                .check(total)
+                .map_err(|why| (format!("ida.{}", key("alpha")), why))?;
+            for (zone, t) in targets {
+                let c_y = self.strength_ratio(t, c);
+                self.systems(physics, c, c_y).map_err(|e| {
+                    (
+                        "ida.structure".to_string(),
+                        format!("zone {zone}, case {i}: {e}"),
+                    )
+                })?;
+            }
+        }
+        let t = &self.tracing;
+        if !(t.first_sa_g.is_finite() && t.first_sa_g > 0.0) {
+            return err(
+                "tracing.first_sa_g",
+                format!("{} must be > 0", t.first_sa_g),
+            );
+        }
+        if !(t.step_increment_sa_g.is_finite() && t.step_increment_sa_g >= 0.0) {
+            return err(
+                "tracing.step_increment_sa_g",
+                format!("{} must be ≥ 0", t.step_increment_sa_g),
+            );
+        }
+        if !(t.cap_sa_g.is_finite() && t.cap_sa_g >= t.first_sa_g) {
+            return err(
+                "tracing.cap_sa_g",
+                format!("{} must be ≥ first_sa_g", t.cap_sa_g),
+            );
+        }
+        // Bounded before the hunt is counted: its steps are at least `first_sa_g`.
+        let hunt_bound = (t.cap_sa_g / t.first_sa_g).ceil() + 1.0;
+        let extra = t.bracket_runs.saturating_add(t.fill_runs);
+        let runs = if hunt_bound > MAX_IDA_TRACE_RUNS as f64 {
+            usize::MAX
+        } else {
+            t.max_hunt_runs().saturating_add(extra)
+        };
+        if runs > MAX_IDA_TRACE_RUNS {
+            return err(
+                "tracing",
+                format!(
+                    "{} runs per trace (hunt up to cap_sa_g, brackets, fills); at most \
+                     {MAX_IDA_TRACE_RUNS}",
+                    if runs == usize::MAX {
+                        "too many".to_string()
+                    } else {
+                        runs.to_string()
+                    }
+                ),
+            );
+        }
+        if self.grid_points < 2 || self.grid_points > MAX_IDA_GRID_POINTS {
+            return err(
+                "grid_points",
+                format!("{} must be 2 to {MAX_IDA_GRID_POINTS}", self.grid_points),
+            );
+        }
+        let d = self.collapse_ductility;
+        if !(d.is_finite() && d > 1.0 && d <= MAX_TARGET_DUCTILITY) {
+            return err(
+                "collapse_ductility",
+                format!("{d} must be > 1 and ≤ {MAX_TARGET_DUCTILITY}"),
+            );
+        }
+        let sl = self.slip_limit_m;
+        if !(sl.is_finite() && sl > 0.0) {
+            return err("slip_limit_m", format!("{sl} must be > 0"));
+        }
+        if !(self.pad_s.is_finite() && (0.0..=MAX_IDA_PAD_S).contains(&self.pad_s)) {
+            return err(
+                "pad_s",
+                format!("{} must be in [0, {MAX_IDA_PAD_S}]", self.pad_s),
+            );
+        }
+        if self.limit_states.is_empty() {
+            return err("limit_states", "needs at least one limit state".into());
+        }
+        for (i, l) in self.limit_states.iter().enumerate() {
+            let key = format!("limit_states[{i}]");
+            if l.name.is_empty()
+                || !l
+                    .name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+            {
+                return err(
+                    &format!("{key}.name"),
+                    format!("`{}` must be letters, digits, `_` or `-`", l.name),
+                );
+            }
+            if self.limit_states[..i].iter().any(|o| o.name == l.name) {
+                return err(
+                    &format!("{key}.name"),
+                    format!("`{}` appears twice", l.name),
+                );
+            }
+            match (l.ductility, l.slip_m) {
+                (Some(v), None) if v.is_finite() && v > 0.0 => {}
+                (None, Some(v)) if v.is_finite() && v > 0.0 => {}
+                (Some(_), Some(_)) | (None, None) => {
+                    return err(&key, "give exactly one of `ductility` and `slip_m`".into());
+                }
+                _ => return err(&key, "the threshold must be finite and > 0".into()),
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What one run leaves: the demands in the order of [`IdaConfig::demand_names`], and the flags.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunDemand {
+    pub values: Vec<f64>,
+    pub slip_exceeded: bool,
+}
+
+/// `Sa(T_p, 5 %)` of a record, g (exact peak between samples, `spectrum::response`).
+pub fn sa_g(
+    accel_mps2: &[f64],
+    dt_s: f64,
+    period_s: f64,
+) -> Result<f64, crate::spectrum::SpectrumError> {
+    let peak = crate::spectrum::response::peak_response(accel_mps2, dt_s, period_s, 0.05)?;
+    let omega = std::f64::consts::TAU / period_s;
+    Ok(omega * omega * peak.sd_m / G)
+}
+
+/// Traces one system under one record: `padded_mps2` is the record followed by the pad of zeros,
+/// `record_sa_g` the unscaled record's `Sa(T_p, 5 %)`; every run scales the whole record.
+pub fn trace_system(
+    cfg: &IdaConfig,
+    sys: &System,
+    padded_mps2: &[f64],
+    dt_s: f64,
+    record_sa_g: f64,
+) -> Result<Trace<RunDemand>, SimError> {
+    let opts = ExactOptions {
+        energy_balance: false,
+        ..ExactOptions::default()
+    };
+    let n = cfg.blocks();
+    let mut accel = Vec::with_capacity(padded_mps2.len());
+    hunt_fill(&cfg.tracing, |sa| {
+        let lambda = sa / record_sa_g;
+        accel.clear();
+        accel.extend(padded_mps2.iter().map(|a| lambda * a));
+        let r = simulate_exact(
+            sys,
+            &Ground {
+                dt_s,
+                accel_mps2: &accel,
+            },
+            &opts,
+        )?;
+        let ductility = r.ductility.unwrap_or(f64::NAN);
+        let mut values = vec![ductility, r.residual_displacement_m.abs()];
+        let slips = |v: &[f64]| -> Vec<f64> {
+            let mut s: Vec<f64> = v.iter().map(|x| x.abs()).collect();
+            s.resize(n, 0.0);
+            s
+        };
+        let peak = slips(&r.peak_slip_m);
+        let slip_exceeded = peak.iter().any(|&s| s >= cfg.slip_limit_m);
+        values.extend(peak);
+        values.extend(slips(&r.residual_slip_m));
+        Ok((
+            RunDemand {
+                values,
+                slip_exceeded,
+            },
+            ductility >= cfg.collapse_ductility,
+        ))
+    })
+}
+
+/// The record followed by `pad_s` of zeros, m/s².
+pub fn padded(accel_mps2: &[f64], dt_s: f64, pad_s: f64) -> Vec<f64> {
+    let extra = (pad_s / dt_s).ceil() as usize;
+    let mut v = Vec::with_capacity(accel_mps2.len() + extra);
+    v.extend_from_slice(accel_mps2);
+    v.resize(accel_mps2.len() + extra, 0.0);
+    v
+}

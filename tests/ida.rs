@@ -1,0 +1,295 @@
+//! The IDA stage end to end on `configs/ida-quick.yaml`: it runs, a rerun is skipped, a
+//! `kill -9` then a rerun gives the same bytes, so does one thread against two, xarray reads the
+//! labelled dimensions; bad `ida:` keys are refused before any work; the report shows the IDA
+//! and needs `ida.h5`. And hunt & fill on a bare bilinear SDOF, whose response is homogeneous in
+//! the intensity (docs/model.md, "For a study stage").
+
+mod common;
+
+use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, Yielding, simulate_exact};
+use slidestack::ida::trace::{HuntFill, hunt_fill};
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn slidestack(args: &[&str], threads: &str) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .args(args)
+        .env("RAYON_NUM_THREADS", threads)
+        .output()
+        .unwrap()
+}
+
+fn ok(o: Output) -> Output {
+    assert!(
+        o.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn quick() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("configs/ida-quick.yaml")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Copies `motions.h5` and its checksum sidecar.
+fn copy_motions(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for f in ["motions.h5", "motions.h5.sha256"] {
+        std::fs::copy(from.join(f), to.join(f)).unwrap();
+    }
+}
+
+#[test]
+fn the_stage_runs_skips_resumes_after_a_kill_and_ignores_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = quick();
+    let out = dir.path().join("ref");
+    ok(slidestack(&["motions", s(&cfg), "--out", s(&out)], "2"));
+
+    let start = std::time::Instant::now();
+    let o = ok(slidestack(&["ida", s(&cfg), "--out", s(&out)], "2"));
+    let secs = start.elapsed().as_secs_f64();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("ida: wrote"), "{text}");
+    assert!(text.contains("fitted"), "{text}");
+    assert!(out.join("ida.h5.sha256").exists());
+    let want = std::fs::read(out.join("ida.h5")).unwrap();
+    eprintln!("ida on the quick config: {secs:.2} s");
+
+    // Up to date: skipped; `status` says so.
+    let o = ok(slidestack(&["ida", s(&cfg), "--out", s(&out)], "2"));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("is up to date"));
+    let o = ok(slidestack(
+        &["status", s(&cfg), "--out", s(&out), "--format", "env"],
+        "1",
+    ));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("IDA=up_to_date"));
+
+    // SIGKILL once the stage has started computing, then a rerun: the same bytes.
+    let killed = dir.path().join("killed");
+    copy_motions(&out, &killed);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .args(["ida", s(&cfg), "--out", s(&killed)])
+        .env("RAYON_NUM_THREADS", "1")
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    assert!(line.contains("traces"), "{line}");
+    std::thread::sleep(std::time::Duration::from_millis(10));
+    assert!(child.try_wait().unwrap().is_none(), "ended before the kill");
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!killed.join("ida.h5").exists());
+    ok(slidestack(&["ida", s(&cfg), "--out", s(&killed)], "2"));
+    assert_eq!(std::fs::read(killed.join("ida.h5")).unwrap(), want);
+    let leftovers: Vec<_> = std::fs::read_dir(&killed)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+
+    // One thread: the same bytes.
+    let one = dir.path().join("one");
+    copy_motions(&out, &one);
+    ok(slidestack(&["ida", s(&cfg), "--out", s(&one)], "1"));
+    assert_eq!(std::fs::read(one.join("ida.h5")).unwrap(), want);
+
+    // xarray opens a zone with its named dimensions (scripts/install-deps.sh --test).
+    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".venv-test/bin/python");
+    assert!(
+        python.exists(),
+        "{} is missing: run scripts/install-deps.sh --test",
+        python.display()
+    );
+    let script = "import sys, xarray as xr\n\
+        ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_III')\n\
+        print(list(ds['fractile_curve'].dims), list(ds['theta'].dims), list(ds['run_demand'].dims))\n\
+        print(ds['Sa'].attrs['units'], [str(v) for v in ds['demand'].values[:2]], [str(v) for v in ds['system'].values])\n";
+    let o = ok(Command::new(python)
+        .args(["-c", script, s(&out.join("ida.h5"))])
+        .output()
+        .unwrap());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        text.lines().collect::<Vec<_>>(),
+        [
+            "['system', 'case', 'fractile', 'Sa', 'demand'] ['system', 'case', 'limit_state'] \
+             ['system', 'record', 'case', 'run', 'demand']",
+            "g ['ductility', 'residual_drift_m'] ['stack', 'rigid']",
+        ],
+        "{text}"
+    );
+}
+
+#[test]
+fn bad_ida_keys_are_refused_naming_the_file_and_key_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(quick()).unwrap();
+    let cases = [
+        (
+            "period_s: 1.0, alpha",
+            "period_s: -1.0, alpha",
+            "ida.cases[0].period_s",
+        ),
+        (
+            "c_y: 0.3 ",
+            "c_y: 0.3\n    design: { importance: 1, response_reduction: 3 }\n    # ",
+            "ida.structure",
+        ),
+        (
+            "post_yield_ratio: 0.05",
+            "post_yield_ratio: 1.5",
+            "ida.structure.post_yield_ratio",
+        ),
+        ("first_sa_g: 0.1", "first_sa_g: 1e-9", "ida.tracing"),
+        ("grid_points: 40", "grid_points: 1", "ida.grid_points"),
+        (
+            "collapse_ductility: 10",
+            "collapse_ductility: 1e9",
+            "ida.collapse_ductility",
+        ),
+        (
+            "{ name: LS, ductility: 4 }",
+            "{ name: DL, ductility: 4 }",
+            "ida.limit_states[1].name",
+        ),
+        (
+            "{ name: fall, slip_m: 0.3 }",
+            "{ name: fall, slip_m: 0.3, ductility: 2 }",
+            "ida.limit_states[2]",
+        ),
+        ("pad_s: 2", "pad_s: 1e6", "ida.pad_s"),
+        (
+            "cap_sa_g: 2.0",
+            "cap_sa_g: 2.0\n    hunt_more: 1",
+            "hunt_more",
+        ),
+        // r = 0.001 makes the post-yield branch overdamped.
+        (
+            "post_yield_ratio: 0.05",
+            "post_yield_ratio: 0.001",
+            "ida.structure",
+        ),
+    ];
+    for (i, (from, to, key)) in cases.iter().enumerate() {
+        assert!(text.contains(from), "{from}");
+        let cfg = dir.path().join(format!("bad{i}.yaml"));
+        let out = dir.path().join(format!("out{i}"));
+        std::fs::write(&cfg, text.replacen(from, to, 1)).unwrap();
+        let o = slidestack(&["ida", s(&cfg), "--out", s(&out)], "1");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{to}: {err}");
+        assert!(err.contains(s(&cfg)) && err.contains(key), "{to}: {err}");
+        assert!(!out.exists(), "{to}: work started");
+    }
+    // Without an `ida` section: refused, naming the file.
+    let cfg = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
+    let out = dir.path().join("none");
+    let o = slidestack(&["ida", s(&cfg), "--out", s(&out)], "1");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs an `ida` section"));
+}
+
+/// Hunt & fill on a bare bilinear SDOF: `λ·a_g` on `F_y` gives `λ` times the displacements of
+/// `a_g` on `F_y/λ` and the same ductility (the response is homogeneous), so every traced run
+/// has an independent twin; the collapse bracket holds the cap.
+#[test]
+fn hunt_and_fill_on_a_bare_bilinear_sdof_matches_its_homogeneous_twin() {
+    let rec = &common::real_records()[0];
+    let accel = rec.accel_mps2(1.0);
+    let (c_y, r, cap) = (0.05, 0.05, 6.0);
+    let spec = SystemSpec::new(0.8, &[], &[]);
+    let opts = ExactOptions {
+        energy_balance: false,
+        ..ExactOptions::default()
+    };
+    let run = |c_y: f64, scale: f64| {
+        let sys = System::new(&spec)
+            .unwrap()
+            .with_yielding(Yielding::bilinear(c_y, r))
+            .unwrap();
+        let a: Vec<f64> = accel.iter().map(|x| scale * x).collect();
+        simulate_exact(
+            &sys,
+            &Ground {
+                dt_s: rec.dt_s,
+                accel_mps2: &a,
+            },
+            &opts,
+        )
+        .unwrap()
+    };
+    let p = HuntFill {
+        first_sa_g: 0.2,
+        step_increment_sa_g: 0.1,
+        bracket_runs: 4,
+        fill_runs: 3,
+        cap_sa_g: 5.0,
+    };
+    // The intensity is the scale factor itself here: the twin identity does not depend on it.
+    let trace = hunt_fill(&p, |lambda| {
+        let resp = run(c_y, lambda);
+        let mu = resp.ductility.unwrap();
+        Ok::<_, ()>(((mu, resp.peak_displacement_m), mu >= cap))
+    })
+    .unwrap();
+    assert!(trace.runs.len() > 6);
+    for t in &trace.runs {
+        let twin = run(c_y / t.sa_g, 1.0);
+        let (mu, u) = t.demand;
+        let mu_twin = twin.ductility.unwrap();
+        assert!(
+            (mu - mu_twin).abs() <= 1e-9 * mu,
+            "λ = {}: {mu} vs {mu_twin}",
+            t.sa_g
+        );
+        assert!((u - t.sa_g * twin.peak_displacement_m).abs() <= 1e-9 * u);
+    }
+    let (lo, hi) = trace
+        .capacity_sa_g()
+        .expect("the cap is reached below λ = 5");
+    let at = |l: f64| run(c_y, l).ductility.unwrap();
+    assert!(at(lo) < cap && at(hi) >= cap, "{lo} {hi}");
+}
+
+/// With an `ida:` section beside a grid, `run` builds `ida.h5` before the report, and the report
+/// shows the curves and the fits; without an up-to-date `ida.h5` the report is refused.
+#[test]
+fn the_report_shows_the_ida_section_and_needs_ida_h5() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let grid = std::fs::read_to_string(root.join("configs/quick.yaml")).unwrap();
+    let ida = std::fs::read_to_string(quick()).unwrap();
+    let cfg = dir.path().join("both.yaml");
+    std::fs::write(&cfg, grid + &ida[ida.find("\nida:").unwrap()..]).unwrap();
+    let out = dir.path().join("out");
+    let o = ok(slidestack(&["run", s(&cfg), "--out", s(&out)], "2"));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("ida 0.") || text.contains("ida 1."), "{text}");
+    let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    for needle in ["ida-fragility", "ida-median", "ida.svg", "fitted"] {
+        assert!(html.contains(needle), "{needle}");
+    }
+    let svg = std::fs::read_to_string(out.join("report/ida.svg")).unwrap();
+    roxmltree::Document::parse(&svg).unwrap();
+    std::fs::remove_file(out.join("ida.h5")).unwrap();
+    let o = slidestack(&["report", s(&cfg), "--out", s(&out), "--force"], "1");
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("ida.h5 is missing") && err.contains("slidestack ida"),
+        "{err}"
+    );
+}
