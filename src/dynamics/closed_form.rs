@@ -8,7 +8,7 @@
 //! (the Nigam–Jennings solution of a linear SDOF under linearly varying load). [`Wave`] is that
 //! form; [`Basis`] caches `e^{−aτ}`, `cos ωτ`, `sin ωτ` at one `τ` so many waves share them.
 
-use crate::numeric::{Cx, phi1};
+use crate::numeric::{Cx, GAUSS8, phi1};
 
 /// Decay rate `a = ζ_e·ω_n` (1/s) and damped circular frequency `ω = ω_n·sqrt(1−ζ_e²)` (rad/s).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -317,19 +317,6 @@ fn phi_small(k: u32, x: f64) -> f64 {
     }
     sum
 }
-
-/// Nodes and weights of 8-point Gauss–Legendre quadrature on `[0, 1]` (the roots of `P₈` by
-/// Newton's method at 50 digits, rounded).
-const GAUSS8: [(f64, f64); 8] = [
-    (0.019855071751231884, 0.05061426814518813),
-    (0.10166676129318664, 0.11119051722668724),
-    (0.2372337950418355, 0.15685332293894363),
-    (0.4082826787521751, 0.181341891689181),
-    (0.591717321247825, 0.181341891689181),
-    (0.7627662049581645, 0.15685332293894363),
-    (0.8983332387068134, 0.11119051722668724),
-    (0.9801449282487681, 0.05061426814518813),
-];
 
 /// The end state and integrals of a piece of `ü + a·u̇ = p₀ + p₁τ` (a structure without
 /// stiffness, `r = 0`) from `(u₀, v₀)` over `[0, h]`.
