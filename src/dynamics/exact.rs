@@ -41,13 +41,14 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::closed_form::{
-    Basis, DecayPiece, Osc, PieceIntegrals, Wave, decay_piece, hermite_range,
-    integral_of_square_decay, integral_of_square_with,
+    Basis, Osc, PieceIntegrals, Wave, hermite_range, integral_of_square_decay,
+    integral_of_square_with,
 };
 use super::contact::{Contact, ContactSelector};
 use super::model::System;
 use super::response::{Energy, History, Response};
 use super::{Ground, SimError};
+use crate::sdof::{self, Piece, decay_piece};
 
 /// Relative tolerance on the static friction limit before a stuck interface breaks away.
 pub const BREAK_TOLERANCE: f64 = 1e-10;
@@ -106,7 +107,18 @@ struct Cluster0 {
     basis_dt: Basis,
     /// The energy integrals over a whole sample interval.
     integrals_dt: PieceIntegrals,
+    /// Whether `ω_n·dt < SDOF_FORM_OMEGA_STEP`: the state and integrals of a piece then come
+    /// from [`sdof::piece`] ([`Exact::stable_piece`]).
+    sdof_form: bool,
 }
+
+/// Below this `ω_n·dt` the particular-plus-homogeneous wave of the structure cluster loses more
+/// than `1/(ω_n·dt)² ≈ 4e4` ulps of the state to cancellation per piece (its terms grow like
+/// `p₀/ω²` and `ȧ_g/ω³`), so the piece's end state and energy integrals come from the
+/// φ-function form ([`sdof::piece`]). Above it the wave is kept: it is cheaper, as accurate, and
+/// the study's grid (`ω_n·dt ≥ 0.009`) runs bit for bit as before (`docs/model.md`,
+/// "Long periods").
+const SDOF_FORM_OMEGA_STEP: f64 = 5e-3;
 
 impl Cluster0 {
     /// The cluster of mass `mass` (kg) on a spring of stiffness `stiffness` (N/m, `≥ 0`) and
@@ -133,6 +145,7 @@ impl Cluster0 {
             natural: osc.natural(),
             basis_dt,
             integrals_dt: PieceIntegrals::new(osc, &basis_dt),
+            sdof_form: omega2 > 0.0 && omega2.sqrt() * dt < SDOF_FORM_OMEGA_STEP,
         }
     }
 }
@@ -761,23 +774,38 @@ impl<'s, const Y: bool> Exact<'s, Y> {
         -(f_top0 + self.spring.line().1) / cl.mass - ga
     }
 
-    /// The structure cluster's piece ending at `b` in the cancellation-free form of
-    /// [`decay_piece`], when the branch has no stiffness (`r = 0`) and `a·h ≤ 1` (beyond, the
-    /// wave's terms of order `p₀/a²` no longer exceed its values); `None` otherwise.
-    fn stable_decay_piece(&self, ga: f64, slope: f64, b: &Basis) -> Option<DecayPiece> {
-        if !Y {
-            return None;
-        }
+    /// The structure cluster's piece ending at `b` in a cancellation-free φ-function form, or
+    /// `None` where its wave is accurate: on a branch without stiffness (`r = 0`) with `a·h ≤ 1`,
+    /// [`decay_piece`] (beyond, the wave's terms of order `p₀/a²` no longer exceed its values);
+    /// at long periods (`ω_n·dt` below `SDOF_FORM_OMEGA_STEP`), [`sdof::piece`].
+    fn stable_piece(&self, ga: f64, slope: f64, b: &Basis) -> Option<Piece> {
         let cl = self.cl();
-        if cl.omega2 != 0.0 || cl.osc.decay * b.tau > 1.0 {
-            return None;
-        }
         let e0 = self.top[0];
         let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
+        let state = (self.x[0], self.v[0]);
+        if cl.sdof_form {
+            let p0 = if Y {
+                self.plastic_load(cl, f_top0, ga)
+            } else {
+                -f_top0 / cl.mass - ga
+            };
+            let omega_n = cl.omega2.sqrt();
+            return Some(sdof::piece(
+                omega_n,
+                cl.osc.decay / omega_n,
+                (p0, -slope),
+                state,
+                b.tau,
+                self.opts.energy_balance,
+            ));
+        }
+        if !Y || cl.omega2 != 0.0 || cl.osc.decay * b.tau > 1.0 {
+            return None;
+        }
         Some(decay_piece(
             cl.osc.decay,
             (self.plastic_load(cl, f_top0, ga), -slope),
-            (self.x[0], self.v[0]),
+            state,
             b.tau,
             self.opts.energy_balance,
         ))
@@ -954,9 +982,9 @@ impl<'s, const Y: bool> Exact<'s, Y> {
         let end = b.tau;
         // Energy: input −Σ M_c∫a_g·v_c, damping ∫c·u̇².
         let nc = self.cluster_of[self.n] + 1;
-        // A plastic piece without stiffness: the structure cluster's state and integrals from
-        // the cancellation-free form (always `None` for the linear structure).
-        let stable = self.stable_decay_piece(ga, slope, b);
+        // A plastic piece without stiffness, or a long period: the structure cluster's state and
+        // integrals from a cancellation-free form.
+        let stable = self.stable_piece(ga, slope, b);
         if self.opts.energy_balance {
             let cl = *self.cl();
             let pi = if *b == cl.basis_dt {

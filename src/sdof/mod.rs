@@ -137,6 +137,66 @@ pub fn piece(
     }
 }
 
+/// `φ_k(x) = Σ_{m≥0} x^m/(m+k)!` for `−1 ≤ x ≤ 0`: alternating terms that fall at least
+/// tenfold per two terms, so the sum keeps every digit.
+fn phi_small(k: u32, x: f64) -> f64 {
+    let mut term = 1.0 / (1..=k).fold(1.0, |f, j| f * f64::from(j));
+    let mut sum = term;
+    for m in 1..40 {
+        term *= x / f64::from(m + k);
+        let next = sum + term;
+        if next == sum {
+            break;
+        }
+        sum = next;
+    }
+    sum
+}
+
+/// The end state and integrals ([`Piece`]) of a piece of `ü + a·u̇ = p₀ + p₁τ` (a structure
+/// without stiffness, a yielding structure's branch with `r = 0`) from `(u₀, v₀)` over `[0, h]`,
+/// in φ-function form, for `a·h ≤ 1`: with `φ_k = φ_k(−aτ)`,
+/// `u̇ = v₀φ₀ + p₀τφ₁ + p₁τ²φ₂`, `u = u₀ + v₀τφ₁ + p₀τ²φ₂ + p₁τ³φ₃`,
+/// `∫u = u₀h + v₀h²φ₂ + p₀h³φ₃ + p₁h⁴φ₄` (at `τ = h`), and `∫u̇²` by 8-point Gauss–Legendre
+/// (exact to round-off: the integrand is a quartic plus terms in `e^{−aτ}` with `2a·h ≤ 2`,
+/// whose 16th derivative bounds the error below `1e-18·h·max u̇²`). The same motion as the
+/// structure wave of `r = 0` (`dynamics::exact`), without its terms of order `p₀/a²`
+/// that cancel when `a·h` is small. `square`: whether to compute `∫u̇²` (eight evaluations).
+pub fn decay_piece(
+    decay: f64,
+    (p0, p1): (f64, f64),
+    (u0, v0): (f64, f64),
+    h: f64,
+    square: bool,
+) -> Piece {
+    debug_assert!(decay * h <= 1.0);
+    let vel = |t: f64| {
+        let x = -decay * t;
+        v0 * phi_small(0, x) + t * (p0 * phi_small(1, x) + t * p1 * phi_small(2, x))
+    };
+    let x = -decay * h;
+    let (f1, f2, f3, f4) = (
+        phi_small(1, x),
+        phi_small(2, x),
+        phi_small(3, x),
+        phi_small(4, x),
+    );
+    let int_v2 = if square {
+        h * GAUSS8
+            .iter()
+            .map(|&(node, weight)| weight * vel(node * h).powi(2))
+            .sum::<f64>()
+    } else {
+        f64::NAN
+    };
+    Piece {
+        u: u0 + h * (v0 * f1 + h * (p0 * f2 + h * p1 * f3)),
+        v: vel(h),
+        int_u: h * (u0 + h * (v0 * f2 + h * (p0 * f3 + h * p1 * f4))),
+        int_v2,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
