@@ -28,14 +28,15 @@
 //! chattering. More than `max_switches_per_step` switches within one sample interval stop the run
 //! with [`SimError::Zeno`].
 //!
-//! Known limit: the structure's cluster is written as particular plus homogeneous solution, whose
-//! terms grow like `ȧ_g/ω³` and cancel when `ω·dt` is small. On band-limited records the energy
-//! error grows like `(T_rigid/dt)²` (below `7e-14·(T_rigid/dt)²` over the stress suite's survey,
-//! `docs/stress.md`: ~1e-12 for real records on structures up to a few seconds, 5e-7 for
-//! `T_rigid = 201 s`), and the displacement error like `T_rigid²`. A ground acceleration that
-//! jumps every sample of a very fine record is worse at any period (±0.05 g alternating at
-//! `dt = 0.0005 s`: energy error 1.5e-5 at `T_rigid = 1 s`). A φ-function form of the same
-//! solution would remove the cancellation; not done.
+//! Long periods: the structure's cluster is written as particular plus homogeneous solution,
+//! whose terms grow like `a_g/ω²` and `ȧ_g/ω³` and cancel when `ω·dt` is small (the energy
+//! error of that form grows like `(T_rigid/dt)²`: 5e-3 at `T_rigid = 201 s`, `dt = 0.0005 s`).
+//! Below `ω_n·dt = SDOF_FORM_OMEGA_STEP` the piece's end state and energy integrals come from the
+//! φ-function step instead ([`sdof::piece`]; `docs/model.md`, "Long periods"), exact to
+//! round-off at any `T_rigid/dt` (2e-13 there). The events and peaks are still searched on the
+//! wave: the peak displacement keeps a relative error of about `2e-14·(T_rigid/s)²` on
+//! stochastic records (`limits::MAX_RIGID_PERIOD_S`), more under a ground acceleration that
+//! jumps every sample (2e-3 at 5025 s, `docs/evidence/long-periods.md`).
 
 // Parallel per-body and per-interface arrays read best with index loops.
 #![allow(clippy::needless_range_loop)]
@@ -84,7 +85,7 @@ pub fn simulate_exact(
     opts: &ExactOptions,
 ) -> Result<Response, SimError> {
     ground.validate()?;
-    super::check_accuracy(sys, ground)?;
+    super::check_accuracy(sys)?;
     let r = if sys.hysteresis().is_some() {
         Exact::<true>::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?
     } else {

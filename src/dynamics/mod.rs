@@ -53,8 +53,8 @@ pub use response::{Energy, History, Response};
 pub use rk4::simulate_rk4;
 
 use crate::limits::{
-    DT_RANGE_S, MAX_RIGID_PERIOD_STEPS, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP,
-    WARN_RIGID_PERIOD_STEPS,
+    DT_RANGE_S, MAX_RIGID_PERIOD_S, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP,
+    WARN_RIGID_PERIOD_S,
 };
 use thiserror::Error;
 
@@ -101,27 +101,17 @@ pub enum SimError {
         needed: usize,
     },
     #[error(
-        "T_rigid = {t_rigid_s} s is {ratio:.3e} record steps (dt = {dt_s} s); the exact integrator \
-         is accurate up to {MAX_RIGID_PERIOD_STEPS:e} steps (its energy error grows like \
-         3e-15·(T_rigid/dt)²): use a shorter period or a coarser record"
+        "T_rigid = {t_rigid_s} s: the exact integrator is accurate up to {MAX_RIGID_PERIOD_S:e} s \
+         (its peak displacement error grows like 2e-14·(T_rigid/s)²): use a shorter period"
     )]
-    BeyondAccuracy {
-        t_rigid_s: f64,
-        dt_s: f64,
-        ratio: f64,
-    },
+    BeyondAccuracy { t_rigid_s: f64 },
     #[error(
-        "the post-yield period T_rigid/√r = {period_s} s (r = {r}) is {ratio:.3e} record steps \
-         (dt = {dt_s} s); the exact integrator is accurate up to {MAX_RIGID_PERIOD_STEPS:e} steps \
-         (its energy error grows like 3e-15·(T/dt)²): use a larger r, r = 0 (elastic–perfectly \
-         plastic, which has no such limit), or a coarser record"
+        "the post-yield period T_rigid/√r = {period_s} s (r = {r}): the exact integrator is \
+         accurate up to {MAX_RIGID_PERIOD_S:e} s (its peak displacement error grows like \
+         2e-14·(T/s)²): use a larger r, or r = 0 (elastic–perfectly plastic, which has no such \
+         limit)"
     )]
-    PostYieldBeyondAccuracy {
-        period_s: f64,
-        r: f64,
-        dt_s: f64,
-        ratio: f64,
-    },
+    PostYieldBeyondAccuracy { period_s: f64, r: f64 },
     #[error("the response is not finite (the integration diverged)")]
     Diverged,
     #[error(transparent)]
@@ -167,30 +157,22 @@ impl Ground<'_> {
     }
 }
 
-/// Refuses a system the exact integrator cannot run accurately on this record (limit in
-/// [`crate::limits::MAX_RIGID_PERIOD_STEPS`]). A yielding structure with `r > 0` has a longer
+/// Refuses a system the exact integrator cannot run accurately (limit in
+/// [`crate::limits::MAX_RIGID_PERIOD_S`]). A yielding structure with `r > 0` has a longer
 /// period on its post-yield branch, `T_rigid/√r`, held to the same limit; with `r = 0` the
-/// plastic branch has its own cancellation-free form (`closed_form::decay_piece`).
-pub fn check_accuracy(sys: &System, ground: &Ground) -> Result<(), SimError> {
+/// plastic branch has its own cancellation-free form (`sdof::decay_piece`).
+pub fn check_accuracy(sys: &System) -> Result<(), SimError> {
     let t_rigid_s = sys.period_rigid_s();
-    let ratio = t_rigid_s / ground.dt_s;
-    if ratio > MAX_RIGID_PERIOD_STEPS {
-        return Err(SimError::BeyondAccuracy {
-            t_rigid_s,
-            dt_s: ground.dt_s,
-            ratio,
-        });
+    if t_rigid_s > MAX_RIGID_PERIOD_S {
+        return Err(SimError::BeyondAccuracy { t_rigid_s });
     }
-    if let Some(period_s) = post_yield_period_s(sys) {
-        let ratio = period_s / ground.dt_s;
-        if ratio > MAX_RIGID_PERIOD_STEPS {
-            return Err(SimError::PostYieldBeyondAccuracy {
-                period_s,
-                r: sys.hysteresis().map_or(0.0, |h| h.post_yield_ratio),
-                dt_s: ground.dt_s,
-                ratio,
-            });
-        }
+    if let Some(period_s) = post_yield_period_s(sys)
+        && period_s > MAX_RIGID_PERIOD_S
+    {
+        return Err(SimError::PostYieldBeyondAccuracy {
+            period_s,
+            r: sys.hysteresis().map_or(0.0, |h| h.post_yield_ratio),
+        });
     }
     Ok(())
 }
@@ -206,24 +188,22 @@ fn post_yield_period_s(sys: &System) -> Option<f64> {
 pub fn accuracy_warnings(sys: &System, ground: &Ground) -> Vec<String> {
     let t_rigid_s = sys.period_rigid_s();
     let mut out = Vec::new();
-    let ratio = t_rigid_s / ground.dt_s;
-    if ratio > WARN_RIGID_PERIOD_STEPS {
+    let peak_error = |t: f64| 2e-14 * t * t;
+    if t_rigid_s > WARN_RIGID_PERIOD_S {
         out.push(format!(
-            "T_rigid = {t_rigid_s} s is {ratio:.2e} record steps: the exact integrator's energy \
-             error may reach {:.0e} of the input (it grows like 3e-15·(T_rigid/dt)²)",
-            3e-15 * ratio * ratio
+            "T_rigid = {t_rigid_s} s: the exact integrator's peak displacement may be off by \
+             {:.0e} of itself (the error grows like 2e-14·(T_rigid/s)²)",
+            peak_error(t_rigid_s)
         ));
     }
-    if let Some(period_s) = post_yield_period_s(sys) {
-        let ratio = period_s / ground.dt_s;
-        if ratio > WARN_RIGID_PERIOD_STEPS {
-            out.push(format!(
-                "the post-yield period T_rigid/√r = {period_s} s is {ratio:.2e} record steps: the \
-                 exact integrator's energy error may reach {:.0e} of the input (it grows like \
-                 3e-15·(T/dt)²)",
-                3e-15 * ratio * ratio
-            ));
-        }
+    if let Some(period_s) = post_yield_period_s(sys)
+        && period_s > WARN_RIGID_PERIOD_S
+    {
+        out.push(format!(
+            "the post-yield period T_rigid/√r = {period_s} s: the exact integrator's peak \
+             displacement may be off by {:.0e} of itself (the error grows like 2e-14·(T/s)²)",
+            peak_error(period_s)
+        ));
     }
     let duration = ground.duration_s();
     if t_rigid_s > 10.0 * duration {

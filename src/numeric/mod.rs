@@ -38,9 +38,9 @@ impl Cx {
     }
 }
 
-/// Taylor series `Σ_{k≥0} x^k/(k+j)!` of `φ_j`, used where the closed forms cancel (`|x| < 1`),
+/// Taylor series `Σ_{k≥0} x^k/(k+j)!` of `φ_j`, used where the closed forms cancel (`|x| < 2`),
 /// summed until a term no longer changes the sum (at most 30 terms).
-fn phi_series(x: Cx, j: u32) -> Cx {
+pub(crate) fn phi_series(x: Cx, j: u32) -> Cx {
     let first = (1..=j).fold(1.0, |f, k| f * k as f64);
     let mut term = Cx(1.0 / first, 0.0);
     let mut sum = term;

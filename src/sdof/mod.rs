@@ -12,7 +12,7 @@
 //! near 0 (`numeric::phi1`), so no coefficient cancels when `ω·h` is small, where the textbook
 //! formulas subtract terms of order `1/(ωh)²`.
 
-use crate::numeric::{Cx, GAUSS8, phi1, phi2, phi3};
+use crate::numeric::{Cx, GAUSS8, phi_series, phi1, phi2, phi3};
 
 /// `(α, β)` with `f(Mh) = αI + β·Mh`, from `f(z)` at the eigenvalue `z` of `Mh` in the upper half
 /// plane; at `z = 0` (`ω·h = 0`, `Mh` nilpotent) from `f(0)` and `f'(0)`.
@@ -137,20 +137,10 @@ pub fn piece(
     }
 }
 
-/// `φ_k(x) = Σ_{m≥0} x^m/(m+k)!` for `−1 ≤ x ≤ 0`: alternating terms that fall at least
-/// tenfold per two terms, so the sum keeps every digit.
+/// `φ_k(x)` for real `−1 ≤ x ≤ 0` by its series (alternating terms that fall at least tenfold per
+/// two, so the sum keeps every digit).
 fn phi_small(k: u32, x: f64) -> f64 {
-    let mut term = 1.0 / (1..=k).fold(1.0, |f, j| f * f64::from(j));
-    let mut sum = term;
-    for m in 1..40 {
-        term *= x / f64::from(m + k);
-        let next = sum + term;
-        if next == sum {
-            break;
-        }
-        sum = next;
-    }
-    sum
+    phi_series(Cx(x, 0.0), k).0
 }
 
 /// The end state and integrals ([`Piece`]) of a piece of `ü + a·u̇ = p₀ + p₁τ` (a structure
