@@ -86,13 +86,24 @@ pub fn simulate_exact(
 ) -> Result<Response, SimError> {
     ground.validate()?;
     super::check_accuracy(sys)?;
-    let r = if sys.hysteresis().is_some() {
-        Exact::<true>::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?
-    } else {
-        Exact::<false>::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?
+    let (dt, accel) = (ground.dt_s, ground.accel_mps2);
+    let r = match (sys.hysteresis().is_some(), long_periods(sys, dt)) {
+        (true, true) => Exact::<true, true>::new(sys, dt, *opts).run(accel)?,
+        (true, false) => Exact::<true, false>::new(sys, dt, *opts).run(accel)?,
+        (false, true) => Exact::<false, true>::new(sys, dt, *opts).run(accel)?,
+        (false, false) => Exact::<false, false>::new(sys, dt, *opts).run(accel)?,
     };
     r.check_finite()?;
     Ok(r)
+}
+
+/// Whether some structure cluster of `sys` takes [`sdof::piece`] at `dt`: the slowest are those
+/// of the whole stack, on the elastic and on the post-yield branch (`ω_n·dt` falls with `ω_n`).
+/// As a constant of [`Exact`] it leaves every other run's code as it was.
+fn long_periods(sys: &System, dt: f64) -> bool {
+    let mass: f64 = sys.masses().iter().sum();
+    let slowest = |k: f64| Cluster0::new(mass, k, sys.damping(), dt).sdof_form;
+    slowest(sys.stiffness()) || (sys.hysteresis().is_some() && slowest(Spring::new(sys).k_post))
 }
 
 /// Coefficients of the structure's cluster when its top body is `e0`. With a post-yield
@@ -358,8 +369,8 @@ struct Event {
 }
 
 /// The integrator; `Y` is whether the structure yields (its spring and plastic clusters are read
-/// only then).
-struct Exact<'s, const Y: bool> {
+/// only then), `L` whether some cluster takes [`sdof::piece`] ([`long_periods`]).
+struct Exact<'s, const Y: bool, const L: bool> {
     sys: &'s System,
     dt: f64,
     opts: ExactOptions,
@@ -399,7 +410,7 @@ struct Exact<'s, const Y: bool> {
     energy: Energy,
 }
 
-impl<'s, const Y: bool> Exact<'s, Y> {
+impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
     fn new(sys: &'s System, dt: f64, opts: ExactOptions) -> Self {
         let n = sys.blocks();
         let m = sys.masses();
@@ -781,35 +792,47 @@ impl<'s, const Y: bool> Exact<'s, Y> {
     /// at long periods (`ω_n·dt` below `SDOF_FORM_OMEGA_STEP`), [`sdof::piece`].
     fn stable_piece(&self, ga: f64, slope: f64, b: &Basis) -> Option<Piece> {
         let cl = self.cl();
-        let e0 = self.top[0];
-        let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
-        let state = (self.x[0], self.v[0]);
-        if cl.sdof_form {
-            let p0 = if Y {
-                self.plastic_load(cl, f_top0, ga)
-            } else {
-                -f_top0 / cl.mass - ga
-            };
-            let omega_n = cl.omega2.sqrt();
-            return Some(sdof::piece(
-                omega_n,
-                cl.osc.decay / omega_n,
-                (p0, -slope),
-                state,
-                b.tau,
-                self.opts.energy_balance,
-            ));
+        if L && cl.sdof_form {
+            return Some(self.sdof_piece(cl, ga, slope, b));
         }
         if !Y || cl.omega2 != 0.0 || cl.osc.decay * b.tau > 1.0 {
             return None;
         }
         Some(decay_piece(
             cl.osc.decay,
-            (self.plastic_load(cl, f_top0, ga), -slope),
-            state,
+            (self.plastic_load(cl, self.f_top0(), ga), -slope),
+            (self.x[0], self.v[0]),
             b.tau,
             self.opts.energy_balance,
         ))
+    }
+
+    /// The [`sdof::piece`] branch of [`Exact::stable_piece`], kept out of line: the study's grid
+    /// never takes it.
+    #[cold]
+    #[inline(never)]
+    fn sdof_piece(&self, cl: &Cluster0, ga: f64, slope: f64, b: &Basis) -> Piece {
+        let p0 = if Y {
+            self.plastic_load(cl, self.f_top0(), ga)
+        } else {
+            -self.f_top0() / cl.mass - ga
+        };
+        let omega_n = cl.omega2.sqrt();
+        sdof::piece(
+            omega_n,
+            cl.osc.decay / omega_n,
+            (p0, -slope),
+            (self.x[0], self.v[0]),
+            b.tau,
+            self.opts.energy_balance,
+        )
+    }
+
+    /// The friction force on the structure cluster's top body from the body above, N (0 when the
+    /// whole stack is in the cluster).
+    fn f_top0(&self) -> f64 {
+        let e0 = self.top[0];
+        if e0 < self.n { self.force[e0] } else { 0.0 }
     }
 
     /// A whole sample interval on which, with every interface stuck, nothing can happen: the

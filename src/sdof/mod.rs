@@ -11,6 +11,11 @@
 //! `Mh` is `αI + β·Mh` with `α + β·z = f(z)` at its eigenvalue `z = λh`; `φ_k` by their series
 //! near 0 (`numeric::phi1`), so no coefficient cancels when `ω·h` is small, where the textbook
 //! formulas subtract terms of order `1/(ωh)²`.
+//!
+//! [`Step`] holds the coefficients for one `h` (the spectra and the matcher step many samples
+//! with them); [`piece`] gives the end state and the energy integrals of one piece of any length;
+//! [`decay_piece`] is the same for an SDOF without stiffness (`ü + a·u̇ = p₀ + p₁τ`, the plastic
+//! branch of an elastic–perfectly-plastic structure), whose eigenvalues `0` and `−a` are real.
 
 use crate::numeric::{Cx, GAUSS8, phi_series, phi1, phi2, phi3};
 
