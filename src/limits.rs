@@ -75,17 +75,6 @@ pub const MAX_TARGET_DUCTILITY: f64 = 100.0;
 /// `μ(f̄_y)` narrower than 2 % of `f̄_y` can be missed.
 pub const DUCTILITY_SCAN_STEP: f64 = 0.98;
 
-/// Longest `T_rigid` (and post-yield period `T_rigid/√r`) the exact integrator runs, s. At long
-/// periods the structure cluster's state and energy come from the φ-function step
-/// (`sdof::piece`), exact to round-off at any `T/dt`; its peak displacement is still searched on
-/// the particular-plus-homogeneous wave, whose terms of order `a_g/ω²` leave a relative error
-/// of about `2e-14·(T/s)²` on stochastic records (`docs/evidence/long-periods.md`): `2e-4` here,
-/// the order the old limit on `T_rigid/dt` allowed in the energy (`1e-3`).
-pub const MAX_RIGID_PERIOD_S: f64 = 1e5;
-
-/// Above this period the same peak error exceeds about `1e-6`: a warning, s.
-pub const WARN_RIGID_PERIOD_S: f64 = 7e3;
-
 /// RK4 sub-steps per record interval (the accuracy bench goes to 1000).
 pub const MAX_RK4_SUBSTEPS: usize = 100_000;
 

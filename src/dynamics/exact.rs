@@ -31,12 +31,11 @@
 //! Long periods: the structure's cluster is written as particular plus homogeneous solution,
 //! whose terms grow like `a_g/ω²` and `ȧ_g/ω³` and cancel when `ω·dt` is small (the energy
 //! error of that form grows like `(T_rigid/dt)²`: 5e-3 at `T_rigid = 201 s`, `dt = 0.0005 s`).
-//! Below `ω_n·dt = SDOF_FORM_OMEGA_STEP` the piece's end state and energy integrals come from the
-//! φ-function step instead ([`sdof::piece`]; `docs/model.md`, "Long periods"), exact to
-//! round-off at any `T_rigid/dt` (2e-13 there). The events and peaks are still searched on the
-//! wave: the peak displacement keeps a relative error of about `2e-14·(T_rigid/s)²` on
-//! stochastic records (`limits::MAX_RIGID_PERIOD_S`), more under a ground acceleration that
-//! jumps every sample (2e-3 at 5025 s, `docs/evidence/long-periods.md`).
+//! Below `ω_n·dt = SDOF_FORM_OMEGA_STEP` each piece's end state, energy integrals and peak
+//! displacement come from the φ-function step instead ([`sdof::piece`], [`sdof::Step`];
+//! `docs/model.md`, "Long periods"), exact to round-off at any `T_rigid/dt` (energy 2e-13 there,
+//! peak within 1e-10 of a fine-step reference up to `T_rigid = 1e6 s`); the wave still locates
+//! the events, whose switching functions it keeps to round-off of the accelerations.
 
 // Parallel per-body and per-interface arrays read best with index loops.
 #![allow(clippy::needless_range_loop)]
@@ -85,7 +84,6 @@ pub fn simulate_exact(
     opts: &ExactOptions,
 ) -> Result<Response, SimError> {
     ground.validate()?;
-    super::check_accuracy(sys)?;
     let (dt, accel) = (ground.dt_s, ground.accel_mps2);
     let r = match (sys.hysteresis().is_some(), long_periods(sys, dt)) {
         (true, true) => Exact::<true, true>::new(sys, dt, *opts).run(accel)?,

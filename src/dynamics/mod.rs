@@ -52,10 +52,7 @@ pub use model::{G, Hysteresis, ModelError, System, SystemSpec, Yielding};
 pub use response::{Energy, History, Response};
 pub use rk4::simulate_rk4;
 
-use crate::limits::{
-    DT_RANGE_S, MAX_RIGID_PERIOD_S, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP,
-    WARN_RIGID_PERIOD_S,
-};
+use crate::limits::{DT_RANGE_S, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP};
 use thiserror::Error;
 
 /// A ground acceleration sampled at a constant step, linear between samples.
@@ -100,18 +97,6 @@ pub enum SimError {
         omega_step: f64,
         needed: usize,
     },
-    #[error(
-        "T_rigid = {t_rigid_s} s: the exact integrator is accurate up to {MAX_RIGID_PERIOD_S:e} s \
-         (its peak displacement error grows like 2e-14·(T_rigid/s)²): use a shorter period"
-    )]
-    BeyondAccuracy { t_rigid_s: f64 },
-    #[error(
-        "the post-yield period T_rigid/√r = {period_s} s (r = {r}): the exact integrator is \
-         accurate up to {MAX_RIGID_PERIOD_S:e} s (its peak displacement error grows like \
-         2e-14·(T/s)²): use a larger r, or r = 0 (elastic–perfectly plastic, which has no such \
-         limit)"
-    )]
-    PostYieldBeyondAccuracy { period_s: f64, r: f64 },
     #[error("the response is not finite (the integration diverged)")]
     Diverged,
     #[error(transparent)]
@@ -157,54 +142,11 @@ impl Ground<'_> {
     }
 }
 
-/// Refuses a system the exact integrator cannot run accurately (limit in
-/// [`crate::limits::MAX_RIGID_PERIOD_S`]). A yielding structure with `r > 0` has a longer
-/// period on its post-yield branch, `T_rigid/√r`, held to the same limit; with `r = 0` the
-/// plastic branch has its own cancellation-free form (`sdof::decay_piece`).
-pub fn check_accuracy(sys: &System) -> Result<(), SimError> {
-    let t_rigid_s = sys.period_rigid_s();
-    if t_rigid_s > MAX_RIGID_PERIOD_S {
-        return Err(SimError::BeyondAccuracy { t_rigid_s });
-    }
-    if let Some(period_s) = post_yield_period_s(sys)
-        && period_s > MAX_RIGID_PERIOD_S
-    {
-        return Err(SimError::PostYieldBeyondAccuracy {
-            period_s,
-            r: sys.hysteresis().map_or(0.0, |h| h.post_yield_ratio),
-        });
-    }
-    Ok(())
-}
-
-/// `T_rigid/√r`, s, of a yielding structure with `r > 0`: its longest post-yield period.
-fn post_yield_period_s(sys: &System) -> Option<f64> {
-    let r = sys.hysteresis()?.post_yield_ratio;
-    (r > 0.0).then(|| sys.period_rigid_s() / r.sqrt())
-}
-
 /// What a user should know before trusting a run that is allowed but near the edge of what the
 /// record and the integrator resolve.
 pub fn accuracy_warnings(sys: &System, ground: &Ground) -> Vec<String> {
     let t_rigid_s = sys.period_rigid_s();
     let mut out = Vec::new();
-    let peak_error = |t: f64| 2e-14 * t * t;
-    if t_rigid_s > WARN_RIGID_PERIOD_S {
-        out.push(format!(
-            "T_rigid = {t_rigid_s} s: the exact integrator's peak displacement may be off by \
-             {:.0e} of itself (the error grows like 2e-14·(T_rigid/s)²)",
-            peak_error(t_rigid_s)
-        ));
-    }
-    if let Some(period_s) = post_yield_period_s(sys)
-        && period_s > WARN_RIGID_PERIOD_S
-    {
-        out.push(format!(
-            "the post-yield period T_rigid/√r = {period_s} s: the exact integrator's peak \
-             displacement may be off by {:.0e} of itself (the error grows like 2e-14·(T/s)²)",
-            peak_error(period_s)
-        ));
-    }
     let duration = ground.duration_s();
     if t_rigid_s > 10.0 * duration {
         out.push(format!(
