@@ -2,6 +2,7 @@
 //!
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
 //! * [`motion`]: ground-motion records, processing, spectral matching, stochastic motions.
+//! * [`sdof`]: one linear SDOF step, exact for piecewise-linear load, stable at every period.
 //! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
 //! * [`fit`]: the design equation for T_new: forms, argmin problems, metrics.
 //! * [`report`]: SVG figures and the HTML report.
@@ -27,6 +28,7 @@ pub mod motion;
 mod numeric;
 pub mod pipeline;
 pub mod report;
+pub mod sdof;
 pub mod simulation;
 pub mod spectrum;
 pub mod store;

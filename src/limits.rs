@@ -95,14 +95,6 @@ pub const MAX_IDA_GRID_POINTS: usize = 1_000;
 /// structure.
 pub const MAX_IDA_PAD_S: f64 = 600.0;
 
-/// Largest `T_rigid/dt` the exact integrator runs: its structure cluster is written as a
-/// particular plus a homogeneous solution whose terms cancel when `ω·dt` is small, so the energy
-/// error grows like `3e-15·(T_rigid/dt)²` (module doc of `dynamics::exact`): about `1e-3` here.
-pub const MAX_RIGID_PERIOD_STEPS: f64 = 5.5e5;
-
-/// Above this `T_rigid/dt` the same error exceeds about `1e-6`: a warning.
-pub const WARN_RIGID_PERIOD_STEPS: f64 = 1.7e4;
-
 /// RK4 sub-steps per record interval (the accuracy bench goes to 1000).
 pub const MAX_RK4_SUBSTEPS: usize = 100_000;
 

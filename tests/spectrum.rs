@@ -5,7 +5,8 @@ mod common;
 
 use common::{max_rel_diff, real_records, sdof_oracle};
 use slidestack::dynamics::G;
-use slidestack::spectrum::response::{NjStep, sampled_peak};
+use slidestack::sdof::Step;
+use slidestack::spectrum::response::sampled_peak;
 use slidestack::spectrum::{peak_response, response_spectrum};
 use std::f64::consts::TAU;
 
@@ -37,7 +38,7 @@ fn recurrence_equals_matrix_exponential_at_every_sample() {
             for &zeta in &[0.0, 0.05, 0.5] {
                 let w = TAU / period;
                 let oracle = sdof_oracle(w, zeta, rec.dt_s, &accel);
-                let step = NjStep::new(w, zeta, rec.dt_s);
+                let step = Step::new(w, zeta, rec.dt_s);
                 let mut u = vec![0.0];
                 let (mut x, mut v) = (0.0, 0.0);
                 for s in accel.windows(2) {

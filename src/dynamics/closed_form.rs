@@ -302,89 +302,6 @@ pub fn integral_of_square_decay(v: &Wave, decay: f64, h: f64) -> f64 {
     poly + 2.0 * v.c * cross + v.c * v.c * h * exp_moment(0, 2.0 * x)
 }
 
-/// `φ_k(x) = Σ_{m≥0} x^m/(m+k)!` for `−1 ≤ x ≤ 0`: alternating terms that fall at least
-/// tenfold per two terms, so the sum keeps every digit.
-fn phi_small(k: u32, x: f64) -> f64 {
-    let mut term = 1.0 / (1..=k).fold(1.0, |f, j| f * f64::from(j));
-    let mut sum = term;
-    for m in 1..40 {
-        term *= x / f64::from(m + k);
-        let next = sum + term;
-        if next == sum {
-            break;
-        }
-        sum = next;
-    }
-    sum
-}
-
-/// Nodes and weights of 8-point Gauss–Legendre quadrature on `[0, 1]` (the roots of `P₈` by
-/// Newton's method at 50 digits, rounded).
-const GAUSS8: [(f64, f64); 8] = [
-    (0.019855071751231884, 0.05061426814518813),
-    (0.10166676129318664, 0.11119051722668724),
-    (0.2372337950418355, 0.15685332293894363),
-    (0.4082826787521751, 0.181341891689181),
-    (0.591717321247825, 0.181341891689181),
-    (0.7627662049581645, 0.15685332293894363),
-    (0.8983332387068134, 0.11119051722668724),
-    (0.9801449282487681, 0.05061426814518813),
-];
-
-/// The end state and integrals of a piece of `ü + a·u̇ = p₀ + p₁τ` (a structure without
-/// stiffness, `r = 0`) from `(u₀, v₀)` over `[0, h]`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DecayPiece {
-    /// `u(h)`, `u̇(h)`.
-    pub u: f64,
-    pub v: f64,
-    /// `∫₀^h u dτ` and `∫₀^h u̇² dτ` (NaN unless asked for).
-    pub int_u: f64,
-    pub int_v2: f64,
-}
-
-/// [`DecayPiece`] in φ-function form, for `a·h ≤ 1`: with `φ_k = φ_k(−aτ)`,
-/// `u̇ = v₀φ₀ + p₀τφ₁ + p₁τ²φ₂`, `u = u₀ + v₀τφ₁ + p₀τ²φ₂ + p₁τ³φ₃`,
-/// `∫u = u₀h + v₀h²φ₂ + p₀h³φ₃ + p₁h⁴φ₄` (at `τ = h`), and `∫u̇²` by 8-point Gauss–Legendre
-/// (exact to round-off: the integrand is a quartic plus terms in `e^{−aτ}` with `2a·h ≤ 2`,
-/// whose 16th derivative bounds the error below `1e-18·h·max u̇²`). The same motion as the
-/// structure wave of `r = 0` (`Exact::structure_wave`), without its terms of order `p₀/a²`
-/// that cancel when `a·h` is small. `square`: whether to compute `∫u̇²` (eight evaluations).
-pub fn decay_piece(
-    decay: f64,
-    (p0, p1): (f64, f64),
-    (u0, v0): (f64, f64),
-    h: f64,
-    square: bool,
-) -> DecayPiece {
-    debug_assert!(decay * h <= 1.0);
-    let vel = |t: f64| {
-        let x = -decay * t;
-        v0 * phi_small(0, x) + t * (p0 * phi_small(1, x) + t * p1 * phi_small(2, x))
-    };
-    let x = -decay * h;
-    let (f1, f2, f3, f4) = (
-        phi_small(1, x),
-        phi_small(2, x),
-        phi_small(3, x),
-        phi_small(4, x),
-    );
-    let int_v2 = if square {
-        h * GAUSS8
-            .iter()
-            .map(|&(node, weight)| weight * vel(node * h).powi(2))
-            .sum::<f64>()
-    } else {
-        f64::NAN
-    };
-    DecayPiece {
-        u: u0 + h * (v0 * f1 + h * (p0 * f2 + h * p1 * f3)),
-        v: vel(h),
-        int_u: h * (u0 + h * (v0 * f2 + h * (p0 * f3 + h * p1 * f4))),
-        int_v2,
-    }
-}
-
 /// Smallest and largest value over `s ∈ [0, 1]` of the cubic Hermite interpolant with end values
 /// `f0`, `f1` and end slopes `m0`, `m1` (derivatives with respect to `s`). For a function `g` on
 /// an interval of width `w`, `|g − H| ≤ max|g⁗|·w⁴/384` there, so the range of `H` widened by that
@@ -537,6 +454,7 @@ mod tests {
 
     #[test]
     fn decay_piece_matches_the_wave_and_numerics() {
+        use crate::sdof::decay_piece;
         // Two independent forms of one motion: the φ form against the wave form (exact where
         // a·h is not small) and Simpson's rule on the wave.
         let (p0, p1, u0, v0) = (-2.5, 40.0, 0.03, -0.4);

@@ -28,26 +28,27 @@
 //! chattering. More than `max_switches_per_step` switches within one sample interval stop the run
 //! with [`SimError::Zeno`].
 //!
-//! Known limit: the structure's cluster is written as particular plus homogeneous solution, whose
-//! terms grow like `ȧ_g/ω³` and cancel when `ω·dt` is small. On band-limited records the energy
-//! error grows like `(T_rigid/dt)²` (below `7e-14·(T_rigid/dt)²` over the stress suite's survey,
-//! `docs/stress.md`: ~1e-12 for real records on structures up to a few seconds, 5e-7 for
-//! `T_rigid = 201 s`), and the displacement error like `T_rigid²`. A ground acceleration that
-//! jumps every sample of a very fine record is worse at any period (±0.05 g alternating at
-//! `dt = 0.0005 s`: energy error 1.5e-5 at `T_rigid = 1 s`). A φ-function form of the same
-//! solution would remove the cancellation; not done.
+//! Long periods: the structure's cluster is written as particular plus homogeneous solution,
+//! whose terms grow like `a_g/ω²` and `ȧ_g/ω³` and cancel when `ω·dt` is small (the energy
+//! error of that form grows like `(T_rigid/dt)²`: 5e-3 at `T_rigid = 201 s`, `dt = 0.0005 s`).
+//! Below `ω_n·dt = SDOF_FORM_OMEGA_STEP` each piece's end state, energy integrals and peak
+//! displacement come from the φ-function step instead ([`sdof::piece`], [`sdof::Step`];
+//! `docs/model.md`, "Long periods"), exact to round-off at any `T_rigid/dt` (energy 2e-13 there,
+//! peak within 1e-10 of a fine-step reference up to `T_rigid = 1e6 s`); the wave still locates
+//! the events, whose switching functions it keeps to round-off of the accelerations.
 
 // Parallel per-body and per-interface arrays read best with index loops.
 #![allow(clippy::needless_range_loop)]
 
 use super::closed_form::{
-    Basis, DecayPiece, Osc, PieceIntegrals, Wave, decay_piece, hermite_range,
-    integral_of_square_decay, integral_of_square_with,
+    Basis, Osc, PieceIntegrals, Wave, hermite_range, integral_of_square_decay,
+    integral_of_square_with,
 };
 use super::contact::{Contact, ContactSelector};
 use super::model::System;
 use super::response::{Energy, History, Response};
 use super::{Ground, SimError};
+use crate::sdof::{self, Piece, decay_piece};
 
 /// Relative tolerance on the static friction limit before a stuck interface breaks away.
 pub const BREAK_TOLERANCE: f64 = 1e-10;
@@ -83,14 +84,24 @@ pub fn simulate_exact(
     opts: &ExactOptions,
 ) -> Result<Response, SimError> {
     ground.validate()?;
-    super::check_accuracy(sys, ground)?;
-    let r = if sys.hysteresis().is_some() {
-        Exact::<true>::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?
-    } else {
-        Exact::<false>::new(sys, ground.dt_s, *opts).run(ground.accel_mps2)?
+    let (dt, accel) = (ground.dt_s, ground.accel_mps2);
+    let r = match (sys.hysteresis().is_some(), long_periods(sys, dt)) {
+        (true, true) => Exact::<true, true>::new(sys, dt, *opts).run(accel)?,
+        (true, false) => Exact::<true, false>::new(sys, dt, *opts).run(accel)?,
+        (false, true) => Exact::<false, true>::new(sys, dt, *opts).run(accel)?,
+        (false, false) => Exact::<false, false>::new(sys, dt, *opts).run(accel)?,
     };
     r.check_finite()?;
     Ok(r)
+}
+
+/// Whether some structure cluster of `sys` takes [`sdof::piece`] at `dt`: the slowest are those
+/// of the whole stack, on the elastic and on the post-yield branch (`ω_n·dt` falls with `ω_n`).
+/// As a constant of [`Exact`] it leaves every other run's code as it was.
+fn long_periods(sys: &System, dt: f64) -> bool {
+    let mass: f64 = sys.masses().iter().sum();
+    let slowest = |k: f64| Cluster0::new(mass, k, sys.damping(), dt).sdof_form;
+    slowest(sys.stiffness()) || (sys.hysteresis().is_some() && slowest(Spring::new(sys).k_post))
 }
 
 /// Coefficients of the structure's cluster when its top body is `e0`. With a post-yield
@@ -106,7 +117,18 @@ struct Cluster0 {
     basis_dt: Basis,
     /// The energy integrals over a whole sample interval.
     integrals_dt: PieceIntegrals,
+    /// Whether `ω_n·dt < SDOF_FORM_OMEGA_STEP`: the state and integrals of a piece then come
+    /// from [`sdof::piece`] ([`Exact::stable_piece`]).
+    sdof_form: bool,
 }
+
+/// Below this `ω_n·dt` the particular-plus-homogeneous wave of the structure cluster loses more
+/// than `1/(ω_n·dt)² ≈ 4e4` ulps of the state to cancellation per piece (its terms grow like
+/// `p₀/ω²` and `ȧ_g/ω³`), so the piece's end state and energy integrals come from the
+/// φ-function form ([`sdof::piece`]). Above it the wave is kept: it is cheaper, as accurate, and
+/// the study's grid (`ω_n·dt ≥ 0.009`) runs bit for bit as before (`docs/model.md`,
+/// "Long periods").
+const SDOF_FORM_OMEGA_STEP: f64 = 5e-3;
 
 impl Cluster0 {
     /// The cluster of mass `mass` (kg) on a spring of stiffness `stiffness` (N/m, `≥ 0`) and
@@ -133,6 +155,7 @@ impl Cluster0 {
             natural: osc.natural(),
             basis_dt,
             integrals_dt: PieceIntegrals::new(osc, &basis_dt),
+            sdof_form: omega2 > 0.0 && omega2.sqrt() * dt < SDOF_FORM_OMEGA_STEP,
         }
     }
 }
@@ -344,8 +367,8 @@ struct Event {
 }
 
 /// The integrator; `Y` is whether the structure yields (its spring and plastic clusters are read
-/// only then).
-struct Exact<'s, const Y: bool> {
+/// only then), `L` whether some cluster takes [`sdof::piece`] ([`long_periods`]).
+struct Exact<'s, const Y: bool, const L: bool> {
     sys: &'s System,
     dt: f64,
     opts: ExactOptions,
@@ -385,7 +408,7 @@ struct Exact<'s, const Y: bool> {
     energy: Energy,
 }
 
-impl<'s, const Y: bool> Exact<'s, Y> {
+impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
     fn new(sys: &'s System, dt: f64, opts: ExactOptions) -> Self {
         let n = sys.blocks();
         let m = sys.masses();
@@ -761,26 +784,109 @@ impl<'s, const Y: bool> Exact<'s, Y> {
         -(f_top0 + self.spring.line().1) / cl.mass - ga
     }
 
-    /// The structure cluster's piece ending at `b` in the cancellation-free form of
-    /// [`decay_piece`], when the branch has no stiffness (`r = 0`) and `a·h ≤ 1` (beyond, the
-    /// wave's terms of order `p₀/a²` no longer exceed its values); `None` otherwise.
-    fn stable_decay_piece(&self, ga: f64, slope: f64, b: &Basis) -> Option<DecayPiece> {
-        if !Y {
-            return None;
-        }
+    /// The structure cluster's piece ending at `b` in a cancellation-free φ-function form, or
+    /// `None` where its wave is accurate: on a branch without stiffness (`r = 0`) with `a·h ≤ 1`,
+    /// [`decay_piece`] (beyond, the wave's terms of order `p₀/a²` no longer exceed its values);
+    /// at long periods (`ω_n·dt` below `SDOF_FORM_OMEGA_STEP`), [`sdof::piece`].
+    fn stable_piece(&self, ga: f64, slope: f64, b: &Basis) -> Option<Piece> {
         let cl = self.cl();
-        if cl.omega2 != 0.0 || cl.osc.decay * b.tau > 1.0 {
+        if L && cl.sdof_form {
+            return Some(self.sdof_piece(cl, ga, slope, b));
+        }
+        if !Y || cl.omega2 != 0.0 || cl.osc.decay * b.tau > 1.0 {
             return None;
         }
-        let e0 = self.top[0];
-        let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
         Some(decay_piece(
             cl.osc.decay,
-            (self.plastic_load(cl, f_top0, ga), -slope),
+            (self.plastic_load(cl, self.f_top0(), ga), -slope),
             (self.x[0], self.v[0]),
             b.tau,
             self.opts.energy_balance,
         ))
+    }
+
+    /// The [`sdof::piece`] branch of [`Exact::stable_piece`], kept out of line: the study's grid
+    /// never takes it.
+    #[cold]
+    #[inline(never)]
+    fn sdof_piece(&self, cl: &Cluster0, ga: f64, slope: f64, b: &Basis) -> Piece {
+        let (omega_n, zeta, p0) = self.sdof_params(cl, ga);
+        sdof::piece(
+            omega_n,
+            zeta,
+            (p0, -slope),
+            (self.x[0], self.v[0]),
+            b.tau,
+            self.opts.energy_balance,
+        )
+    }
+
+    /// `(max |u|, τ)` over the piece `[0, h]` by [`sdof::Step`], for a cluster that takes
+    /// [`sdof::piece`] (the wave's values lose digits there): the piece's end and every zero of
+    /// the exact `u̇` inside it, each found by Newton steps (`ü = p₀ + p₁τ − 2ζω_nu̇ − ω_n²u`)
+    /// from a root of the velocity's Taylor polynomial `v₀ + ü₀τ + u⃛₀τ²/2`, whose error is of
+    /// relative order `(ω_n·h)² < 2.5e-5`. The start is the previous piece's end.
+    #[cold]
+    #[inline(never)]
+    fn sdof_peak(&self, ga: f64, slope: f64, h: f64) -> (f64, f64) {
+        let (omega_n, zeta, p0) = self.sdof_params(self.cl(), ga);
+        let (x0, v0, p1) = (self.x[0], self.v[0], -slope);
+        let at = |t: f64| sdof::Step::new(omega_n, zeta, t).step(x0, v0, -p0, -(p0 + p1 * t));
+        let mut best = (at(h).0.abs(), h);
+        // v₀ + ü₀τ + (u⃛₀/2)τ² = 0 (Taylor to second order) without cancellation.
+        let acc0 = p0 - 2.0 * zeta * omega_n * v0 - omega_n * omega_n * x0;
+        let jerk0 = p1 - 2.0 * zeta * omega_n * acc0 - omega_n * omega_n * v0;
+        let (qa, qb, qc) = (0.5 * jerk0, acc0, v0);
+        let mut starts = [f64::NAN; 2];
+        if qa == 0.0 {
+            starts[0] = -qc / qb;
+        } else {
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc >= 0.0 {
+                let q = -0.5 * (qb + qb.signum() * disc.sqrt());
+                starts = [q / qa, qc / q];
+            }
+        }
+        for mut t in starts {
+            if !(t > -0.01 * h && t < 1.01 * h) {
+                continue;
+            }
+            for _ in 0..4 {
+                let (u, v) = at(t);
+                let acc = p0 + p1 * t - 2.0 * zeta * omega_n * v - omega_n * omega_n * u;
+                let next = t - v / acc;
+                if !next.is_finite() || next == t {
+                    break;
+                }
+                t = next;
+            }
+            if t > 0.0 && t < h {
+                let u = at(t).0.abs();
+                if u > best.0 {
+                    best = (u, t);
+                }
+            }
+        }
+        best
+    }
+
+    /// `(ω_n, ζ, p₀)` of the structure cluster's equation `ü + 2ζω_nu̇ + ω_n²u = p₀ + p₁τ`
+    /// (the load of [`Exact::structure_wave`]).
+    fn sdof_params(&self, cl: &Cluster0, ga: f64) -> (f64, f64, f64) {
+        let p0 = if Y {
+            self.plastic_load(cl, self.f_top0(), ga)
+        } else {
+            -self.f_top0() / cl.mass - ga
+        };
+        let omega_n = cl.omega2.sqrt();
+        (omega_n, cl.osc.decay / omega_n, p0)
+    }
+
+    /// The friction force on the structure cluster's top body from the body above, N (0 when the
+    /// whole stack is in the cluster).
+    fn f_top0(&self) -> f64 {
+        let e0 = self.top[0];
+        if e0 < self.n { self.force[e0] } else { 0.0 }
     }
 
     /// A whole sample interval on which, with every interface stuck, nothing can happen: the
@@ -922,7 +1028,11 @@ impl<'s, const Y: bool> Exact<'s, Y> {
         let e0 = self.top[0];
         let b0 = Basis::ZERO;
         // Peaks of the structure's displacement and its cluster's absolute acceleration.
-        let (best, at) = peak_abs(&self.u0, osc, &b0, b, self.out.peak_displacement_m, self.dt);
+        let (best, at) = if L && self.cl().sdof_form {
+            self.sdof_peak(ga, slope, b.tau)
+        } else {
+            peak_abs(&self.u0, osc, &b0, b, self.out.peak_displacement_m, self.dt)
+        };
         if best > self.out.peak_displacement_m {
             self.out.peak_displacement_m = best;
             self.out.peak_displacement_time_s = t_start + at;
@@ -954,9 +1064,9 @@ impl<'s, const Y: bool> Exact<'s, Y> {
         let end = b.tau;
         // Energy: input −Σ M_c∫a_g·v_c, damping ∫c·u̇².
         let nc = self.cluster_of[self.n] + 1;
-        // A plastic piece without stiffness: the structure cluster's state and integrals from
-        // the cancellation-free form (always `None` for the linear structure).
-        let stable = self.stable_decay_piece(ga, slope, b);
+        // A plastic piece without stiffness, or a long period: the structure cluster's state and
+        // integrals from a cancellation-free form.
+        let stable = self.stable_piece(ga, slope, b);
         if self.opts.energy_balance {
             let cl = *self.cl();
             let pi = if *b == cl.basis_dt {

@@ -52,10 +52,7 @@ pub use model::{G, Hysteresis, ModelError, System, SystemSpec, Yielding};
 pub use response::{Energy, History, Response};
 pub use rk4::simulate_rk4;
 
-use crate::limits::{
-    DT_RANGE_S, MAX_RIGID_PERIOD_STEPS, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP,
-    WARN_RIGID_PERIOD_STEPS,
-};
+use crate::limits::{DT_RANGE_S, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP};
 use thiserror::Error;
 
 /// A ground acceleration sampled at a constant step, linear between samples.
@@ -99,28 +96,6 @@ pub enum SimError {
         substeps: usize,
         omega_step: f64,
         needed: usize,
-    },
-    #[error(
-        "T_rigid = {t_rigid_s} s is {ratio:.3e} record steps (dt = {dt_s} s); the exact integrator \
-         is accurate up to {MAX_RIGID_PERIOD_STEPS:e} steps (its energy error grows like \
-         3e-15·(T_rigid/dt)²): use a shorter period or a coarser record"
-    )]
-    BeyondAccuracy {
-        t_rigid_s: f64,
-        dt_s: f64,
-        ratio: f64,
-    },
-    #[error(
-        "the post-yield period T_rigid/√r = {period_s} s (r = {r}) is {ratio:.3e} record steps \
-         (dt = {dt_s} s); the exact integrator is accurate up to {MAX_RIGID_PERIOD_STEPS:e} steps \
-         (its energy error grows like 3e-15·(T/dt)²): use a larger r, r = 0 (elastic–perfectly \
-         plastic, which has no such limit), or a coarser record"
-    )]
-    PostYieldBeyondAccuracy {
-        period_s: f64,
-        r: f64,
-        dt_s: f64,
-        ratio: f64,
     },
     #[error("the response is not finite (the integration diverged)")]
     Diverged,
@@ -167,64 +142,11 @@ impl Ground<'_> {
     }
 }
 
-/// Refuses a system the exact integrator cannot run accurately on this record (limit in
-/// [`crate::limits::MAX_RIGID_PERIOD_STEPS`]). A yielding structure with `r > 0` has a longer
-/// period on its post-yield branch, `T_rigid/√r`, held to the same limit; with `r = 0` the
-/// plastic branch has its own cancellation-free form (`closed_form::decay_piece`).
-pub fn check_accuracy(sys: &System, ground: &Ground) -> Result<(), SimError> {
-    let t_rigid_s = sys.period_rigid_s();
-    let ratio = t_rigid_s / ground.dt_s;
-    if ratio > MAX_RIGID_PERIOD_STEPS {
-        return Err(SimError::BeyondAccuracy {
-            t_rigid_s,
-            dt_s: ground.dt_s,
-            ratio,
-        });
-    }
-    if let Some(period_s) = post_yield_period_s(sys) {
-        let ratio = period_s / ground.dt_s;
-        if ratio > MAX_RIGID_PERIOD_STEPS {
-            return Err(SimError::PostYieldBeyondAccuracy {
-                period_s,
-                r: sys.hysteresis().map_or(0.0, |h| h.post_yield_ratio),
-                dt_s: ground.dt_s,
-                ratio,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// `T_rigid/√r`, s, of a yielding structure with `r > 0`: its longest post-yield period.
-fn post_yield_period_s(sys: &System) -> Option<f64> {
-    let r = sys.hysteresis()?.post_yield_ratio;
-    (r > 0.0).then(|| sys.period_rigid_s() / r.sqrt())
-}
-
 /// What a user should know before trusting a run that is allowed but near the edge of what the
 /// record and the integrator resolve.
 pub fn accuracy_warnings(sys: &System, ground: &Ground) -> Vec<String> {
     let t_rigid_s = sys.period_rigid_s();
     let mut out = Vec::new();
-    let ratio = t_rigid_s / ground.dt_s;
-    if ratio > WARN_RIGID_PERIOD_STEPS {
-        out.push(format!(
-            "T_rigid = {t_rigid_s} s is {ratio:.2e} record steps: the exact integrator's energy \
-             error may reach {:.0e} of the input (it grows like 3e-15·(T_rigid/dt)²)",
-            3e-15 * ratio * ratio
-        ));
-    }
-    if let Some(period_s) = post_yield_period_s(sys) {
-        let ratio = period_s / ground.dt_s;
-        if ratio > WARN_RIGID_PERIOD_STEPS {
-            out.push(format!(
-                "the post-yield period T_rigid/√r = {period_s} s is {ratio:.2e} record steps: the \
-                 exact integrator's energy error may reach {:.0e} of the input (it grows like \
-                 3e-15·(T/dt)²)",
-                3e-15 * ratio * ratio
-            ));
-        }
-    }
     let duration = ground.duration_s();
     if t_rigid_s > 10.0 * duration {
         out.push(format!(

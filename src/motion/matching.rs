@@ -19,8 +19,9 @@
 
 use super::process::{BaselineCorrection, ProcessError};
 use crate::limits::{MAX_PERIODS, PERIOD_RANGE_S};
+use crate::sdof::{self, free_displacement};
 pub use crate::spectrum::log_space;
-use crate::spectrum::response::{NjStep, response_spectrum, validate_record};
+use crate::spectrum::response::{response_spectrum, validate_record};
 use crate::spectrum::{SpectrumError, TargetError, TargetSpectrum};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
@@ -316,7 +317,7 @@ fn wavelet(period_s: f64, damping: f64, peak_s: f64, dt_s: f64, n: usize) -> (us
 /// [`wavelet_column`].
 #[cfg(test)]
 fn response_at(
-    step: &NjStep,
+    step: &sdof::Step,
     omega: f64,
     damping: f64,
     dt_s: f64,
@@ -346,7 +347,7 @@ fn response_at(
         } else {
             (0.0, 0.0)
         };
-        (u, _) = NjStep::new(omega, damping, rest).step(u, v, a0, a1);
+        (u, _) = sdof::Step::new(omega, damping, rest).step(u, v, a0, a1);
     }
     omega * omega * u
 }
@@ -358,7 +359,7 @@ struct Probe {
     time_s: f64,
     k: usize,
     rest_s: f64,
-    partial: NjStep,
+    partial: sdof::Step,
 }
 
 impl Probe {
@@ -370,7 +371,7 @@ impl Probe {
             time_s: c.time_s,
             k,
             rest_s,
-            partial: NjStep::new(grid.omega[c.grid], grid.zeta, rest_s.max(f64::MIN_POSITIVE)),
+            partial: sdof::Step::new(grid.omega[c.grid], grid.zeta, rest_s.max(f64::MIN_POSITIVE)),
         }
     }
 }
@@ -426,7 +427,7 @@ fn wavelet_column_generic(
             cap[l] = c as f64;
             end = end.max(c);
         }
-        let s = |f: fn(&NjStep) -> f64| -> [f64; L] {
+        let s = |f: fn(&sdof::Step) -> f64| -> [f64; L] {
             std::array::from_fn(|l| chunk.get(l).map_or(0.0, |p| f(&grid.steps[p.grid])))
         };
         let (uu, uv, ug0, ug1) = (s(|s| s.uu), s(|s| s.uv), s(|s| s.ug0), s(|s| s.ug1));
@@ -462,11 +463,7 @@ fn wavelet_column_generic(
             } else {
                 // Free vibration from the wavelet's end.
                 let s = p.time_s - last as f64 * grid.dt_s;
-                let zw = grid.zeta * omega;
-                let wd = omega * (1.0 - grid.zeta * grid.zeta).sqrt();
-                let (sn, cs) = (wd * s).sin_cos();
-                let u = (-zw * s).exp() * (ku[l] * cs + (kv[l] + zw * ku[l]) / wd * sn);
-                omega * omega * u
+                omega * omega * free_displacement(omega, grid.zeta, (ku[l], kv[l]), s)
             };
         }
     }
@@ -560,7 +557,7 @@ struct Grid {
     check: (usize, usize),
     target_g: Vec<f64>,
     omega: Vec<f64>,
-    steps: Vec<NjStep>,
+    steps: Vec<sdof::Step>,
     zeta: f64,
     dt_s: f64,
 }
@@ -595,7 +592,10 @@ impl Grid {
         let omega: Vec<f64> = periods_s.iter().map(|t| TAU / t).collect();
         Ok(Self {
             target_g: periods_s.iter().map(|&t| target.sa_g(t)).collect(),
-            steps: omega.iter().map(|&w| NjStep::new(w, zeta, dt_s)).collect(),
+            steps: omega
+                .iter()
+                .map(|&w| sdof::Step::new(w, zeta, dt_s))
+                .collect(),
             omega,
             periods_s,
             check: (below, below + n),
@@ -1130,7 +1130,7 @@ mod tests {
         rec[first..first + w.len()].copy_from_slice(&w);
         for &(t, at) in &[(0.5, 12.0), (0.2, 11.03), (2.0, 25.0), (1.0, 11.6)] {
             let omega = TAU / t;
-            let step = NjStep::new(omega, 0.05, dt);
+            let step = sdof::Step::new(omega, 0.05, dt);
             let got = response_at(&step, omega, 0.05, dt, first, &w, at);
             let k = (at / dt).floor() as usize;
             let (mut u, mut v) = (0.0, 0.0);
@@ -1140,7 +1140,7 @@ mod tests {
             let rest = at - k as f64 * dt;
             if rest > 0.0 {
                 let a1 = rec[k] + (rec[k + 1] - rec[k]) * rest / dt;
-                (u, _) = NjStep::new(omega, 0.05, rest).step(u, v, rec[k], a1);
+                (u, _) = sdof::Step::new(omega, 0.05, rest).step(u, v, rec[k], a1);
             }
             let want = omega * omega * u;
             assert!(

@@ -1,7 +1,7 @@
 //! Small numerical kernels, each written once and tested against its own oracle:
 //!
-//! * here: complex arithmetic, the φ-functions of exponential integrators, a bracketed Newton
-//!   root finder;
+//! * here: complex arithmetic, the φ-functions of exponential integrators, 8-point
+//!   Gauss–Legendre nodes, a bracketed Newton root finder;
 //! * [`linalg`]: Cholesky, least squares by Householder QR, the 4×4 matrix exponential;
 //! * [`special`]: `ln Γ`, the regularised incomplete gamma functions and the gamma quantile,
 //!   the normal distribution function;
@@ -39,9 +39,9 @@ impl Cx {
     }
 }
 
-/// Taylor series `Σ_{k≥0} x^k/(k+j)!` of `φ_j`, used where the closed forms cancel (`|x| < 1`),
+/// Taylor series `Σ_{k≥0} x^k/(k+j)!` of `φ_j`, used where the closed forms cancel (`|x| < 2`),
 /// summed until a term no longer changes the sum (at most 30 terms).
-fn phi_series(x: Cx, j: u32) -> Cx {
+pub(crate) fn phi_series(x: Cx, j: u32) -> Cx {
     let first = (1..=j).fold(1.0, |f, k| f * k as f64);
     let mut term = Cx(1.0 / first, 0.0);
     let mut sum = term;
@@ -77,6 +77,28 @@ pub(crate) fn phi2(x: Cx) -> Cx {
         phi1(x).add(Cx(-1.0, 0.0)).div(x)
     }
 }
+
+/// `φ₃(x) = (eˣ − 1 − x − x²/2)/x³` for complex `x`, accurate also near 0.
+pub(crate) fn phi3(x: Cx) -> Cx {
+    if x.norm_sqr() < 4.0 {
+        phi_series(x, 3)
+    } else {
+        phi2(x).add(Cx(-0.5, 0.0)).div(x)
+    }
+}
+
+/// Nodes and weights of 8-point Gauss–Legendre quadrature on `[0, 1]` (the roots of `P₈` by
+/// Newton's method at 50 digits, rounded).
+pub(crate) const GAUSS8: [(f64, f64); 8] = [
+    (0.019855071751231884, 0.05061426814518813),
+    (0.10166676129318664, 0.11119051722668724),
+    (0.2372337950418355, 0.15685332293894363),
+    (0.4082826787521751, 0.181341891689181),
+    (0.591717321247825, 0.181341891689181),
+    (0.7627662049581645, 0.15685332293894363),
+    (0.8983332387068134, 0.11119051722668724),
+    (0.9801449282487681, 0.05061426814518813),
+];
 
 /// A root in `[lo, hi]` of `f`, where `f_lo = f(lo)` and `f_hi = f(hi)` differ in sign (or one
 /// is zero), by Newton steps kept inside the shrinking bracket (bisection when a step leaves
@@ -144,6 +166,57 @@ mod tests {
             let (q1, q2) = (phi1(x), phi2(x));
             assert!((q1.0 - p1.0).abs() + (q1.1 - p1.1).abs() < 1e-14);
             assert!((q2.0 - p2.0).abs() + (q2.1 - p2.1).abs() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn phi_functions_at_tiny_and_huge_arguments() {
+        // Tiny: the first three Taylor terms are exact to round-off at |x| = 1e-9.
+        for x in [Cx(-1e-9, 3e-10), Cx(0.0, 1e-12), Cx(-1e-300, 0.0)] {
+            let x2 = x.mul(x);
+            for (got, c) in [
+                (phi1(x), [1.0, 1.0 / 2.0, 1.0 / 6.0]),
+                (phi2(x), [1.0 / 2.0, 1.0 / 6.0, 1.0 / 24.0]),
+                (phi3(x), [1.0 / 6.0, 1.0 / 24.0, 1.0 / 120.0]),
+            ] {
+                let want = Cx(c[0] + c[1] * x.0 + c[2] * x2.0, c[1] * x.1 + c[2] * x2.1);
+                assert!((got.0 - want.0).abs() <= 1e-16 * c[0], "{x:?} {got:?}");
+                assert!(
+                    (got.1 - want.1).abs() <= 1e-16 * (c[1] * x.1).abs(),
+                    "{x:?} {got:?}"
+                );
+            }
+        }
+        // Huge, in the left half plane: eˣ vanishes, φ₁ = −1/x, φ₂ = −(1 + x)/x², φ₃ = …
+        for x in [Cx(-1e3, 0.0), Cx(-50.0, 1e4), Cx(-800.0, -2e5)] {
+            let inv = Cx(1.0, 0.0).div(x);
+            let w1 = Cx(-inv.0, -inv.1);
+            let w2 = w1.add(Cx(-1.0, 0.0)).div(x);
+            let w3 = w2.add(Cx(-0.5, 0.0)).div(x);
+            let e = Cx(x.0.exp() * x.1.cos(), x.0.exp() * x.1.sin());
+            let (w1, w2, w3) = (
+                w1.add(e.div(x)),
+                w2.add(e.div(x.mul(x))),
+                w3.add(e.div(x.mul(x).mul(x))),
+            );
+            for (got, want) in [(phi1(x), w1), (phi2(x), w2), (phi3(x), w3)] {
+                let err = ((got.0 - want.0).powi(2) + (got.1 - want.1).powi(2)).sqrt();
+                assert!(
+                    err <= 1e-15 * want.norm_sqr().sqrt(),
+                    "{x:?} {got:?} {want:?}"
+                );
+            }
+        }
+        // φ₃ on both sides of its switch from the series (|x| = 2) against the definition.
+        for x in [Cx(-1.99, 0.1), Cx(-2.01, 0.1), Cx(0.3, -2.5)] {
+            let e = Cx(x.0.exp() * x.1.cos(), x.0.exp() * x.1.sin());
+            let x2 = x.mul(x);
+            let want = Cx(e.0 - 1.0 - x.0 - x2.0 / 2.0, e.1 - x.1 - x2.1 / 2.0).div(x2.mul(x));
+            let got = phi3(x);
+            assert!(
+                (got.0 - want.0).abs() + (got.1 - want.1).abs() < 1e-14,
+                "{x:?}"
+            );
         }
     }
 

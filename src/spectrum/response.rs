@@ -3,9 +3,8 @@
 //! The ground acceleration is linear between samples, so a damped linear oscillator has a
 //! closed-form solution on each sample interval; stepping it from sample to sample is the
 //! Nigam–Jennings recurrence (Nigam & Jennings 1969; Chopra, *Dynamics of Structures*,
-//! Table 5.2.1). Its coefficients are built here from the φ-functions of the oscillator matrix
-//! (`x₁ = e^{Mh}x₀ + h[φ₁(Mh) − φ₂(Mh)]·b·p₀ + h·φ₂(Mh)·b·p₁`, `p = −a_g`), which keeps every
-//! digit at long periods where the textbook formulas cancel (`2ζ/(ωh)` against `1`).
+//! Table 5.2.1), whose coefficients in φ-function form ([`crate::sdof::Step`]) keep every digit
+//! at long periods where the textbook formulas cancel (`2ζ/(ωh)` against `1`).
 //!
 //! The peak `max_t |u(t)|` is exact too, not only over the samples: sampling alone can be low by
 //! up to `1 − cos(π·dt/T)`. A first pass runs the recurrence and takes the sampled peak; a second
@@ -21,7 +20,8 @@
 
 use crate::dynamics::closed_form::{Basis, Osc, Wave};
 use crate::limits::{DT_RANGE_S, MAX_SAMPLES, PERIOD_RANGE_S};
-use crate::numeric::{Cx, bracketed_root, phi1, phi2};
+use crate::numeric::bracketed_root;
+use crate::sdof::Step;
 use rayon::prelude::*;
 use thiserror::Error;
 
@@ -87,62 +87,6 @@ impl ResponseSpectrum {
             .iter()
             .map(|t| std::f64::consts::TAU / t)
             .zip(&self.peaks)
-    }
-}
-
-/// One Nigam–Jennings step of length `h` for `ü + 2ζωu̇ + ω²u = −a_g`:
-/// `u₁ = uu·u₀ + uv·v₀ + ug0·a_g0 + ug1·a_g1`, likewise `v₁`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NjStep {
-    pub uu: f64,
-    pub uv: f64,
-    pub vu: f64,
-    pub vv: f64,
-    pub ug0: f64,
-    pub ug1: f64,
-    pub vg0: f64,
-    pub vg1: f64,
-}
-
-impl NjStep {
-    /// Coefficients for circular frequency `omega` (rad/s), damping `zeta` (`0 ≤ ζ < 1`) and
-    /// step `h` (s).
-    pub fn new(omega: f64, zeta: f64, h: f64) -> Self {
-        let wd = omega * (1.0 - zeta * zeta).sqrt();
-        let z = Cx(-zeta * omega * h, wd * h);
-        // A function f of the 2×2 matrix Mh, M = [[0, 1], [−ω², −2ζω]], equals αI + β·Mh with
-        // α + β·z = f(z) at its eigenvalue z = λh; applied to b = (0, 1) it gives
-        // (β·h, α − 2ζω·β·h).
-        let alpha_beta = |f: Cx| {
-            let beta = f.1 / z.1;
-            (f.0 - beta * z.0, beta)
-        };
-        let e = Cx(z.0.exp() * z.1.cos(), z.0.exp() * z.1.sin());
-        let (ae, be) = alpha_beta(e);
-        let p1 = phi1(z);
-        let p2 = phi2(z);
-        let (a2, b2) = alpha_beta(p2);
-        let (a12, b12) = alpha_beta(Cx(p1.0 - p2.0, p1.1 - p2.1));
-        let two_zw = 2.0 * zeta * omega;
-        // Forcing p = −a_g enters with a minus sign.
-        Self {
-            uu: ae,
-            uv: be * h,
-            vu: -be * h * omega * omega,
-            vv: ae - two_zw * be * h,
-            ug0: -h * b12 * h,
-            ug1: -h * b2 * h,
-            vg0: -h * (a12 - two_zw * b12 * h),
-            vg1: -h * (a2 - two_zw * b2 * h),
-        }
-    }
-
-    #[inline(always)]
-    pub fn step(&self, u: f64, v: f64, ag0: f64, ag1: f64) -> (f64, f64) {
-        (
-            self.uu * u + self.uv * v + self.ug0 * ag0 + self.ug1 * ag1,
-            self.vu * u + self.vv * v + self.vg0 * ag0 + self.vg1 * ag1,
-        )
     }
 }
 
@@ -214,7 +158,7 @@ pub fn peak_response(
 /// Peak of one oscillator over the samples only (no search between samples): the textbook
 /// scalar loop, kept as the baseline of the spectrum benchmark and to show the sampling error.
 pub fn sampled_peak(accel_mps2: &[f64], dt_s: f64, period_s: f64, damping: f64) -> f64 {
-    let step = NjStep::new(std::f64::consts::TAU / period_s, damping, dt_s);
+    let step = Step::new(std::f64::consts::TAU / period_s, damping, dt_s);
     let (mut u, mut v, mut peak) = (0.0f64, 0.0f64, 0.0f64);
     for w in accel_mps2.windows(2) {
         (u, v) = step.step(u, v, w[0], w[1]);
@@ -246,7 +190,7 @@ struct Lanes {
     inv_wd2: [f64; LANES],
     /// A quarter of the damped period, s.
     quarter: [f64; LANES],
-    steps: [NjStep; LANES],
+    steps: [Step; LANES],
     zeta: f64,
     h: f64,
 }
@@ -396,7 +340,7 @@ impl Lanes {
     /// first sample on ties).
     #[inline(always)]
     fn sample_states(&self, accel: &[f64]) -> SampleStates {
-        let c = |f: fn(&NjStep) -> f64| self.steps.map(|s| f(&s));
+        let c = |f: fn(&Step) -> f64| self.steps.map(|s| f(&s));
         let (uu, uv, ug0, ug1) = (c(|s| s.uu), c(|s| s.uv), c(|s| s.ug0), c(|s| s.ug1));
         let (vu, vv, vg0, vg1) = (c(|s| s.vu), c(|s| s.vv), c(|s| s.vg0), c(|s| s.vg1));
         let (mut us, mut vs) = STATES.take();
@@ -475,7 +419,7 @@ fn peaks_in_lanes(
         lag: omega.map(|w| 2.0 * zeta / (w * w * w)),
         inv_wd2: omega.map(|w| 1.0 / (w * w * (1.0 - zeta * zeta))),
         quarter: omega.map(|w| 0.25 * std::f64::consts::TAU / (w * (1.0 - zeta * zeta).sqrt())),
-        steps: omega.map(|w| NjStep::new(w, zeta, h)),
+        steps: omega.map(|w| Step::new(w, zeta, h)),
         zeta,
         h,
     };
@@ -619,7 +563,7 @@ mod tests {
         // agreement to a few ulps of the largest term.
         for &(period, h) in &[(0.1, 0.01), (1.0, 0.1), (0.02, 0.02)] {
             let w: f64 = std::f64::consts::TAU / period;
-            let s = NjStep::new(w, 0.0, h);
+            let s = Step::new(w, 0.0, h);
             let (sn, cs) = (w * h).sin_cos();
             let w2 = w * w;
             let want = [
@@ -650,7 +594,7 @@ mod tests {
         let accel = [0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
         let w = std::f64::consts::TAU / period;
         let n = 100_000;
-        let fine = NjStep::new(w, 0.0, dt / n as f64);
+        let fine = Step::new(w, 0.0, dt / n as f64);
         let (mut u, mut v, mut during) = (0.0f64, 0.0f64, 0.0f64);
         for k in 0..2 {
             for i in 0..n {

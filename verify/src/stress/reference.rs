@@ -6,7 +6,8 @@ use super::{Check, Reference, ReferenceOutcome, Samples, StressCase, options, re
 use slidestack::dynamics::{
     G, History, Response, System, SystemSpec, simulate_exact, simulate_rk4,
 };
-use slidestack::spectrum::response::{NjStep, peak_response};
+use slidestack::sdof::Step;
+use slidestack::spectrum::response::peak_response;
 
 pub(super) fn compare(
     case: &StressCase,
@@ -150,7 +151,7 @@ fn against_zero(resp: &Response) -> Result<f64, String> {
 
 /// Displacements at the samples of `ü + 2ζωu̇ + ω²u = −a_g`, from rest.
 fn sdof_displacements(omega: f64, zeta: f64, samples: &Samples) -> Vec<f64> {
-    let step = NjStep::new(omega, zeta, samples.dt_s);
+    let step = Step::new(omega, zeta, samples.dt_s);
     let (mut u, mut v) = (0.0, 0.0);
     let mut out = Vec::with_capacity(samples.accel_mps2.len());
     out.push(0.0);
