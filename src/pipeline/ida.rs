@@ -59,17 +59,22 @@ struct UnitOut {
     traces: Vec<Trace<RunDemand>>,
 }
 
-/// Builds `ida.h5`.
-pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
-    let study = &s.study;
-    let me = StageId::Ida;
-    let cfg = study
+/// The config's `ida:` section, which the stage needs.
+fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
+    study
         .cfg
         .ida
         .as_ref()
         .ok_or_else(|| IdaStageError::NoSection {
             config: study.config_path.clone(),
-        })?;
+        })
+}
+
+/// Builds `ida.h5`.
+pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+    let study = &s.study;
+    let me = StageId::Ida;
+    let cfg = section(study)?;
     let fp = study.fingerprint(me)?;
     let motions = super::sweep::load_motions(study)?;
     let physics = study.physics();
@@ -505,13 +510,7 @@ pub fn figure(study: &Study) -> Result<String, PipelineError> {
 pub fn figure_of(study: &Study) -> Result<crate::report::chart::Figure, PipelineError> {
     use crate::report::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Ida)?;
-    let cfg = study
-        .cfg
-        .ida
-        .as_ref()
-        .ok_or_else(|| IdaStageError::NoSection {
-            config: study.config_path.clone(),
-        })?;
+    let cfg = section(study)?;
     let cap = cfg.collapse_ductility;
     let clip = |v: f64| if v.is_infinite() { cap } else { v };
     let path = study.path(StageId::Ida.output());

@@ -456,13 +456,3 @@ pub fn read_zone_ida(path: &Path, zone: &str) -> Result<(IdaAxes, ZoneIda), Stor
     }
     Ok((axes, z))
 }
-
-/// The zone names of `ida.h5`, in file order.
-pub fn zones(path: &Path) -> Result<Vec<String>, StoreError> {
-    let f = open(path)?;
-    Ok(f.member_names()
-        .at(path)?
-        .into_iter()
-        .filter_map(|n| n.strip_prefix("zone_").map(str::to_string))
-        .collect())
-}
