@@ -4,6 +4,7 @@
 use super::select::{Selection, case_index, label_of};
 use super::text::{num, paper_figure};
 use super::{Files, Inputs, ReportError};
+use crate::grid::Grid;
 use crate::report::chart::{Axis, Figure, Mark, Panel, Series, Stroke};
 use crate::report::page::{Section, para, table_with_id};
 use crate::study::tnew::BandCounts;
@@ -28,6 +29,40 @@ fn every_pair(
     series
 }
 
+/// What names one zone's figure over the mass-ratio panels.
+struct ZoneFigure {
+    file: String,
+    title: String,
+    y_label: &'static str,
+    caption: String,
+}
+
+/// One zone's figure: a panel per selected mass-ratio pair with `T_p` on the x axis and the
+/// lines `series(α indices)` gives, rendered into `files`; returns its HTML.
+fn zone_figure(
+    files: &mut Files,
+    sel: &Selection,
+    grid: &Grid,
+    fig: ZoneFigure,
+    series: impl Fn(&[usize]) -> Vec<Series>,
+) -> Result<String, ReportError> {
+    let panels = sel
+        .panels
+        .iter()
+        .enumerate()
+        .map(|(p, a)| {
+            Panel::xy(
+                sel.panel_title(grid, p),
+                Axis::new("T_p (s)"),
+                Axis::new(fig.y_label),
+                series(a),
+            )
+        })
+        .collect();
+    let figure = Figure::grid(fig.title, panels, sel.columns);
+    files.figure(&fig.file, &figure, &fig.caption)
+}
+
 pub(super) fn drr_section(
     inp: &Inputs,
     sel: &Selection,
@@ -45,73 +80,68 @@ pub(super) fn drr_section(
     ));
     for z in &inp.zones {
         let v = &z.tnew.vars;
-        let mut panels = Vec::new();
-        for (p, a) in sel.panels.iter().enumerate() {
-            let mut series = every_pair(
-                sel,
-                tp,
-                format!("DRR_1, each of the {} friction pairs", sel.all_mu.len()),
-                |m| z.column(&v.drr_1, per, case_index(grid, a, m)),
-            );
-            let mut drawn_mu1 = Vec::new();
-            let mut drr2 = Vec::new();
-            for (m, colour, stroke) in &sel.lines {
-                let c = case_index(grid, a, m);
-                series.push(
-                    Series::line(
-                        format!("DRR_1: {}", label_of("μ", &grid.mu, m)),
-                        tp.clone(),
-                        z.column(&v.drr_1, per, c),
-                    )
-                    .colour(*colour)
-                    .stroke(*stroke, 2),
+        body += &zone_figure(
+            files,
+            sel,
+            grid,
+            ZoneFigure {
+                file: format!("drr_{}.svg", z.name),
+                title: format!(
+                    "Zone {}: displacement response ratios against T_p ({})",
+                    z.name,
+                    paper_figure(&z.name, 10, 11)
+                ),
+                y_label: "DRR (–)",
+                caption: format!(
+                    "Zone {}: DRR_1 (lines) and DRR_2 (lines with dots) against T_p, panels over \
+                     the mass ratios.",
+                    z.name
+                ),
+            },
+            |a| {
+                let mut series = every_pair(
+                    sel,
+                    tp,
+                    format!("DRR_1, each of the {} friction pairs", sel.all_mu.len()),
+                    |m| z.column(&v.drr_1, per, case_index(grid, a, m)),
                 );
-                if !drawn_mu1.contains(&m[0]) {
-                    drawn_mu1.push(m[0]);
-                    drr2.push(
+                let mut drawn_mu1 = Vec::new();
+                let mut drr2 = Vec::new();
+                for (m, colour, stroke) in &sel.lines {
+                    let c = case_index(grid, a, m);
+                    series.push(
                         Series::line(
-                            format!("DRR_2 (single block): μ_1 = {}", num(grid.mu[0][m[0]])),
+                            format!("DRR_1: {}", label_of("μ", &grid.mu, m)),
                             tp.clone(),
-                            z.column(&v.drr_2, per, c),
+                            z.column(&v.drr_1, per, c),
                         )
-                        .mark(Mark::LinePoints)
-                        .colour(*colour),
+                        .colour(*colour)
+                        .stroke(*stroke, 2),
                     );
+                    if !drawn_mu1.contains(&m[0]) {
+                        drawn_mu1.push(m[0]);
+                        drr2.push(
+                            Series::line(
+                                format!("DRR_2 (single block): μ_1 = {}", num(grid.mu[0][m[0]])),
+                                tp.clone(),
+                                z.column(&v.drr_2, per, c),
+                            )
+                            .mark(Mark::LinePoints)
+                            .colour(*colour),
+                        );
+                    }
                 }
-            }
-            // DRR_2 and the no-slide line under the DRR_1 lines.
-            let under = sel.all_mu.len();
-            series.splice(under..under, drr2);
-            series.insert(
-                under,
-                Series::hline("DRR = 1 (nothing slides)", tp[0], tp[tp.len() - 1], 1.0)
-                    .colour(RGBColor(0, 0, 0))
-                    .stroke(Stroke::Dotted, 1),
-            );
-            panels.push(Panel::xy(
-                sel.panel_title(grid, p),
-                Axis::new("T_p (s)"),
-                Axis::new("DRR (–)"),
-                series,
-            ));
-        }
-        let fig = Figure::grid(
-            format!(
-                "Zone {}: displacement response ratios against T_p ({})",
-                z.name,
-                paper_figure(&z.name, 10, 11)
-            ),
-            panels,
-            sel.columns,
-        );
-        body += &files.figure(
-            &format!("drr_{}.svg", z.name),
-            &fig,
-            &format!(
-                "Zone {}: DRR_1 (lines) and DRR_2 (lines with dots) against T_p, panels over the \
-                 mass ratios.",
-                z.name
-            ),
+                // DRR_2 and the no-slide line under the DRR_1 lines.
+                let under = sel.all_mu.len();
+                series.splice(under..under, drr2);
+                series.insert(
+                    under,
+                    Series::hline("DRR = 1 (nothing slides)", tp[0], tp[tp.len() - 1], 1.0)
+                        .colour(RGBColor(0, 0, 0))
+                        .stroke(Stroke::Dotted, 1),
+                );
+                series
+            },
         )?;
     }
     Ok(Section::new(
@@ -166,65 +196,60 @@ pub(super) fn tnew_section(
     let black = RGBColor(0, 0, 0);
     for z in &inp.zones {
         let v = &z.tnew.vars;
-        let mut panels = Vec::new();
-        for (p, a) in sel.panels.iter().enumerate() {
-            let mut series = every_pair(
-                sel,
-                tp,
-                format!("each of the {} friction pairs", sel.all_mu.len()),
-                |m| z.column(&v.t_new, per, case_index(grid, a, m)),
-            );
-            // The limits under the data.
-            let c0 = case_index(grid, a, &sel.all_mu[0]);
-            series.push(
-                Series::line("T_p (bare structure)", tp.clone(), tp.clone())
-                    .colour(black)
-                    .stroke(Stroke::Solid, 1),
-            );
-            series.push(
-                Series::line(
-                    "T_rigid (load rigidly attached)",
-                    tp.clone(),
-                    z.column(&v.t_rigid, per, c0),
-                )
-                .colour(black)
-                .stroke(Stroke::Dashed, 1),
-            );
-            for (m, colour, stroke) in &sel.lines {
+        body += &zone_figure(
+            files,
+            sel,
+            grid,
+            ZoneFigure {
+                file: format!("tnew_{}.svg", z.name),
+                title: format!(
+                    "Zone {}: T_new against T_p ({})",
+                    z.name,
+                    paper_figure(&z.name, 16, 17)
+                ),
+                y_label: "T_new (s)",
+                caption: format!(
+                    "Zone {}: T_new against T_p, panels over the mass ratios, between T_p and \
+                     T_rigid.",
+                    z.name
+                ),
+            },
+            |a| {
+                let mut series = every_pair(
+                    sel,
+                    tp,
+                    format!("each of the {} friction pairs", sel.all_mu.len()),
+                    |m| z.column(&v.t_new, per, case_index(grid, a, m)),
+                );
+                // The limits under the data.
+                let c0 = case_index(grid, a, &sel.all_mu[0]);
+                series.push(
+                    Series::line("T_p (bare structure)", tp.clone(), tp.clone())
+                        .colour(black)
+                        .stroke(Stroke::Solid, 1),
+                );
                 series.push(
                     Series::line(
-                        label_of("μ", &grid.mu, m),
+                        "T_rigid (load rigidly attached)",
                         tp.clone(),
-                        z.column(&v.t_new, per, case_index(grid, a, m)),
+                        z.column(&v.t_rigid, per, c0),
                     )
-                    .colour(*colour)
-                    .stroke(*stroke, 2),
+                    .colour(black)
+                    .stroke(Stroke::Dashed, 1),
                 );
-            }
-            panels.push(Panel::xy(
-                sel.panel_title(grid, p),
-                Axis::new("T_p (s)"),
-                Axis::new("T_new (s)"),
-                series,
-            ));
-        }
-        let fig = Figure::grid(
-            format!(
-                "Zone {}: T_new against T_p ({})",
-                z.name,
-                paper_figure(&z.name, 16, 17)
-            ),
-            panels,
-            sel.columns,
-        );
-        body += &files.figure(
-            &format!("tnew_{}.svg", z.name),
-            &fig,
-            &format!(
-                "Zone {}: T_new against T_p, panels over the mass ratios, between T_p and \
-                 T_rigid.",
-                z.name
-            ),
+                for (m, colour, stroke) in &sel.lines {
+                    series.push(
+                        Series::line(
+                            label_of("μ", &grid.mu, m),
+                            tp.clone(),
+                            z.column(&v.t_new, per, case_index(grid, a, m)),
+                        )
+                        .colour(*colour)
+                        .stroke(*stroke, 2),
+                    );
+                }
+                series
+            },
         )?;
     }
     body += &para(
