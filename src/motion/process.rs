@@ -259,8 +259,8 @@ pub enum BaselineCorrection {
     /// polynomial of degree `order`, is subtracted from the acceleration. (Boore-style; `order = 0`
     /// removes the best constant acceleration offset, i.e. a quadratic displacement drift.)
     ///
-    /// `q` is written in Legendre polynomials of `2τ − 1` and the least-squares problem is solved
-    /// by Householder QR, which keeps it well conditioned up to [`MAX_POLY_ORDER`].
+    /// `q` is written in Legendre polynomials of `2τ − 1`, which keeps the least-squares problem
+    /// (`numeric::linalg::least_squares`, an SVD) well conditioned up to [`MAX_POLY_ORDER`].
     ///
     /// The fit does not force the corrected record to end at rest: its final velocity and
     /// displacement are small but not zero.

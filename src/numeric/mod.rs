@@ -2,7 +2,7 @@
 //!
 //! * here: complex arithmetic, the φ-functions of exponential integrators, 8-point
 //!   Gauss–Legendre nodes, a bracketed Newton root finder;
-//! * [`linalg`]: Cholesky, least squares by Householder QR, the 4×4 matrix exponential;
+//! * [`linalg`]: Cholesky, least squares by `nalgebra`'s SVD, the 4×4 matrix exponential;
 //! * [`special`]: `ln Γ`, the regularised incomplete gamma functions and the gamma quantile,
 //!   the normal distribution function;
 //! * [`rng`]: the seeded generator of the stochastic motions;
