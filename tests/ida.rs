@@ -38,14 +38,6 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// Copies `motions.h5` and its checksum sidecar.
-fn copy_motions(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for f in ["motions.h5", "motions.h5.sha256"] {
-        std::fs::copy(from.join(f), to.join(f)).unwrap();
-    }
-}
-
 #[test]
 fn the_stage_runs_skips_resumes_after_a_kill_and_ignores_the_thread_count() {
     let dir = tempfile::tempdir().unwrap();
@@ -74,7 +66,7 @@ fn the_stage_runs_skips_resumes_after_a_kill_and_ignores_the_thread_count() {
 
     // SIGKILL once the stage has started computing, then a rerun: the same bytes.
     let killed = dir.path().join("killed");
-    copy_motions(&out, &killed);
+    common::copy_motions(&out, &killed);
     let mut child = Command::new(env!("CARGO_BIN_EXE_slidestack"))
         .args(["ida", s(&cfg), "--out", s(&killed)])
         .env("RAYON_NUM_THREADS", "1")
@@ -102,7 +94,7 @@ fn the_stage_runs_skips_resumes_after_a_kill_and_ignores_the_thread_count() {
 
     // One thread: the same bytes.
     let one = dir.path().join("one");
-    copy_motions(&out, &one);
+    common::copy_motions(&out, &one);
     ok(slidestack(&["ida", s(&cfg), "--out", s(&one)], "1"));
     assert_eq!(std::fs::read(one.join("ida.h5")).unwrap(), want);
 

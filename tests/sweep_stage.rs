@@ -39,14 +39,6 @@ fn config(dir: &Path) -> PathBuf {
     cfg
 }
 
-/// Copies `motions.h5` and its checksum sidecar.
-fn copy_motions(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for f in ["motions.h5", "motions.h5.sha256"] {
-        std::fs::copy(from.join(f), to.join(f)).unwrap();
-    }
-}
-
 #[test]
 fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
     let dir = tempfile::tempdir().unwrap();
@@ -57,7 +49,7 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
 
     // Reference: one uninterrupted run on two threads.
     let reference = dir.path().join("ref");
-    copy_motions(&out, &reference);
+    common::copy_motions(&out, &reference);
     ok(slidestack(
         &["sweep", cfg_s, "--out", reference.to_str().unwrap()],
         "2",
@@ -66,7 +58,7 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
 
     // Killed with SIGKILL once some units are on disk, then resumed.
     let killed = dir.path().join("killed");
-    copy_motions(&out, &killed);
+    common::copy_motions(&out, &killed);
     let mut child = Command::new(env!("CARGO_BIN_EXE_slidestack"))
         .args(["sweep", cfg_s, "--out", killed.to_str().unwrap()])
         .env("RAYON_NUM_THREADS", "1")
@@ -110,7 +102,7 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
 
     // Three shards on one thread each, then merge.
     let sharded = dir.path().join("sharded");
-    copy_motions(&out, &sharded);
+    common::copy_motions(&out, &sharded);
     let s = sharded.to_str().unwrap();
     for k in ["1/3", "3/3"] {
         ok(slidestack(&["sweep", cfg_s, "--out", s, "--shard", k], "1"));

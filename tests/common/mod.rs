@@ -3,12 +3,20 @@
 #![allow(clippy::needless_range_loop)]
 
 use slidestack::motion::{Record, read_record};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/fixtures/records")
         .join(name)
+}
+
+/// Copies a study's `motions.h5` and its checksum sidecar from one output directory to another.
+pub fn copy_motions(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for f in ["motions.h5", "motions.h5.sha256"] {
+        std::fs::copy(from.join(f), to.join(f)).unwrap();
+    }
 }
 
 /// The committed real records (PROVENANCE.md beside them).
