@@ -102,6 +102,20 @@ pub const MAX_RK4_SUBSTEPS: usize = 100_000;
 /// margin keeps the damped structure safely inside.
 pub const RK4_MAX_OMEGA_STEP: f64 = 2.5;
 
+/// Storeys of a building. Each contact and yield state of a building needs the eigenvectors of
+/// its `2N × 2N` state matrix (`O(N³)`, cached per state) and every piece evaluates `O(N²)`
+/// modal terms: at 60 storeys a run of a real record takes seconds to minutes; shear buildings
+/// of more storeys are beyond what a shear model describes anyway.
+pub const MAX_STOREYS: usize = 60;
+
+/// Stacks in one building (any number may share a floor; each is a chain of up to
+/// [`MAX_BLOCKS`]): the contact state is chosen floor by floor over all of a floor's stacks.
+pub const MAX_STACKS: usize = 64;
+
+/// A building's relative floor masses and storey stiffnesses: within `1e-6 … 1e6` of each other
+/// (a ratio of `1e12` between two storeys makes the modes of the stiff one round-off).
+pub const STOREY_RATIO_RANGE: (f64, f64) = (1e-6, 1e6);
+
 /// Nesting depth of a YAML config (the study's is 4).
 pub const MAX_YAML_DEPTH: usize = 32;
 

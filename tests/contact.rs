@@ -237,3 +237,265 @@ fn progressive_release_sticks_when_static_friction_can_hold() {
         assert!((f[0] - expected_force).abs() < 1e-12);
     }
 }
+
+/// A floor with several stacks: body 0 the floor, interface `i` under body `i + 1` and above
+/// `below[i]`.
+struct Tree {
+    st: State,
+    below: Vec<usize>,
+}
+
+/// Forces and relative accelerations of a full pattern on a tree, cluster by cluster: a
+/// cluster's acceleration is its net known force over its mass; a stuck interface carries what
+/// moves the part of its cluster above it (and what that part's slipping interfaces pull).
+fn evaluate_tree(t: &Tree, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
+    let (st, n) = (&t.st, pattern.len());
+    let mut force = vec![0.0; n];
+    for i in 0..n {
+        if let Contact::Slip(d) = pattern[i] {
+            force[i] = -st.lim_k[i] * f64::from(d);
+        }
+    }
+    // Cluster of each body: the lowest body reached through stuck interfaces.
+    let mut cluster: Vec<usize> = (0..=n).collect();
+    for i in 0..n {
+        if pattern[i] == Contact::Stick {
+            cluster[i + 1] = cluster[t.below[i]];
+        }
+    }
+    let net = |b: usize, force: &[f64]| {
+        let mut e = st.external[b];
+        if b > 0 && pattern[b - 1] != Contact::Stick {
+            e += force[b - 1];
+        }
+        for i in 0..n {
+            if t.below[i] == b && pattern[i] != Contact::Stick {
+                e -= force[i];
+            }
+        }
+        e
+    };
+    let mut accel = vec![0.0; n + 1];
+    for c in 0..=n {
+        let members: Vec<usize> = (0..=n).filter(|&b| cluster[b] == c).collect();
+        if members.is_empty() {
+            continue;
+        }
+        let mass: f64 = members.iter().map(|&b| st.masses[b]).sum();
+        let f: f64 = members.iter().map(|&b| net(b, &force)).sum();
+        for &b in &members {
+            accel[b] = f / mass;
+        }
+    }
+    // A stuck interface: the bodies above it in its cluster (its subtree) need m·a − net.
+    for i in (0..n).rev() {
+        if pattern[i] != Contact::Stick {
+            continue;
+        }
+        let mut subtree = vec![i + 1];
+        for j in i + 1..n {
+            if pattern[j] == Contact::Stick && subtree.contains(&t.below[j]) {
+                subtree.push(j + 1);
+            }
+        }
+        force[i] = subtree
+            .iter()
+            .map(|&b| st.masses[b] * accel[b] - net(b, &force))
+            .sum();
+    }
+    let rel = (0..n).map(|i| accel[i + 1] - accel[t.below[i]]).collect();
+    (force, rel)
+}
+
+fn consistent_tree(t: &Tree, pattern: &[Contact], tol: f64) -> bool {
+    let (force, rel) = evaluate_tree(t, pattern);
+    let st = &t.st;
+    pattern
+        .iter()
+        .enumerate()
+        .all(|(i, c)| match (st.given[i], *c) {
+            (Contact::Stick, Contact::Stick) => force[i].abs() <= st.lim_s[i] * (1.0 + tol),
+            (Contact::Stick, Contact::Slip(d)) => {
+                let scale = st.lim_s[i] / st.masses[i + 1].min(st.masses[t.below[i]]) + 1e-300;
+                f64::from(d) * rel[i] > -tol * scale
+            }
+            (g, c) => g == c,
+        })
+}
+
+/// Two to three stacks of one to three blocks on a floor.
+fn random_tree(rng: &mut Rng, static_gap: bool) -> Tree {
+    let stacks = 2 + rng.below(2);
+    let mut below = Vec::new();
+    for _ in 0..stacks {
+        let blocks = 1 + rng.below(3);
+        for b in 0..blocks {
+            let i = below.len();
+            below.push(if b == 0 { 0 } else { i });
+        }
+    }
+    let n = below.len();
+    let masses: Vec<f64> = (0..=n).map(|_| rng.log_range(0.01, 10.0)).collect();
+    let (mut lim_s, mut lim_k, mut given) = (vec![], vec![], vec![]);
+    for i in 0..n {
+        // Normal force: the block and everything stacked on it.
+        let mut above = vec![i + 1];
+        for j in i + 1..n {
+            if above.contains(&below[j]) {
+                above.push(j + 1);
+            }
+        }
+        let normal: f64 = G * above.iter().map(|&b| masses[b]).sum::<f64>();
+        let mu_k = rng.range(0.02, 0.8);
+        let mu_s = if static_gap {
+            mu_k * rng.range(1.0, 2.0)
+        } else {
+            mu_k
+        };
+        lim_k.push(mu_k * normal);
+        lim_s.push(mu_s * normal);
+        given.push(match rng.below(4) {
+            0 => Contact::Slip(if rng.unit() < 0.5 { 1 } else { -1 }),
+            _ => Contact::Stick,
+        });
+    }
+    let external = masses.iter().map(|m| m * G * 0.6 * rng.normal()).collect();
+    Tree {
+        st: State {
+            masses,
+            external,
+            lim_s,
+            lim_k,
+            given,
+        },
+        below,
+    }
+}
+
+fn select_tree(t: &Tree) -> Vec<Contact> {
+    let st = &t.st;
+    let n = st.given.len();
+    let mut contacts = st.given.clone();
+    let mut force = vec![0.0; n];
+    ContactSelector::new(n)
+        .select_tree(
+            &t.below,
+            &st.masses,
+            &st.external,
+            &st.lim_s,
+            &st.lim_k,
+            &mut contacts,
+            &mut force,
+        )
+        .unwrap();
+    let (f_ref, _) = evaluate_tree(t, &contacts);
+    let scale = st
+        .lim_s
+        .iter()
+        .chain(st.external.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    for i in 0..n {
+        assert!(
+            (force[i] - f_ref[i]).abs() <= 1e-9 * scale,
+            "force {i}: {} vs {}",
+            force[i],
+            f_ref[i]
+        );
+    }
+    contacts
+}
+
+/// Several stacks on one floor, `μ_s = μ_k`: the unique consistent pattern over all of them,
+/// found by brute force over every stick/slip pattern, is the one chosen.
+#[test]
+fn several_stacks_on_a_floor_get_the_unique_consistent_pattern() {
+    let mut rng = Rng::new(23);
+    let (mut checked, mut skipped, mut coupled) = (0, 0, 0);
+    for _ in 0..3000 {
+        let t = random_tree(&mut rng, false);
+        let patterns = all_patterns(&t.st.given);
+        let loose: Vec<_> = patterns
+            .iter()
+            .filter(|p| consistent_tree(&t, p, 1e-9))
+            .collect();
+        let strict = patterns
+            .iter()
+            .filter(|p| consistent_tree(&t, p, -1e-12))
+            .count();
+        if loose.len() != 1 || strict != 1 {
+            skipped += 1;
+            continue;
+        }
+        let chosen = select_tree(&t);
+        assert_eq!(
+            &chosen, loose[0],
+            "below {:?} given {:?}",
+            t.below, t.st.given
+        );
+        // Count states where two stacks' first interfaces both take part (the floor couples).
+        let firsts: Vec<usize> = (0..t.below.len()).filter(|&i| t.below[i] == 0).collect();
+        if firsts
+            .iter()
+            .filter(|&&i| t.st.given[i] == Contact::Stick)
+            .count()
+            >= 2
+        {
+            coupled += 1;
+        }
+        checked += 1;
+    }
+    assert!(skipped * 50 <= checked, "{skipped} near-ties of {checked}");
+    assert!(coupled > 500, "coupled states: {coupled}");
+}
+
+/// `μ_s > μ_k` on several stacks: the chosen pattern is always among the consistent ones.
+#[test]
+fn several_stacks_with_a_static_gap_get_a_consistent_pattern() {
+    let mut rng = Rng::new(29);
+    for _ in 0..3000 {
+        let t = random_tree(&mut rng, true);
+        let chosen = select_tree(&t);
+        assert!(
+            consistent_tree(&t, &chosen, 1e-9),
+            "chosen {chosen:?} inconsistent for {:?} below {:?}",
+            t.st.given,
+            t.below
+        );
+    }
+}
+
+/// On a chain the tree selector is the chain selector, bit for bit.
+#[test]
+fn the_tree_selector_on_a_chain_is_the_chain_selector() {
+    let mut rng = Rng::new(31);
+    for _ in 0..2000 {
+        let gap = rng.unit() < 0.5;
+        let st = random_state(&mut rng, gap);
+        let n = st.given.len();
+        let below: Vec<usize> = (0..n).collect();
+        let (mut c1, mut c2) = (st.given.clone(), st.given.clone());
+        let (mut f1, mut f2) = (vec![0.0; n], vec![0.0; n]);
+        let mut sel = ContactSelector::new(n);
+        sel.select(
+            &st.masses,
+            &st.external,
+            &st.lim_s,
+            &st.lim_k,
+            &mut c1,
+            &mut f1,
+        )
+        .unwrap();
+        sel.select_tree(
+            &below,
+            &st.masses,
+            &st.external,
+            &st.lim_s,
+            &st.lim_k,
+            &mut c2,
+            &mut f2,
+        )
+        .unwrap();
+        assert_eq!(c1, c2);
+        assert_eq!(f1, f2);
+    }
+}

@@ -20,6 +20,9 @@
 //! `4p + 4` rounds for `p` interfaces), the kinetic solution (all bounds at `μ_k·N`) is taken: it
 //! is always consistent. With `μ_s = μ_k` the first solve is final and the pattern unique.
 
+// Parallel per-interface arrays read best with index loops.
+#![allow(clippy::needless_range_loop)]
+
 use thiserror::Error;
 
 /// State of one interface.
@@ -65,6 +68,32 @@ pub struct ContactSelector {
     off: Vec<f64>,
     rhs: Vec<f64>,
     released: Vec<bool>,
+    /// The interfaces of the segment being solved, ascending (a tree's; a chain's are
+    /// `i0..i1`).
+    seg: Vec<usize>,
+    /// Dense workspace of a tree segment's Newton step, and the bodies' accelerations.
+    dense: Vec<f64>,
+    accel: Vec<f64>,
+}
+
+/// How the bodies hang together: body 0 at the bottom, interface `i` (0-based) under body
+/// `i + 1` and above body `lower(i)`.
+#[derive(Debug, Clone, Copy)]
+enum Shape<'a> {
+    /// `lower(i) = i`: a stack on a structure.
+    Chain,
+    /// `lower(i) = below[i] < i + 1`: several stacks on one floor (body 0).
+    Tree(&'a [usize]),
+}
+
+impl Shape<'_> {
+    #[inline]
+    fn lower(self, i: usize) -> usize {
+        match self {
+            Shape::Chain => i,
+            Shape::Tree(b) => b[i],
+        }
+    }
 }
 
 impl ContactSelector {
@@ -81,10 +110,13 @@ impl ContactSelector {
             off: z.clone(),
             rhs: z,
             released: vec![false; blocks],
+            seg: Vec::with_capacity(blocks),
+            dense: Vec::new(),
+            accel: vec![0.0; blocks + 1],
         }
     }
 
-    /// Chooses the contact state and friction force of every interface.
+    /// Chooses the contact state and friction force of every interface of a stack.
     ///
     /// * `masses`: `[m_p, m_1, …, m_n]`, kg.
     /// * `external`: force on each body from everything but interface friction, N.
@@ -102,6 +134,58 @@ impl ContactSelector {
         contacts: &mut [Contact],
         force: &mut [f64],
     ) -> Result<(), ContactError> {
+        self.select_shaped(
+            Shape::Chain,
+            masses,
+            external,
+            limit_static,
+            limit_kinetic,
+            contacts,
+            force,
+        )
+    }
+
+    /// [`ContactSelector::select`] for a tree: body 0 (a floor) carries several stacks.
+    /// Interface `i` lies under body `i + 1` and above body `below[i]` (`< i + 1`); the rule is
+    /// the same (the module doc), solved over every stack of the floor together.
+    #[allow(clippy::too_many_arguments)]
+    pub fn select_tree(
+        &mut self,
+        below: &[usize],
+        masses: &[f64],
+        external: &[f64],
+        limit_static: &[f64],
+        limit_kinetic: &[f64],
+        contacts: &mut [Contact],
+        force: &mut [f64],
+    ) -> Result<(), ContactError> {
+        let shape = if below.iter().enumerate().all(|(i, &b)| b == i) {
+            Shape::Chain
+        } else {
+            Shape::Tree(below)
+        };
+        self.select_shaped(
+            shape,
+            masses,
+            external,
+            limit_static,
+            limit_kinetic,
+            contacts,
+            force,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn select_shaped(
+        &mut self,
+        shape: Shape,
+        masses: &[f64],
+        external: &[f64],
+        limit_static: &[f64],
+        limit_kinetic: &[f64],
+        contacts: &mut [Contact],
+        force: &mut [f64],
+    ) -> Result<(), ContactError> {
         let n = contacts.len();
         for i in 0..n {
             force[i] = match contacts[i] {
@@ -109,91 +193,137 @@ impl ContactSelector {
                 _ => 0.0,
             };
         }
-        // Segments: maximal runs of zero-velocity interfaces i0..i1 (0-based interface indices,
-        // interface index i sits between bodies i and i+1).
-        let mut i = 0;
-        while i < n {
-            if contacts[i] != Contact::Stick {
-                i += 1;
-                continue;
+        let lim = Limits {
+            external,
+            limit_static,
+            limit_kinetic,
+        };
+        match shape {
+            Shape::Chain => {
+                // Segments: maximal runs of zero-velocity interfaces i0..i1 (interface index i
+                // sits between bodies i and i+1).
+                let mut i = 0;
+                while i < n {
+                    if contacts[i] != Contact::Stick {
+                        i += 1;
+                        continue;
+                    }
+                    let i0 = i;
+                    while i < n && contacts[i] == Contact::Stick {
+                        i += 1;
+                    }
+                    self.seg.clear();
+                    self.seg.extend(i0..i);
+                    self.solve_segment(shape, masses, &lim, contacts, force)?;
+                }
             }
-            let i0 = i;
-            while i < n && contacts[i] == Contact::Stick {
-                i += 1;
+            Shape::Tree(below) => {
+                // Segments: the connected sets of zero-velocity interfaces (joined through a
+                // shared body), each found from its lowest interface.
+                let mut done = vec![false; n];
+                for start in 0..n {
+                    if done[start] || contacts[start] != Contact::Stick {
+                        continue;
+                    }
+                    self.seg.clear();
+                    self.seg.push(start);
+                    done[start] = true;
+                    for i in start + 1..n {
+                        if done[i] || contacts[i] != Contact::Stick {
+                            continue;
+                        }
+                        let b = below[i];
+                        let joined = self.seg.iter().any(|&j| j + 1 == b || below[j] == b);
+                        if joined {
+                            self.seg.push(i);
+                            done[i] = true;
+                        }
+                    }
+                    self.solve_segment(shape, masses, &lim, contacts, force)?;
+                }
             }
-            self.solve_segment(
-                masses,
-                external,
-                limit_static,
-                limit_kinetic,
-                i0,
-                i,
-                contacts,
-                force,
-            )?;
         }
         Ok(())
     }
 
-    /// Interfaces `i0..i1` (0-based) are all at zero relative velocity; bodies `i0..=i1` form the
-    /// segment. Forces of the interfaces bounding the segment are already in `force`.
-    #[allow(clippy::too_many_arguments)]
+    /// The interfaces in `self.seg` are all at zero relative velocity; with the bodies they
+    /// join they form the segment. Forces of the interfaces bounding it are already in `force`.
     fn solve_segment(
         &mut self,
+        shape: Shape,
         masses: &[f64],
-        external: &[f64],
-        limit_static: &[f64],
-        limit_kinetic: &[f64],
-        i0: usize,
-        i1: usize,
+        lim: &Limits,
         contacts: &mut [Contact],
         force: &mut [f64],
     ) -> Result<(), ContactError> {
-        let p = i1 - i0;
+        let p = self.seg.len();
+        let (first, last) = (self.seg[0] + 1, self.seg[p - 1] + 1);
+        let in_seg = |seg: &[usize], i: usize| match shape {
+            Shape::Chain => i >= seg[0] && i <= seg[seg.len() - 1],
+            Shape::Tree(_) => seg.contains(&i),
+        };
         // Known force on body j of the segment: external plus bounding kinetic friction.
-        let known = |j: usize, force: &[f64]| -> f64 {
-            let mut e = external[j];
-            if j == i0 && j > 0 {
-                e += force[j - 1];
-            }
-            if j == i1 && j < force.len() {
-                e -= force[j];
+        let known = |seg: &[usize], j: usize, force: &[f64]| -> f64 {
+            let mut e = lim.external[j];
+            match shape {
+                Shape::Chain => {
+                    if j == seg[0] && j > 0 {
+                        e += force[j - 1];
+                    }
+                    if j == seg[seg.len() - 1] + 1 && j < force.len() {
+                        e -= force[j];
+                    }
+                }
+                Shape::Tree(below) => {
+                    if j > 0 && !in_seg(seg, j - 1) {
+                        e += force[j - 1];
+                    }
+                    for (i, &b) in below.iter().enumerate() {
+                        if b == j && !in_seg(seg, i) {
+                            e -= force[i];
+                        }
+                    }
+                }
             }
             e
         };
         let mut scale = 0.0f64;
-        for j in i0..=i1 {
-            scale = scale.max(known(j, force).abs());
+        for k in 0..p {
+            let i = self.seg[k];
+            for j in [shape.lower(i), i + 1] {
+                scale = scale.max(known(&self.seg, j, force).abs());
+            }
         }
         for k in 0..p {
+            let i = self.seg[k];
             self.released[k] = false;
-            self.lo[k] = -limit_static[i0 + k];
-            self.hi[k] = limit_static[i0 + k];
-            scale = scale.max(limit_static[i0 + k]);
+            self.lo[k] = -lim.limit_static[i];
+            self.hi[k] = lim.limit_static[i];
+            scale = scale.max(lim.limit_static[i]);
         }
+        let seg = std::mem::take(&mut self.seg);
+        let known_now = |j: usize| known(&seg, j, force);
         let mut rounds = 0;
         loop {
-            self.active_set(masses, i0, p, |j| known(j, force), scale)
-                .ok_or(ContactError::NoConvergence {
-                    first: i0 + 1,
-                    last: i1,
-                })?;
+            self.active_set(shape, masses, &seg, known_now, scale)
+                .ok_or(ContactError::NoConvergence { first, last })?;
             // Release every force pinned at a static bound while its relative acceleration
             // pushes beyond it; reopen a released one whose slip the others have reversed
             // (progressive release; see the module doc).
             let mut changed = false;
             for k in 0..p {
-                let tol = release_tolerance(masses, external, limit_static, i0 + k);
+                let i = seg[k];
+                let tol = release_tolerance(shape, masses, lim, i);
                 let push = f64::from(self.active[k]) * self.grad[k];
                 if self.released[k] {
                     if push > tol {
-                        self.lo[k] = -limit_static[i0 + k];
-                        self.hi[k] = limit_static[i0 + k];
+                        self.lo[k] = -lim.limit_static[i];
+                        self.hi[k] = lim.limit_static[i];
                         self.released[k] = false;
                         changed = true;
                     }
                 } else if self.active[k] != 0 && push < -tol {
-                    let fk = f64::from(self.active[k]) * limit_kinetic[i0 + k];
+                    let fk = f64::from(self.active[k]) * lim.limit_kinetic[i];
                     self.lo[k] = fk;
                     self.hi[k] = fk;
                     self.released[k] = true;
@@ -208,16 +338,13 @@ impl ContactSelector {
                 // Release and reopening cycle: fall back to the kinetic solution, which is
                 // always Coulomb-consistent (stuck forces within μ_k·N ≤ μ_s·N).
                 for k in 0..p {
-                    self.lo[k] = -limit_kinetic[i0 + k];
-                    self.hi[k] = limit_kinetic[i0 + k];
+                    self.lo[k] = -lim.limit_kinetic[seg[k]];
+                    self.hi[k] = lim.limit_kinetic[seg[k]];
                 }
-                self.active_set(masses, i0, p, |j| known(j, force), scale)
-                    .ok_or(ContactError::NoConvergence {
-                        first: i0 + 1,
-                        last: i1,
-                    })?;
+                self.active_set(shape, masses, &seg, known_now, scale)
+                    .ok_or(ContactError::NoConvergence { first, last })?;
                 for k in 0..p {
-                    let tol = release_tolerance(masses, external, limit_static, i0 + k);
+                    let tol = release_tolerance(shape, masses, lim, seg[k]);
                     self.released[k] =
                         self.active[k] != 0 && f64::from(self.active[k]) * self.grad[k] < -tol;
                 }
@@ -225,7 +352,7 @@ impl ContactSelector {
             }
         }
         for k in 0..p {
-            let i = i0 + k;
+            let i = seg[k];
             force[i] = self.f[k];
             contacts[i] = if self.released[k] {
                 // Force +μ_k·N (lower body drags the upper forward) means the upper body lags:
@@ -235,23 +362,138 @@ impl ContactSelector {
                 Contact::Stick
             };
         }
+        self.seg = seg;
         Ok(())
     }
 
     /// Relative accelerations `ṡ_k = ∂Φ/∂f_k` of the segment at the current forces.
-    fn gradient(&mut self, masses: &[f64], i0: usize, p: usize, known: &impl Fn(usize) -> f64) {
-        let accel = |j: usize, f: &[f64]| -> f64 {
-            // body j = i0 + jj; interfaces below/above are k = jj-1 and k = jj.
-            let jj = j - i0;
-            let below = if jj > 0 { f[jj - 1] } else { 0.0 };
-            let above = if jj < p { f[jj] } else { 0.0 };
-            (known(j) + below - above) / masses[j]
-        };
-        let mut prev = accel(i0, &self.f);
-        for k in 0..p {
-            let next = accel(i0 + k + 1, &self.f);
-            self.grad[k] = next - prev;
-            prev = next;
+    fn gradient(
+        &mut self,
+        shape: Shape,
+        masses: &[f64],
+        seg: &[usize],
+        known: &impl Fn(usize) -> f64,
+    ) {
+        let p = seg.len();
+        match shape {
+            Shape::Chain => {
+                let i0 = seg[0];
+                let accel = |j: usize, f: &[f64]| -> f64 {
+                    // body j = i0 + jj; interfaces below/above are k = jj-1 and k = jj.
+                    let jj = j - i0;
+                    let below = if jj > 0 { f[jj - 1] } else { 0.0 };
+                    let above = if jj < p { f[jj] } else { 0.0 };
+                    (known(j) + below - above) / masses[j]
+                };
+                let mut prev = accel(i0, &self.f);
+                for k in 0..p {
+                    let next = accel(i0 + k + 1, &self.f);
+                    self.grad[k] = next - prev;
+                    prev = next;
+                }
+            }
+            Shape::Tree(below) => {
+                // Every body the segment touches: net force over mass.
+                let bodies = self.accel.len();
+                for j in 0..bodies {
+                    self.accel[j] = f64::NAN;
+                }
+                for k in 0..p {
+                    for j in [below[seg[k]], seg[k] + 1] {
+                        if !self.accel[j].is_nan() {
+                            continue;
+                        }
+                        let mut e = known(j);
+                        for (kk, &i) in seg.iter().enumerate() {
+                            if i + 1 == j {
+                                e += self.f[kk];
+                            }
+                            if below[i] == j {
+                                e -= self.f[kk];
+                            }
+                        }
+                        self.accel[j] = e / masses[j];
+                    }
+                }
+                for k in 0..p {
+                    let i = seg[k];
+                    self.grad[k] = self.accel[i + 1] - self.accel[below[i]];
+                }
+            }
+        }
+    }
+
+    /// The Newton direction on the free forces, `H_FF·d_F = −grad_F`, `d_W = 0`, into
+    /// `self.dir`. `H` is the Hessian of the dual: `∂ṡ_k/∂f_l`.
+    fn newton(&mut self, shape: Shape, masses: &[f64], seg: &[usize]) {
+        let p = seg.len();
+        match shape {
+            Shape::Chain => {
+                let i0 = seg[0];
+                for k in 0..p {
+                    let m_lo = masses[i0 + k];
+                    let m_hi = masses[i0 + k + 1];
+                    if self.active[k] != 0 {
+                        self.diag[k] = 1.0;
+                        self.rhs[k] = 0.0;
+                    } else {
+                        self.diag[k] = 1.0 / m_lo + 1.0 / m_hi;
+                        self.rhs[k] = -self.grad[k];
+                    }
+                    // Coupling between k and k+1 is −1/m of the body between them.
+                    self.off[k] = if k + 1 < p && self.active[k] == 0 && self.active[k + 1] == 0 {
+                        -1.0 / m_hi
+                    } else {
+                        0.0
+                    };
+                }
+                thomas(
+                    &mut self.diag[..p],
+                    &self.off[..p],
+                    &mut self.rhs[..p],
+                    &mut self.dir[..p],
+                );
+            }
+            Shape::Tree(below) => {
+                // H_kl = Σ_bodies D_bk·D_bl/m_b, D_bk = +1 for the body above interface k, −1
+                // for the body below it.
+                self.dense.clear();
+                self.dense.resize(p * p, 0.0);
+                for k in 0..p {
+                    let (ik, jk) = (seg[k], below[seg[k]]);
+                    for l in 0..p {
+                        let (il, jl) = (seg[l], below[seg[l]]);
+                        let mut h = 0.0;
+                        for (b, sb) in [(ik + 1, 1.0), (jk, -1.0)] {
+                            for (c, sc) in [(il + 1, 1.0), (jl, -1.0)] {
+                                if b == c {
+                                    h += sb * sc / masses[b];
+                                }
+                            }
+                        }
+                        let free = self.active[k] == 0 && self.active[l] == 0;
+                        self.dense[k * p + l] = if k == l && !free {
+                            1.0
+                        } else if free {
+                            h
+                        } else {
+                            0.0
+                        };
+                    }
+                    self.rhs[k] = if self.active[k] == 0 {
+                        -self.grad[k]
+                    } else {
+                        0.0
+                    };
+                }
+                crate::numeric::cholesky_solve(
+                    &mut self.dense,
+                    &mut self.rhs[..p],
+                    p,
+                    f64::MIN_POSITIVE,
+                );
+                self.dir[..p].copy_from_slice(&self.rhs[..p]);
+            }
         }
     }
 
@@ -260,12 +502,13 @@ impl ContactSelector {
     /// accelerations in `self.grad`. `None` if it fails to terminate (non-finite input).
     fn active_set(
         &mut self,
+        shape: Shape,
         masses: &[f64],
-        i0: usize,
-        p: usize,
+        seg: &[usize],
         known: impl Fn(usize) -> f64,
         scale: f64,
     ) -> Option<()> {
+        let p = seg.len();
         for k in 0..p {
             self.f[k] = 0.0f64.clamp(self.lo[k], self.hi[k]);
             self.active[k] = if self.lo[k] == self.hi[k] {
@@ -276,31 +519,8 @@ impl ContactSelector {
         }
         let max_iter = 50 * (p + 2);
         for _ in 0..max_iter {
-            self.gradient(masses, i0, p, &known);
-            // Newton direction on the free variables: H_FF·d_F = −grad_F, d_W = 0.
-            for k in 0..p {
-                let m_lo = masses[i0 + k];
-                let m_hi = masses[i0 + k + 1];
-                if self.active[k] != 0 {
-                    self.diag[k] = 1.0;
-                    self.rhs[k] = 0.0;
-                } else {
-                    self.diag[k] = 1.0 / m_lo + 1.0 / m_hi;
-                    self.rhs[k] = -self.grad[k];
-                }
-                // Coupling between k and k+1 is −1/m of the body between them.
-                self.off[k] = if k + 1 < p && self.active[k] == 0 && self.active[k + 1] == 0 {
-                    -1.0 / m_hi
-                } else {
-                    0.0
-                };
-            }
-            thomas(
-                &mut self.diag[..p],
-                &self.off[..p],
-                &mut self.rhs[..p],
-                &mut self.dir[..p],
-            );
+            self.gradient(shape, masses, seg, &known);
+            self.newton(shape, masses, seg);
             let mut step = 1.0;
             let mut block = None;
             for k in 0..p {
@@ -335,7 +555,7 @@ impl ContactSelector {
                 continue;
             }
             // Subspace optimum: check the multipliers of the pinned forces.
-            self.gradient(masses, i0, p, &known);
+            self.gradient(shape, masses, seg, &known);
             let mut worst = None;
             let mut worst_val = 0.0;
             for k in 0..p {
@@ -344,7 +564,8 @@ impl ContactSelector {
                 }
                 // At the upper bound optimality needs grad ≤ 0, at the lower grad ≥ 0.
                 let wrong = f64::from(self.active[k]) * self.grad[k];
-                let tol = 1e-15 * scale * (1.0 / masses[i0 + k] + 1.0 / masses[i0 + k + 1]);
+                let i = seg[k];
+                let tol = 1e-15 * scale * (1.0 / masses[shape.lower(i)] + 1.0 / masses[i + 1]);
                 if wrong > tol && wrong > worst_val {
                     worst_val = wrong;
                     worst = Some(k);
@@ -359,11 +580,19 @@ impl ContactSelector {
     }
 }
 
+/// The forces a selection is given.
+struct Limits<'a> {
+    external: &'a [f64],
+    limit_static: &'a [f64],
+    limit_kinetic: &'a [f64],
+}
+
 /// Relative acceleration below which interface `i` (0-based) pinned at its bound counts as not
 /// pushing: round-off of the forces acting on its two bodies.
-fn release_tolerance(masses: &[f64], external: &[f64], limit_static: &[f64], i: usize) -> f64 {
-    let force = limit_static[i] + external[i].abs() + external[i + 1].abs();
-    1e-11 * force * (1.0 / masses[i] + 1.0 / masses[i + 1])
+fn release_tolerance(shape: Shape, masses: &[f64], lim: &Limits, i: usize) -> f64 {
+    let j = shape.lower(i);
+    let force = lim.limit_static[i] + lim.external[j].abs() + lim.external[i + 1].abs();
+    1e-11 * force * (1.0 / masses[j] + 1.0 / masses[i + 1])
 }
 
 /// Solves a symmetric tridiagonal system in place: `diag` on the diagonal, `off[k]` coupling

@@ -39,12 +39,14 @@
 //! read it at rest); `yield_events == 0` means the structure stayed elastic. Neither model has
 //! negative stiffness, so a collapse criterion must be a ductility or drift cap.
 
+pub mod building;
 pub mod closed_form;
 pub mod contact;
 pub mod exact;
 pub mod model;
 pub mod response;
 pub mod rk4;
+pub(crate) mod search;
 
 pub use contact::{Contact, ContactSelector};
 pub use exact::{ExactOptions, simulate_exact};
@@ -99,6 +101,9 @@ pub enum SimError {
     },
     #[error("the response is not finite (the integration diverged)")]
     Diverged,
+    /// A building's contact and yield state that the modal solution cannot represent.
+    #[error("{0}")]
+    Modal(String),
     #[error(transparent)]
     Contact(#[from] contact::ContactError),
 }

@@ -30,12 +30,28 @@ impl Cx {
             (self.1 * o.0 - self.0 * o.1) / den,
         )
     }
-    fn add(self, o: Cx) -> Cx {
+    pub fn add(self, o: Cx) -> Cx {
         Cx(self.0 + o.0, self.1 + o.1)
+    }
+    pub fn sub(self, o: Cx) -> Cx {
+        Cx(self.0 - o.0, self.1 - o.1)
+    }
+    pub fn scale(self, s: f64) -> Cx {
+        Cx(self.0 * s, self.1 * s)
+    }
+    /// `|x|`.
+    pub fn abs(self) -> f64 {
+        self.0.hypot(self.1)
     }
     /// `|x|²` (cheaper than `hypot` where only a comparison is needed).
     pub fn norm_sqr(self) -> f64 {
         self.0 * self.0 + self.1 * self.1
+    }
+    /// `eˣ`.
+    pub fn exp(self) -> Cx {
+        let e = self.0.exp();
+        let (s, c) = self.1.sin_cos();
+        Cx(e * c, e * s)
     }
 }
 
@@ -85,6 +101,29 @@ pub(crate) fn phi3(x: Cx) -> Cx {
     } else {
         phi2(x).add(Cx(-0.5, 0.0)).div(x)
     }
+}
+
+/// `[eˣ, φ₁(x), φ₂(x), φ₃(x)]` with one exponential, each φ as [`phi1`], [`phi2`], [`phi3`]
+/// compute it (the same branches, the same bits).
+pub(crate) fn exp_phis(x: Cx) -> [Cx; 4] {
+    let e = x.exp();
+    let n2 = x.norm_sqr();
+    let p1 = if n2 < 0.25 {
+        phi_series(x, 1)
+    } else {
+        Cx(e.0 - 1.0, e.1).div(x)
+    };
+    let p2 = if n2 < 1.0 {
+        phi_series(x, 2)
+    } else {
+        p1.add(Cx(-1.0, 0.0)).div(x)
+    };
+    let p3 = if n2 < 4.0 {
+        phi_series(x, 3)
+    } else {
+        p2.add(Cx(-0.5, 0.0)).div(x)
+    };
+    [e, p1, p2, p3]
 }
 
 /// Nodes and weights of 8-point Gauss–Legendre quadrature on `[0, 1]` (the roots of `P₈` by

@@ -1,0 +1,16 @@
+//! A multi-storey shear building carrying stacks of sliding blocks on its floors
+//! (docs/model.md, "A multi-storey building").
+//!
+//! * [`model`]: the building as stated and validated (floors, storeys, stacks, damping matrix).
+//! * `modal`: the floors' exact motion within one contact and yield state.
+//! * [`exact`]: the event-driven integrator ([`simulate_building`]).
+//! * [`response`]: what it returns.
+
+pub mod exact;
+pub(crate) mod modal;
+pub mod model;
+pub mod response;
+
+pub use exact::simulate_building;
+pub use model::{Building, BuildingError, BuildingSpec, ModalBasis, StackSpec, StoreyYielding};
+pub use response::BuildingResponse;

@@ -1,0 +1,576 @@
+//! The building's floors within one contact and yield state (docs/model.md, "A multi-storey
+//! building"): a linear system `M·ü + C·u̇ + K_t·u = −M·1·a_g(t) − d − f_top` with constant `M`
+//! (each floor's mass plus the blocks stuck to it), `C`, `K_t` (each storey's branch
+//! stiffness) and loads, linear in time within a piece.
+//!
+//! Its state `z = (u, u̇)` (floor displacements and velocities relative to the ground) obeys
+//! `ż = A·z + (0, p₀ + p₁·τ)` with `p = −1·a_g − M⁻¹(d + f_top)`. In the eigenvector basis of `A`
+//! (`A = V·Λ·V⁻¹`) every mode is a scalar equation `ẏ_r = λ_r·y_r + β₀ + β₁·τ` with the exact
+//! solution `y_r(τ) = e^{λτ}·y₀ + τφ₁(λτ)·β₀ + τ²φ₂(λτ)·β₁` (Hochbruck & Ostermann 2010), stable
+//! for every `λ`, zero included (an elastic–perfectly plastic storey). Any linear function of the
+//! state (a floor's displacement or absolute acceleration, a storey's drift, a relative velocity)
+//! is `Σ_r w_r·Re(c_r·y_r(τ))` plus a polynomial, and its `k`-th derivative (`k ≥ 2`) is bounded by
+//! `Σ_r w_r·|c_r|·|λ^k·y₀ + λ^{k−1}·β₀ + λ^{k−2}·β₁|·e^{Re λ·τ}`: the bounds the certified searches
+//! need ([`super::super::search`]). A complex pair is kept once with weight 2.
+//!
+//! The eigenvectors: `A` is written in the undamped modes `Φ` of `(K_t, M)` (mass-normalised) and
+//! balanced, `B = [[0, S], [−Ω²S⁻¹, −Φᵀ·C·Φ]]` on `(S·q, q̇)` with `S = diag(ω_r)`, so every entry
+//! is of the size of a frequency; its eigenvalues come from `nalgebra`'s real Schur form and each
+//! eigenvector from two steps of inverse iteration (complex LU at a shift `1e-10·‖B‖` off the
+//! eigenvalue), orthogonalised within a cluster of repeated eigenvalues. `V⁻¹` is an LU solve;
+//! a basis whose eigenvectors are too close to dependent (a defective or nearly defective state
+//! matrix, near critical damping of a mode) is refused with [`ModalError::Defective`].
+
+use super::model::modes;
+use crate::numeric::{Cx, exp_phis};
+use nalgebra::{Complex, DMatrix, DVector, Schur};
+use thiserror::Error;
+
+/// Eigenvectors whose matrix has a condition number above this lose more than about 8 digits;
+/// such a state is refused rather than run.
+pub const MAX_MODAL_CONDITION: f64 = 1e8;
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ModalError {
+    #[error(
+        "the building's state matrix in this contact and yield state has (nearly) coinciding \
+         modes (eigenvector condition number {condition:.1e} > {MAX_MODAL_CONDITION:.0e}, e.g. a \
+         mode at critical damping); this state is not supported: change the damping slightly"
+    )]
+    Defective { condition: f64 },
+    #[error("the eigenvalues of the building's state matrix did not converge")]
+    NoConvergence,
+}
+
+/// The eigenvector basis of one contact and yield state.
+#[derive(Debug, Clone)]
+pub struct StateModes {
+    /// Floors `N`.
+    pub n: usize,
+    /// Kept eigenvalues (one of each complex pair, and the real ones), rad/s.
+    pub lambda: Vec<Cx>,
+    /// 2 for a kept complex pair, 1 for a real mode.
+    pub weight: Vec<f64>,
+    /// `V`: `2N × m` row-major, `z_i = Σ_r w_r·Re(v[i][r]·y_r)`.
+    v: Vec<Cx>,
+    /// Rows of `V⁻¹` for the kept modes: `y = uz·z` (`m × 2N`), `β = up·p` (`m × N`).
+    uz: Vec<Cx>,
+    up: Vec<Cx>,
+    /// `up·1` (`β₁ = −ȧ_g·up_ones`).
+    up_ones: Vec<Cx>,
+    /// `|λ_r|`.
+    abs_lambda: Vec<f64>,
+}
+
+impl StateModes {
+    /// The basis of `M = diag(masses)`, storey stiffnesses `k_t` (N/m, `≥ 0`) and damping
+    /// `c` (row-major `N × N`).
+    pub fn new(masses: &[f64], k_t: &[f64], c: &[f64]) -> Result<Self, ModalError> {
+        let n = masses.len();
+        let (omega2, phi) = modes(masses, k_t);
+        let omega: Vec<f64> = omega2.iter().map(|w| w.max(0.0).sqrt()).collect();
+        let top = omega.iter().copied().fold(0.0, f64::max);
+        let cm = DMatrix::from_row_slice(n, n, c);
+        let c_modal = phi.transpose() * &cm * &phi;
+        let top = top.max(c_modal.amax()).max(1e-300);
+        // Balancing (any positive scale is exact): a mode of little or no stiffness takes a
+        // scale near the largest frequency, so that no entry is a round-off ratio.
+        let s: Vec<f64> = omega.iter().map(|&w| w.max(1e-4 * top)).collect();
+        let dim = 2 * n;
+        let b = DMatrix::from_fn(dim, dim, |r, col| match (r < n, col < n) {
+            (true, true) => 0.0,
+            (true, false) => {
+                if col - n == r {
+                    s[r]
+                } else {
+                    0.0
+                }
+            }
+            (false, true) => {
+                if r - n == col {
+                    -omega2[col].max(0.0) / s[col]
+                } else {
+                    0.0
+                }
+            }
+            (false, false) => -c_modal[(r - n, col - n)],
+        });
+        let (lambda, weight, vb) = eigenvectors(&b)?;
+        let m = lambda.len();
+        // Full V_B (conjugate partners as columns) and its inverse.
+        let mut full = DMatrix::<Complex<f64>>::zeros(dim, dim);
+        let mut col = 0;
+        for r in 0..m {
+            for i in 0..dim {
+                full[(i, col)] = vb[(i, r)];
+            }
+            col += 1;
+            if weight[r] == 2.0 {
+                for i in 0..dim {
+                    full[(i, col)] = vb[(i, r)].conj();
+                }
+                col += 1;
+            }
+        }
+        let norm1 = |a: &DMatrix<Complex<f64>>| {
+            (0..a.ncols())
+                .map(|j| (0..a.nrows()).map(|i| a[(i, j)].norm()).sum::<f64>())
+                .fold(0.0, f64::max)
+        };
+        let inv = full
+            .clone()
+            .lu()
+            .try_inverse()
+            .ok_or(ModalError::Defective {
+                condition: f64::INFINITY,
+            })?;
+        let condition = norm1(&full) * norm1(&inv);
+        if condition.is_nan() || condition > MAX_MODAL_CONDITION {
+            return Err(ModalError::Defective { condition });
+        }
+        // Back to physical coordinates: u = Φ·S⁻¹·w₁, u̇ = Φ·w₂; w₁ = S·ΦᵀM·u, w₂ = ΦᵀM·u̇.
+        let mut v = vec![Cx(0.0, 0.0); dim * m];
+        for r in 0..m {
+            for j in 0..n {
+                let (mut du, mut dv) = (Complex::new(0.0, 0.0), Complex::new(0.0, 0.0));
+                for q in 0..n {
+                    du += vb[(q, r)] * (phi[(j, q)] / s[q]);
+                    dv += vb[(n + q, r)] * phi[(j, q)];
+                }
+                v[j * m + r] = Cx(du.re, du.im);
+                v[(n + j) * m + r] = Cx(dv.re, dv.im);
+            }
+        }
+        // Rows of the inverse for the kept modes: the kept column order of `full`.
+        let mut kept_rows = Vec::with_capacity(m);
+        let mut col = 0;
+        for &w in &weight {
+            kept_rows.push(col);
+            col += if w == 2.0 { 2 } else { 1 };
+        }
+        let mut uz = vec![Cx(0.0, 0.0); m * dim];
+        let mut up = vec![Cx(0.0, 0.0); m * n];
+        for (r, &row) in kept_rows.iter().enumerate() {
+            for j in 0..n {
+                let (mut gu, mut gv) = (Complex::new(0.0, 0.0), Complex::new(0.0, 0.0));
+                for q in 0..n {
+                    let pm = phi[(j, q)] * masses[j];
+                    gu += inv[(row, q)] * (s[q] * pm);
+                    gv += inv[(row, n + q)] * pm;
+                }
+                uz[r * dim + j] = Cx(gu.re, gu.im);
+                uz[r * dim + n + j] = Cx(gv.re, gv.im);
+                up[r * n + j] = Cx(gv.re, gv.im);
+            }
+        }
+        let up_ones = (0..m)
+            .map(|r| (0..n).map(|j| up[r * n + j]).fold(Cx(0.0, 0.0), Cx::add))
+            .collect();
+        let lambda: Vec<Cx> = lambda.iter().map(|l| Cx(l.re, l.im)).collect();
+        let abs_lambda = lambda.iter().map(|l| l.abs()).collect();
+        Ok(Self {
+            n,
+            lambda,
+            weight,
+            v,
+            uz,
+            up,
+            up_ones,
+            abs_lambda,
+        })
+    }
+
+    /// Kept modes `m`.
+    pub fn modes(&self) -> usize {
+        self.lambda.len()
+    }
+
+    /// Row `i` of `V` (state component `i`: `u_j` for `i = j`, `u̇_j` for `i = N + j`).
+    pub fn row(&self, i: usize) -> &[Cx] {
+        let m = self.modes();
+        &self.v[i * m..(i + 1) * m]
+    }
+
+    /// The largest `|λ|`, rad/s.
+    pub fn fastest(&self) -> f64 {
+        self.abs_lambda.iter().copied().fold(0.0, f64::max)
+    }
+
+    /// The piece from state `z` (`2N`) under `p(τ) = p₀ + p₁·1·τ` (`p₀` per floor, m/s²).
+    pub fn piece(&self, z: &[f64], p0: &[f64], p1: f64, out: &mut Piece) {
+        let (m, n, dim) = (self.modes(), self.n, 2 * self.n);
+        out.resize(m);
+        for r in 0..m {
+            let row = &self.uz[r * dim..(r + 1) * dim];
+            let y0 = row
+                .iter()
+                .zip(z)
+                .fold(Cx(0.0, 0.0), |s, (c, &x)| s.add(c.scale(x)));
+            let b0 = self.up[r * n..(r + 1) * n]
+                .iter()
+                .zip(p0)
+                .fold(Cx(0.0, 0.0), |s, (c, &x)| s.add(c.scale(x)));
+            let b1 = self.up_ones[r].scale(p1);
+            let l = self.lambda[r];
+            let q2 = l.mul(l).mul(y0).add(l.mul(b0)).add(b1);
+            out.y0[r] = y0;
+            out.b0[r] = b0;
+            out.b1[r] = b1;
+            out.q2[r] = q2;
+            let a = q2.abs();
+            let al = self.abs_lambda[r];
+            out.mag[r] = [a, al * a, al * al * a];
+        }
+    }
+}
+
+/// Eigenvalues (one per complex pair, Im > 0, then real ones in Schur order), weights and
+/// unit eigenvectors (columns) of the real matrix `b`.
+#[allow(clippy::type_complexity)]
+fn eigenvectors(
+    b: &DMatrix<f64>,
+) -> Result<(Vec<Complex<f64>>, Vec<f64>, DMatrix<Complex<f64>>), ModalError> {
+    let dim = b.nrows();
+    let schur = Schur::try_new(b.clone(), f64::EPSILON, 10_000).ok_or(ModalError::NoConvergence)?;
+    let all = schur.complex_eigenvalues();
+    let scale = b.amax().max(1e-300);
+    let mut lambda = Vec::new();
+    let mut weight = Vec::new();
+    for l in all.iter() {
+        if l.im > 0.0 {
+            lambda.push(*l);
+            weight.push(2.0);
+        } else if l.im == 0.0 {
+            lambda.push(*l);
+            weight.push(1.0);
+        }
+    }
+    let bc = b.map(|x| Complex::new(x, 0.0));
+    let mut vecs = DMatrix::<Complex<f64>>::zeros(dim, lambda.len());
+    let cluster = 1e-6 * scale;
+    for r in 0..lambda.len() {
+        let l = lambda[r];
+        // Earlier eigenvectors of (nearly) the same eigenvalue: the new one is kept apart from
+        // them.
+        let same: Vec<usize> = (0..r)
+            .filter(|&q| (lambda[q] - l).norm() < cluster)
+            .collect();
+        let shift = l + Complex::new(1e-10 * scale, 0.0);
+        let mut a = bc.clone();
+        for i in 0..dim {
+            a[(i, i)] -= shift;
+        }
+        let lu = a.lu();
+        let mut x = DVector::from_fn(dim, |i, _| {
+            Complex::new(1.0 + (i as f64 + 1.0) * 0.618_033_988_749_895 % 1.0, 0.0)
+        });
+        for _ in 0..3 {
+            for &q in &same {
+                let col = vecs.column(q).clone_owned();
+                let d = col.dotc(&x);
+                x -= col * d;
+            }
+            x = lu.solve(&x).ok_or(ModalError::Defective {
+                condition: f64::INFINITY,
+            })?;
+            let norm = x.norm();
+            if !(norm.is_finite() && norm > 0.0) {
+                return Err(ModalError::Defective {
+                    condition: f64::INFINITY,
+                });
+            }
+            x /= Complex::new(norm, 0.0);
+        }
+        if weight[r] == 1.0 {
+            // A real eigenvalue's eigenvector, made real: rotate by the phase of its largest entry.
+            let (imax, _) = x.iter().enumerate().fold((0, 0.0), |best, (i, c)| {
+                if c.norm() > best.1 {
+                    (i, c.norm())
+                } else {
+                    best
+                }
+            });
+            let phase = x[imax] / Complex::new(x[imax].norm(), 0.0);
+            x = x.map(|c| Complex::new((c / phase).re, 0.0));
+            let norm = x.norm();
+            x /= Complex::new(norm, 0.0);
+        }
+        vecs.set_column(r, &x);
+    }
+    Ok((lambda, weight, vecs))
+}
+
+/// One piece's modal coefficients (reused buffers).
+#[derive(Debug, Clone, Default)]
+pub struct Piece {
+    pub y0: Vec<Cx>,
+    pub b0: Vec<Cx>,
+    pub b1: Vec<Cx>,
+    /// `λ²·y₀ + λ·β₀ + β₁`: `y''(τ) = e^{λτ}·q₂`.
+    pub q2: Vec<Cx>,
+    /// `|q₂|·|λ|^{k−2}` for `k = 2, 3, 4`.
+    pub mag: Vec<[f64; 3]>,
+}
+
+impl Piece {
+    fn resize(&mut self, m: usize) {
+        for v in [&mut self.y0, &mut self.b0, &mut self.b1, &mut self.q2] {
+            v.resize(m, Cx(0.0, 0.0));
+        }
+        self.mag.resize(m, [0.0; 3]);
+    }
+}
+
+/// The modal state at one instant of a piece: `y(τ)`, `y'(τ)`, `∫₀^τ y` per kept mode.
+#[derive(Debug, Clone, Default)]
+pub struct ModalPoint {
+    pub tau: f64,
+    pub y: Vec<Cx>,
+    pub dy: Vec<Cx>,
+    pub iy: Vec<Cx>,
+}
+
+impl ModalPoint {
+    pub fn at(&mut self, modes: &StateModes, piece: &Piece, tau: f64) {
+        let m = modes.modes();
+        self.tau = tau;
+        self.y.resize(m, Cx(0.0, 0.0));
+        self.dy.resize(m, Cx(0.0, 0.0));
+        self.iy.resize(m, Cx(0.0, 0.0));
+        for r in 0..m {
+            let [e, p1, p2, p3] = mode_terms(modes.lambda[r], tau);
+            let (y0, b0, b1) = (piece.y0[r], piece.b0[r], piece.b1[r]);
+            self.y[r] = e.mul(y0).add(p1.mul(b0)).add(p2.mul(b1));
+            self.dy[r] = modes.lambda[r]
+                .mul(e)
+                .mul(y0)
+                .add(e.mul(b0))
+                .add(p1.mul(b1));
+            self.iy[r] = p1.mul(y0).add(p2.mul(b0)).add(p3.mul(b1));
+        }
+    }
+
+    /// `Σ_r w_r·Re(c_r·x_r)` of a row `c` over one of this point's vectors.
+    pub fn dot(modes: &StateModes, c: &[Cx], x: &[Cx]) -> f64 {
+        c.iter()
+            .zip(x)
+            .zip(&modes.weight)
+            .map(|((c, x), w)| w * c.mul(*x).0)
+            .sum()
+    }
+}
+
+/// `[e^{λτ}, τφ₁(λτ), τ²φ₂(λτ), τ³φ₃(λτ)]`.
+#[inline]
+fn mode_terms(lambda: Cx, tau: f64) -> [Cx; 4] {
+    let [e, p1, p2, p3] = exp_phis(lambda.scale(tau));
+    let t2 = tau * tau;
+    [e, p1.scale(tau), p2.scale(t2), p3.scale(t2 * tau)]
+}
+
+/// A linear function of the floors' state plus a cubic in `τ`:
+/// `f(τ) = scale·Σ_r w_r·Re(c_r·y_r(τ)) + poly(τ)`, over one piece.
+#[derive(Clone, Copy)]
+pub struct ModalFn<'a> {
+    pub modes: &'a StateModes,
+    pub piece: &'a Piece,
+    /// Coefficients per kept mode (empty: the polynomial alone), times `scale`.
+    pub c: &'a [Cx],
+    pub scale: f64,
+    /// `poly(τ) = p[0] + p[1]·τ + p[2]·τ² + p[3]·τ³`.
+    pub poly: [f64; 4],
+}
+
+impl ModalFn<'_> {
+    fn poly_eval(&self, t: f64) -> (f64, f64, f64) {
+        let p = &self.poly;
+        (
+            p[0] + t * (p[1] + t * (p[2] + t * p[3])),
+            p[1] + t * (2.0 * p[2] + 3.0 * t * p[3]),
+            2.0 * p[2] + 6.0 * t * p[3],
+        )
+    }
+}
+
+impl super::super::search::Smooth for ModalFn<'_> {
+    type At = f64;
+
+    fn at(&self, tau: f64) -> f64 {
+        tau
+    }
+
+    fn tau(at: &f64) -> f64 {
+        *at
+    }
+
+    fn eval(&self, &t: &f64) -> (f64, f64) {
+        let (mut f, mut df, _) = self.poly_eval(t);
+        for (r, c) in self.c.iter().enumerate() {
+            let l = self.modes.lambda[r];
+            let [e, p1, p2, _] = mode_terms(l, t);
+            let pc = self.piece;
+            let y = e.mul(pc.y0[r]).add(p1.mul(pc.b0[r])).add(p2.mul(pc.b1[r]));
+            let dy = l
+                .mul(e)
+                .mul(pc.y0[r])
+                .add(e.mul(pc.b0[r]))
+                .add(p1.mul(pc.b1[r]));
+            let w = self.scale * self.modes.weight[r];
+            f += w * c.mul(y).0;
+            df += w * c.mul(dy).0;
+        }
+        (f, df)
+    }
+
+    fn second(&self, &t: &f64) -> f64 {
+        let (_, _, mut d2) = self.poly_eval(t);
+        for (r, c) in self.c.iter().enumerate() {
+            let e = self.modes.lambda[r].scale(t).exp();
+            d2 += self.scale * self.modes.weight[r] * c.mul(e.mul(self.piece.q2[r])).0;
+        }
+        d2
+    }
+
+    fn bound(&self, k: usize, &lo: &f64, t1: f64) -> f64 {
+        let p = &self.poly;
+        let t = lo.abs().max(t1.abs());
+        let poly = match k {
+            2 => 2.0 * p[2].abs() + 6.0 * t * p[3].abs(),
+            3 => 6.0 * p[3].abs(),
+            _ => 0.0,
+        };
+        let mut modal = 0.0;
+        for (r, c) in self.c.iter().enumerate() {
+            let re = self.modes.lambda[r].0;
+            let env = (re * lo).max(re * t1).exp();
+            modal += self.modes.weight[r] * c.abs() * self.piece.mag[r][k - 2] * env;
+        }
+        // A few ulps of slack for the rounding of the terms above.
+        (poly + self.scale.abs() * modal) * (1.0 + 1e-12)
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)]
+mod tests {
+    use super::super::model::{Building, BuildingSpec, StackSpec, stiffness_matrix};
+    use super::*;
+
+    /// The state matrix `A` of `(M, K_t, C)` in physical coordinates.
+    fn state_matrix(m: &[f64], k: &[f64], c: &[f64]) -> DMatrix<f64> {
+        let n = m.len();
+        let kk = stiffness_matrix(k);
+        DMatrix::from_fn(2 * n, 2 * n, |r, col| match (r < n, col < n) {
+            (true, true) => 0.0,
+            (true, false) => f64::from(u8::from(col - n == r)),
+            (false, true) => -kk[(r - n, col)] / m[r - n],
+            (false, false) => -c[(r - n) * n + col - n] / m[r - n],
+        })
+    }
+
+    fn building() -> Building {
+        let mut s = BuildingSpec::uniform(3, 0.6);
+        s.storey_stiffnesses = vec![3.0, 2.0, 1.0];
+        s.stacks = vec![StackSpec {
+            floor: 2,
+            alpha: vec![2.0],
+            mu: vec![0.2],
+            mu_static: None,
+        }];
+        Building::new(&s).unwrap()
+    }
+
+    /// `A·V = V·Λ` and `V⁻¹·V = I` in physical coordinates, for a non-classical state (the
+    /// stack slides, so `C` is not proportional in the current modes) and one with a storey
+    /// without stiffness.
+    #[test]
+    fn the_eigenvectors_diagonalise_the_state_matrix() {
+        let b = building();
+        let bare = &b.masses()[..3];
+        for k_t in [
+            b.stiffness().to_vec(),
+            vec![0.0, b.stiffness()[1], 0.05 * b.stiffness()[2]],
+        ] {
+            let sm = StateModes::new(bare, &k_t, b.damping()).unwrap();
+            let a = state_matrix(bare, &k_t, b.damping());
+            let dim = 6;
+            let scale = a.amax();
+            for r in 0..sm.modes() {
+                let l = sm.lambda[r];
+                for i in 0..dim {
+                    let av = (0..dim).fold(Cx(0.0, 0.0), |s, j| {
+                        s.add(sm.v[j * sm.modes() + r].scale(a[(i, j)]))
+                    });
+                    let lv = l.mul(sm.v[i * sm.modes() + r]);
+                    assert!(av.sub(lv).abs() < 1e-11 * scale, "mode {r} row {i}");
+                }
+            }
+            // y = V⁻¹z then z = Σ w·Re(V·y): the identity on a test state.
+            let z = [0.01, -0.02, 0.03, 0.4, 0.1, -0.3];
+            let mut piece = Piece::default();
+            sm.piece(&z, &[0.0; 3], 0.0, &mut piece);
+            for i in 0..dim {
+                let back = ModalPoint::dot(&sm, sm.row(i), &piece.y0);
+                assert!((back - z[i]).abs() < 1e-13, "{i}: {back} vs {}", z[i]);
+            }
+        }
+    }
+
+    /// A piece against an independent integration of `ż = A·z + (0, p₀ + p₁τ)`: RK4 at a very
+    /// small step (error ~h⁴, far below the tolerance).
+    #[test]
+    fn a_piece_matches_a_fine_step_integration() {
+        let b = building();
+        let m = [1.0, 3.0, 1.0];
+        let k_t = b.stiffness().to_vec();
+        let sm = StateModes::new(&m, &k_t, b.damping()).unwrap();
+        let a = state_matrix(&m, &k_t, b.damping());
+        let z0 = [0.01, -0.02, 0.03, 0.4, 0.1, -0.3];
+        let p0 = [-1.0, 2.0, 0.5];
+        let p1 = -3.0;
+        let mut piece = Piece::default();
+        sm.piece(&z0, &p0, p1, &mut piece);
+        let rhs = |t: f64, z: &[f64; 6]| {
+            let mut d = [0.0; 6];
+            for i in 0..6 {
+                d[i] = (0..6).map(|j| a[(i, j)] * z[j]).sum::<f64>();
+                if i >= 3 {
+                    d[i] += p0[i - 3] + p1 * t;
+                }
+            }
+            d
+        };
+        let (h, steps) = (0.02, 20_000);
+        let dt = h / steps as f64;
+        let mut z = z0;
+        for s in 0..steps {
+            let t = s as f64 * dt;
+            let k1 = rhs(t, &z);
+            let add = |z: &[f64; 6], k: &[f64; 6], f: f64| {
+                let mut o = *z;
+                for i in 0..6 {
+                    o[i] += f * k[i];
+                }
+                o
+            };
+            let k2 = rhs(t + 0.5 * dt, &add(&z, &k1, 0.5 * dt));
+            let k3 = rhs(t + 0.5 * dt, &add(&z, &k2, 0.5 * dt));
+            let k4 = rhs(t + dt, &add(&z, &k3, dt));
+            for i in 0..6 {
+                z[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        let mut pt = ModalPoint::default();
+        pt.at(&sm, &piece, h);
+        for i in 0..6 {
+            let exact = ModalPoint::dot(&sm, sm.row(i), &pt.y);
+            assert!((exact - z[i]).abs() < 1e-12, "{i}: {exact} vs {}", z[i]);
+        }
+        // The derivative of the displacement rows is the velocity rows.
+        for j in 0..3 {
+            let du = ModalPoint::dot(&sm, sm.row(j), &pt.dy);
+            let v = ModalPoint::dot(&sm, sm.row(3 + j), &pt.y);
+            assert!((du - v).abs() < 1e-12);
+        }
+    }
+}

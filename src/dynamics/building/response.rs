@@ -1,0 +1,64 @@
+//! What a building simulation returns: per floor, per storey, per stack and the energy terms.
+
+use super::super::response::{Energy, History};
+
+/// The response of a building to one record (docs/model.md, "A multi-storey building"). Peaks
+/// are exact over time (between samples and at switches, one-sided limits included).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BuildingResponse {
+    /// Peak `|u_j|` of each floor relative to the ground, m, floor 1 first.
+    pub floor_peak_displacement_m: Vec<f64>,
+    /// Peak absolute acceleration of each floor, m/s².
+    pub floor_peak_abs_accel_mps2: Vec<f64>,
+    /// Peak `|δ_i|`, `δ_i = u_i − u_{i−1}`, m, storey 1 first.
+    pub storey_peak_drift_m: Vec<f64>,
+    /// `max|δ_i| / (F_y,i/k_i)`; `None` when the storeys are elastic.
+    pub storey_ductility: Option<Vec<f64>>,
+    /// Signed `δ_i` at the record's end, m.
+    pub storey_residual_drift_m: Vec<f64>,
+    /// Peak absolute acceleration of every block, m/s² (stacks in order, bottom-up).
+    pub block_peak_abs_accel_mps2: Vec<f64>,
+    /// Peak `|slip|` of every interface relative to the body below, m.
+    pub peak_slip_m: Vec<f64>,
+    /// Signed slip at the record's end, m.
+    pub residual_slip_m: Vec<f64>,
+    /// Stick/slip switches.
+    pub switches: u64,
+    /// Yield and unloading events of all storeys.
+    pub yield_events: u64,
+    /// Energy per kg of the bare building's mass.
+    pub energy: Energy,
+    /// Largest `|residual|/input` at the end of a sample interval (NaN without the balance).
+    pub energy_balance_error_max: f64,
+    /// Bodies: floors, then blocks; interfaces: every stack's, in order.
+    pub history: Option<History>,
+}
+
+impl BuildingResponse {
+    /// Refuses a response with a non-finite number.
+    pub fn check_finite(&self) -> Result<(), super::super::SimError> {
+        let lists = [
+            &self.floor_peak_displacement_m,
+            &self.floor_peak_abs_accel_mps2,
+            &self.storey_peak_drift_m,
+            &self.storey_residual_drift_m,
+            &self.block_peak_abs_accel_mps2,
+            &self.peak_slip_m,
+            &self.residual_slip_m,
+        ];
+        let e = &self.energy;
+        let finite = lists.iter().all(|l| l.iter().all(|x| x.is_finite()))
+            && self
+                .storey_ductility
+                .as_ref()
+                .is_none_or(|d| d.iter().all(|x| x.is_finite()))
+            && [e.kinetic, e.strain, e.friction, e.hysteretic]
+                .iter()
+                .all(|x| x.is_finite());
+        if finite {
+            Ok(())
+        } else {
+            Err(super::super::SimError::Diverged)
+        }
+    }
+}

@@ -1,0 +1,327 @@
+//! Certified searches over one piece of a closed-form motion: the first instant a switching
+//! function goes negative, and the largest `|f|` over an interval (docs/model.md, "The physical
+//! system": every switch and every peak is found exactly, not sampled).
+//!
+//! A function is known through [`Smooth`]: its value and slope at a point, its second derivative,
+//! and an upper bound of `|f⁽ᵏ⁾|` (`k = 2, 3, 4`) over an interval. From these, a stretch is
+//! cleared without evaluation inside it by the better of two bounds: the curvature bound
+//! (`max|f''|·w²/8` beyond the end values) and the cubic Hermite bound (`max|f⁗|·w⁴/384` beyond
+//! the Hermite interpolant of the end values and slopes); a stretch whose slope keeps one sign
+//! (`max|f'''|·w²/8` below the end slopes) is monotone. What is not cleared is halved. A root is
+//! refined by Illinois regula falsi to a few ulps of the sample interval.
+//!
+//! The building integrator (`super::building`) uses these on its modal functions.
+
+use super::closed_form::hermite_range;
+
+/// A function of a piece's local time `τ ≥ 0` with certified derivative bounds.
+pub(crate) trait Smooth {
+    /// What an evaluation at a point computes and a bound from that point can reuse.
+    type At: Copy;
+    fn at(&self, tau: f64) -> Self::At;
+    fn tau(at: &Self::At) -> f64;
+    /// `(f, f')` at the point.
+    fn eval(&self, at: &Self::At) -> (f64, f64);
+    /// `f''` at the point.
+    fn second(&self, at: &Self::At) -> f64;
+    /// An upper bound of `|f⁽ᵏ⁾|` over `[tau(lo), t1]`, `k ∈ {2, 3, 4}`.
+    fn bound(&self, k: usize, lo: &Self::At, t1: f64) -> f64;
+}
+
+/// A point of a piece with the function's value and slope there.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Node<A> {
+    pub at: A,
+    pub f: f64,
+    pub df: f64,
+}
+
+impl<A: Copy> Node<A> {
+    pub fn of<S: Smooth<At = A>>(s: &S, tau: f64) -> Self {
+        let at = s.at(tau);
+        let (f, df) = s.eval(&at);
+        Node { at, f, df }
+    }
+}
+
+/// Whether `lower ≤ f ≤ upper` on `[lo, hi]`, certified from the end values and slopes.
+pub(crate) fn range_within<S: Smooth>(
+    s: &S,
+    lo: &Node<S::At>,
+    hi: &Node<S::At>,
+    lower: f64,
+    upper: f64,
+) -> bool {
+    let (t_lo, t_hi) = (S::tau(&lo.at), S::tau(&hi.at));
+    let w = t_hi - t_lo;
+    let curv = s.bound(2, &lo.at, t_hi) * w * w / 8.0;
+    if lo.f.min(hi.f) - curv >= lower && lo.f.max(hi.f) + curv <= upper {
+        return true;
+    }
+    let quart = s.bound(4, &lo.at, t_hi) * (w * w) * (w * w) / 384.0;
+    let (h_lo, h_hi) = hermite_range(lo.f, hi.f, lo.df * w, hi.df * w);
+    (lo.f.min(hi.f) - curv).max(h_lo - quart) >= lower
+        && (lo.f.max(hi.f) + curv).min(h_hi + quart) <= upper
+}
+
+/// Whether `f'` keeps one sign on `[lo, hi]`: then the end values are the extremes.
+pub(crate) fn monotone<S: Smooth>(s: &S, lo: &Node<S::At>, hi: &Node<S::At>) -> bool {
+    let t_hi = S::tau(&hi.at);
+    let w = t_hi - S::tau(&lo.at);
+    lo.df * hi.df > 0.0 && lo.df.abs().min(hi.df.abs()) > s.bound(3, &lo.at, t_hi) * w * w / 8.0
+}
+
+/// Earliest `τ ∈ (τ(start), τ(end)]` where `f` goes negative, refined to a few ulps of `dt`;
+/// `None` if it stays non-negative. A start exactly on the boundary (`f = 0`, a fresh slip or a
+/// branch just left) is cleared for a first stretch by the Taylor bound
+/// `f ≥ f'·τ + f''·τ²/2 − max|f'''|·τ³/6`.
+pub(crate) fn first_violation<S: Smooth>(
+    s: &S,
+    start: &Node<S::At>,
+    end: &Node<S::At>,
+    dt: f64,
+) -> Option<f64> {
+    let (t0, h) = (S::tau(&start.at), S::tau(&end.at));
+    if start.f < 0.0 {
+        return Some(t0);
+    }
+    let mut lo = *start;
+    if start.f == 0.0 {
+        let g2 = s.second(&start.at);
+        let g3 = s.bound(3, &start.at, h);
+        let tc = taylor_clearance(start.df, g2, g3);
+        if tc <= 0.0 {
+            return Some(t0);
+        }
+        let clear = t0 + 0.999 * tc;
+        if clear >= h {
+            return None;
+        }
+        lo = Node::of(s, clear);
+    }
+    let min_width = 4.0 * f64::EPSILON * dt;
+    let (a, b) = search(s, &lo, end, min_width, 0)?;
+    Some(refine(|t| s.eval(&s.at(t)).0, a, b, min_width))
+}
+
+/// Largest `τ_c` with `g₁τ + g₂τ²/2 − g₃τ³/6 > 0` on `(0, τ_c)`; 0 if there is none.
+pub(crate) fn taylor_clearance(g1: f64, g2: f64, g3: f64) -> f64 {
+    if g1 < 0.0 || (g1 == 0.0 && g2 <= 0.0) {
+        return 0.0;
+    }
+    let (qa, qb, qc) = (g3 / 6.0, g2 / 2.0, g1);
+    if qa == 0.0 {
+        return if qb >= 0.0 { f64::INFINITY } else { -qc / qb };
+    }
+    (qb + (qb * qb + 4.0 * qa * qc).sqrt()) / (2.0 * qa)
+}
+
+/// Bracket `(a, b)` with `f(a) ≥ 0 > f(b)` around the earliest sign change in `[lo, hi]`.
+fn search<S: Smooth>(
+    s: &S,
+    lo: &Node<S::At>,
+    hi: &Node<S::At>,
+    min_width: f64,
+    depth: u32,
+) -> Option<(f64, f64)> {
+    if range_within(s, lo, hi, 0.0, f64::INFINITY) {
+        return None;
+    }
+    let (t_lo, t_hi) = (S::tau(&lo.at), S::tau(&hi.at));
+    let width = t_hi - t_lo;
+    if monotone(s, lo, hi) || width <= min_width || depth > 80 {
+        return (hi.f < 0.0).then_some((t_lo, t_hi));
+    }
+    let mid = Node::of(s, t_lo + 0.5 * width);
+    search(s, lo, &mid, min_width, depth + 1).or_else(|| search(s, &mid, hi, min_width, depth + 1))
+}
+
+/// Shrinks a bracket `g(a) ≥ 0 > g(b)` (Illinois regula falsi with a bisection safeguard) and
+/// returns its right end: the first representable time at which the function is negative.
+pub(crate) fn refine(g: impl Fn(f64) -> f64, mut a: f64, mut b: f64, min_width: f64) -> f64 {
+    let mut ga = g(a);
+    let mut gb = g(b);
+    if gb >= 0.0 {
+        return b;
+    }
+    let mut side = 0;
+    for _ in 0..200 {
+        if b - a <= min_width {
+            break;
+        }
+        let mut t = (a * gb - b * ga) / (gb - ga);
+        if !(t > a && t < b) {
+            t = 0.5 * (a + b);
+        }
+        let gt = g(t);
+        if gt < 0.0 {
+            b = t;
+            gb = gt;
+            if side == -1 {
+                ga *= 0.5;
+            }
+            side = -1;
+        } else {
+            a = t;
+            ga = gt;
+            if side == 1 {
+                gb *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    b
+}
+
+/// Peak `|f|` over `[lo, hi]` if it exceeds `best`, with its time; else `(best, NaN)`. The end
+/// values count (at a switch they are the one-sided limits). Branch and bound: a stretch is
+/// dropped when `|f| ≤ best` is certified on it or it is monotone; where `f'` changes sign once
+/// (certified by the bound on `f'''`) the extremum is refined.
+pub(crate) fn peak_abs<S: Smooth>(
+    s: &S,
+    lo: &Node<S::At>,
+    hi: &Node<S::At>,
+    best: f64,
+    dt: f64,
+) -> (f64, f64) {
+    let mut out = (best, f64::NAN);
+    for n in [lo, hi] {
+        if n.f.abs() > out.0 {
+            out = (n.f.abs(), S::tau(&n.at));
+        }
+    }
+    let min_width = 4.0 * f64::EPSILON * dt;
+    peak_rec(s, lo, hi, &mut out, min_width, 0);
+    out
+}
+
+fn peak_rec<S: Smooth>(
+    s: &S,
+    lo: &Node<S::At>,
+    hi: &Node<S::At>,
+    best: &mut (f64, f64),
+    min_width: f64,
+    depth: u32,
+) {
+    if range_within(s, lo, hi, -best.0, best.0) || monotone(s, lo, hi) {
+        return;
+    }
+    let (t_lo, t_hi) = (S::tau(&lo.at), S::tau(&hi.at));
+    let width = t_hi - t_lo;
+    if lo.df * hi.df < 0.0 {
+        let jerk = s.bound(3, &lo.at, t_hi);
+        let c_lo = s.second(&lo.at);
+        if c_lo.abs() > jerk * width {
+            // f' is monotone here: its single zero is the only interior extremum.
+            let sign = lo.df.signum();
+            let t = refine(|t| s.eval(&s.at(t)).1 * sign, t_lo, t_hi, min_width);
+            let v = s.eval(&s.at(t)).0.abs();
+            if v > best.0 {
+                *best = (v, t);
+            }
+            return;
+        }
+    }
+    if width <= min_width || depth > 60 {
+        return;
+    }
+    let mid = Node::of(s, t_lo + 0.5 * width);
+    if mid.f.abs() > best.0 {
+        *best = (mid.f.abs(), S::tau(&mid.at));
+    }
+    peak_rec(s, lo, &mid, best, min_width, depth + 1);
+    peak_rec(s, &mid, hi, best, min_width, depth + 1);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `f(τ) = a·sin(ωτ) + c`: derivatives bounded by `|a|·ωᵏ`.
+    struct Sine {
+        a: f64,
+        omega: f64,
+        c: f64,
+    }
+
+    impl Smooth for Sine {
+        type At = f64;
+        fn at(&self, tau: f64) -> f64 {
+            tau
+        }
+        fn tau(at: &f64) -> f64 {
+            *at
+        }
+        fn eval(&self, t: &f64) -> (f64, f64) {
+            let (s, c) = (self.omega * t).sin_cos();
+            (self.a * s + self.c, self.a * self.omega * c)
+        }
+        fn second(&self, t: &f64) -> f64 {
+            -self.a * self.omega * self.omega * (self.omega * t).sin()
+        }
+        fn bound(&self, k: usize, _: &f64, _: f64) -> f64 {
+            self.a.abs() * self.omega.powi(k as i32)
+        }
+    }
+
+    #[test]
+    fn first_violation_finds_a_grazing_root_between_samples() {
+        // 0.999·sin(ωτ) + ... dips below zero only in a narrow window near 3π/2ω.
+        let s = Sine {
+            a: 1.0,
+            omega: 7.0,
+            c: 0.999_999,
+        };
+        let h = 1.0;
+        let t = first_violation(&s, &Node::of(&s, 0.0), &Node::of(&s, h), h).unwrap();
+        // Independent: the first root of sin(ωτ) = −c, by its closed form.
+        let exact = (std::f64::consts::PI + (0.999_999f64).asin()) / 7.0;
+        assert!((t - exact).abs() < 1e-12, "{t} vs {exact}");
+        // Coarse sampling at 1000 points misses it altogether.
+        let sampled_min = (0..=1000)
+            .map(|k| s.eval(&(k as f64 * h / 1000.0)).0)
+            .fold(f64::INFINITY, f64::min);
+        assert!(sampled_min > 0.0);
+    }
+
+    #[test]
+    fn peak_abs_matches_the_closed_form_extremum() {
+        let s = Sine {
+            a: -2.5,
+            omega: 3.3,
+            c: 0.4,
+        };
+        let h = 2.0;
+        let (p, t) = peak_abs(&s, &Node::of(&s, 0.0), &Node::of(&s, h), 0.0, h);
+        // |f| is largest where sin = +1 (f = −2.1) or −1 (f = 2.9): at ωτ = 3π/2.
+        let t_exact = 1.5 * std::f64::consts::PI / 3.3;
+        assert!(
+            (p - 2.9).abs() < 1e-14 && (t - t_exact).abs() < 1e-7,
+            "{p} at {t}"
+        );
+    }
+
+    #[test]
+    fn a_boundary_start_moving_inward_is_cleared_and_moving_outward_is_not() {
+        let inward = Sine {
+            a: 1.0,
+            omega: 2.0,
+            c: 0.0,
+        };
+        let h = 1.0;
+        assert_eq!(
+            first_violation(&inward, &Node::of(&inward, 0.0), &Node::of(&inward, h), h),
+            None
+        );
+        let outward = Sine {
+            a: -1.0,
+            omega: 2.0,
+            c: 0.0,
+        };
+        let start = Node::of(&outward, 0.0);
+        assert_eq!(
+            first_violation(&outward, &start, &Node::of(&outward, h), h),
+            Some(0.0)
+        );
+    }
+}
