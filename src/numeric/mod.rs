@@ -103,29 +103,6 @@ pub(crate) fn phi3(x: Cx) -> Cx {
     }
 }
 
-/// `[eˣ, φ₁(x), φ₂(x), φ₃(x)]` with one exponential, each φ as [`phi1`], [`phi2`], [`phi3`]
-/// compute it (the same branches, the same bits).
-pub(crate) fn exp_phis(x: Cx) -> [Cx; 4] {
-    let e = x.exp();
-    let n2 = x.norm_sqr();
-    let p1 = if n2 < 0.25 {
-        phi_series(x, 1)
-    } else {
-        Cx(e.0 - 1.0, e.1).div(x)
-    };
-    let p2 = if n2 < 1.0 {
-        phi_series(x, 2)
-    } else {
-        p1.add(Cx(-1.0, 0.0)).div(x)
-    };
-    let p3 = if n2 < 4.0 {
-        phi_series(x, 3)
-    } else {
-        p2.add(Cx(-0.5, 0.0)).div(x)
-    };
-    [e, p1, p2, p3]
-}
-
 /// Nodes and weights of 8-point Gauss–Legendre quadrature on `[0, 1]` (the roots of `P₈` by
 /// Newton's method at 50 digits, rounded).
 pub(crate) const GAUSS8: [(f64, f64); 8] = [

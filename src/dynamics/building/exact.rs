@@ -28,7 +28,7 @@ use super::super::exact::{BREAK_TOLERANCE, ExactOptions};
 use super::super::response::{Energy, History};
 use super::super::search::{self, Node};
 use super::super::{Ground, SimError};
-use super::modal::{ModalError, ModalFn, ModalPoint, Piece, StateModes};
+use super::modal::{ModalError, ModalFn, ModalPoint, Piece, StateModes, mode_terms};
 use super::model::{Building, StoreySpring};
 use super::response::BuildingResponse;
 use crate::numeric::{Cx, GAUSS8};
@@ -125,15 +125,18 @@ enum Row {
 
 const ROWS: usize = 5;
 
-/// A mode's basis and its rows.
+/// A mode's basis, its rows and what a whole sample interval needs of it.
 struct Mode {
     modes: StateModes,
-    /// `ROWS × N` rows of `m` coefficients.
+    /// `ROWS × N` rows of `m` coefficients, and their magnitudes times the modes' weights.
     rows: Vec<Cx>,
+    rows_abs: Vec<f64>,
+    /// [`mode_terms`] at `dt`, per kept mode.
+    terms_dt: Vec<[Cx; 4]>,
 }
 
 impl Mode {
-    fn new(modes: StateModes) -> Self {
+    fn new(modes: StateModes, dt: f64) -> Self {
         let (n, m) = (modes.n, modes.modes());
         let mut rows = vec![Cx(0.0, 0.0); ROWS * n * m];
         for j in 0..n {
@@ -152,13 +155,30 @@ impl Mode {
                 rows[(Row::Accel as usize * n + j) * m + r] = modes.lambda[r].mul(v);
             }
         }
-        Self { modes, rows }
+        let rows_abs = rows
+            .iter()
+            .enumerate()
+            .map(|(i, c)| modes.weight[i % m] * c.abs())
+            .collect();
+        let terms_dt = modes.lambda.iter().map(|&l| mode_terms(l, dt)).collect();
+        Self {
+            modes,
+            rows,
+            rows_abs,
+            terms_dt,
+        }
     }
 
     fn row(&self, row: Row, j: usize) -> &[Cx] {
         let (n, m) = (self.modes.n, self.modes.modes());
         let at = (row as usize * n + j) * m;
         &self.rows[at..at + m]
+    }
+
+    fn row_abs(&self, row: Row, j: usize) -> &[f64] {
+        let (n, m) = (self.modes.n, self.modes.modes());
+        let at = (row as usize * n + j) * m;
+        &self.rows_abs[at..at + m]
     }
 }
 
@@ -256,6 +276,14 @@ struct Integrator<'b> {
     /// acceleration, `−(d_j + f_top,j)/M_j` (m/s²).
     floor_mass: Vec<f64>,
     accel_const: Vec<f64>,
+    /// Per floor: the friction on it from the slipping interfaces above its stuck blocks (N);
+    /// per storey: branch stiffness (N/m) and force offset (N).
+    f_top: Vec<f64>,
+    k_t: Vec<f64>,
+    offsets: Vec<f64>,
+    /// Scratch per floor.
+    x_new: Vec<f64>,
+    v_new: Vec<f64>,
     holder: Vec<Holder>,
     free: Vec<FreeCluster>,
     piece: Piece,
@@ -379,6 +407,11 @@ impl<'b> Integrator<'b> {
             stuck: vec![0; b.stacks().len()],
             floor_mass: vec![0.0; n],
             accel_const: vec![0.0; n],
+            f_top: vec![0.0; n],
+            k_t: vec![0.0; n],
+            offsets: vec![0.0; n],
+            x_new: vec![0.0; n],
+            v_new: vec![0.0; n],
             holder: vec![Holder::Floor(0); nb],
             free: Vec::with_capacity(nb),
             piece: Piece::default(),
@@ -420,10 +453,18 @@ impl<'b> Integrator<'b> {
                 self.build(ga, slope)?;
                 let h = self.dt - tau;
                 let mode = self.mode();
-                self.p_end.at(&mode.modes, &self.piece, h);
+                if tau == 0.0 {
+                    self.p_end
+                        .at_terms(&mode.modes, &self.piece, h, &mode.terms_dt);
+                } else {
+                    self.p_end.at(&mode.modes, &self.piece, h);
+                }
                 let mut first: Option<(f64, usize)> = None;
                 for e in 0..self.events.len() {
                     let g = self.events[e].g;
+                    if first.is_none() && self.clear(&mode, &g, h, 0.0, f64::INFINITY) {
+                        continue;
+                    }
                     let f = self.func(&mode, &g);
                     let n0 = self.node0(&mode, &g);
                     let limit = first.map_or(h, |f| f.0);
@@ -487,6 +528,7 @@ impl<'b> Integrator<'b> {
             modes: &mode.modes,
             piece: &self.piece,
             c: g.row.map_or(&[][..], |(row, j)| mode.row(row, j)),
+            c_abs: g.row.map_or(&[][..], |(row, j)| mode.row_abs(row, j)),
             scale: g.scale,
             poly: g.poly,
         }
@@ -511,13 +553,37 @@ impl<'b> Integrator<'b> {
         Node { at: p.tau, f, df }
     }
 
+    /// Whether `lower ≤ g ≤ upper` over the whole piece `[0, h]` (`self.p_end` at `h`) is
+    /// certified by the curvature bound on the end values alone: the first test of
+    /// [`search::range_within`], without the slopes, which most functions of most pieces pass.
+    fn clear(&self, mode: &Mode, g: &Func, h: f64, lower: f64, upper: f64) -> bool {
+        let q = &g.poly;
+        let mut f1 = q[0] + h * (q[1] + h * (q[2] + h * q[3]));
+        let mut curv = 2.0 * q[2].abs() + 6.0 * h * q[3].abs();
+        if let Some((row, j)) = g.row {
+            f1 += g.scale * ModalPoint::dot(&mode.modes, mode.row(row, j), &self.p_end.y);
+            let modal: f64 = mode
+                .row_abs(row, j)
+                .iter()
+                .zip(&self.piece.mag)
+                .map(|(a, m)| a * m[0])
+                .sum();
+            curv += g.scale.abs() * modal * (1.0 + 1e-12);
+        }
+        let slack = curv * h * h / 8.0;
+        g.f0.min(f1) - slack >= lower && g.f0.max(f1) + slack <= upper
+    }
+
     /// The start node: the state's exact value (and slope where the state gives it).
     fn node0(&self, mode: &Mode, g: &Func) -> Node<f64> {
-        let (_, df) = Self::value_at(mode, g, &self.p_start);
+        let df = match g.df0 {
+            Some(d) => d,
+            None => Self::value_at(mode, g, &self.p_start).1,
+        };
         Node {
             at: 0.0,
             f: g.f0,
-            df: g.df0.unwrap_or(df),
+            df,
         }
     }
 
@@ -581,14 +647,41 @@ impl<'b> Integrator<'b> {
         Ok(())
     }
 
-    /// The mode's basis, the piece from the current state, the free clusters and the switching
-    /// and peak functions.
+    /// The piece from the current state: the mode (set up again after a switch), the floors'
+    /// loads and modal coefficients, the free clusters' cubics, and the switching and peak
+    /// functions.
     fn build(&mut self, ga: f64, slope: f64) -> Result<(), SimError> {
+        if self.mode.is_none() {
+            self.set_up_mode()?;
+        }
+        let mode = self.mode();
+        let n = self.n;
+        for j in 0..n {
+            self.p0[j] = -ga + self.accel_const[j];
+            self.z[j] = self.x[j];
+            self.z[n + j] = self.v[j];
+        }
+        mode.modes.piece(&self.z, &self.p0, -slope, &mut self.piece);
+        self.p_start.start(&mode.modes, &self.piece);
+        for c in &mut self.free {
+            c.disp = [
+                self.x[c.bottom],
+                self.v[c.bottom],
+                0.5 * (c.accel - ga),
+                -slope / 6.0,
+            ];
+        }
+        self.build_functions(&mode);
+        Ok(())
+    }
+
+    /// Which blocks ride on their floor and which form free clusters, each floor's mass and
+    /// load constant, and the mode's basis (from the cache, or computed once).
+    fn set_up_mode(&mut self) -> Result<(), SimError> {
         let (n, b) = (self.n, self.b);
-        // Which blocks ride on their floor; the key of the mode.
         self.key.clear();
         self.floor_mass.copy_from_slice(&b.masses()[..n]);
-        let mut f_top = vec![0.0; n];
+        self.f_top.fill(0.0);
         self.free.clear();
         for (si, s) in b.stacks().iter().enumerate() {
             let mut e = 0;
@@ -604,7 +697,7 @@ impl<'b> Integrator<'b> {
             if e < s.blocks {
                 // The slipping (or free) interface above the stuck part pulls on the floor's
                 // cluster with −f.
-                f_top[s.floor] += self.force[s.first + e];
+                self.f_top[s.floor] += self.force[s.first + e];
             }
             // Free clusters above: runs of stuck interfaces.
             let mut q = e;
@@ -621,14 +714,12 @@ impl<'b> Integrator<'b> {
                 } else {
                     0.0
                 };
-                let accel = (self.force[s.first + bottom] - above) / mass;
-                let body = n + s.first + bottom;
                 self.free.push(FreeCluster {
-                    bottom: body,
+                    bottom: n + s.first + bottom,
                     top: n + s.first + top,
                     mass,
-                    accel,
-                    disp: [self.x[body], self.v[body], 0.5 * (accel - ga), -slope / 6.0],
+                    accel: (self.force[s.first + bottom] - above) / mass,
+                    disp: [0.0; 4],
                 });
                 for t in bottom..=top {
                     self.holder[s.first + t] = Holder::Free(ci);
@@ -636,39 +727,31 @@ impl<'b> Integrator<'b> {
                 q = top + 1;
             }
         }
-        let mut k_t = vec![0.0; n];
-        let mut offsets = vec![0.0; n];
         for (i, s) in self.storeys.iter().enumerate() {
             let (kb, off) = s.line();
-            k_t[i] = kb;
-            offsets[i] = off;
+            self.k_t[i] = kb;
+            self.offsets[i] = off;
             self.key
                 .push(u16::from(matches!(s.branch, Branch::Plastic(_))));
+        }
+        // Constant part of each floor's absolute acceleration: −(d_j + f_top,j)/M_j with
+        // d_j = off_j − off_{j+1}.
+        for j in 0..n {
+            let d = self.offsets[j] - if j + 1 < n { self.offsets[j + 1] } else { 0.0 };
+            self.accel_const[j] = -(d + self.f_top[j]) / self.floor_mass[j];
         }
         let mode = match self.cache.get(&self.key) {
             Some(m) => Rc::clone(m),
             None => {
-                let m = Rc::new(Mode::new(StateModes::new(
-                    &self.floor_mass,
-                    &k_t,
-                    b.damping(),
-                )?));
+                let m = Rc::new(Mode::new(
+                    StateModes::new(&self.floor_mass, &self.k_t, b.damping())?,
+                    self.dt,
+                ));
                 self.cache.insert(self.key.clone(), Rc::clone(&m));
                 m
             }
         };
-        // Loads: p_j = −a_g − (d_j + f_top,j)/M_j, d_j = off_j − off_{j+1}.
-        for j in 0..n {
-            let d = offsets[j] - if j + 1 < n { offsets[j + 1] } else { 0.0 };
-            self.accel_const[j] = -(d + f_top[j]) / self.floor_mass[j];
-            self.p0[j] = -ga + self.accel_const[j];
-            self.z[j] = self.x[j];
-            self.z[n + j] = self.v[j];
-        }
-        mode.modes.piece(&self.z, &self.p0, -slope, &mut self.piece);
-        self.p_start.at(&mode.modes, &self.piece, 0.0);
-        self.mode = Some(Rc::clone(&mode));
-        self.build_functions(&mode, ga);
+        self.mode = Some(mode);
         Ok(())
     }
 
@@ -686,13 +769,12 @@ impl<'b> Integrator<'b> {
         }
     }
 
-    fn build_functions(&mut self, mode: &Mode, ga: f64) {
+    fn build_functions(&mut self, mode: &Mode) {
         let (n, b) = (self.n, self.b);
         let mut events = std::mem::take(&mut self.events);
         let mut peaks = std::mem::take(&mut self.peaks);
         events.clear();
         peaks.clear();
-        let state_accel = self.floor_accels(ga);
         // Break bounds per floor: the tightest over its stacks' stuck interfaces.
         let tie = 0.1 * BREAK_TOLERANCE;
         for f in 0..n {
@@ -721,19 +803,19 @@ impl<'b> Integrator<'b> {
                     m_above -= b.masses()[n + k];
                 }
             }
-            let a0 = state_accel[f];
             for (bound, sign) in [(upper, -1.0), (lower, 1.0)] {
                 if let Some((value, k)) = bound {
-                    let g = Func {
+                    let mut g = Func {
                         row: Some((Row::Accel, f)),
                         scale: sign,
                         poly: [sign * (self.accel_const[f] - value), 0.0, 0.0, 0.0],
-                        f0: sign * (a0 - value),
+                        f0: 0.0,
                         df0: None,
                     };
+                    g.f0 = Self::value_at(mode, &g, &self.p_start).0;
                     events.push(Event {
                         kind: EventKind::Break(k),
-                        g: self.anchored(mode, g),
+                        g,
                     });
                 }
             }
@@ -806,15 +888,16 @@ impl<'b> Integrator<'b> {
                 }
             }
         }
+        // Peak functions start at the state; inside the piece the modal values differ from it
+        // by round-off only, so they need no anchoring.
         for j in 0..n {
-            let g = Func {
+            peaks.push(Func {
                 row: Some((Row::Disp, j)),
                 scale: 1.0,
                 poly: [0.0; 4],
                 f0: self.x[j],
                 df0: Some(self.v[j]),
-            };
-            peaks.push(self.anchored(mode, g));
+            });
         }
         for i in 0..n {
             let (x_prev, v_prev) = if i > 0 {
@@ -822,24 +905,24 @@ impl<'b> Integrator<'b> {
             } else {
                 (0.0, 0.0)
             };
-            let g = Func {
+            peaks.push(Func {
                 row: Some((Row::Drift, i)),
                 scale: 1.0,
                 poly: [0.0; 4],
                 f0: self.x[i] - x_prev,
                 df0: Some(self.v[i] - v_prev),
-            };
-            peaks.push(self.anchored(mode, g));
+            });
         }
         for f in 0..n {
-            let g = Func {
+            let mut g = Func {
                 row: Some((Row::Accel, f)),
                 scale: 1.0,
                 poly: [self.accel_const[f], 0.0, 0.0, 0.0],
-                f0: state_accel[f],
+                f0: 0.0,
                 df0: None,
             };
-            peaks.push(self.anchored(mode, g));
+            g.f0 = Self::value_at(mode, &g, &self.p_start).0;
+            peaks.push(g);
         }
         self.events = events;
         self.peaks = peaks;
@@ -889,6 +972,9 @@ impl<'b> Integrator<'b> {
                     floor
                 }
             };
+            if self.clear(mode, &g, end, -best, best) {
+                continue;
+            }
             let f = self.func(mode, &g);
             let n0 = self.node0(mode, &g);
             let n1 = self.node_at(mode, &g, &self.p_end);
@@ -917,8 +1003,8 @@ impl<'b> Integrator<'b> {
             }
         }
         // New floor state.
-        let mut x_new = vec![0.0; n];
-        let mut v_new = vec![0.0; n];
+        let mut x_new = std::mem::take(&mut self.x_new);
+        let mut v_new = std::mem::take(&mut self.v_new);
         for j in 0..n {
             x_new[j] = ModalPoint::dot(&mode.modes, mode.row(Row::Disp, j), &self.p_end.y);
             v_new[j] = ModalPoint::dot(&mode.modes, mode.row(Row::Vel, j), &self.p_end.y);
@@ -974,6 +1060,8 @@ impl<'b> Integrator<'b> {
         }
         self.x[..n].copy_from_slice(&x_new);
         self.v[..n].copy_from_slice(&v_new);
+        self.x_new = x_new;
+        self.v_new = v_new;
         for k in 0..nb {
             let slip = self.x[n + k] - self.x[self.b.below(k)];
             if let Contact::Slip(_) = self.contacts[k] {

@@ -22,7 +22,7 @@
 //! matrix, near critical damping of a mode) is refused with [`ModalError::Defective`].
 
 use super::model::modes;
-use crate::numeric::{Cx, exp_phis};
+use crate::numeric::Cx;
 use nalgebra::{Complex, DMatrix, DVector, Schur};
 use thiserror::Error;
 
@@ -217,7 +217,7 @@ impl StateModes {
             out.b0[r] = b0;
             out.b1[r] = b1;
             out.q2[r] = q2;
-            let a = q2.abs();
+            let a = q2.norm_sqr().sqrt();
             let al = self.abs_lambda[r];
             out.mag[r] = [a, al * a, al * al * a];
         }
@@ -331,14 +331,36 @@ pub struct ModalPoint {
 }
 
 impl ModalPoint {
+    /// The point at `tau`.
     pub fn at(&mut self, modes: &StateModes, piece: &Piece, tau: f64) {
+        self.fill(modes, piece, tau, |r| mode_terms(modes.lambda[r], tau));
+    }
+
+    /// The point at `tau` with the mode terms given (cached for a whole sample interval).
+    pub fn at_terms(&mut self, modes: &StateModes, piece: &Piece, tau: f64, terms: &[[Cx; 4]]) {
+        self.fill(modes, piece, tau, |r| terms[r]);
+    }
+
+    /// The piece's start: `y(0) = y₀`, `y'(0) = λ·y₀ + β₀`, no exponential needed.
+    pub fn start(&mut self, modes: &StateModes, piece: &Piece) {
+        let zero = Cx(0.0, 0.0);
+        self.fill(modes, piece, 0.0, |_| [Cx(1.0, 0.0), zero, zero, zero]);
+    }
+
+    fn fill(
+        &mut self,
+        modes: &StateModes,
+        piece: &Piece,
+        tau: f64,
+        terms: impl Fn(usize) -> [Cx; 4],
+    ) {
         let m = modes.modes();
         self.tau = tau;
         self.y.resize(m, Cx(0.0, 0.0));
         self.dy.resize(m, Cx(0.0, 0.0));
         self.iy.resize(m, Cx(0.0, 0.0));
         for r in 0..m {
-            let [e, p1, p2, p3] = mode_terms(modes.lambda[r], tau);
+            let [e, p1, p2, p3] = terms(r);
             let (y0, b0, b1) = (piece.y0[r], piece.b0[r], piece.b1[r]);
             self.y[r] = e.mul(y0).add(p1.mul(b0)).add(p2.mul(b1));
             self.dy[r] = modes.lambda[r]
@@ -362,10 +384,44 @@ impl ModalPoint {
 
 /// `[e^{λτ}, τφ₁(λτ), τ²φ₂(λτ), τ³φ₃(λτ)]`.
 #[inline]
-fn mode_terms(lambda: Cx, tau: f64) -> [Cx; 4] {
-    let [e, p1, p2, p3] = exp_phis(lambda.scale(tau));
+pub fn mode_terms(lambda: Cx, tau: f64) -> [Cx; 4] {
+    let x = lambda.scale(tau);
+    let [e, p1, p2, p3] = if x.norm_sqr() < 1.0 {
+        // φ₃ by its Taylor series (Horner, 17 terms: the next is below 1e-17 for |x| < 1), the
+        // others by φ_{k−1}(x) = 1/(k−1)! + x·φ_k(x): no cancellation for |x| < 1.
+        let p3 = horner(x, &INV_FACTORIAL[3..20]);
+        let p2 = Cx(0.5, 0.0).add(x.mul(p3));
+        let p1 = Cx(1.0, 0.0).add(x.mul(p2));
+        [Cx(1.0, 0.0).add(x.mul(p1)), p1, p2, p3]
+    } else {
+        // Each φ_{k−1} − 1/(k−1)! is at least of the size of x/k!: a few ulps lost at most.
+        let e = x.exp();
+        let p1 = Cx(e.0 - 1.0, e.1).div(x);
+        let p2 = p1.sub(Cx(1.0, 0.0)).div(x);
+        let p3 = p2.sub(Cx(0.5, 0.0)).div(x);
+        [e, p1, p2, p3]
+    };
     let t2 = tau * tau;
     [e, p1.scale(tau), p2.scale(t2), p3.scale(t2 * tau)]
+}
+
+/// `1/k!` for `k = 0 … 19`.
+const INV_FACTORIAL: [f64; 20] = {
+    let mut out = [1.0; 20];
+    let mut k = 1;
+    while k < 20 {
+        out[k] = out[k - 1] / k as f64;
+        k += 1;
+    }
+    out
+};
+
+/// `Σ_k c_k·x^k` by Horner's rule.
+#[inline]
+fn horner(x: Cx, c: &[f64]) -> Cx {
+    c.iter()
+        .rev()
+        .fold(Cx(0.0, 0.0), |acc, &ck| acc.mul(x).add(Cx(ck, 0.0)))
 }
 
 /// A linear function of the floors' state plus a cubic in `τ`:
@@ -374,8 +430,10 @@ fn mode_terms(lambda: Cx, tau: f64) -> [Cx; 4] {
 pub struct ModalFn<'a> {
     pub modes: &'a StateModes,
     pub piece: &'a Piece,
-    /// Coefficients per kept mode (empty: the polynomial alone), times `scale`.
+    /// Coefficients per kept mode (empty: the polynomial alone), times `scale`, and their
+    /// magnitudes `w_r·|c_r|`.
     pub c: &'a [Cx],
+    pub c_abs: &'a [f64],
     pub scale: f64,
     /// `poly(τ) = p[0] + p[1]·τ + p[2]·τ² + p[3]·τ³`.
     pub poly: [f64; 4],
@@ -440,10 +498,15 @@ impl super::super::search::Smooth for ModalFn<'_> {
             _ => 0.0,
         };
         let mut modal = 0.0;
-        for (r, c) in self.c.iter().enumerate() {
+        for (r, a) in self.c_abs.iter().enumerate() {
+            // e^{Re λ·τ} over the interval; 1 from the start of a decaying mode.
             let re = self.modes.lambda[r].0;
-            let env = (re * lo).max(re * t1).exp();
-            modal += self.modes.weight[r] * c.abs() * self.piece.mag[r][k - 2] * env;
+            let env = if lo == 0.0 && re <= 0.0 {
+                1.0
+            } else {
+                (re * lo).max(re * t1).exp()
+            };
+            modal += a * self.piece.mag[r][k - 2] * env;
         }
         // A few ulps of slack for the rounding of the terms above.
         (poly + self.scale.abs() * modal) * (1.0 + 1e-12)
@@ -453,6 +516,36 @@ impl super::super::search::Smooth for ModalFn<'_> {
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
 mod tests {
+    /// The mode terms against the φ-functions of `numeric` (series and closed forms, an
+    /// independent evaluation) on both sides of the switch at `|λτ| = 1`: within 4 ulps of the
+    /// largest term.
+    #[test]
+    fn mode_terms_match_the_phi_functions() {
+        use crate::numeric::{phi1, phi2, phi3};
+        for (re, im) in [
+            (-0.3, 0.9),
+            (-0.01, 0.2),
+            (-1e-9, 0.0),
+            (0.0, 0.0),
+            (-0.999, 0.04),
+            (-1.001, 0.0),
+            (-0.05, 1.2),
+            (-3.0, 25.0),
+            (-40.0, 0.0),
+        ] {
+            let x = Cx(re, im);
+            let [e, p1, p2, p3] = mode_terms(x, 1.0);
+            let want = [x.exp(), phi1(x), phi2(x), phi3(x)];
+            for (got, want) in [e, p1, p2, p3].iter().zip(want) {
+                let err = got.sub(want).abs();
+                assert!(
+                    err <= 4.0 * f64::EPSILON * want.abs().max(1e-300),
+                    "{x:?}: {got:?} vs {want:?}"
+                );
+            }
+        }
+    }
+
     use super::super::model::{Building, BuildingSpec, StackSpec, stiffness_matrix};
     use super::*;
 
