@@ -102,6 +102,8 @@ fn one_storey_equals_the_sdof_integrator() {
             if let Some((c, r)) = yielding {
                 sys = sys.with_yielding(Yielding::bilinear(*c, *r)).unwrap();
             }
+            // The building's own mapping to the one-storey model is this system.
+            assert_eq!(b.one_storey().as_ref(), Some(&sys));
             let rs = simulate_exact(&sys, &ground, &opts()).unwrap();
             let what = format!("{} {basis:?} {yielding:?} α {alpha:?}", rec.name);
             let close = |a: f64, b: f64, tol: f64, name: &str| {

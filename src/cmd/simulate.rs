@@ -10,7 +10,7 @@
 
 use anyhow::Result;
 use slidestack::simulation::{CaseSettings, Integrator, StructureKind, Summary};
-use slidestack::store::write_history;
+use slidestack::store::{HistoryLayout, write_history};
 use slidestack::study::sweep::DampingBasis;
 use std::path::PathBuf;
 
@@ -105,7 +105,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let (summary, history) = case.simulate(&accel)?;
     if let (Some(path), Some(h)) = (&case.history, &history) {
-        write_history(path, h)?;
+        write_history(path, h, &HistoryLayout::one_storey(h.interfaces))?;
     }
     if json {
         println!("{}", serde_json::to_string_pretty(&summary)?);

@@ -98,20 +98,28 @@ pub struct History {
     pub abs_accel_mps2: Vec<f64>,
     /// Interface state ([`crate::dynamics::Contact::code`]): row-major `[time][interface]`.
     pub contact: Vec<i8>,
-    /// Number of bodies (structure plus blocks).
+    /// Number of bodies (structure plus blocks; for a building, floors plus blocks).
     pub bodies: usize,
+    /// Number of interfaces.
+    pub interfaces: usize,
 }
 
 impl History {
+    /// A history of one storey: `bodies` (structure and blocks), one interface under each block.
     pub fn with_capacity(rows: usize, bodies: usize) -> Self {
+        Self::with_layout(rows, bodies, bodies.saturating_sub(1))
+    }
+
+    pub fn with_layout(rows: usize, bodies: usize, interfaces: usize) -> Self {
         Self {
             time_s: Vec::with_capacity(rows),
             ground_accel_mps2: Vec::with_capacity(rows),
             displacement_m: Vec::with_capacity(rows * bodies),
             velocity_mps: Vec::with_capacity(rows * bodies),
             abs_accel_mps2: Vec::with_capacity(rows * bodies),
-            contact: Vec::with_capacity(rows * bodies.saturating_sub(1)),
+            contact: Vec::with_capacity(rows * interfaces),
             bodies,
+            interfaces,
         }
     }
 

@@ -30,36 +30,73 @@ impl HistoryFormat {
     }
 }
 
+/// The names of a history's bodies and interfaces, in order, and what the file holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HistoryLayout {
+    pub contents: String,
+    pub bodies: Vec<String>,
+    pub interfaces: Vec<String>,
+}
+
+impl HistoryLayout {
+    /// One storey: `ps` (the structure), then `block1…` bottom-up; `interface1…`.
+    pub fn one_storey(blocks: usize) -> Self {
+        let mut bodies = vec!["ps".to_string()];
+        bodies.extend((1..=blocks).map(|j| format!("block{j}")));
+        Self {
+            contents: "slidestack simulate time history; body 0 is the structure, blocks \
+                       bottom-up"
+                .into(),
+            bodies,
+            interfaces: (1..=blocks).map(|i| format!("interface{i}")).collect(),
+        }
+    }
+
+    /// A building of `storeys` with stacks of `blocks[s]` blocks: `floor1…`, then
+    /// `stack1_block1…`; `stack1_interface1…` (interface 1 between the floor and block 1).
+    pub fn building(storeys: usize, blocks: &[usize]) -> Self {
+        let mut bodies: Vec<String> = (1..=storeys).map(|j| format!("floor{j}")).collect();
+        let mut interfaces = Vec::new();
+        for (s, &nb) in blocks.iter().enumerate() {
+            bodies.extend((1..=nb).map(|b| format!("stack{}_block{b}", s + 1)));
+            interfaces.extend((1..=nb).map(|b| format!("stack{}_interface{b}", s + 1)));
+        }
+        Self {
+            contents: "slidestack simulate time history of a building; bodies: the floors \
+                       (floor 1 the lowest), then each stack's blocks bottom-up"
+                .into(),
+            bodies,
+            interfaces,
+        }
+    }
+}
+
 /// Writes `history` to `path` in the format its extension names: into a temporary, checked
 /// (every write, the flush and, for HDF5, the close), synced and renamed, so a full disk or a
 /// kill leaves no partial or zero-filled file behind.
-pub fn write_history(path: &Path, history: &History) -> Result<(), StoreError> {
+pub fn write_history(
+    path: &Path,
+    history: &History,
+    layout: &HistoryLayout,
+) -> Result<(), StoreError> {
     let format = HistoryFormat::from_path(path)?;
     let tmp = Temp::for_path(path);
     match format {
-        HistoryFormat::Csv => {
-            write_csv(tmp.path(), history).map_err(|e| StoreError::io(path, "cannot write", e))?
-        }
-        HistoryFormat::Hdf5 => write_hdf5(tmp.path(), history).at(path)?,
+        HistoryFormat::Csv => write_csv(tmp.path(), history, layout)
+            .map_err(|e| StoreError::io(path, "cannot write", e))?,
+        HistoryFormat::Hdf5 => write_hdf5(tmp.path(), history, layout).at(path)?,
     }
     tmp.commit(path)
 }
 
-fn write_csv(path: &Path, h: &History) -> std::io::Result<()> {
+fn write_csv(path: &Path, h: &History, layout: &HistoryLayout) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    let nb = h.bodies;
-    let body = |j: usize| {
-        if j == 0 {
-            "ps".to_string()
-        } else {
-            format!("block{j}")
-        }
-    };
+    let (nb, ni) = (h.bodies, h.interfaces);
     let mut cols = vec!["time_s".to_string(), "ground_accel_mps2".to_string()];
     for (what, unit) in [("disp", "m"), ("vel", "mps"), ("abs_accel", "mps2")] {
-        cols.extend((0..nb).map(|j| format!("{}_{what}_{unit}", body(j))));
+        cols.extend(layout.bodies.iter().map(|b| format!("{b}_{what}_{unit}")));
     }
-    cols.extend((1..nb).map(|i| format!("interface{i}_state")));
+    cols.extend(layout.interfaces.iter().map(|i| format!("{i}_state")));
     writeln!(w, "{}", cols.join(","))?;
     for r in 0..h.rows() {
         write!(w, "{},{}", h.time_s[r], h.ground_accel_mps2[r])?;
@@ -68,7 +105,7 @@ fn write_csv(path: &Path, h: &History) -> std::io::Result<()> {
                 write!(w, ",{v}")?;
             }
         }
-        for c in &h.contact[r * (nb - 1)..(r + 1) * (nb - 1)] {
+        for c in &h.contact[r * ni..(r + 1) * ni] {
             write!(w, ",{c}")?;
         }
         writeln!(w)?;
@@ -76,21 +113,17 @@ fn write_csv(path: &Path, h: &History) -> std::io::Result<()> {
     w.flush()
 }
 
-fn write_hdf5(path: &Path, h: &History) -> hdf5::Result<()> {
+fn write_hdf5(path: &Path, h: &History, layout: &HistoryLayout) -> hdf5::Result<()> {
     let f = hdf5::File::create(path)?;
-    fill_hdf5(&f, h)?;
+    fill_hdf5(&f, h, layout)?;
     f.flush()?;
     f.close()
 }
 
-fn fill_hdf5(f: &hdf5::File, h: &History) -> hdf5::Result<()> {
+fn fill_hdf5(f: &hdf5::File, h: &History, layout: &HistoryLayout) -> hdf5::Result<()> {
     let rows = h.rows();
     let nb = h.bodies;
-    attr(
-        f,
-        "contents",
-        "slidestack simulate time history; body 0 is the structure, blocks bottom-up",
-    )?;
+    attr(f, "contents", &layout.contents)?;
     attr(f, "slidestack_version", env!("CARGO_PKG_VERSION"))?;
     attr(
         f,
@@ -115,7 +148,8 @@ fn fill_hdf5(f: &hdf5::File, h: &History) -> hdf5::Result<()> {
         ds.write_raw(data)?;
         attr(&ds, "units", units)?;
         attr(&ds, "long_name", long)?;
-        attr(&ds, "dims", "time, body")
+        attr(&ds, "dims", "time, body")?;
+        attr(&ds, "bodies", &layout.bodies.join(", "))
     };
     two(
         "displacement",
@@ -137,7 +171,7 @@ fn fill_hdf5(f: &hdf5::File, h: &History) -> hdf5::Result<()> {
     )?;
     let ds = f
         .new_dataset::<i8>()
-        .shape((rows, nb - 1))
+        .shape((rows, h.interfaces))
         .create("contact")?;
     ds.write_raw(&h.contact)?;
     attr(
@@ -146,5 +180,6 @@ fn fill_hdf5(f: &hdf5::File, h: &History) -> hdf5::Result<()> {
         "interface state (see file attribute contact_codes)",
     )?;
     attr(&ds, "dims", "time, interface")?;
+    attr(&ds, "interfaces", &layout.interfaces.join(", "))?;
     Ok(())
 }

@@ -23,7 +23,7 @@ pub mod sweep;
 pub mod tnew;
 pub mod units;
 
-pub use history::{HistoryFormat, write_history};
+pub use history::{HistoryFormat, HistoryLayout, write_history};
 
 use std::path::{Path, PathBuf};
 use thiserror::Error;

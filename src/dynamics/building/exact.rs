@@ -436,7 +436,7 @@ impl<'b> Integrator<'b> {
         let mut history = self
             .opts
             .history
-            .then(|| History::with_capacity(steps + 1, self.bodies));
+            .then(|| History::with_layout(steps + 1, self.bodies, self.b.blocks()));
         self.select(accel[0])?;
         self.build(accel[0], (accel[1] - accel[0]) / self.dt)?;
         if let Some(h) = history.as_mut() {

@@ -7,7 +7,7 @@
 //! they carry: interface `k` lies under block body `N + k`, so a stack's interface 1 is between
 //! its floor and its bottom block. Displacements are relative to the ground.
 
-use super::super::model::G;
+use super::super::model::{G, System, SystemSpec, Yielding};
 use crate::limits::{
     MAX_ALPHA, MAX_BLOCKS, MAX_MU, MAX_STACKS, MAX_STOREYS, STOREY_RATIO_RANGE,
     STRENGTH_RATIO_RANGE, STRUCTURE_PERIOD_RANGE_S,
@@ -419,6 +419,42 @@ impl Building {
     pub fn springs(&self) -> Option<&[StoreySpring]> {
         self.springs.as_deref()
     }
+    /// The same building as the one-storey model, when it is one: one storey with at most one
+    /// stack. Its `System` has the floor's mass, the storey's stiffness (`T_p` = `period_s`),
+    /// the bare structure's damping ratio that gives this building's damper, the stack and the
+    /// storey's yielding, so the one-storey integrator runs it bit for bit as a `simulate` case
+    /// without `building` (docs/model.md, "A multi-storey building").
+    pub fn one_storey(&self) -> Option<System> {
+        if self.storeys != 1 || self.spec.stacks.len() > 1 {
+            return None;
+        }
+        let m = self.masses[0];
+        let (alpha, mu, mu_static) = match self.spec.stacks.first() {
+            Some(s) => (s.alpha.clone(), s.mu.clone(), s.mu_static.clone()),
+            None => (Vec::new(), Vec::new(), None),
+        };
+        // c = 2ζ_b·sqrt(k·M_b) = 2ζ_p·sqrt(k·m): the bare ratio ζ_p = ζ_b·sqrt(M_b/m).
+        let basis_mass = match self.spec.damping_basis {
+            ModalBasis::Structure => m,
+            ModalBasis::Rigid => m * (1.0 + alpha.iter().sum::<f64>()),
+        };
+        let spec = SystemSpec {
+            period_s: self.spec.period_s,
+            damping_ratio: self.spec.damping_ratio * (basis_mass / m).sqrt(),
+            mass_kg: m,
+            alpha,
+            mu,
+            mu_static,
+        };
+        let sys = System::new(&spec).ok()?;
+        match &self.spec.yielding {
+            None => Some(sys),
+            Some(y) => sys
+                .with_yielding(Yielding::bilinear(y.strength_ratios[0], y.post_yield_ratio))
+                .ok(),
+        }
+    }
+
     /// The stack interface `k` belongs to.
     pub fn stack_of(&self, k: usize) -> usize {
         self.stacks

@@ -1,6 +1,6 @@
 //! What a building simulation returns: per floor, per storey, per stack and the energy terms.
 
-use super::super::response::{Energy, History};
+use super::super::response::{Energy, History, Response};
 
 /// The response of a building to one record (docs/model.md, "A multi-storey building"). Peaks
 /// are exact over time (between samples and at switches, one-sided limits included).
@@ -35,6 +35,27 @@ pub struct BuildingResponse {
 }
 
 impl BuildingResponse {
+    /// The one-storey integrator's response in a building's terms (floor 1 = the structure,
+    /// one stack), for [`super::Building::one_storey`].
+    pub fn from_one_storey(r: Response) -> Self {
+        let blocks = r.peak_slip_m.len();
+        Self {
+            floor_peak_displacement_m: vec![r.peak_displacement_m],
+            floor_peak_abs_accel_mps2: vec![r.peak_abs_accel_mps2[0]],
+            storey_peak_drift_m: vec![r.peak_displacement_m],
+            storey_ductility: r.ductility.map(|d| vec![d]),
+            storey_residual_drift_m: vec![r.residual_displacement_m],
+            block_peak_abs_accel_mps2: r.peak_abs_accel_mps2[1..=blocks].to_vec(),
+            peak_slip_m: r.peak_slip_m,
+            residual_slip_m: r.residual_slip_m,
+            switches: r.switches,
+            yield_events: r.yield_events,
+            energy: r.energy,
+            energy_balance_error_max: r.energy_balance_error_max,
+            history: r.history,
+        }
+    }
+
     /// Refuses a response with a non-finite number.
     pub fn check_finite(&self) -> Result<(), super::super::SimError> {
         let lists = [
