@@ -307,6 +307,22 @@ fn stacks_that_cannot_slide_are_masses_added_to_their_floors() {
             );
         }
     }
+    // The library's own attached variant is the same building.
+    let attached = b.with_stacks_attached();
+    assert_eq!(attached.stiffness(), b.stiffness());
+    assert_eq!(attached.damping(), b.damping());
+    let rt = simulate_building(&attached, &ground, &opts()).unwrap();
+    for j in 0..3 {
+        let (a, e) = (
+            rt.floor_peak_displacement_m[j],
+            ra.floor_peak_displacement_m[j],
+        );
+        assert!(
+            (a - e).abs() < 1e-10 * e,
+            "attached floor {}: {a} vs {e}",
+            j + 1
+        );
+    }
     // Every block rides with its floor.
     for (q, floor) in [(0, 2), (1, 2), (2, 0), (3, 0)] {
         assert_eq!(

@@ -219,6 +219,11 @@ pub struct Building {
     mu_s: Vec<f64>,
     /// Per storey, when the storeys yield.
     springs: Option<Vec<StoreySpring>>,
+    /// The bare floors' total mass, kg.
+    bare_mass_kg: f64,
+    /// For one storey: the damping ratio of floor 1 alone that gives its damper,
+    /// `c/(2·sqrt(k·m_1))`, as the one-storey model states it.
+    first_floor_damping_ratio: f64,
 }
 
 impl Building {
@@ -350,8 +355,11 @@ impl Building {
                 })
                 .collect()
         });
+        let first_floor_damping_ratio = zeta * (basis_masses[0] / floor_m[0]).sqrt();
         Ok(Self {
             spec: spec.clone(),
+            bare_mass_kg: floor_m.iter().sum(),
+            first_floor_damping_ratio,
             storeys: n,
             masses,
             stiffness,
@@ -379,7 +387,7 @@ impl Building {
     }
     /// The bare floors' total mass, kg (energies are per kg of it).
     pub fn bare_mass_kg(&self) -> f64 {
-        self.masses[..self.storeys].iter().sum()
+        self.bare_mass_kg
     }
     /// Storey stiffnesses `k_i`, N/m, storey 1 first.
     pub fn stiffness(&self) -> &[f64] {
@@ -433,14 +441,10 @@ impl Building {
             Some(s) => (s.alpha.clone(), s.mu.clone(), s.mu_static.clone()),
             None => (Vec::new(), Vec::new(), None),
         };
-        // c = 2ζ_b·sqrt(k·M_b) = 2ζ_p·sqrt(k·m): the bare ratio ζ_p = ζ_b·sqrt(M_b/m).
-        let basis_mass = match self.spec.damping_basis {
-            ModalBasis::Structure => m,
-            ModalBasis::Rigid => m * (1.0 + alpha.iter().sum::<f64>()),
-        };
         let spec = SystemSpec {
-            period_s: self.spec.period_s,
-            damping_ratio: self.spec.damping_ratio * (basis_mass / m).sqrt(),
+            // The attached variant's floor carries its stacks: T·sqrt(M/m) (exactly T otherwise).
+            period_s: self.spec.period_s * (m / self.bare_mass_kg).sqrt(),
+            damping_ratio: self.first_floor_damping_ratio,
             mass_kg: m,
             alpha,
             mu,
@@ -452,6 +456,42 @@ impl Building {
             Some(y) => sys
                 .with_yielding(Yielding::bilinear(y.strength_ratios[0], y.post_yield_ratio))
                 .ok(),
+        }
+    }
+
+    /// The same building with every stack rigidly attached to its floor: the stacks' masses
+    /// added to their floors', the same stiffnesses `K`, damping matrix `C` and storey springs
+    /// (so the same `F_y`), no interfaces. The sliding stacks' reference system, as the rigid
+    /// system is on one storey (docs/model.md, "Derived quantities").
+    pub fn with_stacks_attached(&self) -> Building {
+        let n = self.storeys;
+        let mut masses = self.masses[..n].to_vec();
+        for s in &self.stacks {
+            for q in 0..s.blocks {
+                masses[s.floor] += self.masses[n + s.first + q];
+            }
+        }
+        let mut spec = self.spec.clone();
+        spec.floor_masses = masses.clone();
+        spec.stacks.clear();
+        // The same damper on the loaded floor: c = 2ζ·sqrt(k·m) = 2ζ'·sqrt(k·M).
+        let first_floor_damping_ratio =
+            self.first_floor_damping_ratio * (self.masses[0] / masses[0]).sqrt();
+        Building {
+            spec,
+            bare_mass_kg: self.bare_mass_kg,
+            first_floor_damping_ratio,
+            storeys: n,
+            masses,
+            stiffness: self.stiffness.clone(),
+            damping: self.damping.clone(),
+            periods_s: self.periods_s.clone(),
+            stacks: Vec::new(),
+            below: Vec::new(),
+            lim_s: Vec::new(),
+            lim_k: Vec::new(),
+            mu_s: Vec::new(),
+            springs: self.springs.clone(),
         }
     }
 
@@ -659,6 +699,34 @@ mod tests {
                 assert!((modal[(r, s)] - expect).abs() < 1e-12, "{r},{s}");
             }
         }
+    }
+
+    /// One storey with its stack attached is the one-storey model's rigid system: period
+    /// `T_p·sqrt(1+α)`, the same damper, `C_y/(1+α)` on the loaded mass (docs/model.md,
+    /// "Derived quantities" and "Incremental dynamic analysis").
+    #[test]
+    fn one_storey_attached_is_the_rigid_system() {
+        let mut s = BuildingSpec::uniform(1, 1.0);
+        s.stacks = vec![StackSpec {
+            floor: 1,
+            alpha: vec![0.5, 0.5],
+            mu: vec![0.2, 0.1],
+            mu_static: None,
+        }];
+        s.yielding = Some(StoreyYielding {
+            strength_ratios: vec![0.3],
+            post_yield_ratio: 0.05,
+        });
+        let b = Building::new(&s).unwrap();
+        let loose = b.one_storey().unwrap();
+        let rigid = b.with_stacks_attached().one_storey().unwrap();
+        assert!((rigid.period_s() - 2f64.sqrt()).abs() < 1e-15);
+        assert!((rigid.damping() - loose.damping()).abs() < 1e-15);
+        assert!((rigid.stiffness() - loose.stiffness()).abs() < 1e-12);
+        let (h, hl) = (rigid.hysteresis().unwrap(), loose.hysteresis().unwrap());
+        assert!((h.yield_force_n - hl.yield_force_n).abs() < 1e-12);
+        assert!((h.strength_ratio - 0.15).abs() < 1e-15);
+        assert_eq!(rigid.blocks(), 0);
     }
 
     #[test]
