@@ -266,17 +266,18 @@ mod tests {
 
     #[test]
     fn first_violation_finds_a_grazing_root_between_samples() {
-        // 0.999·sin(ωτ) + ... dips below zero only in a narrow window near 3π/2ω.
+        // sin(ωτ) + c dips below zero only within 1.3e-5 s of 3π/(2ω), between the samples.
+        let c = 1.0 - 1e-9;
         let s = Sine {
             a: 1.0,
             omega: 7.0,
-            c: 0.999_999,
+            c,
         };
         let h = 1.0;
         let t = first_violation(&s, &Node::of(&s, 0.0), &Node::of(&s, h), h).unwrap();
         // Independent: the first root of sin(ωτ) = −c, by its closed form.
-        let exact = (std::f64::consts::PI + (0.999_999f64).asin()) / 7.0;
-        assert!((t - exact).abs() < 1e-12, "{t} vs {exact}");
+        let exact = (std::f64::consts::PI + c.asin()) / 7.0;
+        assert!((t - exact).abs() < 1e-11, "{t} vs {exact}");
         // Coarse sampling at 1000 points misses it altogether.
         let sampled_min = (0..=1000)
             .map(|k| s.eval(&(k as f64 * h / 1000.0)).0)
