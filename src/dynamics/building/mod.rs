@@ -4,13 +4,16 @@
 //! * [`model`]: the building as stated and validated (floors, storeys, stacks, damping matrix).
 //! * `modal`: the floors' exact motion within one contact and yield state.
 //! * [`exact`]: the event-driven integrator ([`simulate_building`]).
+//! * [`rk4`]: the paper's fixed-step RK4 as a reference ([`simulate_building_rk4`]).
 //! * [`response`]: what it returns.
 
 pub mod exact;
 pub(crate) mod modal;
 pub mod model;
 pub mod response;
+pub mod rk4;
 
 pub use exact::simulate_building;
 pub use model::{Building, BuildingError, BuildingSpec, ModalBasis, StackSpec, StoreyYielding};
 pub use response::BuildingResponse;
+pub use rk4::simulate_building_rk4;
