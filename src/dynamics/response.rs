@@ -126,6 +126,16 @@ impl History {
     pub fn rows(&self) -> usize {
         self.time_s.len()
     }
+
+    /// Body `body`'s displacement relative to the ground at every row, m.
+    pub fn displacement_of(&self, body: usize) -> Vec<f64> {
+        self.displacement_m
+            .iter()
+            .skip(body)
+            .step_by(self.bodies)
+            .copied()
+            .collect()
+    }
 }
 
 /// Result of one simulation.
