@@ -5,14 +5,17 @@
 //! only with `extrapolate`, and then from the fit); `T_new` from the zone's recommended fitted
 //! form (`fit.yaml`); `T_new` from the paper's Eqs. 16–17 (zones III and V, two blocks); and
 //! the zone's design spectral acceleration (its target spectrum, `Z·Sa/g` for IS 1893) at `T_p`
-//! and at `T_new`. Reads only verified files of the study directory.
+//! and at `T_new`, from the target spectrum stored in `motions.h5` (never from a table file,
+//! which may have changed since). Reads only verified files of the study directory, and only a
+//! `motions.h5` that `tnew.h5` was made from.
 
 use crate::fit::{Fitted, Sample, paper_equation};
 use crate::grid::OutsideGrid;
-use crate::spectrum::TargetSpectrum;
 use crate::store::StoreError;
 use crate::store::fit::read_fit;
-use crate::store::tnew::{read_zone_tnew, zones_and_blocks};
+use crate::store::h5::stored_fingerprint;
+use crate::store::motions::read_zone_target;
+use crate::store::tnew::{read_motions_fingerprint, read_zone_tnew, zones_and_blocks};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -35,13 +38,9 @@ pub enum DesignError {
     Outside(OutsideGrid),
     #[error("{}: belongs to another tnew.h5 than the study's: rerun `slidestack fit`", file.display())]
     Mismatch { file: PathBuf },
-    #[error("{}: zone {zone}: target `{target}`: {why}", file.display())]
-    Target {
-        file: PathBuf,
-        zone: String,
-        target: String,
-        why: String,
-    },
+    /// `motions.h5` is not the one `tnew.h5` was made from (or `tnew.h5` does not say which).
+    #[error("{}: {why}", file.display())]
+    OtherMotions { file: PathBuf, why: &'static str },
     #[error(transparent)]
     Store(#[from] StoreError),
 }
@@ -51,7 +50,7 @@ impl DesignError {
     pub fn is_bad_input(&self) -> bool {
         !matches!(
             self,
-            DesignError::Store(_) | DesignError::Mismatch { .. } | DesignError::Target { .. }
+            DesignError::Store(_) | DesignError::Mismatch { .. } | DesignError::OtherMotions { .. }
         )
     }
 }
@@ -117,18 +116,30 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
     }
     let tnew = dir.join("tnew.h5");
     let fit_yaml = dir.join("fit.yaml");
-    let Some(tnew_fp) = crate::store::h5::stored_fingerprint(&tnew)? else {
-        return Err(DesignError::Missing {
-            dir: dir.to_path_buf(),
-            file: "tnew.h5",
-        });
+    let motions = dir.join("motions.h5");
+    let missing = |file| DesignError::Missing {
+        dir: dir.to_path_buf(),
+        file,
     };
-    let Some(fit) = read_fit(&fit_yaml)? else {
-        return Err(DesignError::Missing {
-            dir: dir.to_path_buf(),
-            file: "fit.yaml",
-        });
-    };
+    let tnew_fp = stored_fingerprint(&tnew)?.ok_or_else(|| missing("tnew.h5"))?;
+    let motions_fp = stored_fingerprint(&motions)?.ok_or_else(|| missing("motions.h5"))?;
+    match read_motions_fingerprint(&tnew)? {
+        Some(fp) if fp == motions_fp => {}
+        Some(_) => {
+            return Err(DesignError::OtherMotions {
+                file: motions,
+                why: "tnew.h5 was made from another motions.h5: rerun the study",
+            });
+        }
+        None => {
+            return Err(DesignError::OtherMotions {
+                file: tnew,
+                why: "made by an earlier slidestack, it does not record its motions.h5: rebuild it \
+                      (the tnew stage, forced)",
+            });
+        }
+    }
+    let fit = read_fit(&fit_yaml)?.ok_or_else(|| missing("fit.yaml"))?;
     if fit.fingerprint != crate::pipeline::fit::fingerprint(&tnew_fp) {
         return Err(DesignError::Mismatch { file: fit_yaml });
     }
@@ -145,15 +156,7 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         }
     }
     let (grid, t) = read_zone_tnew(&tnew, &q.zone, blocks)?;
-    let target: TargetSpectrum = t
-        .target
-        .parse()
-        .map_err(|e: crate::spectrum::TargetError| DesignError::Target {
-            file: tnew.clone(),
-            zone: q.zone.clone(),
-            target: t.target.clone(),
-            why: e.to_string(),
-        })?;
+    let target = read_zone_target(&motions, &q.zone)?;
     let alpha_total: f64 = q.alpha.iter().sum();
     let t_rigid_s = q.period_s * (1.0 + alpha_total).sqrt();
     let mut notes = Vec::new();

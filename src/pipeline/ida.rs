@@ -15,9 +15,12 @@ use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::ida::curve::{fractile, on_grid};
 use crate::ida::fragility::{FIT_STATUS_FLAGS, FitStatus, fit_lognormal};
 use crate::ida::trace::Trace;
+use crate::spectrum::TargetSpectrum;
+use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
+use crate::store::motions::read_zone_target;
 use crate::study::config::StudyConfig;
 use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
 use ndarray::{ArrayD, IxDyn};
@@ -53,6 +56,17 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
     Some(hash_parts(&[&section.to_string(), motions_fingerprint]))
 }
 
+/// Every zone's target spectrum as `motions.h5` stores it: the one its motions were matched to.
+fn stored_targets(study: &Study) -> Result<Vec<TargetSpectrum>, StoreError> {
+    let path = study.path(StageId::Motions.output());
+    study
+        .cfg
+        .zones
+        .iter()
+        .map(|z| read_zone_target(&path, &z.name))
+        .collect()
+}
+
 /// One unit's result.
 struct UnitOut {
     record_sa_g: f64,
@@ -78,13 +92,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let fp = study.fingerprint(me)?;
     let motions = super::sweep::load_motions(study)?;
     let physics = study.physics();
-    let targets: Vec<_> = (0..study.cfg.zones.len())
-        .map(|i| study.cfg.target(i))
-        .collect::<Result<_, _>>()
-        .map_err(|e| PipelineError::BadInput {
-            file: study.config_path.clone(),
-            why: e.to_string(),
-        })?;
+    let targets = stored_targets(study)?;
     let units: Vec<(usize, usize, usize)> = motions
         .iter()
         .enumerate()
@@ -448,14 +456,12 @@ fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
 /// The median ductility of both systems at [`TARGET_FACTORS`] × the zone's target `Sa(T_p)`,
 /// read off the median curves of `ida.h5` (NaN above the grid).
 pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineError> {
+    study.require(StageId::Motions)?;
     study.require(StageId::Ida)?;
     let path = study.path(StageId::Ida.output());
+    let targets = stored_targets(study)?;
     let mut rows = Vec::new();
-    for (zi, zone) in study.cfg.zones.iter().enumerate() {
-        let target = study.cfg.target(zi).map_err(|e| PipelineError::BadInput {
-            file: study.config_path.clone(),
-            why: e.to_string(),
-        })?;
+    for (zone, target) in study.cfg.zones.iter().zip(&targets) {
         let (axes, z) = read_zone_ida(&path, &zone.name)?;
         let median = FRACTILES.iter().position(|&p| p == 0.5).unwrap_or(1);
         for c in 0..axes.case_period_s.len() {

@@ -265,10 +265,6 @@ impl Study {
     /// Reads and validates the config (every limit is checked here, before any work) and
     /// computes every stage's expected fingerprint.
     pub fn load(config: &Path, out: Option<PathBuf>) -> Result<Self, PipelineError> {
-        let bytes = std::fs::read(config).map_err(|source| ConfigError::Io {
-            file: config.display().to_string(),
-            source,
-        })?;
         let cfg = StudyConfig::load(config)?;
         let out = match out {
             Some(o) => {
@@ -281,7 +277,7 @@ impl Study {
             }
         };
         let grid = cfg.grid.as_ref().map(|g| g.axes());
-        let motions_fp = motions::fingerprint(&cfg)?;
+        let motions_fp = motions::fingerprint(&cfg);
         let ida = ida::fingerprint(&cfg, &motions_fp);
         let rest = match &cfg.grid {
             Some(_) => {
@@ -295,7 +291,7 @@ impl Study {
         };
         Ok(Self {
             config_path: config.to_path_buf(),
-            config_sha256: crate::store::fingerprint::sha256_hex(&bytes),
+            config_sha256: cfg.loaded.config_sha256.clone(),
             cfg,
             out,
             grid,

@@ -148,6 +148,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let meta = TnewMeta {
         fingerprint: study.fingerprint(me)?,
         sweep_fingerprint: study.fingerprint(StageId::Sweep)?,
+        motions_fingerprint: study.fingerprint(StageId::Motions)?,
         flag_codes: TNEW_FLAG_CODES,
         band_flags: &BAND_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,

@@ -8,6 +8,9 @@
 //!                               all_within_band
 //!     period             check grid, s                                  [period]
 //!     target_psa_g, mean_psa_g                                          [period]
+//!     target_table_period (s), target_table_sa_g (g): the rows of a `table:FILE` target, the
+//!                        spectrum the study used (absent for the codes' spectra, which the
+//!                        SPEC string states whole)                      [target_row]
 //!     motion             names of the kept (matched and accepted) motions [motion]
 //!     psa_g              5 %-damped PSA of each kept motion, g          [motion, period]
 //!     seed               names of all seeds                             [seed]
@@ -17,13 +20,14 @@
 //! ```
 
 use super::h5::{
-    attr_f64, attr_str, open, read_attr_f64, read_attr_str, read_strings, write_1d, write_small,
-    write_stage_file, write_strings,
+    attr_f64, attr_str, group, open, read_attr_f64, read_attr_str, read_strings, write_1d,
+    write_small, write_stage_file, write_strings,
 };
 use super::{H5Context, StoreError};
 use crate::motion::Record;
 use crate::motion::matching::MatchReport;
 use crate::motion::set::ZoneMotions;
+use crate::spectrum::{TargetError, TargetSpectrum};
 use std::path::Path;
 
 /// Provenance written on the file.
@@ -89,6 +93,28 @@ fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Resul
         ("all_within_band", z.all_within_band),
     ] {
         attr_f64(&g, k, if v { 1.0 } else { 0.0 })?;
+    }
+    if let TargetSpectrum::Table {
+        periods_s, sa_g, ..
+    } = &z.target
+    {
+        for (name, values, units, long) in [
+            (
+                TABLE_PERIOD,
+                periods_s,
+                "s",
+                "period of a row of the target table",
+            ),
+            (
+                TABLE_SA,
+                sa_g,
+                "g",
+                "target pseudo-spectral acceleration of a row",
+            ),
+        ] {
+            let ds = write_1d(&g, name, values, units, long)?;
+            attr_str(&ds, "dims", "target_row")?;
+        }
     }
     write_1d(&g, "period", &z.periods_s, "s", "oscillator period")?;
     write_1d(
@@ -209,6 +235,48 @@ pub fn zone_names(path: &Path) -> Result<Vec<String>, StoreError> {
         .into_iter()
         .filter_map(|n| n.strip_prefix("zone_").map(str::to_string))
         .collect())
+}
+
+const TABLE_PERIOD: &str = "target_table_period";
+const TABLE_SA: &str = "target_table_sa_g";
+
+/// The target spectrum zone `zone` was matched to: a table from its stored rows (never from its
+/// file, which may have changed since), a code's spectrum from its SPEC string.
+pub fn read_zone_target(path: &Path, zone: &str) -> Result<TargetSpectrum, StoreError> {
+    let f = open(path)?;
+    let g = group(&f, path, &format!("zone_{zone}"))?;
+    let corrupt = |why: String| StoreError::corrupt(path, format!("zone_{zone}: {why}"));
+    let spec = read_attr_str(&g, "target").ok_or_else(|| corrupt("no target attribute".into()))?;
+    let Some(source) = TargetSpectrum::table_file(&spec) else {
+        return spec
+            .parse()
+            .map_err(|e: TargetError| corrupt(format!("target `{spec}`: {e}")));
+    };
+    let read = |name: &str| g.dataset(name)?.read_raw::<f64>();
+    let (periods_s, sa_g) = (read(TABLE_PERIOD).at(path)?, read(TABLE_SA).at(path)?);
+    if sa_g.len() != periods_s.len() {
+        return Err(StoreError::shape(
+            path,
+            format!("zone_{zone}/{TABLE_SA}"),
+            &[sa_g.len()],
+            &[periods_s.len()],
+        ));
+    }
+    let rows_ok = periods_s.len() >= 2
+        && periods_s.iter().all(|t| t.is_finite() && *t >= 0.0)
+        && periods_s.windows(2).all(|w| w[1] > w[0])
+        && sa_g.iter().all(|s| s.is_finite() && *s > 0.0);
+    if !rows_ok {
+        return Err(corrupt(format!(
+            "the rows of target `{spec}` are not a target table (2 rows or more, periods ≥ 0 \
+             increasing, Sa > 0)"
+        )));
+    }
+    Ok(TargetSpectrum::Table {
+        source: source.to_string(),
+        periods_s,
+        sa_g,
+    })
 }
 
 /// The kept motions of one zone, in order.

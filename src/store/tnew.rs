@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! /                  attrs: contents, slidestack_version, fingerprint, sweep_fingerprint,
-//!                           T_new_flag_codes, + the writer's settings
+//!                           motions_fingerprint, T_new_flag_codes, + the writer's settings
 //! /zone_<name>/      attrs: target
 //!     T_p, alpha_1 … alpha_n, mu_1 … mu_n                 coordinates (dimension scales)
 //!     u_stack_mean, u_single_mean, u_rigid_mean (m), T_rigid, T_new (s), DRR_1, DRR_2,
@@ -51,6 +51,9 @@ pub struct ZoneTnew {
 pub struct TnewMeta<'a> {
     pub fingerprint: &'a str,
     pub sweep_fingerprint: &'a str,
+    /// The fingerprint of the `motions.h5` whose motions gave the displacement spectra (and
+    /// whose target spectra `design` reads).
+    pub motions_fingerprint: &'a str,
     /// Long description of the `T_new_flag` codes.
     pub flag_codes: &'a str,
     /// `(code, word)` pairs of the `T_new_band` codes.
@@ -73,6 +76,7 @@ pub fn write_tnew(
         meta.fingerprint,
         |f| {
             attr_str(f, "sweep_fingerprint", meta.sweep_fingerprint)?;
+            attr_str(f, "motions_fingerprint", meta.motions_fingerprint)?;
             attr_str(f, "T_new_flag_codes", meta.flag_codes)?;
             write_attrs(f, meta.settings)?;
             for z in zones {
@@ -222,6 +226,13 @@ pub fn read_zone_tnew(
         ));
     }
     Ok((grid, z))
+}
+
+/// The fingerprint of the `motions.h5` that `tnew.h5` was made from; `None` in a file made
+/// before it was recorded.
+pub fn read_motions_fingerprint(path: &Path) -> Result<Option<String>, StoreError> {
+    let f = open(path)?;
+    Ok(super::h5::read_attr_str(&f, "motions_fingerprint"))
 }
 
 /// The zone names of `tnew.h5` (file order) and its number of blocks.
