@@ -9,7 +9,7 @@
 //! which may have changed since). Reads only verified files of the study directory, and only a
 //! `motions.h5` that `tnew.h5` was made from.
 
-use crate::fit::{Fitted, Sample, paper_equation};
+use crate::fit::{Fitted, Sample, features, paper_equation};
 use crate::grid::OutsideGrid;
 use crate::store::StoreError;
 use crate::store::fit::read_fit;
@@ -144,6 +144,7 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         return Err(DesignError::Mismatch { file: fit_yaml });
     }
     let (zones, blocks) = zones_and_blocks(&tnew)?;
+    fit.check_blocks(&fit_yaml, blocks)?;
     if !zones.contains(&q.zone) {
         return Err(DesignError::UnknownZone {
             zone: q.zone.clone(),
@@ -184,24 +185,19 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
 
     let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
     let recommended = zone_fit.and_then(|z| z.recommended_fit());
+    let x = features(q.period_s, &q.alpha, &q.mu);
     let t_new_fit_s = recommended.map(|f| {
-        let mut x = vec![q.period_s];
-        x.extend(&q.mu);
-        x.extend(&q.alpha);
         Fitted {
             form: f.form,
             params: f.coefficients.iter().map(|c| c.1).collect(),
         }
         .predict(&Sample {
-            x,
+            x: x.clone(),
             t_rigid_s,
             t_new_s: f64::NAN,
         })
     });
-    let mut paper_x = vec![q.period_s];
-    paper_x.extend(&q.mu);
-    paper_x.extend(&q.alpha);
-    let t_new_paper_s = paper_equation(&q.zone, &paper_x);
+    let t_new_paper_s = paper_equation(&q.zone, &x);
     let sa = |t: Option<f64>| t.filter(|t| t.is_finite()).map(|t| target.sa_g(t));
     Ok(Answer {
         zone: q.zone.clone(),

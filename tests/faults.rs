@@ -828,3 +828,53 @@ fn a_record_that_changes_after_the_config_was_loaded_is_refused() {
     );
     assert!(!session.study.path("motions.h5").exists());
 }
+
+#[test]
+fn stage_files_of_other_shapes_are_refused_not_indexed() {
+    use slidestack::store::units::{Stored, UnitId, read_unit, write_unit};
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = study(dir.path(), "");
+    let (c, out) = (s(&cfg), dir.path().join("out"));
+    let o = s(&out);
+    run(&["motions", c, "--out", o], PLAIN).ok();
+
+    // A unit whose checksum holds but whose first column is one case short: merge refuses
+    // naming it; the sweep computes it again.
+    for k in ["1/2", "2/2"] {
+        run(&["sweep", c, "--out", o, "--shard", k], PLAIN).ok();
+    }
+    let unit = out.join("sweep.units/III_000_003.unit");
+    let bytes = std::fs::read(&unit).unwrap();
+    let header = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+    let id: UnitId = serde_json::from_slice(&bytes[12..12 + header]).unwrap();
+    let Stored::Valid(mut columns) = read_unit(&unit, &id).unwrap() else {
+        panic!("a valid unit");
+    };
+    columns.f64s[0].pop();
+    write_unit(&unit, &id, &columns).unwrap();
+    run(&["merge", c, "--out", o], PLAIN).fails(
+        1,
+        "III_000_003.unit: columns has shape [11, 12, 12, 12, 12, 24, 12, 12] where its \
+         dimensions give [12, 12, 12, 12, 12, 24, 12, 12]",
+    );
+    let r = run(&["sweep", c, "--out", o], PLAIN).ok();
+    assert!(r.stderr.contains("computing it again"), "{}", r.stderr);
+    assert!(
+        r.stdout.contains("1 of 24 units to compute"),
+        "{}",
+        r.stdout
+    );
+
+    // sweep.h5 verifies, its slip_peak has another shape: tnew refuses instead of indexing it.
+    common::reshape(&out.join("sweep.h5"), "zone_III/slip_peak");
+    run(&["tnew", c, "--out", o], PLAIN).fails(1, "sweep.h5: zone_III/slip_peak has shape");
+
+    // ida.h5 verifies, its fit_status has another shape: the fragility table is refused.
+    let ida_cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/ida-quick.yaml");
+    let ida_out = dir.path().join("ida");
+    let (ic, io) = (s(&ida_cfg), s(&ida_out));
+    run(&["motions", ic, "--out", io], PLAIN).ok();
+    run(&["ida", ic, "--out", io], PLAIN).ok();
+    common::reshape(&ida_out.join("ida.h5"), "zone_III/fit_status");
+    run(&["ida", ic, "--out", io], PLAIN).fails(1, "ida.h5: zone_III/fit_status has shape");
+}

@@ -163,18 +163,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             rayon::current_num_threads()
         ),
     );
-    let axes = IdaAxes {
-        systems: SYSTEMS.iter().map(|s| s.to_string()).collect(),
-        case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
-        case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
-        case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
-        runs: cfg.tracing.max_runs(),
-        sa_grid_g: cfg.grid_sa_g(),
-        demands: cfg.demand_names(),
-        limit_states: cfg.limit_states.iter().map(|l| l.name.clone()).collect(),
-        limit_state_definitions: cfg.limit_states.iter().map(|l| l.definition()).collect(),
-        fractiles: FRACTILES.to_vec(),
-    };
+    let axes = axes_of(cfg);
     let mut zones = Vec::new();
     let mut at = 0;
     for (z, zc) in study.cfg.zones.iter().enumerate() {
@@ -242,6 +231,34 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     write_ida(&path, &meta, &axes, &zones)?;
     s.reporter.info(me, &format!("verified {}", path.display()));
     Ok(Outcome::Wrote(vec![path]))
+}
+
+/// The axes `ida.h5` has for the `ida:` section `cfg`.
+fn axes_of(cfg: &IdaConfig) -> IdaAxes {
+    IdaAxes {
+        systems: SYSTEMS.iter().map(|s| s.to_string()).collect(),
+        case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
+        case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
+        case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
+        runs: cfg.tracing.max_runs(),
+        sa_grid_g: cfg.grid_sa_g(),
+        demands: cfg.demand_names(),
+        limit_states: cfg.limit_states.iter().map(|l| l.name.clone()).collect(),
+        limit_state_definitions: cfg.limit_states.iter().map(|l| l.definition()).collect(),
+        fractiles: FRACTILES.to_vec(),
+    }
+}
+
+/// Zone `zone` of `ida.h5` (the caller has required it up to date), refused unless its axes
+/// are the ones the config's `ida:` section gives.
+fn read_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
+    let path = study.path(StageId::Ida.output());
+    let (axes, z) = read_zone_ida(&path, zone)?;
+    if axes != axes_of(section(study)?) {
+        let why = format!("zone_{zone}: its axes differ from the config's `ida:` section");
+        return Err(StoreError::corrupt(&path, why).into());
+    }
+    Ok((axes, z))
 }
 
 fn array<T: Clone>(shape: &[usize], fill: T) -> ArrayD<T> {
@@ -385,10 +402,9 @@ pub struct FragilityRow {
 /// Every fit of `ida.h5` (which must be up to date), zone, case, system, limit state in order.
 pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError> {
     study.require(StageId::Ida)?;
-    let path = study.path(StageId::Ida.output());
     let mut rows = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+        let (axes, z) = read_zone(study, &zone.name)?;
         let v = &z.vars;
         for c in 0..axes.case_period_s.len() {
             for (s, system) in axes.systems.iter().enumerate() {
@@ -458,11 +474,10 @@ fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
 pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineError> {
     study.require(StageId::Motions)?;
     study.require(StageId::Ida)?;
-    let path = study.path(StageId::Ida.output());
     let targets = stored_targets(study)?;
     let mut rows = Vec::new();
     for (zone, target) in study.cfg.zones.iter().zip(&targets) {
-        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+        let (axes, z) = read_zone(study, &zone.name)?;
         let median = FRACTILES.iter().position(|&p| p == 0.5).unwrap_or(1);
         for c in 0..axes.case_period_s.len() {
             let curve = |s: usize| -> Vec<f64> {
@@ -516,13 +531,11 @@ pub fn figure(study: &Study) -> Result<String, PipelineError> {
 pub fn figure_of(study: &Study) -> Result<crate::report::chart::Figure, PipelineError> {
     use crate::report::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Ida)?;
-    let cfg = section(study)?;
-    let cap = cfg.collapse_ductility;
+    let cap = section(study)?.collapse_ductility;
     let clip = |v: f64| if v.is_infinite() { cap } else { v };
-    let path = study.path(StageId::Ida.output());
     let mut panels = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+        let (axes, z) = read_zone(study, &zone.name)?;
         let x = axes.sa_grid_g.clone();
         let mut series = Vec::new();
         for s in 0..axes.systems.len() {

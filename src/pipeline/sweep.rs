@@ -144,12 +144,40 @@ impl Units<'_> {
         }
     }
 
+    /// The unit's file, refused (as damaged) unless its columns have the lengths the grid
+    /// gives ([`column_lengths`]).
     fn read(&self, u: Unit) -> Result<Stored, StoreError> {
-        read_unit(&self.path(u), &self.id(u))
+        let path = self.path(u);
+        let stored = read_unit(&path, &self.id(u))?;
+        if let Stored::Valid(c) = &stored {
+            let found: Vec<usize> = (c.f64s.iter().map(Vec::len))
+                .chain(c.u8s.iter().map(Vec::len))
+                .collect();
+            let want = column_lengths(self.grid.cases_per_unit(), self.grid.blocks());
+            if found != want || c.f64s.len() != F64_COLUMNS {
+                return Err(StoreError::shape(&path, "columns", &found, &want));
+            }
+        }
+        Ok(stored)
     }
 }
 
 const F64_COLUMNS: usize = 6;
+
+/// The lengths of the columns [`to_columns`] writes for a unit of `cases` cases of `blocks`
+/// blocks: [`F64_COLUMNS`] `f64` columns (the slip, per interface, last), then two code columns.
+fn column_lengths(cases: usize, blocks: usize) -> Vec<usize> {
+    vec![
+        cases,
+        cases,
+        cases,
+        cases,
+        cases,
+        cases * blocks,
+        cases,
+        cases,
+    ]
+}
 
 fn to_columns(r: &UnitResult) -> Columns {
     Columns {
@@ -305,11 +333,7 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
     let mut read: Vec<Columns> = Vec::with_capacity(all.len());
     for &u in all {
         match units.read(u) {
-            Ok(Stored::Valid(c)) if c.f64s.len() == F64_COLUMNS && c.u8s.len() == 2 => read.push(c),
-            Ok(Stored::Valid(_)) => bad.push(format!(
-                "{}: has the wrong columns",
-                units.path(u).display()
-            )),
+            Ok(Stored::Valid(c)) => read.push(c),
             Ok(Stored::Missing | Stored::Stale) => missing += 1,
             Err(e) => bad.push(e.to_string()),
         }

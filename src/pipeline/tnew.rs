@@ -5,13 +5,13 @@
 //!
 //! Fingerprint: the sweep's, and the step of the spectrum's period grid.
 
-use super::{Outcome, PipelineError, Session, StageId};
+use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::grid::Grid;
 use crate::spectrum::{SpectrumError, response_spectrum};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::read_zone_sweep;
-use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, write_tnew};
+use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, read_zone_tnew, write_tnew};
 use crate::study::tnew::{
     BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES, TnewFlag, period_at_displacement,
 };
@@ -49,6 +49,22 @@ pub fn spectrum_periods_s(grid: &Grid) -> Vec<f64> {
     (1..=steps).map(|k| k as f64 * SD_STEP_S).collect()
 }
 
+/// Zone `zone` of `tnew.h5`, refused unless its grid and its spectrum's periods are the ones
+/// the config gives.
+pub fn read_zone(study: &Study, zone: &str) -> Result<ZoneTnew, PipelineError> {
+    let grid = study.grid(StageId::Tnew)?;
+    let path = study.path(StageId::Tnew.output());
+    let (axes, t) = read_zone_tnew(&path, zone, grid.blocks())?;
+    let why = if axes != *grid {
+        "its grid differs from the config's"
+    } else if t.period_sd_s != spectrum_periods_s(grid) {
+        "its spectrum's periods differ from the config's grid"
+    } else {
+        return Ok(t);
+    };
+    Err(StoreError::corrupt(&path, format!("zone_{zone}: {why}")).into())
+}
+
 /// Builds `tnew.h5`.
 pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let study = &s.study;
@@ -62,12 +78,17 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let mut zones = Vec::new();
     for (z, zc) in study.cfg.zones.iter().enumerate() {
         let (axes, sw) = read_zone_sweep(&sweep_path, &zc.name, n)?;
-        if axes != *grid {
-            return Err(StoreError::corrupt(
-                &sweep_path,
-                format!("zone_{}: its grid differs from the config's", zc.name),
-            )
-            .into());
+        let names: Vec<&String> = motions[z].iter().map(|r| &r.name).collect();
+        let differs = if axes != *grid {
+            Some("its grid differs from the config's")
+        } else if sw.motions.iter().collect::<Vec<_>>() != names {
+            Some("its motions are not those of motions.h5")
+        } else {
+            None
+        };
+        if let Some(why) = differs {
+            let why = format!("zone_{}: {why}", zc.name);
+            return Err(StoreError::corrupt(&sweep_path, why).into());
         }
         let m = sw.motions.len();
         let spectra = motions[z]

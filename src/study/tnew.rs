@@ -12,7 +12,7 @@
 //! attached mass, and the crossing near `T_rigid` is the one that continues the `μ → ∞` limit.
 //! The flag says which case applied.
 
-use crate::fit::Sample;
+use crate::fit::{Sample, features};
 use crate::grid::Grid;
 
 /// The fit's samples: every case of `grid` (flat over `[T_p][case]`) with a finite `T_new`,
@@ -22,11 +22,8 @@ pub fn samples(grid: &Grid, t_rigid_s: &[f64], t_new_s: &[f64]) -> Vec<Sample> {
         .filter(|&c| t_new_s[c].is_finite())
         .map(|c| {
             let case = grid.point(c);
-            let mut x = vec![case.period_s];
-            x.extend(case.mu);
-            x.extend(case.alpha);
             Sample {
-                x,
+                x: features(case.period_s, &case.alpha, &case.mu),
                 t_rigid_s: t_rigid_s[c],
                 t_new_s: t_new_s[c],
             }

@@ -41,9 +41,10 @@ use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::fit::{FitReport, ZoneFit, read_fit};
 use crate::store::motions::{ZoneSpectra, read_zone_spectra};
 use crate::store::report::write_report_dir;
-use crate::store::tnew::{ZoneTnew, read_band_flags, read_zone_tnew};
+use crate::store::tnew::{ZoneTnew, read_band_flags};
 use crate::study::cases::{PAPER_SECTION_7_1, PAPER_TABLE_2, PAPER_TABLE_3, SECTION_7_1, TABLE_2};
 use crate::study::sweep::Physics;
+use crate::study::tnew::BAND_FLAGS;
 use cases::{section71_section, table2_section};
 use fit::fit_section;
 use grid::{drr_section, tnew_section};
@@ -125,6 +126,7 @@ impl<'a> Inputs<'a> {
         );
         let fit = read_fit(&fyaml)?.ok_or_else(|| StoreError::corrupt(&fyaml, "is missing"))?;
         let n = grid.blocks();
+        fit.check_blocks(&fyaml, n)?;
         let mut zones = Vec::new();
         for (zc, motions) in study.cfg.zones.iter().zip(motions) {
             if motions.is_empty() {
@@ -133,13 +135,22 @@ impl<'a> Inputs<'a> {
                 }
                 .into());
             }
-            let (axes, tnew) = read_zone_tnew(&th5, &zc.name, n)?;
-            if axes != *grid {
-                return Err(StoreError::corrupt(
+            let tnew = super::tnew::read_zone(study, &zc.name)?;
+            let band_flags = read_band_flags(&th5, &zc.name)?;
+            let spectra = read_zone_spectra(&mh5, &zc.name)?;
+            let why = if !same_flags(&band_flags, &BAND_FLAGS) {
+                Some((
                     &th5,
-                    format!("zone_{}: its grid differs from the config's", zc.name),
-                )
-                .into());
+                    "T_new_band's flag_values/flag_meanings are not this version's",
+                ))
+            } else if spectra.periods_s != study.cfg.motions.matching.check_grid_s() {
+                Some((&mh5, "its check periods are not the config's"))
+            } else {
+                None
+            };
+            if let Some((file, why)) = why {
+                let why = format!("zone_{}: {why}", zc.name);
+                return Err(StoreError::corrupt(file, why).into());
             }
             let zf = fit
                 .zones
@@ -149,8 +160,8 @@ impl<'a> Inputs<'a> {
                 .ok_or_else(|| StoreError::corrupt(&fyaml, format!("has no zone {}", zc.name)))?;
             zones.push(Zone {
                 name: zc.name.clone(),
-                spectra: read_zone_spectra(&mh5, &zc.name)?,
-                band_flags: read_band_flags(&th5, &zc.name)?,
+                spectra,
+                band_flags,
                 section71: CaseRun::new(&physics, &SECTION_7_1, n, &motions)?,
                 table2: CaseRun::new(&physics, &TABLE_2, n, &motions)?,
                 motions,
@@ -166,6 +177,15 @@ impl<'a> Inputs<'a> {
             zones,
         })
     }
+}
+
+/// Whether stored `(code, word)` flags are `want`.
+fn same_flags(stored: &[(u8, String)], want: &[(u8, &str)]) -> bool {
+    stored.len() == want.len()
+        && stored
+            .iter()
+            .zip(want)
+            .all(|(a, b)| a.0 == b.0 && a.1 == b.1)
 }
 
 /// The report's files as they are made.
