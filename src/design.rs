@@ -22,11 +22,11 @@ use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum DesignError {
-    #[error("{}: no {file} (run the study first: `slidestack run CONFIG --out {}`)", dir.display(), dir.display())]
+    #[error("{}: no {file} (run the study into it first)", dir.display())]
     Missing { dir: PathBuf, file: &'static str },
     #[error("zone `{zone}` is not in the study; it has {known}")]
     UnknownZone { zone: String, known: String },
-    #[error("--{what} lists {got} values but the study's stacks have {blocks} blocks")]
+    #[error("`{what}` lists {got} values but the study's stacks have {blocks} blocks")]
     Count {
         what: &'static str,
         got: usize,
@@ -34,7 +34,7 @@ pub enum DesignError {
     },
     #[error("{what} = {value} must be finite and > 0")]
     Value { what: String, value: f64 },
-    #[error("{0}; add --extrapolate to use the fitted form there")]
+    #[error("{0}; with `extrapolate` the fitted form answers there")]
     Outside(OutsideGrid),
     #[error("{}: belongs to another tnew.h5 than the study's: rerun `slidestack fit`", file.display())]
     Mismatch { file: PathBuf },
@@ -107,7 +107,7 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
             Err(DesignError::Value { what, value })
         }
     };
-    positive("--period".into(), q.period_s)?;
+    positive("`period_s`".into(), q.period_s)?;
     for (i, &a) in q.alpha.iter().enumerate() {
         positive(format!("alpha_{}", i + 1), a)?;
     }

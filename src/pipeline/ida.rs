@@ -128,18 +128,18 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             };
             let accel = rec.accel_mps2(1.0);
             let record_sa_g = sa_g(&accel, rec.dt_s, case.period_s)
-                .map_err(|e| fail(SYSTEMS[0], e.to_string()))?;
+                .map_err(|e| fail(SYSTEMS[0].key(), e.to_string()))?;
             let padded = padded(&accel, rec.dt_s, cfg.pad_s);
             let c_y = cfg.strength_ratio(&targets[z], case);
             let systems = cfg
                 .systems(&physics, case, c_y)
-                .map_err(|e| fail(SYSTEMS[0], e.to_string()))?;
+                .map_err(|e| fail(SYSTEMS[0].key(), e.to_string()))?;
             let traces = systems
                 .iter()
                 .zip(SYSTEMS)
-                .map(|(sys, name)| {
+                .map(|(sys, kind)| {
                     trace_system(cfg, sys, &padded, rec.dt_s, record_sa_g)
-                        .map_err(|e| fail(name, e.to_string()))
+                        .map_err(|e| fail(kind.key(), e.to_string()))
                 })
                 .collect::<Result<Vec<_>, _>>()?;
             bar.inc();
@@ -236,7 +236,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
 /// The axes `ida.h5` has for the `ida:` section `cfg`.
 fn axes_of(cfg: &IdaConfig) -> IdaAxes {
     IdaAxes {
-        systems: SYSTEMS.iter().map(|s| s.to_string()).collect(),
+        systems: SYSTEMS.iter().map(|s| s.key().to_string()).collect(),
         case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
         case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
         case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),

@@ -21,9 +21,8 @@ use crate::store::motions::read_zone_motions;
 use crate::store::sweep::{SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, unit_path, write_unit};
 use crate::study::config::{Seeds, StudyConfig};
-use crate::study::sweep::{
-    Physics, SKIP_RULE_CODES, SKIP_RULE_FLAGS, SweepError, UnitOptions, UnitResult, run_unit,
-};
+use crate::study::physics::{CaseError, Physics, SystemKind};
+use crate::study::sweep::{SKIP_RULE_CODES, SKIP_RULE_FLAGS, UnitOptions, UnitResult, run_unit};
 use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -41,10 +40,10 @@ pub enum SweepStageError {
     Simulation {
         zone: String,
         motion: String,
-        source: Box<SweepError>,
+        source: Box<CaseError>,
     },
     #[error(
-        "{missing} of {total} units are missing from {}: run the remaining shards (or `slidestack sweep` without --shard)",
+        "{missing} of {total} units are missing from {}: run the remaining shards (or the sweep unsharded)",
         dir.display()
     )]
     MissingUnits {
@@ -54,7 +53,7 @@ pub enum SweepStageError {
     },
     #[error(
         "{} of the units in {} are damaged or misplaced, first: {first}; rerun the shards that made \
-         them (or `slidestack sweep` without --shard), which recompute them",
+         them (or the sweep unsharded), which recompute them",
         count, dir.display()
     )]
     BadUnits {
@@ -292,7 +291,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
                  ({threads} threads)",
                 cases as f64 / secs.max(1e-9),
                 sims as f64 / secs.max(1e-9),
-                100.0 * (1.0 - sims as f64 / (3 * cases) as f64),
+                100.0 * (1.0 - sims as f64 / (SystemKind::ALL.len() * cases) as f64),
                 secs * 1e9 * threads as f64 / samples.into_inner().max(1) as f64
             ),
         );

@@ -7,14 +7,12 @@
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::grid::Grid;
-use crate::spectrum::{SpectrumError, response_spectrum};
+use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::read_zone_sweep;
 use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, read_zone_tnew, write_tnew};
-use crate::study::tnew::{
-    BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES, TnewFlag, period_at_displacement,
-};
+use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
 use ndarray::{ArrayD, Axis};
 use rayon::prelude::*;
 use thiserror::Error;
@@ -94,7 +92,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let spectra = motions[z]
             .par_iter()
             .map(|r| {
-                response_spectrum(&r.accel_mps2(1.0), r.dt_s, &period_sd_s, 0.05)
+                response_spectrum(&r.accel_mps2(1.0), r.dt_s, &period_sd_s, TARGET_DAMPING)
                     .map(|s| s.sd_m())
                     .map_err(|source| TnewError::Spectrum {
                         zone: zc.name.clone(),
@@ -126,13 +124,9 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let mut flag = Vec::with_capacity(cases);
         let mut band = Vec::with_capacity(cases);
         for (c, (&us, &slid)) in u_stack.iter().zip(&slides).enumerate() {
-            let case = grid.point(c);
-            let tr = physics.rigid(case.period_s, case.alpha_total()).period_s;
-            let (tn, f) = if slid {
-                period_at_displacement(&period_sd_s, &sd_mean_m, us, tr)
-            } else {
-                (tr, TnewFlag::NoSlip)
-            };
+            let case = grid.case(c);
+            let tr = case.t_rigid_s();
+            let (tn, f) = tnew::t_new(&period_sd_s, &sd_mean_m, us, tr, slid);
             t_rigid.push(tr);
             t_new.push(tn);
             flag.push(f64::from(f as u8));

@@ -23,6 +23,10 @@ use thiserror::Error;
 use crate::dynamics::G;
 use crate::limits::MAX_FILE_BYTES;
 
+/// The damping ratio of target (design) spectra, and so of the record spectra compared with
+/// them: 5 %.
+pub const TARGET_DAMPING: f64 = 0.05;
+
 /// Seismic zone of IS 1893 (Part 1):2016, Fig. 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Zone {

@@ -17,7 +17,7 @@
 //! ```
 
 use super::ida::IdaConfig;
-use super::sweep::{DampingBasis, Physics};
+use super::physics::{DampingBasis, Physics};
 use crate::grid::Grid;
 use crate::grid::linear_range;
 use crate::limits::{
@@ -143,7 +143,7 @@ pub struct GridConfig {
     #[serde(default = "one")]
     pub mu_static_ratio: f64,
     /// Viscous damping ratio, of the system `damping_basis` names.
-    #[serde(default = "five_percent")]
+    #[serde(default = "default_damping")]
     pub damping: f64,
     /// `rigid` (default): `damping` is the ratio of the structure with its whole load rigidly
     /// attached, one damper for every system; `structure`: of the bare structure.
@@ -171,8 +171,8 @@ impl GridConfig {
     }
 }
 
-fn five_percent() -> f64 {
-    0.05
+fn default_damping() -> f64 {
+    Physics::DEFAULT.damping
 }
 
 /// One hazard level: its name (the group `zone_<name>`) and its target spectrum (SPEC string).
@@ -506,14 +506,9 @@ impl StudyConfig {
     /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`; the defaults without a
     /// grid).
     pub fn physics(&self) -> Physics {
-        self.grid.as_ref().map_or(
-            Physics {
-                damping: 0.05,
-                basis: DampingBasis::default(),
-                mu_static_ratio: 1.0,
-            },
-            GridConfig::physics,
-        )
+        self.grid
+            .as_ref()
+            .map_or(Physics::DEFAULT, GridConfig::physics)
     }
 
     /// The grid, or an error naming the missing section.

@@ -21,7 +21,7 @@ pub fn samples(grid: &Grid, t_rigid_s: &[f64], t_new_s: &[f64]) -> Vec<Sample> {
     (0..t_new_s.len())
         .filter(|&c| t_new_s[c].is_finite())
         .map(|c| {
-            let case = grid.point(c);
+            let case = grid.case(c);
             Sample {
                 x: features(case.period_s, &case.alpha, &case.mu),
                 t_rigid_s: t_rigid_s[c],
@@ -132,6 +132,23 @@ impl BandCounts {
             self.sliding(),
             self.above_1_005
         )
+    }
+}
+
+/// `T_new` of a case whose mean peak displacement with the stack is `u_m`: where the mean
+/// displacement spectrum `(periods_s, sd_m)` equals it ([`period_at_displacement`]) when some
+/// interface slipped, `T_rigid` when none did.
+pub fn t_new(
+    periods_s: &[f64],
+    sd_m: &[f64],
+    u_m: f64,
+    t_rigid_s: f64,
+    slides: bool,
+) -> (f64, TnewFlag) {
+    if slides {
+        period_at_displacement(periods_s, sd_m, u_m, t_rigid_s)
+    } else {
+        (t_rigid_s, TnewFlag::NoSlip)
     }
 }
 

@@ -15,7 +15,7 @@
 //!
 //! Panels and lines are picked from the grid's own axes, so any grid (other block counts
 //! included) gives a report. Every simulation uses the study's physics
-//! ([`crate::study::sweep::Physics`]). The directory is replaced as a whole
+//! ([`crate::study::physics::Physics`]). The directory is replaced as a whole
 //! ([`crate::store::report`]).
 //!
 //! Fingerprint: the fit's and the motions' (which carry everything upstream), `ida.h5`'s with an
@@ -31,7 +31,6 @@ mod select;
 mod text;
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
-use crate::dynamics::{ModelError, SimError};
 use crate::grid::Grid;
 use crate::motion::Record;
 use crate::report::chart::{self, ChartError, Figure};
@@ -43,13 +42,13 @@ use crate::store::motions::{ZoneSpectra, read_zone_spectra};
 use crate::store::report::write_report_dir;
 use crate::store::tnew::{ZoneTnew, read_band_flags};
 use crate::study::cases::{PAPER_SECTION_7_1, PAPER_TABLE_2, PAPER_TABLE_3, SECTION_7_1, TABLE_2};
-use crate::study::sweep::Physics;
+use crate::study::physics::{CaseError, Physics, SystemKind};
 use crate::study::tnew::BAND_FLAGS;
 use cases::{section71_section, table2_section};
 use fit::fit_section;
 use grid::{drr_section, tnew_section};
 use motions::motions_section;
-use runs::{CaseRun, System3, section71_tnew};
+use runs::{CaseRun, section71_tnew};
 use select::Selection;
 use text::{fixed, joined, num};
 use thiserror::Error;
@@ -59,13 +58,10 @@ const REPORT_VERSION: &str = "report-2";
 
 #[derive(Debug, Error)]
 pub enum ReportError {
-    #[error("the report's case {case}: {source}")]
-    Model { case: String, source: ModelError },
-    #[error("the report's case {case} under {motion}: {source}")]
-    Simulation {
-        case: String,
+    #[error("the report's {source}, under {motion}")]
+    Case {
         motion: String,
-        source: SimError,
+        source: Box<CaseError>,
     },
     #[error("zone {zone} has no motions")]
     NoMotions { zone: String },
@@ -209,7 +205,7 @@ fn summary(inp: &Inputs) -> String {
     let ph = &inp.physics;
     let mut rows = Vec::new();
     for z in &inp.zones {
-        let (u, _, tn, _) = section71_tnew(z, ph);
+        let (u, _, tn, _) = section71_tnew(z);
         let p71 = (PAPER_SECTION_7_1.0 == z.name).then_some(PAPER_SECTION_7_1);
         rows.push(vec![
             "Section 7.1 case: T_new (s)".into(),
@@ -224,7 +220,8 @@ fn summary(inp: &Inputs) -> String {
             format!("{:.2}", u * 100.0),
         ]);
         let c = &z.table2;
-        let red = 100.0 * (1.0 - c.mean_peak(System3::Stack) / c.mean_peak(System3::Single));
+        let red =
+            100.0 * (1.0 - c.mean_peak(SystemKind::Stack) / c.mean_peak(SystemKind::SingleBlock));
         let p2 = PAPER_TABLE_2.iter().find(|p| p.0 == z.name);
         rows.push(vec![
             "Table 2 case: reduction of the peak by the stack (%)".into(),
