@@ -13,7 +13,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use slidestack::dynamics::building::{
-    Building, BuildingSpec, ModalBasis, StackSpec, StoreyYielding, simulate_building,
+    Building, BuildingSpec, DampingBasis, StackSpec, StoreyYielding, simulate_building,
 };
 use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, Yielding, simulate_exact};
 use slidestack::motion::read_record;
@@ -72,7 +72,7 @@ fn integrators(c: &mut Criterion) {
     one.stacks = vec![stack(1, &[0.5, 0.5], &[0.2, 0.1])];
     let mut three = BuildingSpec::uniform(3, 0.6);
     three.storey_stiffnesses = vec![3.0, 2.0, 1.0];
-    three.damping_basis = ModalBasis::Rigid;
+    three.damping_basis = DampingBasis::Rigid;
     three.stacks = vec![stack(3, &[0.5, 0.5], &[0.2, 0.1]), stack(1, &[1.0], &[0.3])];
     let mut three_yielding = three.clone();
     three_yielding.yielding = Some(StoreyYielding {

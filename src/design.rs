@@ -5,25 +5,28 @@
 //! only with `extrapolate`, and then from the fit); `T_new` from the zone's recommended fitted
 //! form (`fit.yaml`); `T_new` from the paper's Eqs. 16–17 (zones III and V, two blocks); and
 //! the zone's design spectral acceleration (its target spectrum, `Z·Sa/g` for IS 1893) at `T_p`
-//! and at `T_new`. Reads only verified files of the study directory.
+//! and at `T_new`, from the target spectrum stored in `motions.h5` (never from a table file,
+//! which may have changed since). Reads only verified files of the study directory, and only a
+//! `motions.h5` that `tnew.h5` was made from.
 
-use crate::fit::{Fitted, Sample, paper_equation};
+use crate::fit::{Fitted, Sample, features, paper_equation};
 use crate::grid::OutsideGrid;
-use crate::spectrum::TargetSpectrum;
 use crate::store::StoreError;
 use crate::store::fit::read_fit;
-use crate::store::tnew::{read_zone_tnew, zones_and_blocks};
+use crate::store::h5::stored_fingerprint;
+use crate::store::motions::read_zone_target;
+use crate::store::tnew::{read_motions_fingerprint, read_zone_tnew, zones_and_blocks};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum DesignError {
-    #[error("{}: no {file} (run the study first: `slidestack run CONFIG --out {}`)", dir.display(), dir.display())]
+    #[error("{}: no {file} (run the study into it first)", dir.display())]
     Missing { dir: PathBuf, file: &'static str },
     #[error("zone `{zone}` is not in the study; it has {known}")]
     UnknownZone { zone: String, known: String },
-    #[error("--{what} lists {got} values but the study's stacks have {blocks} blocks")]
+    #[error("`{what}` lists {got} values but the study's stacks have {blocks} blocks")]
     Count {
         what: &'static str,
         got: usize,
@@ -31,17 +34,13 @@ pub enum DesignError {
     },
     #[error("{what} = {value} must be finite and > 0")]
     Value { what: String, value: f64 },
-    #[error("{0}; add --extrapolate to use the fitted form there")]
+    #[error("{0}; with `extrapolate` the fitted form answers there")]
     Outside(OutsideGrid),
     #[error("{}: belongs to another tnew.h5 than the study's: rerun `slidestack fit`", file.display())]
     Mismatch { file: PathBuf },
-    #[error("{}: zone {zone}: target `{target}`: {why}", file.display())]
-    Target {
-        file: PathBuf,
-        zone: String,
-        target: String,
-        why: String,
-    },
+    /// `motions.h5` is not the one `tnew.h5` was made from (or `tnew.h5` does not say which).
+    #[error("{}: {why}", file.display())]
+    OtherMotions { file: PathBuf, why: &'static str },
     #[error(transparent)]
     Store(#[from] StoreError),
 }
@@ -51,7 +50,7 @@ impl DesignError {
     pub fn is_bad_input(&self) -> bool {
         !matches!(
             self,
-            DesignError::Store(_) | DesignError::Mismatch { .. } | DesignError::Target { .. }
+            DesignError::Store(_) | DesignError::Mismatch { .. } | DesignError::OtherMotions { .. }
         )
     }
 }
@@ -108,7 +107,7 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
             Err(DesignError::Value { what, value })
         }
     };
-    positive("--period".into(), q.period_s)?;
+    positive("`period_s`".into(), q.period_s)?;
     for (i, &a) in q.alpha.iter().enumerate() {
         positive(format!("alpha_{}", i + 1), a)?;
     }
@@ -117,22 +116,35 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
     }
     let tnew = dir.join("tnew.h5");
     let fit_yaml = dir.join("fit.yaml");
-    let Some(tnew_fp) = crate::store::h5::stored_fingerprint(&tnew)? else {
-        return Err(DesignError::Missing {
-            dir: dir.to_path_buf(),
-            file: "tnew.h5",
-        });
+    let motions = dir.join("motions.h5");
+    let missing = |file| DesignError::Missing {
+        dir: dir.to_path_buf(),
+        file,
     };
-    let Some(fit) = read_fit(&fit_yaml)? else {
-        return Err(DesignError::Missing {
-            dir: dir.to_path_buf(),
-            file: "fit.yaml",
-        });
-    };
+    let tnew_fp = stored_fingerprint(&tnew)?.ok_or_else(|| missing("tnew.h5"))?;
+    let motions_fp = stored_fingerprint(&motions)?.ok_or_else(|| missing("motions.h5"))?;
+    match read_motions_fingerprint(&tnew)? {
+        Some(fp) if fp == motions_fp => {}
+        Some(_) => {
+            return Err(DesignError::OtherMotions {
+                file: motions,
+                why: "tnew.h5 was made from another motions.h5: rerun the study",
+            });
+        }
+        None => {
+            return Err(DesignError::OtherMotions {
+                file: tnew,
+                why: "made by an earlier slidestack, it does not record its motions.h5: rebuild it \
+                      (the tnew stage, forced)",
+            });
+        }
+    }
+    let fit = read_fit(&fit_yaml)?.ok_or_else(|| missing("fit.yaml"))?;
     if fit.fingerprint != crate::pipeline::fit::fingerprint(&tnew_fp) {
         return Err(DesignError::Mismatch { file: fit_yaml });
     }
     let (zones, blocks) = zones_and_blocks(&tnew)?;
+    fit.check_blocks(&fit_yaml, blocks)?;
     if !zones.contains(&q.zone) {
         return Err(DesignError::UnknownZone {
             zone: q.zone.clone(),
@@ -145,15 +157,7 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         }
     }
     let (grid, t) = read_zone_tnew(&tnew, &q.zone, blocks)?;
-    let target: TargetSpectrum = t
-        .target
-        .parse()
-        .map_err(|e: crate::spectrum::TargetError| DesignError::Target {
-            file: tnew.clone(),
-            zone: q.zone.clone(),
-            target: t.target.clone(),
-            why: e.to_string(),
-        })?;
+    let target = read_zone_target(&motions, &q.zone)?;
     let alpha_total: f64 = q.alpha.iter().sum();
     let t_rigid_s = q.period_s * (1.0 + alpha_total).sqrt();
     let mut notes = Vec::new();
@@ -181,24 +185,19 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
 
     let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
     let recommended = zone_fit.and_then(|z| z.recommended_fit());
+    let x = features(q.period_s, &q.alpha, &q.mu);
     let t_new_fit_s = recommended.map(|f| {
-        let mut x = vec![q.period_s];
-        x.extend(&q.mu);
-        x.extend(&q.alpha);
         Fitted {
             form: f.form,
             params: f.coefficients.iter().map(|c| c.1).collect(),
         }
         .predict(&Sample {
-            x,
+            x: x.clone(),
             t_rigid_s,
             t_new_s: f64::NAN,
         })
     });
-    let mut paper_x = vec![q.period_s];
-    paper_x.extend(&q.mu);
-    paper_x.extend(&q.alpha);
-    let t_new_paper_s = paper_equation(&q.zone, &paper_x);
+    let t_new_paper_s = paper_equation(&q.zone, &x);
     let sa = |t: Option<f64>| t.filter(|t| t.is_finite()).map(|t| target.sa_g(t));
     Ok(Answer {
         zone: q.zone.clone(),

@@ -6,8 +6,11 @@
 //! `[T_p, alpha_1 … alpha_n, mu_1 … mu_n]` (with `motion` in front in `sweep.h5`), row-major, the
 //! last `μ` fastest. A *work unit* is one `T_p` (under one motion): all `α` and `μ` combinations.
 //!
-//! Pure data: no physics, no files. The study's physics settings (damping, static friction)
-//! live in [`crate::study::sweep::Physics`], the file layouts in [`crate::store`].
+//! Pure data: no physics, no files. A point of the grid is a [`Case`]; the study's physics
+//! settings (damping, static friction) live in [`crate::study::physics::Physics`], the file
+//! layouts in [`crate::store`].
+
+use crate::case::Case;
 
 /// A point outside the grid's range in one of its dimensions.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -55,23 +58,6 @@ pub struct Grid {
     pub mu: Vec<Vec<f64>>,
 }
 
-/// One case: `(T_p, α, μ)`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Case {
-    pub period_s: f64,
-    /// Per block, bottom first.
-    pub alpha: Vec<f64>,
-    /// Kinetic, per interface.
-    pub mu: Vec<f64>,
-}
-
-impl Case {
-    /// `α = Σα_i`, the whole stack's mass ratio.
-    pub fn alpha_total(&self) -> f64 {
-        self.alpha.iter().sum()
-    }
-}
-
 impl Grid {
     pub fn blocks(&self) -> usize {
         self.alpha.len()
@@ -109,9 +95,9 @@ impl Grid {
     }
 
     /// The case at flat `index` over `[T_p][case]`.
-    pub fn point(&self, index: usize) -> Case {
+    pub fn case(&self, index: usize) -> Case {
         let per = self.cases_per_unit();
-        let (alpha, mu) = self.case(index % per);
+        let (alpha, mu) = self.stack(index % per);
         Case {
             period_s: self.periods_s[index / per],
             alpha,
@@ -119,9 +105,9 @@ impl Grid {
         }
     }
 
-    /// `(α, μ)` of case `index` within a unit (row-major over `case_shape`, the last `μ`
-    /// fastest).
-    pub fn case(&self, mut index: usize) -> (Vec<f64>, Vec<f64>) {
+    /// The stack `(α, μ)` of case `index` within a unit (row-major over `case_shape`, the last
+    /// `μ` fastest).
+    pub fn stack(&self, mut index: usize) -> (Vec<f64>, Vec<f64>) {
         let shape = self.case_shape();
         let mut pick = vec![0; shape.len()];
         for d in (0..shape.len()).rev() {
@@ -211,7 +197,7 @@ mod tests {
         };
         let values: Vec<f64> = (0..g.cases())
             .map(|c| {
-                let case = g.point(c);
+                let case = g.case(c);
                 let mut p = vec![case.period_s];
                 p.extend(&case.alpha);
                 p.extend(&case.mu);
@@ -270,7 +256,7 @@ mod tests {
         assert_eq!(g.cases(), 12);
         assert_eq!(g.dim_names(), ["T_p", "alpha_1", "alpha_2", "mu_1", "mu_2"]);
         // Index 10 = T_p 1 (6 per unit), then case 4 = alpha_1 index 1, mu_2 index 1.
-        let c = g.point(10);
+        let c = g.case(10);
         assert_eq!(c.period_s, 1.0);
         assert_eq!(c.alpha, vec![0.5, 1.0]);
         assert_eq!(c.mu, vec![0.2, 0.1]);

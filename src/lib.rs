@@ -7,10 +7,12 @@
 //! * [`fit`]: the design equation for T_new: forms, argmin problems, metrics.
 //! * [`report`]: SVG figures and the HTML report.
 //! * [`limits`]: the limits every input is checked against, with their reasons.
+//! * [`case`]: a case, one structure and its stack.
 //! * [`grid`]: the study's case grid (axes and indexing).
 //! * [`ida`]: incremental dynamic analysis kernels: hunt & fill, fractiles, fragility fits.
 //! * [`study`]: the study's numerics and configuration.
 //! * [`simulation`]: one case under one ground motion (`slidestack simulate`).
+//! * [`match_files`]: record files matched to a target and written (`slidestack match`).
 //! * [`design`]: `T_new` of one structure from a finished study (the designer's query).
 //! * [`pipeline`]: the study's stages as library code: one shape, the output lock, checks.
 //! * [`store`]: result files (time histories, stage files) and input fingerprints.
@@ -18,12 +20,14 @@
 //! `docs/model.md` states the model, the numbers checked by hand and the choices the paper leaves
 //! open; the code cites its sections as `docs/model.md, "<section>"`.
 
+pub mod case;
 pub mod design;
 pub mod dynamics;
 pub mod fit;
 pub mod grid;
 pub mod ida;
 pub mod limits;
+pub mod match_files;
 pub mod motion;
 mod numeric;
 pub mod pipeline;

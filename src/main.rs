@@ -2,7 +2,7 @@
 
 mod cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use slidestack::pipeline::StageId;
 
 /// Seismic response of a structure carrying stacks of sliding rigid blocks.
@@ -52,7 +52,8 @@ fn main() -> std::process::ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let cli = Cli::parse();
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Spectrum(args) => cmd::spectrum::run(args),
@@ -71,7 +72,12 @@ fn main() -> std::process::ExitCode {
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", cmd::message(&e));
+            let root = Cli::command();
+            let command = matches
+                .subcommand_name()
+                .and_then(|name| root.find_subcommand(name))
+                .unwrap_or(&root);
+            eprintln!("error: {}", cmd::message(&e, command));
             std::process::ExitCode::from(cmd::exit_code(&e))
         }
     }

@@ -1,6 +1,6 @@
-//! One case under one ground motion, as `slidestack simulate` runs it: the case's settings (from
-//! flags, a YAML file or both) checked and resolved into a [`System`], the simulation, and the
-//! [`Summary`] its `--json` prints.
+//! One case under one ground motion, as `slidestack simulate` runs it: its [`Settings`] (from
+//! flags, a YAML file or both) checked and resolved into a [`Simulation`] (the system and the
+//! record), the run, and the [`Summary`] its `--json` prints.
 //!
 //! The physics of the case comes from [`Physics`], as for the study's stages; the yielding model
 //! is docs/model.md, "Yielding structure".
@@ -11,7 +11,7 @@ use crate::dynamics::{
 };
 use crate::motion::{self, Record, RecordError};
 use crate::study::config::{ConfigError, read_yaml_text};
-use crate::study::sweep::{DampingBasis, Physics};
+use crate::study::physics::{DampingBasis, Physics};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -49,40 +49,63 @@ impl StructureKind {
     }
 }
 
-/// The case as flags or a YAML file state it: every setting optional (a default applies), unknown
-/// YAML keys refused.
-#[derive(Debug, Clone, Default, Deserialize)]
+/// The case of a simulation, every setting optional (a default applies): the keys of a YAML
+/// case file (unknown keys refused) and, field by field, the flags of `slidestack simulate`
+/// (`period` is `--period`), which override the file's ([`Settings::over`]). A new setting is a
+/// new field here and nowhere else: a flag unless marked `#[arg(skip)]`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, clap::Args)]
 #[serde(deny_unknown_fields)]
-pub struct CaseSettings {
-    /// Ground-motion file; the built-in record when absent.
+pub struct Settings {
+    /// Ground-motion record: PEER .AT2 or two-column time/acceleration text, values in g [default:
+    /// the built-in record].
+    #[arg(long)]
     pub record: Option<PathBuf>,
-    /// Period of the bare structure `T_p`, s (default 1.0).
+    /// Period of the bare structure T_p, s [default: 1.0].
+    #[arg(long)]
     pub period: Option<f64>,
-    /// Mass ratios `α_i = m_i/m_p`, bottom block first (default 0.5, 0.5).
+    /// Block mass ratios α_i = m_i/m_p, bottom block first [default: 0.5,0.5].
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
     pub alpha: Option<Vec<f64>>,
-    /// Kinetic friction coefficients, interface 1 (structure–block 1) first (default 0.2, 0.1).
+    /// Kinetic friction coefficients μ_i, interface 1 (structure–block 1) first [default:
+    /// 0.2,0.1].
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
     pub mu: Option<Vec<f64>>,
-    /// Static friction coefficients (default equal to `mu`).
+    /// Static friction coefficients (≥ kinetic) [default: equal to mu].
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
     pub mu_static: Option<Vec<f64>>,
-    /// Viscous damping ratio of the system `damping_basis` names (default 0.05).
+    /// Viscous damping ratio, of the system damping_basis names [default: 0.05].
+    #[arg(long)]
     pub damping: Option<f64>,
+    /// `rigid`: the damping ratio is that of the structure with its whole stack rigidly attached
+    /// (the study's default); `structure`: of the bare structure [default: rigid].
+    #[arg(long)]
     pub damping_basis: Option<DampingBasis>,
-    /// Factor on the record (default 1.0).
+    /// Factor applied to the record [default: 1.0].
+    #[arg(long)]
     pub scale: Option<f64>,
+    /// Integrator: exact or rk4 [default: exact].
+    #[arg(long)]
     pub integrator: Option<Integrator>,
-    /// RK4 sub-steps per record interval (default 10).
+    /// RK4 sub-steps per record interval [default: 10].
+    #[arg(long)]
     pub rk4_substeps: Option<usize>,
-    /// Time-history file, `.h5` or `.csv`.
-    pub history: Option<PathBuf>,
+    /// Restoring force of the structure: elastic, epp or bilinear [default: elastic].
+    #[arg(long)]
     pub structure: Option<StructureKind>,
-    /// `C_y = F_y/(m_p·g)`, `m_p` the bare structure's mass.
+    /// Yield strength ratio C_y = F_y/(m_p·g) of an epp or bilinear structure (m_p the bare
+    /// structure's mass).
+    #[arg(long)]
     pub yield_strength_ratio: Option<f64>,
-    /// Post-yield stiffness over elastic stiffness `r`, `0 ≤ r < 1`.
+    /// Post-yield stiffness over elastic stiffness r (0 ≤ r < 1) of a bilinear structure.
+    #[arg(long)]
     pub post_yield_ratio: Option<f64>,
+    /// Write the time history to this .h5 or .csv file.
+    #[arg(long)]
+    pub history: Option<PathBuf>,
 }
 
 #[derive(Debug, thiserror::Error)]
-pub enum CaseError {
+pub enum SimulationError {
     #[error(transparent)]
     Config(#[from] ConfigError),
     #[error("{file}: {message}")]
@@ -99,58 +122,56 @@ pub enum CaseError {
     },
 }
 
-impl CaseError {
+impl SimulationError {
     /// Whether the input was at fault (rather than the run).
     pub fn is_bad_input(&self) -> bool {
         match self {
-            CaseError::Simulation { source, .. } => source.is_bad_input(),
+            SimulationError::Simulation { source, .. } => source.is_bad_input(),
             _ => true,
         }
     }
 }
 
-impl CaseSettings {
-    /// Reads a case file (the keys of [`CaseSettings`]).
-    pub fn read(path: &Path) -> Result<Self, CaseError> {
+impl Settings {
+    /// Reads a case file (the keys of [`Settings`]).
+    pub fn read(path: &Path) -> Result<Self, SimulationError> {
         let text = read_yaml_text(path)?;
-        serde_yaml::from_str(&text).map_err(|e| CaseError::Yaml {
+        serde_yaml::from_str(&text).map_err(|e| SimulationError::Yaml {
             file: path.display().to_string(),
             message: crate::limits::excerpt_message(&e.to_string()),
         })
     }
 
-    /// These settings where given, `base`'s elsewhere.
-    pub fn over(self, base: CaseSettings) -> CaseSettings {
-        CaseSettings {
-            record: self.record.or(base.record),
-            period: self.period.or(base.period),
-            alpha: self.alpha.or(base.alpha),
-            mu: self.mu.or(base.mu),
-            mu_static: self.mu_static.or(base.mu_static),
-            damping: self.damping.or(base.damping),
-            damping_basis: self.damping_basis.or(base.damping_basis),
-            scale: self.scale.or(base.scale),
-            integrator: self.integrator.or(base.integrator),
-            rk4_substeps: self.rk4_substeps.or(base.rk4_substeps),
-            history: self.history.or(base.history),
-            structure: self.structure.or(base.structure),
-            yield_strength_ratio: self.yield_strength_ratio.or(base.yield_strength_ratio),
-            post_yield_ratio: self.post_yield_ratio.or(base.post_yield_ratio),
+    /// These settings where given, `base`'s elsewhere: the one place settings from two sources
+    /// meet, key by key, whatever the keys.
+    pub fn over(self, base: Settings) -> Result<Settings, SimulationError> {
+        let mapping = |s: &Settings| match serde_yaml::to_value(s) {
+            Ok(serde_yaml::Value::Mapping(m)) => Ok(m),
+            Ok(_) => unreachable!("a struct serialises to a mapping"),
+            Err(e) => Err(SimulationError::Invalid(e.to_string())),
+        };
+        let mut merged = mapping(&base)?;
+        for (key, value) in mapping(&self)? {
+            if !value.is_null() {
+                merged.insert(key, value);
+            }
         }
+        serde_yaml::from_value(serde_yaml::Value::Mapping(merged))
+            .map_err(|e| SimulationError::Invalid(e.to_string()))
     }
 
-    /// The case with its defaults, checked: the system built, the record read, the history
+    /// The simulation with its defaults, checked: the system built, the record read, the history
     /// format known, all before any simulation.
-    pub fn resolve(self) -> Result<Case, CaseError> {
+    pub fn resolve(self) -> Result<Simulation, SimulationError> {
         let alpha = self.alpha.unwrap_or_else(|| vec![0.5, 0.5]);
         let physics = Physics {
-            damping: self.damping.unwrap_or(0.05),
-            basis: self.damping_basis.unwrap_or_default(),
-            mu_static_ratio: 1.0,
+            damping: self.damping.unwrap_or(Physics::DEFAULT.damping),
+            basis: self.damping_basis.unwrap_or(Physics::DEFAULT.basis),
+            ..Physics::DEFAULT
         };
         let total: f64 = alpha.iter().sum();
         if total.is_finite() && total <= crate::limits::MAX_ALPHA {
-            physics.check(total).map_err(CaseError::Invalid)?;
+            physics.check(total).map_err(SimulationError::Invalid)?;
         }
         let spec = SystemSpec {
             period_s: self.period.unwrap_or(1.0),
@@ -162,27 +183,27 @@ impl CaseSettings {
         };
         let scale = self.scale.unwrap_or(1.0);
         if !(scale.is_finite() && scale > 0.0 && scale <= MAX_SCALE) {
-            return Err(CaseError::Invalid(format!(
-                "scale must be finite, > 0 and ≤ {MAX_SCALE:e}, got {scale}"
+            return Err(SimulationError::Invalid(format!(
+                "`scale` must be finite, > 0 and ≤ {MAX_SCALE:e}, got {scale}"
             )));
         }
         if let Some(p) = &self.history {
             crate::store::HistoryFormat::from_path(p)
-                .map_err(|e| CaseError::Invalid(e.to_string()))?;
+                .map_err(|e| SimulationError::Invalid(e.to_string()))?;
         }
         let structure = self.structure.unwrap_or(StructureKind::Elastic);
         let yielding = yielding(structure, self.yield_strength_ratio, self.post_yield_ratio)?;
-        let mut system = System::new(&spec).map_err(|e| CaseError::Invalid(e.to_string()))?;
+        let mut system = System::new(&spec).map_err(|e| SimulationError::Invalid(e.to_string()))?;
         if let Some(y) = yielding {
             system = system
                 .with_yielding(y)
-                .map_err(|e| CaseError::Invalid(e.to_string()))?;
+                .map_err(|e| SimulationError::Invalid(e.to_string()))?;
         }
         let record = match &self.record {
             Some(path) => motion::read_record(path)?,
             None => motion::builtin(),
         };
-        Ok(Case {
+        Ok(Simulation {
             record,
             scale,
             physics,
@@ -201,34 +222,34 @@ fn yielding(
     structure: StructureKind,
     strength: Option<f64>,
     r: Option<f64>,
-) -> Result<Option<Yielding>, CaseError> {
-    let bad = |s: String| Err(CaseError::Invalid(s));
+) -> Result<Option<Yielding>, SimulationError> {
+    let bad = |s: String| Err(SimulationError::Invalid(s));
     match (structure, strength, r) {
         (StructureKind::Elastic, None, None) => Ok(None),
         (StructureKind::Elastic, _, _) => bad(
-            "--yield-strength-ratio and --post-yield-ratio apply only to --structure epp or \
-             bilinear"
+            "`yield_strength_ratio` and `post_yield_ratio` apply only to `structure: epp` or \
+             `structure: bilinear`"
                 .into(),
         ),
         (_, None, _) => bad(format!(
-            "--structure {} needs --yield-strength-ratio (C_y = F_y/(m_p·g))",
+            "`structure: {}` needs `yield_strength_ratio` (C_y = F_y/(m_p·g))",
             structure.name()
         )),
         (StructureKind::Epp, Some(c), None) => Ok(Some(Yielding::epp(c))),
         (StructureKind::Epp, Some(_), Some(r)) => bad(format!(
-            "--structure epp has no post-yield stiffness (r = 0), got --post-yield-ratio {r}; \
-             use --structure bilinear"
+            "`structure: epp` has no post-yield stiffness (r = 0), got `post_yield_ratio: {r}`; \
+             use `structure: bilinear`"
         )),
         (StructureKind::Bilinear, Some(_), None) => {
-            bad("--structure bilinear needs --post-yield-ratio (r, 0 ≤ r < 1)".into())
+            bad("`structure: bilinear` needs `post_yield_ratio` (r, 0 ≤ r < 1)".into())
         }
         (StructureKind::Bilinear, Some(c), Some(r)) => Ok(Some(Yielding::bilinear(c, r))),
     }
 }
 
-/// A checked case, ready to simulate.
+/// A checked simulation: one case under one record, ready to run.
 #[derive(Debug, Clone)]
-pub struct Case {
+pub struct Simulation {
     pub record: Record,
     pub scale: f64,
     pub physics: Physics,
@@ -240,7 +261,7 @@ pub struct Case {
     pub history: Option<PathBuf>,
 }
 
-impl Case {
+impl Simulation {
     /// The record scaled, in m/s².
     pub fn accel_mps2(&self) -> Vec<f64> {
         self.record.accel_mps2(self.scale)
@@ -259,9 +280,9 @@ impl Case {
         }
     }
 
-    /// Runs the case on `accel_mps2` (from [`Case::accel_mps2`]); the time history is kept when
-    /// the case names a history file.
-    pub fn simulate(&self, accel_mps2: &[f64]) -> Result<(Summary, Option<History>), CaseError> {
+    /// Runs the case on `accel_mps2` (from [`Simulation::accel_mps2`]); the time history is kept
+    /// when the settings name a history file.
+    pub fn run(&self, accel_mps2: &[f64]) -> Result<(Summary, Option<History>), SimulationError> {
         let ground = self.ground(accel_mps2);
         let history = self.history.is_some();
         let response = match self.integrator {
@@ -275,7 +296,7 @@ impl Case {
             ),
             Integrator::Rk4 => simulate_rk4(&self.system, &ground, self.rk4_substeps, history),
         }
-        .map_err(|source| CaseError::Simulation {
+        .map_err(|source| SimulationError::Simulation {
             record: self.record.name.clone(),
             source,
         })?;
@@ -403,17 +424,17 @@ mod tests {
 
     #[test]
     fn flags_override_the_file_and_defaults_fill_the_rest() {
-        let file = CaseSettings {
+        let file = Settings {
             period: Some(2.0),
             mu: Some(vec![0.3]),
             alpha: Some(vec![1.0]),
-            ..CaseSettings::default()
+            ..Settings::default()
         };
-        let flags = CaseSettings {
+        let flags = Settings {
             period: Some(0.5),
-            ..CaseSettings::default()
+            ..Settings::default()
         };
-        let case = flags.over(file).resolve().unwrap();
+        let case = flags.over(file).unwrap().resolve().unwrap();
         assert_eq!(case.system.period_s(), 0.5);
         assert_eq!(case.system.mu_kinetic(), &[0.3]);
         assert_eq!(case.scale, 1.0);
@@ -422,37 +443,53 @@ mod tests {
     }
 
     #[test]
+    fn every_key_of_the_file_survives_the_merge_and_every_flag_wins() {
+        let yaml = "record: r.AT2\nperiod: 2.0\nalpha: [1.0]\nmu: [0.3]\nmu_static: [0.4]\n\
+                    damping: 0.02\ndamping_basis: structure\nscale: 2.0\nintegrator: rk4\n\
+                    rk4_substeps: 20\nstructure: bilinear\nyield_strength_ratio: 0.3\n\
+                    post_yield_ratio: 0.05\nhistory: h.csv\n";
+        let file: Settings = serde_yaml::from_str(yaml).unwrap();
+        let value = |s: &Settings| serde_yaml::to_value(s).unwrap();
+        // The file sets every key (a new one must be added here too).
+        let keys = value(&file);
+        assert!(keys.as_mapping().unwrap().values().all(|v| !v.is_null()));
+        let nothing = Settings::default();
+        assert_eq!(value(&nothing.clone().over(file.clone()).unwrap()), keys);
+        assert_eq!(value(&file.clone().over(nothing).unwrap()), keys);
+    }
+
+    #[test]
     fn a_bad_setting_is_refused_before_the_record_is_read() {
         for (settings, expect) in [
             (
-                CaseSettings {
+                Settings {
                     scale: Some(-1.0),
-                    ..CaseSettings::default()
+                    ..Settings::default()
                 },
-                "scale must be finite",
+                "`scale` must be finite",
             ),
             (
-                CaseSettings {
+                Settings {
                     yield_strength_ratio: Some(0.1),
-                    ..CaseSettings::default()
+                    ..Settings::default()
                 },
-                "apply only to --structure epp or bilinear",
+                "apply only to `structure: epp` or `structure: bilinear`",
             ),
             (
-                CaseSettings {
+                Settings {
                     history: Some("out.txt".into()),
-                    ..CaseSettings::default()
+                    ..Settings::default()
                 },
                 "out.txt",
             ),
         ] {
-            let settings = CaseSettings {
+            let settings = Settings {
                 record: Some("/nonexistent/record.AT2".into()),
                 ..settings
             };
             let e = settings.resolve().unwrap_err();
             assert!(
-                matches!(&e, CaseError::Invalid(m) if m.contains(expect)) && e.is_bad_input(),
+                matches!(&e, SimulationError::Invalid(m) if m.contains(expect)) && e.is_bad_input(),
                 "{e}"
             );
         }
@@ -460,9 +497,9 @@ mod tests {
 
     #[test]
     fn the_summary_is_the_simulation_of_the_system() {
-        let case = CaseSettings::default().resolve().unwrap();
+        let case = Settings::default().resolve().unwrap();
         let accel = case.accel_mps2();
-        let (summary, history) = case.simulate(&accel).unwrap();
+        let (summary, history) = case.run(&accel).unwrap();
         let direct = simulate_exact(
             &case.system,
             &Ground {

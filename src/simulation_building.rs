@@ -4,15 +4,16 @@
 //! modal one otherwise), and the [`BuildingSummary`] `--json` prints.
 
 use crate::dynamics::building::{
-    Building, BuildingResponse, BuildingSpec, ModalBasis, StackSpec, StoreyYielding,
+    Building, BuildingResponse, BuildingSpec, StackSpec, StoreyYielding,
     simulate_building, simulate_building_rk4,
 };
-use crate::dynamics::{Energy, ExactOptions, G, Ground, History, simulate_exact, simulate_rk4};
+use crate::dynamics::{
+    DampingBasis, Energy, ExactOptions, G, Ground, History, simulate_exact, simulate_rk4,
+};
 use crate::limits::MAX_STOREYS;
 use crate::report::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
 use crate::simulation::{Integrator, StructureKind};
 use crate::store::HistoryLayout;
-use crate::study::sweep::DampingBasis;
 use serde::{Deserialize, Serialize};
 
 /// The `building:` key of a case file.
@@ -144,10 +145,7 @@ pub fn building_spec(
         floor_masses: b.floor_masses.clone().unwrap_or_else(|| vec![1.0; n]),
         storey_stiffnesses: b.storey_stiffnesses.clone().unwrap_or_else(|| vec![1.0; n]),
         damping_ratio: damping,
-        damping_basis: match basis {
-            DampingBasis::Rigid => ModalBasis::Rigid,
-            DampingBasis::Structure => ModalBasis::Structure,
-        },
+        damping_basis: basis,
         yielding,
         stacks,
     })

@@ -7,7 +7,7 @@ mod common;
 
 use common::real_records;
 use slidestack::dynamics::building::{
-    Building, BuildingSpec, ModalBasis, StackSpec, StoreyYielding, simulate_building,
+    Building, BuildingSpec, DampingBasis, StackSpec, StoreyYielding, simulate_building,
 };
 use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, Yielding, simulate_exact};
 
@@ -32,7 +32,7 @@ fn stack(floor: usize, alpha: &[f64], mu: &[f64], mu_static: Option<&[f64]>) -> 
 fn one_storey_equals_the_sdof_integrator() {
     let records = real_records();
     struct Case {
-        basis: ModalBasis,
+        basis: DampingBasis,
         yielding: Option<(f64, f64)>,
         alpha: Vec<f64>,
         mu: Vec<f64>,
@@ -46,18 +46,18 @@ fn one_storey_equals_the_sdof_integrator() {
         mu_static: mu_static.map(<[f64]>::to_vec),
     };
     let cases = [
-        case(ModalBasis::Rigid, None, &[], &[], None),
-        case(ModalBasis::Rigid, None, &[0.5, 0.5], &[0.2, 0.1], None),
+        case(DampingBasis::Rigid, None, &[], &[], None),
+        case(DampingBasis::Rigid, None, &[0.5, 0.5], &[0.2, 0.1], None),
         case(
-            ModalBasis::Structure,
+            DampingBasis::Structure,
             None,
             &[0.5, 0.5],
             &[0.2, 0.1],
             Some(&[0.25, 0.12]),
         ),
-        case(ModalBasis::Rigid, Some((0.15, 0.05)), &[1.0], &[0.3], None),
+        case(DampingBasis::Rigid, Some((0.15, 0.05)), &[1.0], &[0.3], None),
         case(
-            ModalBasis::Structure,
+            DampingBasis::Structure,
             Some((0.2, 0.0)),
             &[0.5, 0.5],
             &[0.2, 0.1],
@@ -95,8 +95,8 @@ fn one_storey_equals_the_sdof_integrator() {
             let mut s = SystemSpec::new(period, alpha, mu);
             s.mu_static = mu_static.clone();
             s.damping_ratio = match basis {
-                ModalBasis::Rigid => 0.05 * (1.0 + total).sqrt(),
-                ModalBasis::Structure => 0.05,
+                DampingBasis::Rigid => 0.05 * (1.0 + total).sqrt(),
+                DampingBasis::Structure => 0.05,
             };
             let mut sys = System::new(&s).unwrap();
             if let Some((c, r)) = yielding {
@@ -151,7 +151,7 @@ fn one_storey_equals_the_sdof_integrator() {
     }
 }
 
-fn three_storeys(basis: ModalBasis) -> BuildingSpec {
+fn three_storeys(basis: DampingBasis) -> BuildingSpec {
     let mut s = BuildingSpec::uniform(3, 0.6);
     s.floor_masses = vec![2.0, 1.5, 1.0];
     s.storey_stiffnesses = vec![3.0, 2.0, 1.0];
@@ -197,7 +197,7 @@ fn a_bare_building_is_the_sum_of_its_modes() {
         dt_s: rec.dt_s,
         accel_mps2: &accel,
     };
-    let spec = three_storeys(ModalBasis::Structure);
+    let spec = three_storeys(DampingBasis::Structure);
     let b = Building::new(&spec).unwrap();
     let r = simulate_building(
         &b,
@@ -268,7 +268,7 @@ fn stacks_that_cannot_slide_are_masses_added_to_their_floors() {
         dt_s: rec.dt_s,
         accel_mps2: &accel,
     };
-    let mut spec = three_storeys(ModalBasis::Rigid);
+    let mut spec = three_storeys(DampingBasis::Rigid);
     spec.stacks = vec![
         stack(3, &[0.5, 0.5], &[50.0, 50.0], None),
         stack(1, &[1.0], &[50.0], None),
@@ -277,7 +277,7 @@ fn stacks_that_cannot_slide_are_masses_added_to_their_floors() {
     let b = Building::new(&spec).unwrap();
     let r = simulate_building(&b, &ground, &opts()).unwrap();
     assert_eq!(r.switches, 0);
-    let mut added = three_storeys(ModalBasis::Rigid);
+    let mut added = three_storeys(DampingBasis::Rigid);
     added.floor_masses = vec![2.0 * 2.3, 1.5, 2.0];
     let (omega2, _) =
         slidestack::dynamics::building::model::modes(&added.floor_masses, b.stiffness());
@@ -348,7 +348,7 @@ fn frictionless_stacks_leave_the_floors_bare() {
         history: true,
         ..opts()
     };
-    let mut spec = three_storeys(ModalBasis::Structure);
+    let mut spec = three_storeys(DampingBasis::Structure);
     let bare = simulate_building(&Building::new(&spec).unwrap(), &ground, &o).unwrap();
     spec.stacks = vec![
         stack(2, &[0.5, 0.5], &[0.0, 0.0], None),
@@ -379,14 +379,14 @@ fn frictionless_stacks_leave_the_floors_bare() {
 #[test]
 fn the_energy_balance_closes_on_real_records() {
     let mut cases = Vec::new();
-    let mut s = three_storeys(ModalBasis::Rigid);
+    let mut s = three_storeys(DampingBasis::Rigid);
     s.stacks = vec![
         stack(3, &[0.5, 0.5], &[0.2, 0.1], Some(&[0.25, 0.1])),
         stack(1, &[1.0], &[0.3], None),
     ];
     cases.push(s.clone());
     s.stacks.push(stack(1, &[0.4, 0.2], &[0.15, 0.05], None));
-    s.damping_basis = ModalBasis::Structure;
+    s.damping_basis = DampingBasis::Structure;
     cases.push(s.clone());
     s.yielding = Some(StoreyYielding {
         strength_ratios: vec![0.15, 0.12, 0.1],
@@ -575,7 +575,7 @@ fn stacks_on_several_floors_match_regularised_friction() {
         dt_s: rec.dt_s,
         accel_mps2: &accel,
     };
-    let mut spec = three_storeys(ModalBasis::Rigid);
+    let mut spec = three_storeys(DampingBasis::Rigid);
     spec.stacks = vec![
         stack(3, &[0.5, 0.5], &[0.2, 0.1], None),
         stack(1, &[1.0], &[0.15], None),

@@ -7,7 +7,7 @@ mod common;
 
 use common::{column, max_rel_diff, real_records};
 use slidestack::dynamics::building::{
-    Building, BuildingResponse, BuildingSpec, ModalBasis, StackSpec, StoreyYielding,
+    Building, BuildingResponse, BuildingSpec, DampingBasis, StackSpec, StoreyYielding,
     simulate_building, simulate_building_rk4,
 };
 use slidestack::dynamics::{
@@ -361,7 +361,7 @@ fn one_storey_equals_the_one_storey_rk4() {
     };
     for yielding in [None, Some((0.15, 0.05))] {
         let mut spec = BuildingSpec::uniform(1, 1.0);
-        spec.damping_basis = ModalBasis::Structure;
+        spec.damping_basis = DampingBasis::Structure;
         spec.stacks = vec![stack(1, &[0.5, 0.5], &[0.2, 0.1])];
         let mut sys = System::new(&SystemSpec::new(1.0, &[0.5, 0.5], &[0.2, 0.1])).unwrap();
         if let Some((c, r)) = yielding {

@@ -67,7 +67,7 @@ fn worked_example_grid_points_and_refusals() {
         slidestack::store::tnew::read_zone_tnew(&out.join("tnew.h5"), "III", 2).unwrap();
     let values: Vec<f64> = t.vars.t_new.iter().copied().collect();
     for c in [0, 7, grid.cases() - 1] {
-        let case = grid.point(c);
+        let case = grid.case(c);
         let a = ask(
             "III",
             &case.period_s.to_string(),

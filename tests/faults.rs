@@ -8,6 +8,7 @@
 mod common;
 
 use common::fixture;
+use slidestack::pipeline::StageId;
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -58,8 +59,14 @@ const QUICK: Opts = Opts {
 };
 
 fn spawn(args: &[&str], opts: Opts) -> std::process::Child {
+    spawn_in(Path::new("."), args, opts)
+}
+
+/// As [`spawn`], with `cwd` as the working directory.
+fn spawn_in(cwd: &Path, args: &[&str], opts: Opts) -> std::process::Child {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
-    cmd.args(args)
+    cmd.current_dir(cwd)
+        .args(args)
         .env("RAYON_NUM_THREADS", "2")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
@@ -104,6 +111,11 @@ fn finish(mut child: std::process::Child, guard: Duration, what: &str) -> Ran {
 
 fn run(args: &[&str], opts: Opts) -> Ran {
     finish(spawn(args, opts), opts.guard, &args.join(" "))
+}
+
+/// A run from another working directory, as a user who is not in the config's folder.
+fn run_in(cwd: &Path, args: &[&str], opts: Opts) -> Ran {
+    finish(spawn_in(cwd, args, opts), opts.guard, &args.join(" "))
 }
 
 /// A small study on two real records, zone III, 24 work units of 12 cases.
@@ -692,4 +704,177 @@ fn an_error_and_its_cause_print_once() {
     let r = run(&["simulate", "--record", "/nonexistent.AT2"], QUICK)
         .fails(2, "No such file or directory");
     assert_eq!(r.stderr.lines().count(), 1, "{}", r.stderr);
+}
+
+/// A target table beside `cfg`'s folder: the IS 1893 zone III (soil I) spectrum times `factor`,
+/// one row every 0.01 s from 0.01 to 6 s, values printed to six decimals.
+fn write_table(path: &Path, factor: f64) {
+    let code: slidestack::spectrum::TargetSpectrum = "is1893:zone=III,soil=I".parse().unwrap();
+    let mut text = String::from("# period_s sa_g\n");
+    for k in 1..=600 {
+        let t = k as f64 / 100.0;
+        text += &format!("{t:.2} {:.6}\n", factor * code.sa_g(t));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// The row of the table at `t` (s) as `write_table` printed it, read back as a number.
+fn table_row(path: &Path, t: &str) -> f64 {
+    let text = std::fs::read_to_string(path).unwrap();
+    let row = text
+        .lines()
+        .find(|l| l.starts_with(&format!("{t} ")))
+        .unwrap();
+    row.split_whitespace().nth(1).unwrap().parse().unwrap()
+}
+
+fn design_sa_tp_g(study: &Path) -> f64 {
+    let r = run(
+        &[
+            "design",
+            "--study",
+            s(study),
+            "--zone",
+            "III",
+            "--period",
+            "0.70",
+            "--alpha",
+            "0.5,0.5",
+            "--mu",
+            "0.3,0.2",
+            "--json",
+        ],
+        QUICK,
+    )
+    .ok();
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    v["sa_tp_g"].as_f64().unwrap()
+}
+
+#[test]
+fn a_target_table_is_found_beside_its_config_hashed_and_stored() {
+    // The config names `table:zone3.txt` beside it and is run from `/`: the table is found like
+    // the record files, relative to the config.
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("study");
+    std::fs::create_dir(&folder).unwrap();
+    let table = folder.join("zone3.txt");
+    write_table(&table, 1.0);
+    let text = std::fs::read_to_string(study(dir.path(), ""))
+        .unwrap()
+        .replace(
+            "target: \"is1893:zone=III,soil=I\"",
+            "target: \"table:zone3.txt\"",
+        );
+    let cfg = config_with(&folder, "study.yaml", &text);
+    let out = dir.path().join("out");
+    let root = Path::new("/");
+    run_in(root, &["run", s(&cfg)], PLAIN).ok();
+    let st = run_in(root, &["status", s(&cfg), "--format", "env"], QUICK).ok();
+    assert!(st.stdout.contains("MOTIONS=up_to_date"), "{}", st.stdout);
+    assert!(st.stdout.contains("REPORT=up_to_date"), "{}", st.stdout);
+    // `design` answers from the spectrum the study used: the table's row at 0.70 s.
+    let first = table_row(&table, "0.70");
+    assert_eq!(design_sa_tp_g(&out), first);
+
+    // New contents, same name: the motions stage (and all after it) is stale; `design` still
+    // answers from the stored spectrum, also once the file is gone.
+    write_table(&table, 1.1);
+    let st = run_in(root, &["status", s(&cfg), "--format", "env"], QUICK).ok();
+    assert!(st.stdout.contains("MOTIONS=stale"), "{}", st.stdout);
+    run(&["report", s(&cfg)], QUICK).fails(1, "motions.h5 was made from other inputs than");
+    assert_eq!(design_sa_tp_g(&out), first);
+    let changed = std::fs::read(&table).unwrap();
+    std::fs::remove_file(&table).unwrap();
+    assert_eq!(design_sa_tp_g(&out), first);
+    run_in(root, &["status", s(&cfg)], QUICK).fails(2, "`zones[0].target`:");
+
+    // Back with the new contents, `run` rebuilds the motions and `design` follows them.
+    std::fs::write(&table, &changed).unwrap();
+    let r = run_in(root, &["run", s(&cfg)], PLAIN).ok();
+    assert!(r.stdout.contains("motions: wrote"), "{}", r.stdout);
+    let second = table_row(&table, "0.70");
+    assert!((second / first - 1.1).abs() < 1e-5, "{second} vs {first}");
+    assert_eq!(design_sa_tp_g(&out), second);
+}
+
+#[test]
+fn a_record_that_changes_after_the_config_was_loaded_is_refused() {
+    use slidestack::pipeline::lock::LockMode;
+    use slidestack::pipeline::{Quiet, Session, StageOptions, Study, execute};
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.AT2");
+    std::fs::copy(fixture("RSN829_CAPEMEND_RIO360.AT2"), &a).unwrap();
+    let cfg = config_with(
+        dir.path(),
+        "study.yaml",
+        &format!(
+            "output_dir: {}\nzones: [{{ name: III, target: \"is1893:zone=III,soil=I\" }}]\n\
+             motions:\n  seeds:\n    records: {{ files: [a.AT2] }}\n",
+            dir.path().join("out").display()
+        ),
+    );
+    let study = Study::load(&cfg, None).unwrap();
+    // Another record under the same name between loading the config and reading the seeds.
+    std::fs::copy(fixture("RSN960_NORTHR_LOS270.AT2"), &a).unwrap();
+    let session = Session::open(study, LockMode::Exclusive, false, &Quiet).unwrap();
+    let e = execute(&session, StageId::Motions, StageOptions::default()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: changed after the study was loaded, while the stage ran: run it again",
+            a.display()
+        )
+    );
+    assert!(!session.study.path("motions.h5").exists());
+}
+
+#[test]
+fn stage_files_of_other_shapes_are_refused_not_indexed() {
+    use slidestack::store::units::{Stored, UnitId, read_unit, write_unit};
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = study(dir.path(), "");
+    let (c, out) = (s(&cfg), dir.path().join("out"));
+    let o = s(&out);
+    run(&["motions", c, "--out", o], PLAIN).ok();
+
+    // A unit whose checksum holds but whose first column is one case short: merge refuses
+    // naming it; the sweep computes it again.
+    for k in ["1/2", "2/2"] {
+        run(&["sweep", c, "--out", o, "--shard", k], PLAIN).ok();
+    }
+    let unit = out.join("sweep.units/III_000_003.unit");
+    let bytes = std::fs::read(&unit).unwrap();
+    let header = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+    let id: UnitId = serde_json::from_slice(&bytes[12..12 + header]).unwrap();
+    let Stored::Valid(mut columns) = read_unit(&unit, &id).unwrap() else {
+        panic!("a valid unit");
+    };
+    columns.f64s[0].pop();
+    write_unit(&unit, &id, &columns).unwrap();
+    run(&["merge", c, "--out", o], PLAIN).fails(
+        1,
+        "III_000_003.unit: columns has shape [11, 12, 12, 12, 12, 24, 12, 12] where its \
+         dimensions give [12, 12, 12, 12, 12, 24, 12, 12]",
+    );
+    let r = run(&["sweep", c, "--out", o], PLAIN).ok();
+    assert!(r.stderr.contains("computing it again"), "{}", r.stderr);
+    assert!(
+        r.stdout.contains("1 of 24 units to compute"),
+        "{}",
+        r.stdout
+    );
+
+    // sweep.h5 verifies, its slip_peak has another shape: tnew refuses instead of indexing it.
+    common::reshape(&out.join("sweep.h5"), "zone_III/slip_peak");
+    run(&["tnew", c, "--out", o], PLAIN).fails(1, "sweep.h5: zone_III/slip_peak has shape");
+
+    // ida.h5 verifies, its fit_status has another shape: the fragility table is refused.
+    let ida_cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/ida-quick.yaml");
+    let ida_out = dir.path().join("ida");
+    let (ic, io) = (s(&ida_cfg), s(&ida_out));
+    run(&["motions", ic, "--out", io], PLAIN).ok();
+    run(&["ida", ic, "--out", io], PLAIN).ok();
+    common::reshape(&ida_out.join("ida.h5"), "zone_III/fit_status");
+    run(&["ida", ic, "--out", io], PLAIN).fails(1, "ida.h5: zone_III/fit_status has shape");
 }

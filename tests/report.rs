@@ -15,6 +15,7 @@ use slidestack::store::fit::read_fit;
 use slidestack::store::motions::read_zone_motions;
 use slidestack::store::tnew::read_zone_tnew;
 use slidestack::study::cases::{PAPER_TABLE_2, PAPER_TABLE_3, TABLE_2};
+use slidestack::study::physics::SystemKind;
 use slidestack::study::tnew::{BAND_FLAGS, BandCounts};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -254,7 +255,7 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
     // motions.h5, simulated here again with the study's physics.
     let study = Study::load(&cfg, Some(out.clone())).unwrap();
     let physics = study.physics();
-    let (alpha, mu) = TABLE_2.for_blocks(2);
+    let case = TABLE_2.case(2);
     let rows = table(&doc, "table2");
     for zc in &study.cfg.zones {
         let r = rows.iter().find(|r| r[0] == zc.name).unwrap();
@@ -276,8 +277,8 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
                 .sum::<f64>()
                 / motions.len() as f64
         };
-        let single = peak(physics.single(TABLE_2.period_s, TABLE_2.alpha_total(), mu[0]));
-        let stack = peak(physics.stack(TABLE_2.period_s, &alpha, &mu));
+        let single = peak(physics.spec(SystemKind::SingleBlock, &case));
+        let stack = peak(physics.spec(SystemKind::Stack, &case));
         close(&r[1], single, 5e-5, "Table 2 single block");
         close(&r[2], stack, 5e-5, "Table 2 stack");
         close(

@@ -6,7 +6,8 @@ use common::real_records;
 use slidestack::dynamics::Ground;
 use slidestack::grid::Grid;
 use slidestack::study::config::{GridConfig, Values};
-use slidestack::study::sweep::{Physics, UnitOptions, run_unit};
+use slidestack::study::physics::Physics;
+use slidestack::study::sweep::{UnitOptions, run_unit};
 
 fn grid(ratio: f64) -> (Grid, Physics) {
     let g = GridConfig {
@@ -51,7 +52,7 @@ fn skip_rules_equal_brute_force() {
                             "{} T={} case {c} ({:?}) rule {}: {what} {a} vs {b}",
                             rec.name,
                             g.periods_s[p],
-                            g.case(c),
+                            g.stack(c),
                             fast.skip_rule[c]
                         );
                     };

@@ -93,7 +93,7 @@ fn simulate_refuses_yielding_flags_that_do_not_fit() {
         ),
         (
             vec!["--yield-strength-ratio", "0.2"],
-            "apply only to --structure epp or bilinear",
+            "apply only to --structure epp or --structure bilinear",
         ),
         (
             vec!["--structure", "bilinear", "--yield-strength-ratio", "0.2"],

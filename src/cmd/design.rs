@@ -17,8 +17,8 @@ pub struct Args {
     #[arg(long)]
     zone: String,
     /// Period of the bare structure T_p, s.
-    #[arg(long)]
-    period: f64,
+    #[arg(long = "period")]
+    period_s: f64,
     /// Block mass ratios α_i = m_i/m_p, bottom block first.
     #[arg(long, value_delimiter = ',', num_args = 1.., required = true)]
     alpha: Vec<f64>,
@@ -36,7 +36,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let q = Query {
         zone: args.zone,
-        period_s: args.period,
+        period_s: args.period_s,
         alpha: args.alpha,
         mu: args.mu,
         extrapolate: args.extrapolate,

@@ -14,7 +14,7 @@ pub mod sweep;
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use slidestack::motion::{ReadOptions, Record, Units, read_record_with};
-use slidestack::pipeline::lock::LockMode;
+use slidestack::pipeline::lock::{LockError, LockMode};
 use slidestack::pipeline::{
     Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, Study,
 };
@@ -115,8 +115,8 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
             || c.is::<slidestack::dynamics::ModelError>()
             || c.downcast_ref::<slidestack::dynamics::SimError>()
                 .is_some_and(slidestack::dynamics::SimError::is_bad_input)
-            || c.downcast_ref::<slidestack::simulation::CaseError>()
-                .is_some_and(slidestack::simulation::CaseError::is_bad_input)
+            || c.downcast_ref::<slidestack::simulation::SimulationError>()
+                .is_some_and(slidestack::simulation::SimulationError::is_bad_input)
             || c.is::<BadInput>()
     });
     if bad_input { 2 } else { 1 }
@@ -127,9 +127,10 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
 #[error("{0}")]
 pub struct BadInput(pub String);
 
-/// The message of an error and its causes, each cause once: a cause whose text the message
-/// already holds (error types that repeat their source) is not printed again.
-pub fn message(e: &anyhow::Error) -> String {
+/// The message of an error and its causes, each cause once (a cause whose text the message
+/// already holds, from error types that repeat their source, is not printed again), with the
+/// settings it names as `command`'s flags ([`with_flags`]).
+pub fn message(e: &anyhow::Error, command: &clap::Command) -> String {
     let mut text = String::new();
     for cause in e.chain() {
         let c = cause.to_string();
@@ -140,7 +141,47 @@ pub fn message(e: &anyhow::Error) -> String {
             text += &c;
         }
     }
-    text
+    if e.chain()
+        .any(|c| matches!(c.downcast_ref::<LockError>(), Some(LockError::Busy { .. })))
+    {
+        text += " (or run without --no-wait to wait)";
+    }
+    with_flags(&text, command)
+}
+
+/// The library names a setting in backticks, with its value where that matters
+/// (`` `period_s` ``, `` `structure: epp` ``); on the command line a setting is the flag of the
+/// argument whose id it is (`--period`, `--structure epp`). A setting `command` has no flag for
+/// is left as it is.
+pub fn with_flags(text: &str, command: &clap::Command) -> String {
+    let flag = |id: &str| {
+        command
+            .get_arguments()
+            .find(|a| a.get_id() == id)
+            .and_then(|a| a.get_long())
+    };
+    let parts: Vec<&str> = text.split('`').collect();
+    let mut out = String::new();
+    for (i, part) in parts.iter().enumerate() {
+        // Odd parts lie between backticks; an unmatched last backtick is text.
+        if i % 2 == 0 || i == parts.len() - 1 {
+            if i % 2 == 1 {
+                out.push('`');
+            }
+            out += part;
+            continue;
+        }
+        let (id, value) = match part.split_once(": ") {
+            Some((id, value)) => (id, Some(value)),
+            None => (*part, None),
+        };
+        match (flag(id), value) {
+            (Some(long), Some(value)) => out += &format!("--{long} {value}"),
+            (Some(long), None) => out += &format!("--{long}"),
+            (None, _) => out += &format!("`{part}`"),
+        }
+    }
+    out
 }
 
 /// Ground-motion files and how to read them, shared by the commands that take records.

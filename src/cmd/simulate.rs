@@ -9,109 +9,43 @@
 //! displacement and hysteretic energy. The case and its checks: `slidestack::simulation`.
 
 use anyhow::Result;
-use slidestack::simulation::{CaseSettings, Integrator, StructureKind, Summary};
+use slidestack::simulation::{Settings, Summary};
 use slidestack::store::{HistoryLayout, write_history};
-use slidestack::study::sweep::DampingBasis;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
 #[command(allow_negative_numbers = true)]
 pub struct Args {
-    /// YAML file with the case (keys: record, period, alpha, mu, mu_static, damping,
-    /// damping_basis, scale, integrator, rk4_substeps, history, structure,
-    /// yield_strength_ratio, post_yield_ratio); flags given on the command line override it.
+    /// YAML file with the case (its keys are the long flags below, with `_` for `-`); flags
+    /// given on the command line override it.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Ground-motion record: PEER .AT2 or two-column time/acceleration text, values in g.
-    #[arg(long)]
-    record: Option<PathBuf>,
-    /// Period of the bare structure T_p, s [default: 1.0].
-    #[arg(long)]
-    period: Option<f64>,
-    /// Block mass ratios α_i = m_i/m_p, bottom block first [default: 0.5,0.5].
-    #[arg(long, value_delimiter = ',', num_args = 1..)]
-    alpha: Option<Vec<f64>>,
-    /// Kinetic friction coefficients μ_i, interface 1 (structure–block 1) first [default: 0.2,0.1].
-    #[arg(long, value_delimiter = ',', num_args = 1..)]
-    mu: Option<Vec<f64>>,
-    /// Static friction coefficients (≥ kinetic) [default: equal to --mu].
-    #[arg(long, value_delimiter = ',', num_args = 1..)]
-    mu_static: Option<Vec<f64>>,
-    /// Viscous damping ratio [default: 0.05], of the system --damping-basis names.
-    #[arg(long)]
-    damping: Option<f64>,
-    /// `rigid`: the damping ratio is that of the structure with its whole stack rigidly attached
-    /// (the study's default); `structure`: of the bare structure [default: rigid].
-    #[arg(long)]
-    damping_basis: Option<DampingBasis>,
-    /// Factor applied to the record [default: 1.0].
-    #[arg(long)]
-    scale: Option<f64>,
-    /// Integrator: exact or rk4 [default: exact].
-    #[arg(long)]
-    integrator: Option<Integrator>,
-    /// RK4 sub-steps per record interval [default: 10].
-    #[arg(long)]
-    rk4_substeps: Option<usize>,
-    /// Restoring force of the structure: elastic, epp or bilinear [default: elastic].
-    #[arg(long)]
-    structure: Option<StructureKind>,
-    /// Yield strength ratio C_y = F_y/(m_p·g) of an epp or bilinear structure (m_p the bare
-    /// structure's mass).
-    #[arg(long)]
-    yield_strength_ratio: Option<f64>,
-    /// Post-yield stiffness over elastic stiffness r (0 ≤ r < 1) of a bilinear structure.
-    #[arg(long)]
-    post_yield_ratio: Option<f64>,
-    /// Write the time history to this .h5 or .csv file.
-    #[arg(long)]
-    history: Option<PathBuf>,
+    #[command(flatten)]
+    settings: Settings,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
 }
 
-impl Args {
-    fn settings(self) -> CaseSettings {
-        CaseSettings {
-            record: self.record,
-            period: self.period,
-            alpha: self.alpha,
-            mu: self.mu,
-            mu_static: self.mu_static,
-            damping: self.damping,
-            damping_basis: self.damping_basis,
-            scale: self.scale,
-            integrator: self.integrator,
-            rk4_substeps: self.rk4_substeps,
-            history: self.history,
-            structure: self.structure,
-            yield_strength_ratio: self.yield_strength_ratio,
-            post_yield_ratio: self.post_yield_ratio,
-        }
-    }
-}
-
 pub fn run(args: Args) -> Result<()> {
-    let json = args.json;
     let file = match &args.config {
-        Some(path) => CaseSettings::read(path)?,
-        None => CaseSettings::default(),
+        Some(path) => Settings::read(path)?,
+        None => Settings::default(),
     };
-    let case = args.settings().over(file).resolve()?;
-    let accel = case.accel_mps2();
-    for w in case.warnings(&accel) {
+    let sim = args.settings.over(file)?.resolve()?;
+    let accel = sim.accel_mps2();
+    for w in sim.warnings(&accel) {
         eprintln!("simulate: warning: {w}");
     }
-    let (summary, history) = case.simulate(&accel)?;
-    if let (Some(path), Some(h)) = (&case.history, &history) {
+    let (summary, history) = sim.run(&accel)?;
+    if let (Some(path), Some(h)) = (&sim.history, &history) {
         write_history(path, h, &HistoryLayout::one_storey(h.interfaces))?;
     }
-    if json {
+    if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         print_table(&summary);
-        if let Some(p) = &case.history {
+        if let Some(p) = &sim.history {
             println!("history written to {}", p.display());
         }
     }

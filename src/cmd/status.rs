@@ -34,12 +34,7 @@ pub fn run(args: Args) -> Result<()> {
             println!("SWEEP_UNITS_DONE={}", st.sweep_units_done);
             println!("SWEEP_CASES_PER_UNIT={}", st.cases_per_unit);
             println!("SWEEP_SAMPLES_PER_MOTION={}", st.samples_per_motion);
-            // At most three simulations per case (stack, single block, rigid): the work bound
-            // job scripts size their tasks with.
-            println!(
-                "SWEEP_SAMPLES_PER_UNIT={}",
-                3 * st.cases_per_unit * st.samples_per_motion
-            );
+            println!("SWEEP_SAMPLES_PER_UNIT={}", st.samples_per_unit);
         }
         Format::Text => {
             println!("output directory {}", study.out.display());

@@ -50,7 +50,7 @@ pub(crate) mod search;
 
 pub use contact::{Contact, ContactSelector};
 pub use exact::{ExactOptions, simulate_exact};
-pub use model::{G, Hysteresis, ModelError, System, SystemSpec, Yielding};
+pub use model::{DampingBasis, G, Hysteresis, ModelError, System, SystemSpec, Yielding};
 pub use response::{Energy, History, Response};
 pub use rk4::simulate_rk4;
 

@@ -10,10 +10,51 @@
 use crate::limits::{
     MAX_ALPHA, MAX_MU, MAX_POST_YIELD_DAMPING, STRENGTH_RATIO_RANGE, STRUCTURE_PERIOD_RANGE_S,
 };
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// Standard gravity, m/s².
 pub const G: f64 = 9.80665;
+
+/// What a damping ratio `ζ` refers to (docs/model.md, "Damping basis"): on one storey the
+/// system whose ratio it is; for a building the system whose modes the damping matrix is built
+/// from (`rigid`: every stack's mass on its floor; `structure`: the bare floors).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DampingBasis {
+    /// `ζ` of the structure with its whole load rigidly attached: one physical
+    /// `c = 2·ζ·sqrt(1+α)·ω_p·m_p` for the stack, the single block and the rigid system, so the
+    /// rigid system is damped at `ζ`, as the 5 %-damped spectrum it is read against (`T_new`
+    /// equals `T_rigid` when nothing slides).
+    #[default]
+    Rigid,
+    /// `ζ` of the bare structure, `c = 2·ζ·ω_p·m_p` (the rigidly loaded system then has
+    /// `ζ/sqrt(1+α)`): the convention of the first versions of the study.
+    Structure,
+}
+
+impl DampingBasis {
+    pub fn name(self) -> &'static str {
+        match self {
+            DampingBasis::Rigid => "rigid",
+            DampingBasis::Structure => "structure",
+        }
+    }
+}
+
+impl std::str::FromStr for DampingBasis {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "rigid" => Ok(DampingBasis::Rigid),
+            "structure" => Ok(DampingBasis::Structure),
+            other => Err(format!(
+                "damping basis `{other}`: expected `rigid` or `structure`"
+            )),
+        }
+    }
+}
 
 /// A parameter that makes the model impossible, named as the user wrote it.
 #[derive(Debug, Error, Clone, PartialEq)]

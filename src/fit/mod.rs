@@ -38,6 +38,23 @@ pub enum FitError {
     Solver(String),
 }
 
+/// The names of the features of a stack of `blocks` blocks, in [`features`] order.
+pub fn feature_names(blocks: usize) -> Vec<String> {
+    let mut names = vec!["T_p".to_string()];
+    names.extend((1..=blocks).map(|i| format!("mu_{i}")));
+    names.extend((1..=blocks).map(|i| format!("alpha_{i}")));
+    names
+}
+
+/// The features of a structure of period `period_s` (s) and its stack: `(T_p, μ_1 … μ_n,
+/// α_1 … α_n)`.
+pub fn features(period_s: f64, alpha: &[f64], mu: &[f64]) -> Vec<f64> {
+    let mut x = vec![period_s];
+    x.extend(mu);
+    x.extend(alpha);
+    x
+}
+
 /// One case: features, its two physical limits and the computed `T_new`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sample {

@@ -22,7 +22,7 @@ use crate::limits::{MAX_PERIODS, PERIOD_RANGE_S};
 use crate::sdof::{self, free_displacement};
 pub use crate::spectrum::log_space;
 use crate::spectrum::response::{response_spectrum, validate_record};
-use crate::spectrum::{SpectrumError, TargetError, TargetSpectrum};
+use crate::spectrum::{SpectrumError, TARGET_DAMPING, TargetError, TargetSpectrum};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 use thiserror::Error;
@@ -99,7 +99,7 @@ mod as_text {
 impl Default for MatchSettings {
     fn default() -> Self {
         Self {
-            damping: 0.05,
+            damping: TARGET_DAMPING,
             check_range_s: (0.05, 4.0),
             check_periods: 200,
             lower: 0.9,

@@ -243,6 +243,11 @@ pub fn read_record(path: &Path) -> Result<Record, RecordError> {
 /// [`parse_text`]), converting to g. `opts` supplies the units and step the file does not
 /// declare; a disagreement with the file is an error (module docs).
 pub fn read_record_with(path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
+    parse_record(&read_record_file(path)?, path, opts)
+}
+
+/// The bytes of a record file, refused above [`MAX_FILE_BYTES`] before they are read.
+pub fn read_record_file(path: &Path) -> Result<Vec<u8>, RecordError> {
     let file = path.display().to_string();
     let io = |source| RecordError::Io {
         file: file.clone(),
@@ -252,8 +257,21 @@ pub fn read_record_with(path: &Path, opts: &ReadOptions) -> Result<Record, Recor
     if bytes > MAX_FILE_BYTES {
         return Err(RecordError::TooLarge { file, bytes });
     }
-    let text = std::fs::read_to_string(path).map_err(io)?;
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    std::fs::read(path).map_err(io)
+}
+
+/// The record in the bytes of the file `path` (its name and extension tell the format), as
+/// [`read_record_with`] reads it.
+pub fn parse_record(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
+    let file = path.display().to_string();
+    let text = std::str::from_utf8(bytes).map_err(|_| RecordError::Io {
+        file: file.clone(),
+        source: std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        ),
+    })?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let is_at2 = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("at2"))

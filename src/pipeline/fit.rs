@@ -16,12 +16,11 @@
 use super::{Outcome, PipelineError, Session, StageId};
 use crate::fit::extrapolation::{BOX_MARGIN, BOX_POINTS};
 use crate::fit::{
-    DesignBox, FitError, Form, Sample, check_box, cross_validate, fit, metrics, paper_equation,
-    uncertainty,
+    DesignBox, FitError, Form, Sample, check_box, cross_validate, feature_names, fit, metrics,
+    paper_equation, uncertainty,
 };
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::fit::{FitReport, FormFit, NotFitted, ZoneFit, write_fit};
-use crate::store::tnew::read_zone_tnew;
 use crate::study::tnew::samples;
 use rayon::prelude::*;
 use thiserror::Error;
@@ -138,11 +137,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Fit;
     let grid = study.grid(me)?;
-    let tnew_path = study.path(StageId::Tnew.output());
     let n = grid.blocks();
-    let mut features = vec!["T_p".to_string()];
-    features.extend((1..=n).map(|i| format!("mu_{i}")));
-    features.extend((1..=n).map(|i| format!("alpha_{i}")));
+    let features = feature_names(n);
     let range = |v: &[f64]| {
         v.iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
@@ -155,7 +151,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let bx = DesignBox::beyond(&ranges, BOX_MARGIN);
     let mut zone_data = Vec::new();
     for zc in &study.cfg.zones {
-        let (_, t) = read_zone_tnew(&tnew_path, &zc.name, n)?;
+        let t = super::tnew::read_zone(study, &zc.name)?;
         let t_rigid: Vec<f64> = t.vars.t_rigid.iter().copied().collect();
         let t_new: Vec<f64> = t.vars.t_new.iter().copied().collect();
         zone_data.push((zc.name.clone(), samples(grid, &t_rigid, &t_new)));

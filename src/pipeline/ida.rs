@@ -15,9 +15,12 @@ use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::ida::curve::{fractile, on_grid};
 use crate::ida::fragility::{FIT_STATUS_FLAGS, FitStatus, fit_lognormal};
 use crate::ida::trace::Trace;
+use crate::spectrum::TargetSpectrum;
+use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
+use crate::store::motions::read_zone_target;
 use crate::study::config::StudyConfig;
 use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
 use ndarray::{ArrayD, IxDyn};
@@ -53,6 +56,17 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
     Some(hash_parts(&[&section.to_string(), motions_fingerprint]))
 }
 
+/// Every zone's target spectrum as `motions.h5` stores it: the one its motions were matched to.
+fn stored_targets(study: &Study) -> Result<Vec<TargetSpectrum>, StoreError> {
+    let path = study.path(StageId::Motions.output());
+    study
+        .cfg
+        .zones
+        .iter()
+        .map(|z| read_zone_target(&path, &z.name))
+        .collect()
+}
+
 /// One unit's result.
 struct UnitOut {
     record_sa_g: f64,
@@ -78,13 +92,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let fp = study.fingerprint(me)?;
     let motions = super::sweep::load_motions(study)?;
     let physics = study.physics();
-    let targets: Vec<_> = (0..study.cfg.zones.len())
-        .map(|i| study.cfg.target(i))
-        .collect::<Result<_, _>>()
-        .map_err(|e| PipelineError::BadInput {
-            file: study.config_path.clone(),
-            why: e.to_string(),
-        })?;
+    let targets = stored_targets(study)?;
     let units: Vec<(usize, usize, usize)> = motions
         .iter()
         .enumerate()
@@ -120,18 +128,18 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             };
             let accel = rec.accel_mps2(1.0);
             let record_sa_g = sa_g(&accel, rec.dt_s, case.period_s)
-                .map_err(|e| fail(SYSTEMS[0], e.to_string()))?;
+                .map_err(|e| fail(SYSTEMS[0].key(), e.to_string()))?;
             let padded = padded(&accel, rec.dt_s, cfg.pad_s);
             let c_y = cfg.strength_ratio(&targets[z], case);
             let systems = cfg
                 .systems(&physics, case, c_y)
-                .map_err(|e| fail(SYSTEMS[0], e.to_string()))?;
+                .map_err(|e| fail(SYSTEMS[0].key(), e.to_string()))?;
             let traces = systems
                 .iter()
                 .zip(SYSTEMS)
-                .map(|(sys, name)| {
+                .map(|(sys, kind)| {
                     trace_system(cfg, sys, &padded, rec.dt_s, record_sa_g)
-                        .map_err(|e| fail(name, e.to_string()))
+                        .map_err(|e| fail(kind.key(), e.to_string()))
                 })
                 .collect::<Result<Vec<_>, _>>()?;
             bar.inc();
@@ -155,18 +163,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             rayon::current_num_threads()
         ),
     );
-    let axes = IdaAxes {
-        systems: SYSTEMS.iter().map(|s| s.to_string()).collect(),
-        case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
-        case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
-        case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
-        runs: cfg.tracing.max_runs(),
-        sa_grid_g: cfg.grid_sa_g(),
-        demands: cfg.demand_names(),
-        limit_states: cfg.limit_states.iter().map(|l| l.name.clone()).collect(),
-        limit_state_definitions: cfg.limit_states.iter().map(|l| l.definition()).collect(),
-        fractiles: FRACTILES.to_vec(),
-    };
+    let axes = axes_of(cfg);
     let mut zones = Vec::new();
     let mut at = 0;
     for (z, zc) in study.cfg.zones.iter().enumerate() {
@@ -234,6 +231,34 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     write_ida(&path, &meta, &axes, &zones)?;
     s.reporter.info(me, &format!("verified {}", path.display()));
     Ok(Outcome::Wrote(vec![path]))
+}
+
+/// The axes `ida.h5` has for the `ida:` section `cfg`.
+fn axes_of(cfg: &IdaConfig) -> IdaAxes {
+    IdaAxes {
+        systems: SYSTEMS.iter().map(|s| s.key().to_string()).collect(),
+        case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
+        case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
+        case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
+        runs: cfg.tracing.max_runs(),
+        sa_grid_g: cfg.grid_sa_g(),
+        demands: cfg.demand_names(),
+        limit_states: cfg.limit_states.iter().map(|l| l.name.clone()).collect(),
+        limit_state_definitions: cfg.limit_states.iter().map(|l| l.definition()).collect(),
+        fractiles: FRACTILES.to_vec(),
+    }
+}
+
+/// Zone `zone` of `ida.h5` (the caller has required it up to date), refused unless its axes
+/// are the ones the config's `ida:` section gives.
+fn read_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
+    let path = study.path(StageId::Ida.output());
+    let (axes, z) = read_zone_ida(&path, zone)?;
+    if axes != axes_of(section(study)?) {
+        let why = format!("zone_{zone}: its axes differ from the config's `ida:` section");
+        return Err(StoreError::corrupt(&path, why).into());
+    }
+    Ok((axes, z))
 }
 
 fn array<T: Clone>(shape: &[usize], fill: T) -> ArrayD<T> {
@@ -377,10 +402,9 @@ pub struct FragilityRow {
 /// Every fit of `ida.h5` (which must be up to date), zone, case, system, limit state in order.
 pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError> {
     study.require(StageId::Ida)?;
-    let path = study.path(StageId::Ida.output());
     let mut rows = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+        let (axes, z) = read_zone(study, &zone.name)?;
         let v = &z.vars;
         for c in 0..axes.case_period_s.len() {
             for (s, system) in axes.systems.iter().enumerate() {
@@ -448,15 +472,12 @@ fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
 /// The median ductility of both systems at [`TARGET_FACTORS`] × the zone's target `Sa(T_p)`,
 /// read off the median curves of `ida.h5` (NaN above the grid).
 pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineError> {
+    study.require(StageId::Motions)?;
     study.require(StageId::Ida)?;
-    let path = study.path(StageId::Ida.output());
+    let targets = stored_targets(study)?;
     let mut rows = Vec::new();
-    for (zi, zone) in study.cfg.zones.iter().enumerate() {
-        let target = study.cfg.target(zi).map_err(|e| PipelineError::BadInput {
-            file: study.config_path.clone(),
-            why: e.to_string(),
-        })?;
-        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+    for (zone, target) in study.cfg.zones.iter().zip(&targets) {
+        let (axes, z) = read_zone(study, &zone.name)?;
         let median = FRACTILES.iter().position(|&p| p == 0.5).unwrap_or(1);
         for c in 0..axes.case_period_s.len() {
             let curve = |s: usize| -> Vec<f64> {
@@ -510,13 +531,11 @@ pub fn figure(study: &Study) -> Result<String, PipelineError> {
 pub fn figure_of(study: &Study) -> Result<crate::report::chart::Figure, PipelineError> {
     use crate::report::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Ida)?;
-    let cfg = section(study)?;
-    let cap = cfg.collapse_ductility;
+    let cap = section(study)?.collapse_ductility;
     let clip = |v: f64| if v.is_infinite() { cap } else { v };
-    let path = study.path(StageId::Ida.output());
     let mut panels = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = read_zone_ida(&path, &zone.name)?;
+        let (axes, z) = read_zone(study, &zone.name)?;
         let x = axes.sa_grid_g.clone();
         let mut series = Vec::new();
         for s in 0..axes.systems.len() {

@@ -41,7 +41,7 @@ pub enum LockError {
         source: std::io::Error,
     },
     #[error(
-        "output directory {} is in use by {holder}; wait for it to finish (or run without --no-wait to wait)",
+        "output directory {} is in use by {holder}; wait for it to finish",
         dir.display()
     )]
     Busy { dir: PathBuf, holder: String },

@@ -37,7 +37,7 @@ pub mod tnew;
 use crate::grid::Grid;
 use crate::store::{StoreError, atomic};
 use crate::study::config::{ConfigError, StudyConfig};
-use crate::study::sweep::Physics;
+use crate::study::physics::{Physics, SystemKind};
 use lock::{LockError, LockMode, OutputLock};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -115,6 +115,9 @@ pub enum PipelineError {
     Config(#[from] ConfigError),
     #[error("{}: {why}", file.display())]
     BadInput { file: PathBuf, why: String },
+    /// A setting of the call (not of the config), named as the library names it.
+    #[error("`{setting}` {why}")]
+    Setting { setting: &'static str, why: String },
     #[error(transparent)]
     Lock(#[from] LockError),
     #[error(transparent)]
@@ -148,6 +151,7 @@ impl PipelineError {
         match self {
             PipelineError::Config(_)
             | PipelineError::BadInput { .. }
+            | PipelineError::Setting { .. }
             | PipelineError::NoGrid { .. }
             | PipelineError::Ida(ida::IdaStageError::NoSection { .. }) => true,
             PipelineError::Sweep(e) => e.is_bad_input(),
@@ -236,8 +240,8 @@ pub struct Study {
 }
 
 /// Refuses output directories that are surely mistakes: empty, the file-system root, an
-/// unexpanded `~`.
-pub fn check_output_dir(out: &Path, origin: &Path, key: &str) -> Result<(), PipelineError> {
+/// unexpanded `~`; `Err(why)`.
+pub fn check_output_dir(out: &Path) -> Result<(), String> {
     let text = out.to_string_lossy();
     let why = if text.trim().is_empty() {
         Some("is empty".to_string())
@@ -252,36 +256,32 @@ pub fn check_output_dir(out: &Path, origin: &Path, key: &str) -> Result<(), Pipe
     } else {
         None
     };
-    match why {
-        Some(why) => Err(PipelineError::BadInput {
-            file: origin.to_path_buf(),
-            why: format!("`{key}` {why}"),
-        }),
-        None => Ok(()),
-    }
+    why.map_or(Ok(()), Err)
 }
 
 impl Study {
     /// Reads and validates the config (every limit is checked here, before any work) and
     /// computes every stage's expected fingerprint.
     pub fn load(config: &Path, out: Option<PathBuf>) -> Result<Self, PipelineError> {
-        let bytes = std::fs::read(config).map_err(|source| ConfigError::Io {
-            file: config.display().to_string(),
-            source,
-        })?;
         let cfg = StudyConfig::load(config)?;
         let out = match out {
             Some(o) => {
-                check_output_dir(&o, Path::new("--out"), "--out")?;
+                check_output_dir(&o).map_err(|why| PipelineError::Setting {
+                    setting: "out",
+                    why,
+                })?;
                 o
             }
             None => {
-                check_output_dir(&cfg.output_dir, config, "output_dir")?;
+                check_output_dir(&cfg.output_dir).map_err(|why| PipelineError::BadInput {
+                    file: config.to_path_buf(),
+                    why: format!("`output_dir` {why}"),
+                })?;
                 cfg.output_dir.clone()
             }
         };
         let grid = cfg.grid.as_ref().map(|g| g.axes());
-        let motions_fp = motions::fingerprint(&cfg)?;
+        let motions_fp = motions::fingerprint(&cfg);
         let ida = ida::fingerprint(&cfg, &motions_fp);
         let rest = match &cfg.grid {
             Some(_) => {
@@ -295,7 +295,7 @@ impl Study {
         };
         Ok(Self {
             config_path: config.to_path_buf(),
-            config_sha256: crate::store::fingerprint::sha256_hex(&bytes),
+            config_sha256: cfg.loaded.config_sha256.clone(),
             cfg,
             out,
             grid,
@@ -557,6 +557,9 @@ pub struct Status {
     pub cases_per_unit: usize,
     /// Record samples per motion, the mean over the stored motions (0 before `motions` ran).
     pub samples_per_motion: usize,
+    /// Record samples a unit simulates at most (every system of every case simulated): the work
+    /// bound job scripts size their tasks with.
+    pub samples_per_unit: usize,
 }
 
 /// What is on disk for every stage; reads only, takes no lock.
@@ -572,11 +575,13 @@ pub fn status(study: &Study) -> Result<Status, PipelineError> {
         Some(_) => sweep::unit_status(study)?,
         None => (0, 0, 0),
     };
+    let cases_per_unit = study.grid.as_ref().map_or(0, Grid::cases_per_unit);
     Ok(Status {
         stages,
         sweep_units,
         sweep_units_done,
-        cases_per_unit: study.grid.as_ref().map_or(0, Grid::cases_per_unit),
+        cases_per_unit,
         samples_per_motion,
+        samples_per_unit: SystemKind::ALL.len() * cases_per_unit * samples_per_motion,
     })
 }

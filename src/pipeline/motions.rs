@@ -3,16 +3,19 @@
 //! [`crate::store::motions`]).
 //!
 //! Fingerprint: the tool version, the `zones` and `motions` sections, and the SHA-256 of every
-//! record file (not its path, which differs between machines).
+//! record file and target table (not its path, which differs between machines), hashed from the
+//! bytes the config loaded; the stage refuses a record whose bytes changed since. Each zone's
+//! target spectrum is stored in `motions.h5`, so later stages never read a table file again.
 
 use super::{Outcome, PipelineError, Session, StageId};
 use crate::motion::matching::MatchError;
-use crate::store::fingerprint::{file_sha256, fingerprint as hash_parts};
+use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::motions::{StageMeta, write_motions};
-use crate::study::config::{ConfigError, Seeds, StudyConfig};
+use crate::study::config::{Seeds, StudyConfig};
 use crate::study::motions::{
     MotionsError as StudyMotionsError, SeedError, Unmatched, match_zone, seed_records,
 };
+use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -26,28 +29,37 @@ pub enum MotionsError {
     Unmatched(Unmatched),
     #[error("zone {zone}: no seed met the matching acceptance")]
     NothingMatched { zone: String },
+    /// A record file's bytes differ from those the config loaded (and the fingerprint hashed).
+    #[error(
+        "{}: changed after the study was loaded, while the stage ran: run it again",
+        file.display()
+    )]
+    Changed { file: PathBuf },
 }
 
-/// The JSON list of the record files (name and SHA-256) the stage reads.
-fn inputs(cfg: &StudyConfig) -> Result<String, ConfigError> {
+/// The JSON list of the files the stage reads, each named by its file name with the SHA-256 of
+/// the bytes the config loaded: the record files, then the target tables (`zone`, `table`).
+fn inputs(cfg: &StudyConfig) -> String {
+    let name = |f: &Path| {
+        f.file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+    };
     let mut inputs = Vec::new();
     if let Seeds::Records(r) = cfg.motions.seeds.kind() {
-        for f in &r.files {
-            let h = file_sha256(f).map_err(|source| ConfigError::Io {
-                file: f.display().to_string(),
-                source,
-            })?;
-            let name = f
-                .file_name()
-                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-            inputs.push(serde_json::json!({ "file": name, "sha256": h }));
+        for (f, h) in r.files.iter().zip(&cfg.loaded.record_sha256) {
+            inputs.push(serde_json::json!({ "file": name(f), "sha256": h }));
         }
     }
-    Ok(serde_json::to_string(&inputs).expect("JSON of strings"))
+    for (z, t) in cfg.zones.iter().zip(&cfg.loaded.targets) {
+        if let Some((f, h)) = &t.table {
+            inputs.push(serde_json::json!({ "zone": z.name, "table": name(f), "sha256": h }));
+        }
+    }
+    serde_json::to_string(&inputs).expect("JSON of strings")
 }
 
 /// The fingerprint `motions.h5` must carry for `cfg`.
-pub fn fingerprint(cfg: &StudyConfig) -> Result<String, ConfigError> {
+pub fn fingerprint(cfg: &StudyConfig) -> String {
     let section = serde_json::json!({
         "zones": cfg.zones,
         "motions": match cfg.motions.seeds.kind() {
@@ -59,7 +71,7 @@ pub fn fingerprint(cfg: &StudyConfig) -> Result<String, ConfigError> {
             Seeds::Stochastic(_) => serde_json::to_value(&cfg.motions).expect("serialisable"),
         },
     });
-    Ok(hash_parts(&[&section.to_string(), &inputs(cfg)?]))
+    hash_parts(&[&section.to_string(), &inputs(cfg)])
 }
 
 /// Builds `motions.h5`.
@@ -67,16 +79,20 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let study = &s.study;
     let cfg = &study.cfg;
     let me = StageId::Motions;
-    let seeds = seed_records(&cfg.motions).map_err(MotionsError::from)?;
+    let (seeds, sha256) = seed_records(&cfg.motions).map_err(MotionsError::from)?;
+    if let Seeds::Records(r) = cfg.motions.seeds.kind()
+        && let Some(i) = (0..r.files.len()).find(|&i| sha256[i] != cfg.loaded.record_sha256[i])
+    {
+        return Err(MotionsError::Changed {
+            file: r.files[i].clone(),
+        }
+        .into());
+    }
     let mut zones = Vec::new();
     for (i, z) in cfg.zones.iter().enumerate() {
-        let target = cfg.target(i).map_err(|e| ConfigError::Invalid {
-            file: study.config_path.display().to_string(),
-            key: format!("zones[{i}].target"),
-            why: e.to_string(),
-        })?;
+        let target = cfg.target(i);
         let start = std::time::Instant::now();
-        let zm = match_zone(&z.name, &target, &seeds, &cfg.motions).map_err(|e| match e {
+        let zm = match_zone(&z.name, target, &seeds, &cfg.motions).map_err(|e| match e {
             StudyMotionsError::Unmatched(u) => MotionsError::Unmatched(u),
             StudyMotionsError::Match(source) => MotionsError::Matching {
                 zone: z.name.clone(),
@@ -128,7 +144,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let meta = StageMeta {
         fingerprint: study.fingerprint(me)?.to_string(),
         config_sha256: study.config_sha256.clone(),
-        inputs: inputs(cfg)?,
+        inputs: inputs(cfg),
     };
     let path = study.path(me.output());
     write_motions(&path, &meta, &seeds, &zones)?;

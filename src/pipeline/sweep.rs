@@ -21,9 +21,8 @@ use crate::store::motions::read_zone_motions;
 use crate::store::sweep::{SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, unit_path, write_unit};
 use crate::study::config::{Seeds, StudyConfig};
-use crate::study::sweep::{
-    Physics, SKIP_RULE_CODES, SKIP_RULE_FLAGS, SweepError, UnitOptions, UnitResult, run_unit,
-};
+use crate::study::physics::{CaseError, Physics, SystemKind};
+use crate::study::sweep::{SKIP_RULE_CODES, SKIP_RULE_FLAGS, UnitOptions, UnitResult, run_unit};
 use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -41,10 +40,10 @@ pub enum SweepStageError {
     Simulation {
         zone: String,
         motion: String,
-        source: Box<SweepError>,
+        source: Box<CaseError>,
     },
     #[error(
-        "{missing} of {total} units are missing from {}: run the remaining shards (or `slidestack sweep` without --shard)",
+        "{missing} of {total} units are missing from {}: run the remaining shards (or the sweep unsharded)",
         dir.display()
     )]
     MissingUnits {
@@ -54,7 +53,7 @@ pub enum SweepStageError {
     },
     #[error(
         "{} of the units in {} are damaged or misplaced, first: {first}; rerun the shards that made \
-         them (or `slidestack sweep` without --shard), which recompute them",
+         them (or the sweep unsharded), which recompute them",
         count, dir.display()
     )]
     BadUnits {
@@ -144,12 +143,40 @@ impl Units<'_> {
         }
     }
 
+    /// The unit's file, refused (as damaged) unless its columns have the lengths the grid
+    /// gives ([`column_lengths`]).
     fn read(&self, u: Unit) -> Result<Stored, StoreError> {
-        read_unit(&self.path(u), &self.id(u))
+        let path = self.path(u);
+        let stored = read_unit(&path, &self.id(u))?;
+        if let Stored::Valid(c) = &stored {
+            let found: Vec<usize> = (c.f64s.iter().map(Vec::len))
+                .chain(c.u8s.iter().map(Vec::len))
+                .collect();
+            let want = column_lengths(self.grid.cases_per_unit(), self.grid.blocks());
+            if found != want || c.f64s.len() != F64_COLUMNS {
+                return Err(StoreError::shape(&path, "columns", &found, &want));
+            }
+        }
+        Ok(stored)
     }
 }
 
 const F64_COLUMNS: usize = 6;
+
+/// The lengths of the columns [`to_columns`] writes for a unit of `cases` cases of `blocks`
+/// blocks: [`F64_COLUMNS`] `f64` columns (the slip, per interface, last), then two code columns.
+fn column_lengths(cases: usize, blocks: usize) -> Vec<usize> {
+    vec![
+        cases,
+        cases,
+        cases,
+        cases,
+        cases,
+        cases * blocks,
+        cases,
+        cases,
+    ]
+}
 
 fn to_columns(r: &UnitResult) -> Columns {
     Columns {
@@ -264,7 +291,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
                  ({threads} threads)",
                 cases as f64 / secs.max(1e-9),
                 sims as f64 / secs.max(1e-9),
-                100.0 * (1.0 - sims as f64 / (3 * cases) as f64),
+                100.0 * (1.0 - sims as f64 / (SystemKind::ALL.len() * cases) as f64),
                 secs * 1e9 * threads as f64 / samples.into_inner().max(1) as f64
             ),
         );
@@ -305,11 +332,7 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
     let mut read: Vec<Columns> = Vec::with_capacity(all.len());
     for &u in all {
         match units.read(u) {
-            Ok(Stored::Valid(c)) if c.f64s.len() == F64_COLUMNS && c.u8s.len() == 2 => read.push(c),
-            Ok(Stored::Valid(_)) => bad.push(format!(
-                "{}: has the wrong columns",
-                units.path(u).display()
-            )),
+            Ok(Stored::Valid(c)) => read.push(c),
             Ok(Stored::Missing | Stored::Stale) => missing += 1,
             Err(e) => bad.push(e.to_string()),
         }

@@ -5,16 +5,14 @@
 //!
 //! Fingerprint: the sweep's, and the step of the spectrum's period grid.
 
-use super::{Outcome, PipelineError, Session, StageId};
+use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::grid::Grid;
-use crate::spectrum::{SpectrumError, response_spectrum};
+use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::read_zone_sweep;
-use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, write_tnew};
-use crate::study::tnew::{
-    BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES, TnewFlag, period_at_displacement,
-};
+use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, read_zone_tnew, write_tnew};
+use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
 use ndarray::{ArrayD, Axis};
 use rayon::prelude::*;
 use thiserror::Error;
@@ -49,6 +47,22 @@ pub fn spectrum_periods_s(grid: &Grid) -> Vec<f64> {
     (1..=steps).map(|k| k as f64 * SD_STEP_S).collect()
 }
 
+/// Zone `zone` of `tnew.h5`, refused unless its grid and its spectrum's periods are the ones
+/// the config gives.
+pub fn read_zone(study: &Study, zone: &str) -> Result<ZoneTnew, PipelineError> {
+    let grid = study.grid(StageId::Tnew)?;
+    let path = study.path(StageId::Tnew.output());
+    let (axes, t) = read_zone_tnew(&path, zone, grid.blocks())?;
+    let why = if axes != *grid {
+        "its grid differs from the config's"
+    } else if t.period_sd_s != spectrum_periods_s(grid) {
+        "its spectrum's periods differ from the config's grid"
+    } else {
+        return Ok(t);
+    };
+    Err(StoreError::corrupt(&path, format!("zone_{zone}: {why}")).into())
+}
+
 /// Builds `tnew.h5`.
 pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let study = &s.study;
@@ -62,18 +76,23 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let mut zones = Vec::new();
     for (z, zc) in study.cfg.zones.iter().enumerate() {
         let (axes, sw) = read_zone_sweep(&sweep_path, &zc.name, n)?;
-        if axes != *grid {
-            return Err(StoreError::corrupt(
-                &sweep_path,
-                format!("zone_{}: its grid differs from the config's", zc.name),
-            )
-            .into());
+        let names: Vec<&String> = motions[z].iter().map(|r| &r.name).collect();
+        let differs = if axes != *grid {
+            Some("its grid differs from the config's")
+        } else if sw.motions.iter().collect::<Vec<_>>() != names {
+            Some("its motions are not those of motions.h5")
+        } else {
+            None
+        };
+        if let Some(why) = differs {
+            let why = format!("zone_{}: {why}", zc.name);
+            return Err(StoreError::corrupt(&sweep_path, why).into());
         }
         let m = sw.motions.len();
         let spectra = motions[z]
             .par_iter()
             .map(|r| {
-                response_spectrum(&r.accel_mps2(1.0), r.dt_s, &period_sd_s, 0.05)
+                response_spectrum(&r.accel_mps2(1.0), r.dt_s, &period_sd_s, TARGET_DAMPING)
                     .map(|s| s.sd_m())
                     .map_err(|source| TnewError::Spectrum {
                         zone: zc.name.clone(),
@@ -105,13 +124,9 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let mut flag = Vec::with_capacity(cases);
         let mut band = Vec::with_capacity(cases);
         for (c, (&us, &slid)) in u_stack.iter().zip(&slides).enumerate() {
-            let case = grid.point(c);
-            let tr = physics.rigid(case.period_s, case.alpha_total()).period_s;
-            let (tn, f) = if slid {
-                period_at_displacement(&period_sd_s, &sd_mean_m, us, tr)
-            } else {
-                (tr, TnewFlag::NoSlip)
-            };
+            let case = grid.case(c);
+            let tr = case.t_rigid_s();
+            let (tn, f) = tnew::t_new(&period_sd_s, &sd_mean_m, us, tr, slid);
             t_rigid.push(tr);
             t_new.push(tn);
             flag.push(f64::from(f as u8));
@@ -148,6 +163,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let meta = TnewMeta {
         fingerprint: study.fingerprint(me)?,
         sweep_fingerprint: study.fingerprint(StageId::Sweep)?,
+        motions_fingerprint: study.fingerprint(StageId::Motions)?,
         flag_codes: TNEW_FLAG_CODES,
         band_flags: &BAND_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,

@@ -13,4 +13,4 @@ pub mod target;
 
 pub use periods::{PeriodsError, log_space, parse_periods};
 pub use response::{Peak, ResponseSpectrum, SpectrumError, peak_response, response_spectrum};
-pub use target::{TargetError, TargetSpectrum};
+pub use target::{TARGET_DAMPING, TargetError, TargetSpectrum};

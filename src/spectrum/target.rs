@@ -21,6 +21,11 @@ use std::str::FromStr;
 use thiserror::Error;
 
 use crate::dynamics::G;
+use crate::limits::MAX_FILE_BYTES;
+
+/// The damping ratio of target (design) spectra, and so of the record spectra compared with
+/// them: 5 %.
+pub const TARGET_DAMPING: f64 = 0.05;
 
 /// Seismic zone of IS 1893 (Part 1):2016, Fig. 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -347,20 +352,42 @@ impl TargetSpectrum {
         }
     }
 
-    /// Reads a target table: one row `period_s sa_g` per line, whitespace or comma separated,
-    /// `#` starts a comment, blank lines are skipped. Errors name `file:line`.
+    /// Reads a target table ([`TargetSpectrum::from_table_text`]), named by its path as given.
     pub fn from_table_file(path: &Path) -> Result<Self, TargetError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| TargetError::Io {
-            file: file.clone(),
-            source,
+        let bytes = read_table_bytes(path)?;
+        TargetSpectrum::from_table_text(&bytes, &file, &file)
+    }
+
+    /// A target table from the bytes of its file: one row `period_s sa_g` per line, whitespace
+    /// or comma separated, `#` starts a comment, blank lines are skipped, a byte-order mark is
+    /// dropped. `source` names the table in its SPEC string and labels, `file` in errors, which
+    /// give `file:line`.
+    pub fn from_table_text(bytes: &[u8], source: &str, file: &str) -> Result<Self, TargetError> {
+        let text = std::str::from_utf8(bytes).map_err(|_| TargetError::Io {
+            file: file.to_string(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                "stream did not contain valid UTF-8",
+            ),
         })?;
-        let (periods_s, sa_g) = parse_table(&text, &file)?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let (periods_s, sa_g) = parse_table(text, file)?;
         Ok(TargetSpectrum::Table {
-            source: file,
+            source: source.to_string(),
             periods_s,
             sa_g,
         })
+    }
+
+    /// The FILE of a `table:FILE` SPEC string, trimmed, as written (`None` for the kinds that
+    /// read no file). An empty FILE is `Some("")`, which parsing refuses.
+    pub fn table_file(spec: &str) -> Option<&str> {
+        let spec = spec.trim();
+        let (kind, params) = spec.split_once(':').unwrap_or((spec, ""));
+        kind.trim()
+            .eq_ignore_ascii_case("table")
+            .then(|| params.trim())
     }
 
     /// Zone numeral (`"III"`) of an IS 1893 target, `None` for the others.
@@ -370,6 +397,20 @@ impl TargetSpectrum {
             _ => None,
         }
     }
+}
+
+/// The bytes of a target table file, refused above [`MAX_FILE_BYTES`] before they are read.
+pub fn read_table_bytes(path: &Path) -> Result<Vec<u8>, TargetError> {
+    let file = path.display().to_string();
+    let io = |source| TargetError::Io {
+        file: file.clone(),
+        source,
+    };
+    let bytes = std::fs::metadata(path).map_err(io)?.len();
+    if bytes > MAX_FILE_BYTES {
+        return Err(TargetError::TableTooLarge { file, bytes });
+    }
+    std::fs::read(path).map_err(io)
 }
 
 /// ASCE 7-16 §11.4.6: `SDS(0.4 + 0.6T/T0)` below `T0 = 0.2·SD1/SDS`, `SDS` up to
@@ -710,6 +751,8 @@ pub enum TargetError {
         #[source]
         source: std::io::Error,
     },
+    #[error("{file}: {bytes} bytes: a target table may have at most {MAX_FILE_BYTES}")]
+    TableTooLarge { file: String, bytes: u64 },
     #[error("{file}:{line}: expected 2 columns (period_s sa_g), found {found}")]
     TableColumns {
         file: String,

@@ -21,7 +21,7 @@
 
 use super::h5::{attr_f64, attr_str, write_1d, write_stage_file};
 use super::{StoreError, checksum};
-use crate::fit::{BoxCheck, Form, Method, Metrics, SolverReport};
+use crate::fit::{BoxCheck, Form, Method, Metrics, SolverReport, feature_names};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -193,15 +193,48 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
     checksum::write_with_sidecar(yaml, text.as_bytes())
 }
 
-/// `fit.yaml`, verified against its sidecar.
+impl FitReport {
+    /// Refuses a report (read from `yaml`) whose features are not those of a stack of `blocks`
+    /// blocks, the stack its forms are evaluated on.
+    pub fn check_blocks(&self, yaml: &Path, blocks: usize) -> Result<(), StoreError> {
+        if self.features == feature_names(blocks) {
+            return Ok(());
+        }
+        Err(StoreError::corrupt(
+            yaml,
+            format!(
+                "its features ({}) are not those of the study's {blocks}-block stacks",
+                self.features.join(", ")
+            ),
+        ))
+    }
+}
+
+/// `fit.yaml`, verified against its sidecar; every form has one coefficient and one standard
+/// error per parameter its features give.
 pub fn read_fit(yaml: &Path) -> Result<Option<FitReport>, StoreError> {
     if !checksum::verify(yaml)? {
         return Ok(None);
     }
     let text = std::fs::read_to_string(yaml).map_err(|e| StoreError::io(yaml, "cannot read", e))?;
-    serde_yaml::from_str(&text)
-        .map(Some)
-        .map_err(|e| StoreError::corrupt(yaml, format!("is not a slidestack fit report: {e}")))
+    let report: FitReport = serde_yaml::from_str(&text)
+        .map_err(|e| StoreError::corrupt(yaml, format!("is not a slidestack fit report: {e}")))?;
+    let k = report.features.len();
+    for z in &report.zones {
+        for f in &z.forms {
+            let want = [f.form.parameter_count(k)];
+            for (what, found) in [
+                ("coefficients", f.coefficients.len()),
+                ("standard_errors", f.standard_errors.len()),
+            ] {
+                if [found] != want {
+                    let variable = format!("zone {}, {} form: {what}", z.zone, f.form.name());
+                    return Err(StoreError::shape(yaml, variable, &[found], &want));
+                }
+            }
+        }
+    }
+    Ok(Some(report))
 }
 
 /// The fingerprint of the fit stage's files: `None` when either is missing; an error when either

@@ -235,16 +235,6 @@ pub fn coordinate(
     Ok(ds)
 }
 
-/// A whole `f64` dataset of a group, with its shape.
-pub fn read_var(g: &hdf5::Group, name: &str) -> hdf5::Result<ArrayD<f64>> {
-    g.dataset(name)?.read_dyn::<f64>()
-}
-
-/// A whole `u8` dataset of a group, with its shape.
-pub fn read_flags(g: &hdf5::Group, name: &str) -> hdf5::Result<ArrayD<u8>> {
-    g.dataset(name)?.read_dyn::<u8>()
-}
-
 /// Opens a stage file for reading, naming it on failure.
 pub fn open(path: &Path) -> Result<hdf5::File, StoreError> {
     hdf5::File::open(path).at(path)
@@ -253,6 +243,101 @@ pub fn open(path: &Path) -> Result<hdf5::File, StoreError> {
 /// A group of a file opened with [`open`], naming the file on failure.
 pub fn group(f: &hdf5::File, path: &Path, name: &str) -> Result<hdf5::Group, StoreError> {
     f.group(name).at(path)
+}
+
+/// One group of a stage file, read variable by variable, each checked against the shape its
+/// dimensions give. A file can verify against its checksum sidecar and still hold other shapes
+/// (written by another program, or by a bug): it is refused with an error naming the file and
+/// the variable ([`StoreError::Shape`]) before any array of it is indexed.
+pub struct GroupReader<'p> {
+    file: &'p Path,
+    name: String,
+    group: hdf5::Group,
+}
+
+impl<'p> GroupReader<'p> {
+    /// Group `name` of the stage file `file`.
+    pub fn open(file: &'p Path, name: &str) -> Result<Self, StoreError> {
+        let group = open(file)?.group(name).at(file)?;
+        Ok(Self {
+            file,
+            name: name.to_string(),
+            group,
+        })
+    }
+
+    /// `group/variable`, as errors name it.
+    pub fn label(&self, variable: &str) -> String {
+        format!("{}/{variable}", self.name)
+    }
+
+    fn dataset(&self, variable: &str) -> Result<hdf5::Dataset, StoreError> {
+        self.group.dataset(variable).at(self.file)
+    }
+
+    /// Refuses `found` unless it is `expected`, naming `variable`.
+    pub fn expect(
+        &self,
+        variable: &str,
+        found: &[usize],
+        expected: &[usize],
+    ) -> Result<(), StoreError> {
+        if found == expected {
+            Ok(())
+        } else {
+            Err(StoreError::shape(
+                self.file,
+                self.label(variable),
+                found,
+                expected,
+            ))
+        }
+    }
+
+    /// A variable of shape `shape`.
+    pub fn array<T: hdf5::H5Type>(
+        &self,
+        variable: &str,
+        shape: &[usize],
+    ) -> Result<ArrayD<T>, StoreError> {
+        let a = self.dataset(variable)?.read_dyn::<T>().at(self.file)?;
+        self.expect(variable, a.shape(), shape)?;
+        Ok(a)
+    }
+
+    /// A one-dimensional `f64` variable of any length (a coordinate, which gives its dimension's
+    /// length, or a record).
+    pub fn vector(&self, variable: &str) -> Result<Vec<f64>, StoreError> {
+        let a = self.dataset(variable)?.read_dyn::<f64>().at(self.file)?;
+        self.expect(variable, a.shape(), &[a.len()])?;
+        Ok(a.iter().copied().collect())
+    }
+
+    /// A one-dimensional string variable of any length.
+    pub fn strings(&self, variable: &str) -> Result<Vec<String>, StoreError> {
+        let ds = self.dataset(variable)?;
+        self.expect(variable, &ds.shape(), &[ds.size()])?;
+        read_strings(&self.group, variable).at(self.file)
+    }
+
+    /// The string attribute `name` of the group, if present.
+    pub fn attr_str(&self, name: &str) -> Option<String> {
+        read_attr_str(&self.group, name)
+    }
+
+    /// The names of the group's members.
+    pub fn members(&self) -> Result<Vec<String>, StoreError> {
+        self.group.member_names().at(self.file)
+    }
+
+    pub fn group(&self) -> &hdf5::Group {
+        &self.group
+    }
+
+    /// The stage file.
+    pub fn file(&self) -> &Path {
+        self.file
+    }
 }
 
 /// Writes a stage file at `path` (see the module doc). `fill` writes the contents into a file
@@ -325,12 +410,16 @@ mod tests {
         assert_eq!(stored_fingerprint(&p).unwrap().as_deref(), Some("abc"));
         let text = std::fs::read_to_string(checksum::sidecar_path(&p)).unwrap();
         assert!(text.ends_with("  x.h5\n"), "{text}");
-        // The chunked variable reads back with its shape.
-        let f = open(&p).unwrap();
-        let v = read_var(&f.group("g").unwrap(), "v").unwrap();
-        assert_eq!(v.shape(), &[3, 4]);
+        // The chunked variable reads back with its shape, and no other shape is taken for it.
+        let g = GroupReader::open(&p, "g").unwrap();
+        let v = g.array::<f64>("v", &[3, 4]).unwrap();
         assert_eq!(v[[2, 3]], 11.0);
-        drop(f);
+        let e = g.array::<f64>("v", &[4, 3]).unwrap_err().to_string();
+        assert!(
+            e.ends_with("x.h5: g/v has shape [3, 4] where its dimensions give [4, 3]"),
+            "{e}"
+        );
+        drop(g);
 
         // One flipped byte anywhere: refused by the sidecar.
         let mut bytes = std::fs::read(&p).unwrap();

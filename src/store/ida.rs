@@ -22,11 +22,11 @@
 //! deflate+shuffle compressed, Fletcher32-checksummed, written in a fixed order with object
 //! times not tracked, so the same inputs give the same bytes.
 
+use super::StoreError;
 use super::h5::{
-    Attr, attach_scale, attr_str, coordinate, group, open, read_flags, read_strings, read_var,
-    set_scale, write_attrs, write_flags, write_stage_file, write_strings, write_var,
+    Attr, GroupReader, attach_scale, attr_str, coordinate, set_scale, write_attrs, write_flags,
+    write_stage_file, write_strings, write_var,
 };
-use super::{H5Context, StoreError};
 use ndarray::ArrayD;
 use std::path::Path;
 
@@ -387,72 +387,70 @@ fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hd
     Ok(())
 }
 
-/// Zone `zone` of `ida.h5` with the axes stored with it.
+/// Zone `zone` of `ida.h5` with the axes stored with it; every variable has the shape its
+/// coordinates give (module doc).
 pub fn read_zone_ida(path: &Path, zone: &str) -> Result<(IdaAxes, ZoneIda), StoreError> {
-    let f = open(path)?;
-    let g = group(&f, path, &format!("zone_{zone}"))?;
-    let read = || -> hdf5::Result<(IdaAxes, ZoneIda)> {
-        let rows = |name: &str| -> hdf5::Result<Vec<Vec<f64>>> {
-            let a = read_var(&g, name)?;
-            Ok(a.outer_iter()
-                .map(|r| r.iter().copied().collect())
-                .collect())
-        };
-        let axes = IdaAxes {
-            systems: read_strings(&g, "system")?,
-            case_period_s: g.dataset("case_T_p")?.read_raw()?,
-            case_alpha: rows("case_alpha")?,
-            case_mu: rows("case_mu")?,
-            runs: g.dataset("run")?.size(),
-            sa_grid_g: g.dataset("Sa")?.read_raw()?,
-            demands: read_strings(&g, "demand")?,
-            limit_states: read_strings(&g, "limit_state")?,
-            limit_state_definitions: read_strings(&g, "limit_state_definition")?,
-            fractiles: g.dataset("fractile")?.read_raw()?,
-        };
-        let vars = IdaVars {
-            c_y: read_var(&g, "c_y")?,
-            record_sa_g: read_var(&g, "record_Sa")?,
-            run_sa_g: read_var(&g, "run_Sa")?,
-            run_demand: read_var(&g, "run_demand")?,
-            run_collapsed: read_flags(&g, "run_collapsed")?,
-            run_slip_exceeded: read_flags(&g, "run_slip_exceeded")?,
-            collapse_sa_g: read_var(&g, "collapse_Sa")?,
-            curve: read_var(&g, "curve")?,
-            fractile_curve: read_var(&g, "fractile_curve")?,
-            exceed_fraction: read_var(&g, "exceed_fraction")?,
-            fragility_curve: read_var(&g, "fragility_curve")?,
-            theta_sa_g: read_var(&g, "theta")?,
-            beta: read_var(&g, "beta")?,
-            theta_ci_low_sa_g: read_var(&g, "theta_ci_low")?,
-            theta_ci_high_sa_g: read_var(&g, "theta_ci_high")?,
-            beta_ci_low: read_var(&g, "beta_ci_low")?,
-            beta_ci_high: read_var(&g, "beta_ci_high")?,
-            fit_status: read_flags(&g, "fit_status")?,
-        };
-        let z = ZoneIda {
-            name: zone.to_string(),
-            target: super::h5::read_attr_str(&g, "target").unwrap_or_default(),
-            records: read_strings(&g, "record")?,
-            vars,
-        };
-        Ok((axes, z))
+    let g = GroupReader::open(path, &format!("zone_{zone}"))?;
+    let (systems, records) = (g.strings("system")?, g.strings("record")?);
+    let (cases, blocks) = (g.vector("case")?.len(), g.vector("block")?.len());
+    let rows = |name: &str| -> Result<Vec<Vec<f64>>, StoreError> {
+        let a = g.array::<f64>(name, &[cases, blocks])?;
+        Ok(a.outer_iter()
+            .map(|r| r.iter().copied().collect())
+            .collect())
     };
-    let (axes, z) = read().at(path)?;
-    let want = [
-        axes.systems.len(),
-        z.records.len(),
-        axes.case_period_s.len(),
-        axes.runs,
-    ];
-    if z.vars.run_sa_g.shape() != want {
-        return Err(StoreError::corrupt(
-            path,
-            format!(
-                "zone_{zone}: run_Sa has shape {:?} where its coordinates give {want:?}",
-                z.vars.run_sa_g.shape()
-            ),
-        ));
-    }
+    let limit_states = g.strings("limit_state")?;
+    let limit_state_definitions = g.strings("limit_state_definition")?;
+    g.expect(
+        "limit_state_definition",
+        &[limit_state_definitions.len()],
+        &[limit_states.len()],
+    )?;
+    let axes = IdaAxes {
+        systems,
+        case_period_s: g.array("case_T_p", &[cases])?.iter().copied().collect(),
+        case_alpha: rows("case_alpha")?,
+        case_mu: rows("case_mu")?,
+        runs: g.vector("run")?.len(),
+        sa_grid_g: g.vector("Sa")?,
+        demands: g.strings("demand")?,
+        limit_states,
+        limit_state_definitions,
+        fractiles: g.vector("fractile")?,
+    };
+    let (s, r, c, n) = (axes.systems.len(), records.len(), cases, axes.runs);
+    let (d, sa, l, q) = (
+        axes.demands.len(),
+        axes.sa_grid_g.len(),
+        axes.limit_states.len(),
+        axes.fractiles.len(),
+    );
+    let fit = [s, c, l];
+    let vars = IdaVars {
+        c_y: g.array("c_y", &[c])?,
+        record_sa_g: g.array("record_Sa", &[r, c])?,
+        run_sa_g: g.array("run_Sa", &[s, r, c, n])?,
+        run_demand: g.array("run_demand", &[s, r, c, n, d])?,
+        run_collapsed: g.array("run_collapsed", &[s, r, c, n])?,
+        run_slip_exceeded: g.array("run_slip_exceeded", &[s, r, c, n])?,
+        collapse_sa_g: g.array("collapse_Sa", &[s, r, c])?,
+        curve: g.array("curve", &[s, r, c, sa, d])?,
+        fractile_curve: g.array("fractile_curve", &[s, c, q, sa, d])?,
+        exceed_fraction: g.array("exceed_fraction", &[s, c, l, sa])?,
+        fragility_curve: g.array("fragility_curve", &[s, c, l, sa])?,
+        theta_sa_g: g.array("theta", &fit)?,
+        beta: g.array("beta", &fit)?,
+        theta_ci_low_sa_g: g.array("theta_ci_low", &fit)?,
+        theta_ci_high_sa_g: g.array("theta_ci_high", &fit)?,
+        beta_ci_low: g.array("beta_ci_low", &fit)?,
+        beta_ci_high: g.array("beta_ci_high", &fit)?,
+        fit_status: g.array("fit_status", &fit)?,
+    };
+    let z = ZoneIda {
+        name: zone.to_string(),
+        target: g.attr_str("target").unwrap_or_default(),
+        records,
+        vars,
+    };
     Ok((axes, z))
 }

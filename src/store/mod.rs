@@ -43,6 +43,17 @@ pub enum StoreError {
     /// The file exists but is not what was written: checksum, identity or layout differs.
     #[error("{}: {why}", file.display())]
     Corrupt { file: PathBuf, why: String },
+    /// A variable whose shape is not the one its dimensions give.
+    #[error(
+        "{}: {variable} has shape {found:?} where its dimensions give {expected:?}",
+        file.display()
+    )]
+    Shape {
+        file: PathBuf,
+        variable: String,
+        found: Vec<usize>,
+        expected: Vec<usize>,
+    },
     #[error("{}: history file must end in .h5, .hdf5 or .csv", .0.display())]
     Format(PathBuf),
 }
@@ -70,10 +81,27 @@ impl StoreError {
         }
     }
 
+    pub fn shape(
+        file: &Path,
+        variable: impl Into<String>,
+        found: &[usize],
+        expected: &[usize],
+    ) -> Self {
+        Self::Shape {
+            file: file.to_path_buf(),
+            variable: variable.into(),
+            found: found.to_vec(),
+            expected: expected.to_vec(),
+        }
+    }
+
     /// The file this error is about.
     pub fn file(&self) -> &Path {
         match self {
-            Self::Io { file, .. } | Self::Hdf5 { file, .. } | Self::Corrupt { file, .. } => file,
+            Self::Io { file, .. }
+            | Self::Hdf5 { file, .. }
+            | Self::Corrupt { file, .. }
+            | Self::Shape { file, .. } => file,
             Self::Format(file) => file,
         }
     }

@@ -8,6 +8,9 @@
 //!                               all_within_band
 //!     period             check grid, s                                  [period]
 //!     target_psa_g, mean_psa_g                                          [period]
+//!     target_table_period (s), target_table_sa_g (g): the rows of a `table:FILE` target, the
+//!                        spectrum the study used (absent for the codes' spectra, which the
+//!                        SPEC string states whole)                      [target_row]
 //!     motion             names of the kept (matched and accepted) motions [motion]
 //!     psa_g              5 %-damped PSA of each kept motion, g          [motion, period]
 //!     seed               names of all seeds                             [seed]
@@ -17,13 +20,14 @@
 //! ```
 
 use super::h5::{
-    attr_f64, attr_str, open, read_attr_f64, read_attr_str, read_strings, write_1d, write_small,
+    GroupReader, attr_f64, attr_str, open, read_attr_f64, read_attr_str, write_1d, write_small,
     write_stage_file, write_strings,
 };
 use super::{H5Context, StoreError};
 use crate::motion::Record;
 use crate::motion::matching::MatchReport;
 use crate::motion::set::ZoneMotions;
+use crate::spectrum::{TargetError, TargetSpectrum};
 use std::path::Path;
 
 /// Provenance written on the file.
@@ -41,12 +45,14 @@ fn write_record(g: &hdf5::Group, key: &str, r: &Record, long: &str) -> hdf5::Res
     attr_f64(&ds, "dt_s", r.dt_s)
 }
 
-fn read_record(g: &hdf5::Group, key: &str) -> hdf5::Result<Record> {
-    let ds = g.dataset(key)?;
+/// The record `key` of `g`: one-dimensional, with its name and step.
+fn read_record(g: &GroupReader, key: &str) -> Result<Record, StoreError> {
+    let accel_g = g.vector(key)?;
+    let ds = g.group().dataset(key).at(g.file())?;
     Ok(Record {
         name: read_attr_str(&ds, "name").unwrap_or_else(|| key.to_string()),
-        dt_s: read_attr_f64(&ds, "dt_s")?,
-        accel_g: ds.read_raw::<f64>()?,
+        dt_s: read_attr_f64(&ds, "dt_s").at(g.file())?,
+        accel_g,
     })
 }
 
@@ -89,6 +95,28 @@ fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Resul
         ("all_within_band", z.all_within_band),
     ] {
         attr_f64(&g, k, if v { 1.0 } else { 0.0 })?;
+    }
+    if let TargetSpectrum::Table {
+        periods_s, sa_g, ..
+    } = &z.target
+    {
+        for (name, values, units, long) in [
+            (
+                TABLE_PERIOD,
+                periods_s,
+                "s",
+                "period of a row of the target table",
+            ),
+            (
+                TABLE_SA,
+                sa_g,
+                "g",
+                "target pseudo-spectral acceleration of a row",
+            ),
+        ] {
+            let ds = write_1d(&g, name, values, units, long)?;
+            attr_str(&ds, "dims", "target_row")?;
+        }
     }
     write_1d(&g, "period", &z.periods_s, "s", "oscillator period")?;
     write_1d(
@@ -211,16 +239,50 @@ pub fn zone_names(path: &Path) -> Result<Vec<String>, StoreError> {
         .collect())
 }
 
-/// The kept motions of one zone, in order.
-pub fn read_zone_motions(path: &Path, zone: &str) -> Result<Vec<Record>, StoreError> {
-    let f = open(path)?;
-    let read = || -> hdf5::Result<Vec<Record>> {
-        let acc = f.group(&format!("zone_{zone}/accel"))?;
-        let mut names = acc.member_names()?;
-        names.sort();
-        names.iter().map(|k| read_record(&acc, k)).collect()
+const TABLE_PERIOD: &str = "target_table_period";
+const TABLE_SA: &str = "target_table_sa_g";
+
+/// The target spectrum zone `zone` was matched to: a table from its stored rows (never from its
+/// file, which may have changed since), a code's spectrum from its SPEC string.
+pub fn read_zone_target(path: &Path, zone: &str) -> Result<TargetSpectrum, StoreError> {
+    let g = GroupReader::open(path, &format!("zone_{zone}"))?;
+    let corrupt = |why: String| StoreError::corrupt(path, format!("zone_{zone}: {why}"));
+    let spec = g
+        .attr_str("target")
+        .ok_or_else(|| corrupt("no target attribute".into()))?;
+    let Some(source) = TargetSpectrum::table_file(&spec) else {
+        return spec
+            .parse()
+            .map_err(|e: TargetError| corrupt(format!("target `{spec}`: {e}")));
     };
-    read().at(path)
+    let periods_s = g.vector(TABLE_PERIOD)?;
+    let sa_g: Vec<f64> = g.array(TABLE_SA, &[periods_s.len()])?.into_iter().collect();
+    let rows_ok = periods_s.len() >= 2
+        && periods_s.iter().all(|t| t.is_finite() && *t >= 0.0)
+        && periods_s.windows(2).all(|w| w[1] > w[0])
+        && sa_g.iter().all(|s| s.is_finite() && *s > 0.0);
+    if !rows_ok {
+        return Err(corrupt(format!(
+            "the rows of target `{spec}` are not a target table (2 rows or more, periods ≥ 0 \
+             increasing, Sa > 0)"
+        )));
+    }
+    Ok(TargetSpectrum::Table {
+        source: source.to_string(),
+        periods_s,
+        sa_g,
+    })
+}
+
+/// The kept motions of one zone, in order: one per name in its `motion` list.
+pub fn read_zone_motions(path: &Path, zone: &str) -> Result<Vec<Record>, StoreError> {
+    let g = GroupReader::open(path, &format!("zone_{zone}"))?;
+    let names = g.strings("motion")?;
+    let acc = GroupReader::open(path, &format!("zone_{zone}/accel"))?;
+    let mut keys = acc.members()?;
+    keys.sort();
+    g.expect("accel", &[keys.len()], &[names.len()])?;
+    keys.iter().map(|k| read_record(&acc, k)).collect()
 }
 
 /// One zone's spectra: the check periods, the target and the set mean (PSA, g), and every kept
@@ -233,32 +295,33 @@ pub struct ZoneSpectra {
     pub psa_g: ndarray::Array2<f64>,
 }
 
+/// One zone's spectra, each of the shape its `period` and `motion` lists give.
 pub fn read_zone_spectra(path: &Path, zone: &str) -> Result<ZoneSpectra, StoreError> {
-    let f = open(path)?;
-    let read = || -> hdf5::Result<ZoneSpectra> {
-        let g = f.group(&format!("zone_{zone}"))?;
-        let read = |n: &str| g.dataset(n)?.read_raw::<f64>();
-        Ok(ZoneSpectra {
-            periods_s: read("period")?,
-            target_psa_g: read("target_psa_g")?,
-            mean_psa_g: read("mean_psa_g")?,
-            psa_g: g.dataset("psa_g")?.read_2d::<f64>()?,
-        })
+    let g = GroupReader::open(path, &format!("zone_{zone}"))?;
+    let periods_s = g.vector("period")?;
+    let n = periods_s.len();
+    let motions = g.strings("motion")?.len();
+    let list = |name: &str| -> Result<Vec<f64>, StoreError> {
+        Ok(g.array(name, &[n])?.into_iter().collect())
     };
-    read().at(path)
+    let psa_g = g.array::<f64>("psa_g", &[motions, n])?;
+    Ok(ZoneSpectra {
+        target_psa_g: list("target_psa_g")?,
+        mean_psa_g: list("mean_psa_g")?,
+        psa_g: psa_g
+            .into_dimensionality()
+            .map_err(|e| StoreError::corrupt(path, e.to_string()))?,
+        periods_s,
+    })
 }
 
 /// The seed names of one zone's report and whether each was kept.
 pub fn read_zone_report(path: &Path, zone: &str) -> Result<Vec<(String, bool)>, StoreError> {
-    let f = open(path)?;
-    let read = || -> hdf5::Result<Vec<(String, bool)>> {
-        let g = f.group(&format!("zone_{zone}"))?;
-        let names = read_strings(&g, "seed")?;
-        let conv = g.dataset("converged")?.read_raw::<f64>()?;
-        Ok(names
-            .into_iter()
-            .zip(conv.into_iter().map(|c| c == 1.0))
-            .collect())
-    };
-    read().at(path)
+    let g = GroupReader::open(path, &format!("zone_{zone}"))?;
+    let names = g.strings("seed")?;
+    let converged = g.array::<f64>("converged", &[names.len()])?;
+    Ok(names
+        .into_iter()
+        .zip(converged.into_iter().map(|c| c == 1.0))
+        .collect())
 }

@@ -13,11 +13,11 @@
 //! Fletcher32-checksummed, with NaN (255 for the codes) as fill value. Objects are written in a
 //! fixed order with their times not tracked, so the same inputs give the same bytes.
 
+use super::StoreError;
 use super::h5::{
-    Attr, attach_all, attach_scale, attr_str, coordinate, group, open, read_flags, read_strings,
-    read_var, set_scale, write_attrs, write_flags, write_stage_file, write_strings, write_var,
+    Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, set_scale, write_attrs,
+    write_flags, write_stage_file, write_strings, write_var,
 };
-use super::{H5Context, StoreError};
 use crate::grid::Grid;
 use ndarray::ArrayD;
 use std::path::Path;
@@ -91,17 +91,16 @@ pub fn case_coordinates(
     Ok(scales)
 }
 
-/// The grid axes stored in group `g`.
-pub fn read_case_coordinates(g: &hdf5::Group, blocks: usize) -> hdf5::Result<Grid> {
-    let read = |n: &str| g.dataset(n)?.read_raw::<f64>();
+/// The grid axes `T_p, alpha_1 … alpha_n, mu_1 … mu_n` stored in a group, each one-dimensional.
+pub fn read_case_coordinates(g: &GroupReader, blocks: usize) -> Result<Grid, StoreError> {
     Ok(Grid {
-        periods_s: read("T_p")?,
+        periods_s: g.vector("T_p")?,
         alpha: (1..=blocks)
-            .map(|i| read(&format!("alpha_{i}")))
-            .collect::<hdf5::Result<_>>()?,
+            .map(|i| g.vector(&format!("alpha_{i}")))
+            .collect::<Result<_, _>>()?,
         mu: (1..=blocks)
-            .map(|i| read(&format!("mu_{i}")))
-            .collect::<hdf5::Result<_>>()?,
+            .map(|i| g.vector(&format!("mu_{i}")))
+            .collect::<Result<_, _>>()?,
     })
 }
 
@@ -223,45 +222,35 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneSweep, meta: &SweepMeta) -> h
     Ok(())
 }
 
-/// Zone `zone` of `sweep.h5` (`blocks` blocks) and the grid axes stored with it.
+/// Zone `zone` of `sweep.h5` (`blocks` blocks) and the grid axes stored with it; every variable
+/// has the shape its coordinates give.
 pub fn read_zone_sweep(
     path: &Path,
     zone: &str,
     blocks: usize,
 ) -> Result<(Grid, ZoneSweep), StoreError> {
-    let f = open(path)?;
-    let g = group(&f, path, &format!("zone_{zone}"))?;
-    let read = || -> hdf5::Result<(Grid, ZoneSweep)> {
-        let grid = read_case_coordinates(&g, blocks)?;
-        let vars = SweepVars {
-            u_stack: read_var(&g, "u_stack")?,
-            u_single: read_var(&g, "u_single")?,
-            u_rigid: read_var(&g, "u_rigid")?,
-            a_stack: read_var(&g, "a_stack")?,
-            friction_energy: read_var(&g, "friction_energy")?,
-            slip_peak: read_var(&g, "slip_peak")?,
-            skip_rule: read_flags(&g, "skip_rule")?,
-            single_rule: read_flags(&g, "single_rule")?,
-        };
-        let zone = ZoneSweep {
-            name: zone.to_string(),
-            target: super::h5::read_attr_str(&g, "target").unwrap_or_default(),
-            motions: read_strings(&g, "motion")?,
-            vars,
-        };
-        Ok((grid, zone))
+    let g = GroupReader::open(path, &format!("zone_{zone}"))?;
+    let grid = read_case_coordinates(&g, blocks)?;
+    let motions = g.strings("motion")?;
+    let mut shape = vec![motions.len()];
+    shape.extend(grid.shape());
+    let mut per_interface = shape.clone();
+    per_interface.push(blocks);
+    let vars = SweepVars {
+        u_stack: g.array("u_stack", &shape)?,
+        u_single: g.array("u_single", &shape)?,
+        u_rigid: g.array("u_rigid", &shape)?,
+        a_stack: g.array("a_stack", &shape)?,
+        friction_energy: g.array("friction_energy", &shape)?,
+        slip_peak: g.array("slip_peak", &per_interface)?,
+        skip_rule: g.array("skip_rule", &shape)?,
+        single_rule: g.array("single_rule", &shape)?,
     };
-    let (grid, z) = read().at(path)?;
-    let mut want = vec![z.motions.len()];
-    want.extend(grid.shape());
-    if z.vars.u_stack.shape() != want.as_slice() {
-        return Err(StoreError::corrupt(
-            path,
-            format!(
-                "zone_{zone}: u_stack has shape {:?} where its coordinates give {want:?}",
-                z.vars.u_stack.shape()
-            ),
-        ));
-    }
-    Ok((grid, z))
+    let zone = ZoneSweep {
+        name: zone.to_string(),
+        target: g.attr_str("target").unwrap_or_default(),
+        motions,
+        vars,
+    };
+    Ok((grid, zone))
 }

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! /                  attrs: contents, slidestack_version, fingerprint, sweep_fingerprint,
-//!                           T_new_flag_codes, + the writer's settings
+//!                           motions_fingerprint, T_new_flag_codes, + the writer's settings
 //! /zone_<name>/      attrs: target
 //!     T_p, alpha_1 … alpha_n, mu_1 … mu_n                 coordinates (dimension scales)
 //!     u_stack_mean, u_single_mean, u_rigid_mean (m), T_rigid, T_new (s), DRR_1, DRR_2,
@@ -11,7 +11,7 @@
 //! ```
 
 use super::h5::{
-    Attr, attach_all, attach_scale, attr_str, coordinate, group, open, read_var, write_attrs,
+    Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, group, open, write_attrs,
     write_flags, write_small, write_stage_file, write_var,
 };
 use super::sweep::{case_coordinates, read_case_coordinates};
@@ -51,6 +51,9 @@ pub struct ZoneTnew {
 pub struct TnewMeta<'a> {
     pub fingerprint: &'a str,
     pub sweep_fingerprint: &'a str,
+    /// The fingerprint of the `motions.h5` whose motions gave the displacement spectra (and
+    /// whose target spectra `design` reads).
+    pub motions_fingerprint: &'a str,
     /// Long description of the `T_new_flag` codes.
     pub flag_codes: &'a str,
     /// `(code, word)` pairs of the `T_new_band` codes.
@@ -73,6 +76,7 @@ pub fn write_tnew(
         meta.fingerprint,
         |f| {
             attr_str(f, "sweep_fingerprint", meta.sweep_fingerprint)?;
+            attr_str(f, "motions_fingerprint", meta.motions_fingerprint)?;
             attr_str(f, "T_new_flag_codes", meta.flag_codes)?;
             write_attrs(f, meta.settings)?;
             for z in zones {
@@ -177,51 +181,55 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, meta: &TnewMeta) -> hdf
     Ok(())
 }
 
-/// Zone `zone` of `tnew.h5` and the grid axes stored with it.
+/// Zone `zone` of `tnew.h5` and the grid axes stored with it; every variable has the shape its
+/// coordinates give, and every `T_new_band` code is one of its `flag_values`.
 pub fn read_zone_tnew(
     path: &Path,
     zone: &str,
     blocks: usize,
 ) -> Result<(Grid, ZoneTnew), StoreError> {
-    let f = open(path)?;
-    let g = group(&f, path, &format!("zone_{zone}"))?;
-    let read = || -> hdf5::Result<(Grid, ZoneTnew)> {
-        let grid = read_case_coordinates(&g, blocks)?;
-        let vars = TnewVars {
-            u_stack_mean: read_var(&g, "u_stack_mean")?,
-            u_single_mean: read_var(&g, "u_single_mean")?,
-            u_rigid_mean: read_var(&g, "u_rigid_mean")?,
-            t_rigid: read_var(&g, "T_rigid")?,
-            t_new: read_var(&g, "T_new")?,
-            drr_1: read_var(&g, "DRR_1")?,
-            drr_2: read_var(&g, "DRR_2")?,
-            slides: read_var(&g, "slides")?,
-            flag: read_var(&g, "T_new_flag")?,
-            band: super::h5::read_flags(&g, "T_new_band")?,
-        };
-        Ok((
-            grid,
-            ZoneTnew {
-                name: zone.to_string(),
-                target: super::h5::read_attr_str(&g, "target").unwrap_or_default(),
-                vars,
-                period_sd_s: g.dataset("period_sd")?.read_raw()?,
-                sd_mean_m: g.dataset("sd_mean")?.read_raw()?,
-            },
-        ))
+    let g = GroupReader::open(path, &format!("zone_{zone}"))?;
+    let grid = read_case_coordinates(&g, blocks)?;
+    let shape = grid.shape();
+    let vars = TnewVars {
+        u_stack_mean: g.array("u_stack_mean", &shape)?,
+        u_single_mean: g.array("u_single_mean", &shape)?,
+        u_rigid_mean: g.array("u_rigid_mean", &shape)?,
+        t_rigid: g.array("T_rigid", &shape)?,
+        t_new: g.array("T_new", &shape)?,
+        drr_1: g.array("DRR_1", &shape)?,
+        drr_2: g.array("DRR_2", &shape)?,
+        slides: g.array("slides", &shape)?,
+        flag: g.array("T_new_flag", &shape)?,
+        band: g.array("T_new_band", &shape)?,
     };
-    let (grid, z) = read().at(path)?;
-    if z.vars.t_new.shape() != grid.shape().as_slice() {
+    let codes: Vec<u8> = band_flags(&g)?.into_iter().map(|f| f.0).collect();
+    if let Some(code) = vars.band.iter().find(|c| !codes.contains(c)) {
         return Err(StoreError::corrupt(
             path,
             format!(
-                "zone_{zone}: T_new has shape {:?} where its coordinates give {:?}",
-                z.vars.t_new.shape(),
-                grid.shape()
+                "{} holds code {code}, which is not one of its flag_values",
+                g.label("T_new_band")
             ),
         ));
     }
+    let period_sd_s = g.vector("period_sd")?;
+    let sd_mean_m = g.array("sd_mean", &[period_sd_s.len()])?;
+    let z = ZoneTnew {
+        name: zone.to_string(),
+        target: g.attr_str("target").unwrap_or_default(),
+        vars,
+        period_sd_s,
+        sd_mean_m: sd_mean_m.iter().copied().collect(),
+    };
     Ok((grid, z))
+}
+
+/// The fingerprint of the `motions.h5` that `tnew.h5` was made from; `None` in a file made
+/// before it was recorded.
+pub fn read_motions_fingerprint(path: &Path) -> Result<Option<String>, StoreError> {
+    let f = open(path)?;
+    Ok(super::h5::read_attr_str(&f, "motions_fingerprint"))
 }
 
 /// The zone names of `tnew.h5` (file order) and its number of blocks.
@@ -248,23 +256,30 @@ pub fn zones_and_blocks(path: &Path) -> Result<(Vec<String>, usize), StoreError>
 
 /// The CF `flag_values`/`flag_meanings` of zone `zone`'s `T_new_band`: `(code, word)` pairs.
 pub fn read_band_flags(path: &Path, zone: &str) -> Result<Vec<(u8, String)>, StoreError> {
-    let f = open(path)?;
-    let g = group(&f, path, &format!("zone_{zone}"))?;
-    let read = || -> hdf5::Result<Vec<(u8, String)>> {
-        let ds = g.dataset("T_new_band")?;
+    band_flags(&GroupReader::open(path, &format!("zone_{zone}"))?)
+}
+
+/// The `(code, word)` pairs of `T_new_band` in `g`: one word per code.
+fn band_flags(g: &GroupReader) -> Result<Vec<(u8, String)>, StoreError> {
+    let variable = "T_new_band";
+    let read = || -> hdf5::Result<(Vec<u8>, String)> {
+        let ds = g.group().dataset(variable)?;
         let values = ds.attr("flag_values")?.read_raw::<u8>()?;
         let words = super::h5::read_attr_str(&ds, "flag_meanings").unwrap_or_default();
-        Ok(values
-            .into_iter()
-            .zip(words.split_whitespace().map(str::to_string))
-            .collect())
+        Ok((values, words))
     };
-    let flags = read().at(path)?;
-    if flags.is_empty() {
+    let (values, words) = read().map_err(|e| StoreError::hdf5(g.file(), e))?;
+    let words: Vec<String> = words.split_whitespace().map(str::to_string).collect();
+    g.expect(
+        &format!("{variable}@flag_meanings"),
+        &[words.len()],
+        &[values.len()],
+    )?;
+    if values.is_empty() {
         return Err(StoreError::corrupt(
-            path,
-            format!("zone_{zone}/T_new_band has no flag_values/flag_meanings"),
+            g.file(),
+            format!("{} has no flag_values/flag_meanings", g.label(variable)),
         ));
     }
-    Ok(flags)
+    Ok(values.into_iter().zip(words).collect())
 }

@@ -5,7 +5,7 @@
 //! output_dir: out/quick            # relative to the working directory; `--out` overrides it
 //! zones:                           # hazard levels: HDF5 groups `zone_<name>`
 //!   - { name: III, target: "is1893:zone=III,soil=I" }
-//!   - { name: V, target: "is1893:zone=V,soil=I" }
+//!   - { name: V, target: "is1893:zone=V,soil=I" }   # or "table:FILE", relative to this file
 //! motions:
 //!   seeds:                         # either stochastic …
 //!     stochastic: { count: 11, seed: 2016 }      # optional `model:` (StochasticModel keys)
@@ -17,7 +17,7 @@
 //! ```
 
 use super::ida::IdaConfig;
-use super::sweep::{DampingBasis, Physics};
+use super::physics::{DampingBasis, Physics};
 use crate::grid::Grid;
 use crate::grid::linear_range;
 use crate::limits::{
@@ -27,7 +27,9 @@ use crate::limits::{
 use crate::motion::matching::{MatchError, MatchSettings};
 use crate::motion::stochastic::{StochasticError, StochasticModel};
 use crate::motion::{ReadOptions, Units};
+use crate::spectrum::target::read_table_bytes;
 use crate::spectrum::{TargetError, TargetSpectrum};
+use crate::store::fingerprint::sha256_hex;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -44,6 +46,51 @@ pub struct StudyConfig {
     /// Incremental dynamic analysis of a yielding structure; required by `ida`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ida: Option<IdaConfig>,
+    /// The config file and the files it names, as [`StudyConfig::load`] read them.
+    #[serde(skip)]
+    pub loaded: Loaded,
+}
+
+/// What [`StudyConfig::load`] read besides the YAML keys, each file once: what the study uses
+/// and what the motions stage's fingerprint hashes are the same bytes.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Loaded {
+    /// SHA-256 of the config file's bytes.
+    pub config_sha256: String,
+    /// Each zone's target spectrum, in `zones` order.
+    pub targets: Vec<ZoneTarget>,
+    /// SHA-256 of each record file, in `motions.seeds.records.files` order (empty for
+    /// stochastic seeds).
+    pub record_sha256: Vec<String>,
+}
+
+/// A zone's target spectrum as the study uses it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ZoneTarget {
+    pub spectrum: TargetSpectrum,
+    /// The table file of a `table:FILE` target: its path (resolved against the config's folder)
+    /// and the SHA-256 of the bytes the spectrum was parsed from.
+    pub table: Option<(PathBuf, String)>,
+}
+
+impl ZoneTarget {
+    /// The target of SPEC string `spec`; a table's FILE is taken relative to `base` (the config's
+    /// folder) and read once. The table keeps FILE as written for its SPEC string and labels.
+    fn load(spec: &str, base: &Path) -> Result<Self, TargetError> {
+        let Some(file) = TargetSpectrum::table_file(spec).filter(|f| !f.is_empty()) else {
+            return Ok(Self {
+                spectrum: spec.parse()?,
+                table: None,
+            });
+        };
+        let path = base.join(file);
+        let bytes = read_table_bytes(&path)?;
+        let spectrum = TargetSpectrum::from_table_text(&bytes, file, &path.display().to_string())?;
+        Ok(Self {
+            spectrum,
+            table: Some((path, sha256_hex(&bytes))),
+        })
+    }
 }
 
 /// A list of values, or an inclusive range `{ from, to, step }`.
@@ -96,7 +143,7 @@ pub struct GridConfig {
     #[serde(default = "one")]
     pub mu_static_ratio: f64,
     /// Viscous damping ratio, of the system `damping_basis` names.
-    #[serde(default = "five_percent")]
+    #[serde(default = "default_damping")]
     pub damping: f64,
     /// `rigid` (default): `damping` is the ratio of the structure with its whole load rigidly
     /// attached, one damper for every system; `structure`: of the bare structure.
@@ -124,8 +171,8 @@ impl GridConfig {
     }
 }
 
-fn five_percent() -> f64 {
-    0.05
+fn default_damping() -> f64 {
+    Physics::DEFAULT.damping
 }
 
 /// One hazard level: its name (the group `zone_<name>`) and its target spectrum (SPEC string).
@@ -236,42 +283,67 @@ pub enum ConfigError {
 /// The text of a YAML file, checked before any parser sees it: at most [`MAX_FILE_BYTES`],
 /// UTF-8, a byte-order mark dropped, nesting at most [`MAX_YAML_DEPTH`] deep.
 pub fn read_yaml_text(path: &Path) -> Result<String, ConfigError> {
+    yaml_text(&read_yaml_bytes(path)?, path)
+}
+
+/// The bytes of a YAML file, refused above [`MAX_FILE_BYTES`] before they are read.
+fn read_yaml_bytes(path: &Path) -> Result<Vec<u8>, ConfigError> {
     let file = path.display().to_string();
     let io = |source| ConfigError::Io {
         file: file.clone(),
         source,
     };
     let bytes = std::fs::metadata(path).map_err(io)?.len();
-    let invalid = |why: String| ConfigError::Invalid {
-        file: file.clone(),
-        key: "(file)".into(),
-        why,
-    };
     if bytes > MAX_FILE_BYTES {
-        return Err(invalid(format!(
-            "{bytes} bytes: a YAML file may have at most {MAX_FILE_BYTES}"
-        )));
+        return Err(ConfigError::Invalid {
+            file: file.clone(),
+            key: "(file)".into(),
+            why: format!("{bytes} bytes: a YAML file may have at most {MAX_FILE_BYTES}"),
+        });
     }
-    let text = std::fs::read_to_string(path).map_err(io)?;
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text).to_string();
-    let depth = yaml_depth(&text);
+    std::fs::read(path).map_err(io)
+}
+
+/// The text of the YAML file `path`'s bytes: UTF-8, a byte-order mark dropped, nesting at most
+/// [`MAX_YAML_DEPTH`] deep.
+fn yaml_text(bytes: &[u8], path: &Path) -> Result<String, ConfigError> {
+    let file = path.display().to_string();
+    let text = std::str::from_utf8(bytes).map_err(|_| ConfigError::Io {
+        file: file.clone(),
+        source: std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        ),
+    })?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let depth = yaml_depth(text);
     if depth > MAX_YAML_DEPTH {
-        return Err(invalid(format!(
-            "nested {depth} levels deep; a config nests at most {MAX_YAML_DEPTH}"
-        )));
+        return Err(ConfigError::Invalid {
+            file,
+            key: "(file)".into(),
+            why: format!("nested {depth} levels deep; a config nests at most {MAX_YAML_DEPTH}"),
+        });
     }
-    Ok(text)
+    Ok(text.to_string())
 }
 
 impl StudyConfig {
-    /// Reads and validates a study file; relative record paths become relative to its folder.
+    /// Reads and validates a study file. Record files and target tables are found relative to
+    /// its folder, like any file it names, and each file is read once ([`Loaded`]).
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
         let file = path.display().to_string();
-        let text = read_yaml_text(path)?;
+        let bytes = read_yaml_bytes(path)?;
+        let text = yaml_text(&bytes, path)?;
         let mut cfg: StudyConfig = serde_yaml::from_str(&text).map_err(|e| ConfigError::Yaml {
             file: file.clone(),
             message: excerpt_message(&e.to_string()),
         })?;
+        cfg.loaded.config_sha256 = sha256_hex(&bytes);
+        let invalid = |key: String, why: String| ConfigError::Invalid {
+            file: file.clone(),
+            key,
+            why,
+        };
         let base = path.parent().unwrap_or(Path::new("."));
         if let Some(r) = &mut cfg.motions.seeds.records {
             for f in &mut r.files {
@@ -280,13 +352,26 @@ impl StudyConfig {
                 }
             }
         }
-        cfg.validate()
-            .map_err(|(key, why)| ConfigError::Invalid { file, key, why })?;
+        for (i, z) in cfg.zones.iter().enumerate() {
+            let target = ZoneTarget::load(&z.target, base)
+                .map_err(|e| invalid(format!("zones[{i}].target"), e.to_string()))?;
+            cfg.loaded.targets.push(target);
+        }
+        cfg.validate().map_err(|(key, why)| invalid(key, why))?;
+        if let Some(r) = &cfg.motions.seeds.records {
+            for f in &r.files {
+                let bytes = std::fs::read(f).map_err(|source| ConfigError::Io {
+                    file: f.display().to_string(),
+                    source,
+                })?;
+                cfg.loaded.record_sha256.push(sha256_hex(&bytes));
+            }
+        }
         Ok(cfg)
     }
 
     /// Every check that needs no computation; `Err((key, why))`.
-    pub fn validate(&self) -> Result<(), (String, String)> {
+    fn validate(&self) -> Result<(), (String, String)> {
         let err = |k: &str, w: String| Err((k.to_string(), w));
         if self.zones.is_empty() {
             return err("zones", "needs at least one zone".into());
@@ -310,11 +395,9 @@ impl StudyConfig {
                     format!("`{}` appears twice", z.name),
                 );
             }
-            let t = self
-                .target(i)
-                .map_err(|e| (format!("{key}.target"), e.to_string()))?;
             let (lo, hi) = self.motions.matching.check_range_s;
-            t.check_covers(lo, hi)
+            self.target(i)
+                .check_covers(lo, hi)
                 .map_err(|e| (format!("{key}.target"), e.to_string()))?;
         }
         self.motions
@@ -351,7 +434,7 @@ impl StudyConfig {
         if let Some(ida) = &self.ida {
             let physics = self.physics();
             let targets: Vec<_> = (0..self.zones.len())
-                .filter_map(|i| Some((self.zones[i].name.clone(), self.target(i).ok()?)))
+                .map(|i| (self.zones[i].name.clone(), self.target(i).clone()))
                 .collect();
             ida.validate(&physics, &targets)?;
         }
@@ -423,14 +506,9 @@ impl StudyConfig {
     /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`; the defaults without a
     /// grid).
     pub fn physics(&self) -> Physics {
-        self.grid.as_ref().map_or(
-            Physics {
-                damping: 0.05,
-                basis: DampingBasis::default(),
-                mu_static_ratio: 1.0,
-            },
-            GridConfig::physics,
-        )
+        self.grid
+            .as_ref()
+            .map_or(Physics::DEFAULT, GridConfig::physics)
     }
 
     /// The grid, or an error naming the missing section.
@@ -442,9 +520,9 @@ impl StudyConfig {
         })
     }
 
-    /// The target spectrum of zone `i`.
-    pub fn target(&self, i: usize) -> Result<TargetSpectrum, TargetError> {
-        self.zones[i].target.parse()
+    /// The target spectrum of zone `i`, as loaded.
+    pub fn target(&self, i: usize) -> &TargetSpectrum {
+        &self.loaded.targets[i].spectrum
     }
 
     /// Reading options of record seeds.

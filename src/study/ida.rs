@@ -9,7 +9,8 @@
 //! curves share one intensity axis. No skip rule is used: a stack that never slides is the
 //! rigid system only while the structure stays elastic.
 
-use super::sweep::Physics;
+use super::physics::{Physics, SystemKind};
+use crate::case::Case;
 use crate::dynamics::{ExactOptions, G, Ground, SimError, System, Yielding, simulate_exact};
 use crate::ida::trace::{HuntFill, Trace, hunt_fill};
 use crate::limits::{
@@ -25,8 +26,9 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct IdaConfig {
     pub structure: StructureConfig,
-    /// The cases traced, each under every motion of every zone.
-    pub cases: Vec<CaseConfig>,
+    /// The cases traced, each under every motion of every zone (static friction =
+    /// `grid.mu_static_ratio` × kinetic).
+    pub cases: Vec<Case>,
     /// Hunt & fill (Vamvatsikos & Cornell 2002), intensities `Sa(T_p, 5 %)` in g.
     pub tracing: HuntFill,
     /// The common intensity grid: `grid_points` equal steps from 0 to `tracing.cap_sa_g`
@@ -66,16 +68,6 @@ pub struct DesignStrength {
     pub response_reduction: f64,
 }
 
-/// One case: the bare structure's period and the stack (bottom first).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CaseConfig {
-    pub period_s: f64,
-    pub alpha: Vec<f64>,
-    /// Kinetic friction per interface (static = `grid.mu_static_ratio` × kinetic).
-    pub mu: Vec<f64>,
-}
-
 /// A limit state for the fragility fits: exactly one of the two thresholds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -101,7 +93,7 @@ impl LimitState {
 }
 
 /// The two systems of a case (module doc), in stored order.
-pub const SYSTEMS: [&str; 2] = ["stack", "rigid"];
+pub const SYSTEMS: [SystemKind; 2] = [SystemKind::Stack, SystemKind::Rigid];
 
 impl IdaConfig {
     /// The common intensity grid, g.
@@ -127,7 +119,7 @@ impl IdaConfig {
     }
 
     /// `C_y` of `case` in the zone with target `target` (validated: IS 1893 when `design`).
-    pub fn strength_ratio(&self, target: &TargetSpectrum, case: &CaseConfig) -> f64 {
+    pub fn strength_ratio(&self, target: &TargetSpectrum, case: &Case) -> f64 {
         match (&self.structure.c_y, &self.structure.design, target) {
             (Some(c), _, _) => *c,
             (None, Some(d), TargetSpectrum::Is1893 { zone, soil, .. }) => TargetSpectrum::Is1893 {
@@ -142,22 +134,18 @@ impl IdaConfig {
         }
     }
 
-    /// The stack and the rigidly attached load of `case` on the yielding structure, in the order
-    /// of [`SYSTEMS`].
+    /// The systems of [`SYSTEMS`] of `case` on the bilinear structure of strength ratio `c_y`.
     pub fn systems(
         &self,
         physics: &Physics,
-        case: &CaseConfig,
+        case: &Case,
         c_y: f64,
-    ) -> Result<[System; 2], crate::dynamics::ModelError> {
-        let r = self.structure.post_yield_ratio;
-        let total: f64 = case.alpha.iter().sum();
-        let stack = physics.stack(case.period_s, &case.alpha, &case.mu);
-        let rigid = physics.rigid(case.period_s, total);
-        Ok([
-            System::new(&stack)?.with_yielding(Yielding::bilinear(c_y, r))?,
-            System::new(&rigid)?.with_yielding(Yielding::bilinear(c_y / (1.0 + total), r))?,
-        ])
+    ) -> Result<Vec<System>, crate::dynamics::ModelError> {
+        let yielding = Yielding::bilinear(c_y, self.structure.post_yield_ratio);
+        SYSTEMS
+            .iter()
+            .map(|&kind| physics.system(kind, case, Some(yielding)))
+            .collect()
     }
 
     /// Every check that needs no record; `Err((key, why))` with keys under `ida.`.
@@ -378,13 +366,19 @@ pub struct RunDemand {
     pub slip_exceeded: bool,
 }
 
-/// `Sa(T_p, 5 %)` of a record, g (exact peak between samples, `spectrum::response`).
+/// `Sa(T_p, 5 %)` of a record, g (exact peak between samples, `spectrum::response`), damped as
+/// the target spectra are.
 pub fn sa_g(
     accel_mps2: &[f64],
     dt_s: f64,
     period_s: f64,
 ) -> Result<f64, crate::spectrum::SpectrumError> {
-    let peak = crate::spectrum::response::peak_response(accel_mps2, dt_s, period_s, 0.05)?;
+    let peak = crate::spectrum::response::peak_response(
+        accel_mps2,
+        dt_s,
+        period_s,
+        crate::spectrum::TARGET_DAMPING,
+    )?;
     let omega = std::f64::consts::TAU / period_s;
     Ok(omega * omega * peak.sd_m / G)
 }

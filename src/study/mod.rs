@@ -5,12 +5,14 @@
 //! * [`config`]: the study file (YAML), validated before any work.
 //! * [`ida`]: the `ida:` section, a case's systems on a yielding structure, one traced unit.
 //! * [`motions`]: seeds, spectral matching per zone, the set checks.
-//! * [`sweep`]: the physics of a case, the skip rules, one work unit.
+//! * [`physics`]: the physics of a case: damping basis, shared settings, its three systems.
+//! * [`sweep`]: the skip rules, one work unit.
 //! * [`tnew`]: `T_new` from the mean displacement spectrum; the fit's samples.
 
 pub mod cases;
 pub mod config;
 pub mod ida;
 pub mod motions;
+pub mod physics;
 pub mod sweep;
 pub mod tnew;

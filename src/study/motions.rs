@@ -22,10 +22,12 @@ use super::config::{MotionsConfig, Seeds, StudyConfig};
 use crate::motion::matching::{
     MatchError, MatchSettings, Matched, match_record, match_record_scaled,
 };
+use crate::motion::record::{parse_record, read_record_file};
 pub use crate::motion::set::{UnmatchedRecord, ZoneMotions};
 use crate::motion::stochastic::StochasticError;
-use crate::motion::{Record, RecordError, read_record_with};
+use crate::motion::{Record, RecordError};
 use crate::spectrum::TargetSpectrum;
+use crate::store::fingerprint::sha256_hex;
 use rayon::prelude::*;
 use std::fmt;
 use thiserror::Error;
@@ -77,19 +79,26 @@ pub enum MotionsError {
     Unmatched(#[from] Unmatched),
 }
 
-/// The seed motions of a study, in configuration order.
-pub fn seed_records(cfg: &MotionsConfig) -> Result<Vec<Record>, SeedError> {
+/// The seed motions of a study, in configuration order. Each record file is read once: the
+/// second vector holds the SHA-256 of the bytes each seed was parsed from (empty for
+/// stochastic seeds).
+pub fn seed_records(cfg: &MotionsConfig) -> Result<(Vec<Record>, Vec<String>), SeedError> {
     match cfg.seeds.kind() {
-        Seeds::Stochastic(s) => {
-            Ok(s.model
-                .simulate_set(s.seed, s.count + s.spare, "stochastic")?)
-        }
+        Seeds::Stochastic(s) => Ok((
+            s.model
+                .simulate_set(s.seed, s.count + s.spare, "stochastic")?,
+            Vec::new(),
+        )),
         Seeds::Records(r) => {
             let opts = StudyConfig::read_options(r);
-            r.files
-                .iter()
-                .map(|f| read_record_with(f, &opts).map_err(SeedError::from))
-                .collect()
+            let mut seeds = Vec::new();
+            let mut sha256 = Vec::new();
+            for f in &r.files {
+                let bytes = read_record_file(f)?;
+                sha256.push(sha256_hex(&bytes));
+                seeds.push(parse_record(&bytes, f, &opts)?);
+            }
+            Ok((seeds, sha256))
         }
     }
 }

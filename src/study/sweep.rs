@@ -1,7 +1,7 @@
-//! The sweep's numerics: the grid of cases, the skip rules, and one work unit (one motion, one
+//! The sweep's numerics: the skip rules, and one work unit (one motion, one
 //! structure period, every block and friction combination).
 //!
-//! Three systems per case (docs/model.md, "Derived quantities"): the stack, the single block (the
+//! Three systems per case ([`super::physics::SystemKind`]): the stack, the single block (the
 //! whole stack as one block on interface 1) and the rigidly attached stack (a linear SDOF of
 //! mass `m_p(1+α)`, `T_rigid = T_p·sqrt(1+α)`, same `c`). What a case does not need is skipped,
 //! exactly:
@@ -15,31 +15,11 @@
 //!   can slip before the one below it, so the stack acts as one block ([`SkipRule::SingleBlock`],
 //!   docs/model.md "Stated special cases").
 
-use crate::dynamics::{
-    ExactOptions, G, Ground, ModelError, Response, SimError, System, SystemSpec, simulate_exact,
-};
+use super::physics::{CaseError, Physics, SystemKind};
+use crate::case::Case;
+use crate::dynamics::{ExactOptions, G, Ground, Response};
 use crate::grid::Grid;
-use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
-use thiserror::Error;
-
-#[derive(Debug, Error)]
-pub enum SweepError {
-    #[error("case T_p = {period_s} s, α = {alpha:?}, μ = {mu:?}: {source}")]
-    Model {
-        period_s: f64,
-        alpha: Vec<f64>,
-        mu: Vec<f64>,
-        source: ModelError,
-    },
-    #[error("case T_p = {period_s} s, α = {alpha:?}, μ = {mu:?}: {source}")]
-    Simulation {
-        period_s: f64,
-        alpha: Vec<f64>,
-        mu: Vec<f64>,
-        source: SimError,
-    },
-}
 
 /// Which rule gave a case's stack result (stored as `skip_rule`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -92,138 +72,6 @@ pub struct UnitOptions {
     pub skip: bool,
 }
 
-/// What the damping ratio `ζ` of the study refers to (docs/model.md, "Damping basis").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum DampingBasis {
-    /// `ζ` of the structure with its whole load rigidly attached: one physical
-    /// `c = 2·ζ·sqrt(1+α)·ω_p·m_p` for the stack, the single block and the rigid system, so the
-    /// rigid system is damped at `ζ`, as the 5 %-damped spectrum it is read against (`T_new`
-    /// equals `T_rigid` when nothing slides).
-    #[default]
-    Rigid,
-    /// `ζ` of the bare structure, `c = 2·ζ·ω_p·m_p` (the rigidly loaded system then has
-    /// `ζ/sqrt(1+α)`): the convention of the first versions of the study.
-    Structure,
-}
-
-impl DampingBasis {
-    pub fn name(self) -> &'static str {
-        match self {
-            DampingBasis::Rigid => "rigid",
-            DampingBasis::Structure => "structure",
-        }
-    }
-}
-
-impl std::str::FromStr for DampingBasis {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "rigid" => Ok(DampingBasis::Rigid),
-            "structure" => Ok(DampingBasis::Structure),
-            other => Err(format!(
-                "damping basis `{other}`: expected `rigid` or `structure`"
-            )),
-        }
-    }
-}
-
-/// How a case becomes the study's three systems (docs/model.md, "Derived quantities"): the one source
-/// of the physics for the sweep, the report and `design`. All three share one viscous damper.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Physics {
-    /// Viscous damping ratio `ζ`, of the system named by `basis`.
-    pub damping: f64,
-    pub basis: DampingBasis,
-    /// Static friction coefficients are this × the kinetic ones (≥ 1).
-    pub mu_static_ratio: f64,
-}
-
-impl Physics {
-    /// Damping ratio of the bare structure that gives the study's `c` for a stack of total mass
-    /// ratio `alpha_total`.
-    pub fn structure_damping(&self, alpha_total: f64) -> f64 {
-        match self.basis {
-            DampingBasis::Structure => self.damping,
-            DampingBasis::Rigid => self.damping * (1.0 + alpha_total).sqrt(),
-        }
-    }
-
-    /// Refuses a damping that would need a bare-structure ratio of 1 or more (critical damping)
-    /// for a stack of total mass ratio `alpha_total`.
-    pub fn check(&self, alpha_total: f64) -> Result<(), String> {
-        let bare = self.structure_damping(alpha_total);
-        if bare < 1.0 {
-            return Ok(());
-        }
-        Err(format!(
-            "damping {} of the rigidly loaded system needs a bare-structure ratio of {bare:.3} for \
-             α = {alpha_total}; it must stay below 1 (use a smaller damping, or the `structure` \
-             basis)",
-            self.damping
-        ))
-    }
-
-    /// The structure with its stack of blocks.
-    pub fn stack(&self, period_s: f64, alpha: &[f64], mu: &[f64]) -> SystemSpec {
-        let mut spec = SystemSpec::new(period_s, alpha, mu);
-        spec.damping_ratio = self.structure_damping(alpha.iter().sum());
-        spec.mu_static = Some(mu.iter().map(|m| m * self.mu_static_ratio).collect());
-        spec
-    }
-
-    /// The whole stack as one block of mass ratio `alpha_total` sliding on interface 1.
-    pub fn single(&self, period_s: f64, alpha_total: f64, mu_1: f64) -> SystemSpec {
-        self.stack(period_s, &[alpha_total], &[mu_1])
-    }
-
-    /// The stack rigidly attached: a linear SDOF (paper Eqs. 10–13) with the same damper.
-    pub fn rigid(&self, period_s: f64, alpha_total: f64) -> SystemSpec {
-        rigid_spec(period_s, alpha_total, self.structure_damping(alpha_total))
-    }
-}
-
-/// The stack rigidly attached: the bare structure's `k` and `c` on the mass `m_p(1+α)`, so
-/// `T_rigid = T_p·sqrt(1+α)` and damping `ζ/sqrt(1+α)` (paper Eqs. 10–13).
-pub fn rigid_spec(period_s: f64, alpha_total: f64, zeta: f64) -> SystemSpec {
-    let root = (1.0 + alpha_total).sqrt();
-    SystemSpec {
-        period_s: period_s * root,
-        damping_ratio: zeta / root,
-        mass_kg: 1.0,
-        alpha: Vec::new(),
-        mu: Vec::new(),
-        mu_static: None,
-    }
-}
-
-fn simulate(
-    spec: &SystemSpec,
-    ground: &Ground,
-    case: (f64, &[f64], &[f64]),
-) -> Result<Response, SweepError> {
-    let (period_s, alpha, mu) = case;
-    let sys = System::new(spec).map_err(|source| SweepError::Model {
-        period_s,
-        alpha: alpha.to_vec(),
-        mu: mu.to_vec(),
-        source,
-    })?;
-    // Only friction energy is stored: the input and damping integrals are not needed.
-    let opts = ExactOptions {
-        energy_balance: false,
-        ..ExactOptions::default()
-    };
-    simulate_exact(&sys, ground, &opts).map_err(|source| SweepError::Simulation {
-        period_s,
-        alpha: alpha.to_vec(),
-        mu: mu.to_vec(),
-        source,
-    })
-}
-
 /// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`.
 pub fn run_unit(
     grid: &Grid,
@@ -231,22 +79,32 @@ pub fn run_unit(
     ground: &Ground,
     period_index: usize,
     opts: UnitOptions,
-) -> Result<UnitResult, SweepError> {
+) -> Result<UnitResult, CaseError> {
     let tp = grid.periods_s[period_index];
     let n = grid.blocks();
     let cases = grid.cases_per_unit();
     let mut out = UnitResult::default();
+    // Only friction energy is stored: the input and damping integrals are not needed.
+    let exact = ExactOptions {
+        energy_balance: false,
+        ..ExactOptions::default()
+    };
+    let simulate = |kind, case: &Case| physics.simulate(kind, case, ground, &exact);
     // Keyed by the bits of α (and the index of μ_1): the same floating-point sum, the same system.
     let mut rigid: HashMap<u64, Response> = HashMap::new();
     let mut single: HashMap<(u64, u64), Response> = HashMap::new();
     for c in 0..cases {
-        let (alpha, mu) = grid.case(c);
+        let (alpha, mu) = grid.stack(c);
+        let case = Case {
+            period_s: tp,
+            alpha,
+            mu,
+        };
+        let mu = &case.mu;
         let mu_s: Vec<f64> = mu.iter().map(|m| m * physics.mu_static_ratio).collect();
-        let total: f64 = alpha.iter().sum();
-        let key = total.to_bits();
-        let case = (tp, alpha.as_slice(), mu.as_slice());
+        let key = case.alpha_total().to_bits();
         if !rigid.contains_key(&key) || !opts.skip {
-            rigid.insert(key, simulate(&physics.rigid(tp, total), ground, case)?);
+            rigid.insert(key, simulate(SystemKind::Rigid, &case)?);
             out.simulations += 1;
         }
         let r = &rigid[&key];
@@ -258,10 +116,7 @@ pub fn run_unit(
         let skey = (key, mu[0].to_bits());
         let single_holds = opts.skip && holds(mu_s[0]);
         if !single_holds && (!single.contains_key(&skey) || !opts.skip) {
-            single.insert(
-                skey,
-                simulate(&physics.single(tp, total, mu[0]), ground, case)?,
-            );
+            single.insert(skey, simulate(SystemKind::SingleBlock, &case)?);
             out.simulations += 1;
         }
         let u_single = if single_holds {
@@ -278,8 +133,10 @@ pub fn run_unit(
             (SkipRule::SingleBlock, None)
         } else {
             out.simulations += 1;
-            let spec = physics.stack(tp, &alpha, &mu);
-            (SkipRule::Simulated, Some(simulate(&spec, ground, case)?))
+            (
+                SkipRule::Simulated,
+                Some(simulate(SystemKind::Stack, &case)?),
+            )
         };
         out.u_rigid.push(r.peak_displacement_m);
         out.u_single.push(u_single);

@@ -12,7 +12,7 @@
 //! attached mass, and the crossing near `T_rigid` is the one that continues the `μ → ∞` limit.
 //! The flag says which case applied.
 
-use crate::fit::Sample;
+use crate::fit::{Sample, features};
 use crate::grid::Grid;
 
 /// The fit's samples: every case of `grid` (flat over `[T_p][case]`) with a finite `T_new`,
@@ -21,12 +21,9 @@ pub fn samples(grid: &Grid, t_rigid_s: &[f64], t_new_s: &[f64]) -> Vec<Sample> {
     (0..t_new_s.len())
         .filter(|&c| t_new_s[c].is_finite())
         .map(|c| {
-            let case = grid.point(c);
-            let mut x = vec![case.period_s];
-            x.extend(case.mu);
-            x.extend(case.alpha);
+            let case = grid.case(c);
             Sample {
-                x,
+                x: features(case.period_s, &case.alpha, &case.mu),
                 t_rigid_s: t_rigid_s[c],
                 t_new_s: t_new_s[c],
             }
@@ -135,6 +132,23 @@ impl BandCounts {
             self.sliding(),
             self.above_1_005
         )
+    }
+}
+
+/// `T_new` of a case whose mean peak displacement with the stack is `u_m`: where the mean
+/// displacement spectrum `(periods_s, sd_m)` equals it ([`period_at_displacement`]) when some
+/// interface slipped, `T_rigid` when none did.
+pub fn t_new(
+    periods_s: &[f64],
+    sd_m: &[f64],
+    u_m: f64,
+    t_rigid_s: f64,
+    slides: bool,
+) -> (f64, TnewFlag) {
+    if slides {
+        period_at_displacement(periods_s, sd_m, u_m, t_rigid_s)
+    } else {
+        (t_rigid_s, TnewFlag::NoSlip)
     }
 }
 

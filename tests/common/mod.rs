@@ -208,3 +208,51 @@ pub fn max_rel_diff(a: &[f64], b: &[f64], scale: f64) -> f64 {
 pub fn column(data: &[f64], bodies: usize, body: usize) -> Vec<f64> {
     data.iter().skip(body).step_by(bodies).copied().collect()
 }
+
+/// Gives the dataset `variable` of the stage file `path` (`zone_III/u_stack`) one more dimension
+/// of length 2, its values zero, and writes a checksum sidecar for the new bytes: a file that
+/// verifies and only a reader's shape check can refuse.
+pub fn reshape(path: &Path, variable: &str) {
+    use hdf5::types::{TypeDescriptor, VarLenUnicode};
+    use ndarray::{ArrayD, IxDyn};
+    {
+        let f = hdf5::File::open_rw(path).unwrap();
+        let (group, name) = variable.rsplit_once('/').unwrap_or(("/", variable));
+        let g = f.group(group).unwrap();
+        let ds = g.dataset(name).unwrap();
+        let mut shape = ds.shape();
+        shape.push(2);
+        let kind = ds.dtype().unwrap().to_descriptor().unwrap();
+        drop(ds);
+        g.unlink(name).unwrap();
+        match kind {
+            TypeDescriptor::Float(_) => g
+                .new_dataset::<f64>()
+                .shape(shape.clone())
+                .create(name)
+                .unwrap()
+                .write(&ArrayD::<f64>::zeros(IxDyn(&shape)))
+                .unwrap(),
+            TypeDescriptor::Unsigned(_) => g
+                .new_dataset::<u8>()
+                .shape(shape.clone())
+                .create(name)
+                .unwrap()
+                .write(&ArrayD::<u8>::zeros(IxDyn(&shape)))
+                .unwrap(),
+            TypeDescriptor::VarLenUnicode => {
+                let x: VarLenUnicode = "x".parse().unwrap();
+                g.new_dataset::<VarLenUnicode>()
+                    .shape(shape.clone())
+                    .create(name)
+                    .unwrap()
+                    .write(&ArrayD::from_elem(IxDyn(&shape), x))
+                    .unwrap()
+            }
+            other => panic!("{variable}: no test for type {other:?}"),
+        }
+    }
+    let bytes = std::fs::read(path).unwrap();
+    slidestack::store::checksum::write_with_sidecar(path, &bytes).unwrap();
+    assert!(slidestack::store::checksum::verify(path).unwrap());
+}

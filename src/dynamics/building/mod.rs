@@ -14,6 +14,6 @@ pub mod response;
 pub mod rk4;
 
 pub use exact::simulate_building;
-pub use model::{Building, BuildingError, BuildingSpec, ModalBasis, StackSpec, StoreyYielding};
+pub use model::{Building, BuildingError, BuildingSpec, DampingBasis, StackSpec, StoreyYielding};
 pub use response::BuildingResponse;
 pub use rk4::simulate_building_rk4;

@@ -7,6 +7,7 @@
 //! they carry: interface `k` lies under block body `N + k`, so a stack's interface 1 is between
 //! its floor and its bottom block. Displacements are relative to the ground.
 
+pub use super::super::model::DampingBasis;
 use super::super::model::{G, System, SystemSpec, Yielding};
 use crate::limits::{
     MAX_ALPHA, MAX_BLOCKS, MAX_MU, MAX_STACKS, MAX_STOREYS, STOREY_RATIO_RANGE,
@@ -14,16 +15,6 @@ use crate::limits::{
 };
 use nalgebra::{DMatrix, SymmetricEigen};
 use thiserror::Error;
-
-/// What the damping ratio refers to (docs/model.md, "Damping basis").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ModalBasis {
-    /// The modes of the building with every stack rigidly attached to its floor.
-    #[default]
-    Rigid,
-    /// The modes of the bare building.
-    Structure,
-}
 
 /// A stack of blocks on one floor, as a user states it.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,7 +49,7 @@ pub struct BuildingSpec {
     pub storey_stiffnesses: Vec<f64>,
     /// Damping ratio `ζ` of every mode of the basis.
     pub damping_ratio: f64,
-    pub damping_basis: ModalBasis,
+    pub damping_basis: DampingBasis,
     /// `None`: every storey elastic.
     pub yielding: Option<StoreyYielding>,
     pub stacks: Vec<StackSpec>,
@@ -73,7 +64,7 @@ impl BuildingSpec {
             floor_masses: vec![1.0; storeys],
             storey_stiffnesses: vec![1.0; storeys],
             damping_ratio: 0.05,
-            damping_basis: ModalBasis::Rigid,
+            damping_basis: DampingBasis::Rigid,
             yielding: None,
             stacks: Vec::new(),
         }
@@ -330,8 +321,8 @@ impl Building {
             .map(|w2| std::f64::consts::TAU / (w2 * scale).sqrt())
             .collect();
         let basis_masses: Vec<f64> = match spec.damping_basis {
-            ModalBasis::Structure => floor_m.clone(),
-            ModalBasis::Rigid => floor_m
+            DampingBasis::Structure => floor_m.clone(),
+            DampingBasis::Rigid => floor_m
                 .iter()
                 .zip(&load)
                 .map(|(m, a)| m * (1.0 + a))
@@ -676,7 +667,7 @@ mod tests {
             mu_static: None,
         }];
         let k = (std::f64::consts::TAU).powi(2);
-        for (basis, mass) in [(ModalBasis::Structure, 1.0), (ModalBasis::Rigid, 2.0)] {
+        for (basis, mass) in [(DampingBasis::Structure, 1.0), (DampingBasis::Rigid, 2.0)] {
             s.damping_basis = basis;
             let b = Building::new(&s).unwrap();
             let expect = 2.0 * 0.05 * (k * mass).sqrt();

@@ -1,13 +1,13 @@
 //! The paper's two named cases: Section 7.1 (histories, the construction of `T_new` of Fig. 12,
 //! the energy partition) and Table 2 (stack against single block).
 
-use super::runs::{System3, section71_tnew, simulate};
+use super::runs::{section71_tnew, simulate};
 use super::text::{fixed, mean, nums, sig};
 use super::{Files, Inputs, ReportError, Zone};
 use crate::report::chart::{Axis, Figure, Mark, PALETTE, Panel, Plot, Segment, Series, Stroke};
 use crate::report::page::{Section, para, table_with_id};
 use crate::study::cases::{PAPER_SECTION_7_1, PAPER_TABLE_2, SECTION_7_1};
-use crate::study::sweep::Physics;
+use crate::study::physics::{Physics, SystemKind};
 use crate::study::tnew::TnewFlag;
 use plotters::style::RGBColor;
 
@@ -37,7 +37,7 @@ pub(super) fn section71_section(inp: &Inputs, files: &mut Files) -> Result<Secti
     let mut energy_panels = Vec::new();
     for z in &inp.zones {
         body += &histories(z, physics, files)?;
-        let (fig, row) = construction(z, physics, files)?;
+        let (fig, row) = construction(z, files)?;
         body += &fig;
         rows.push(row);
         let (e_rows, panel) = energy(z, n);
@@ -119,8 +119,8 @@ fn histories(z: &Zone, physics: &Physics, files: &mut Files) -> Result<String, R
     // Histories under the median motion, then all three around their peaks.
     let mut panels = Vec::new();
     let mut lines = Vec::new();
-    for (i, s) in System3::ALL.into_iter().enumerate() {
-        let r = simulate(rec, &s.spec(physics, c.period_s, &c.alpha, &c.mu), true)?;
+    for (i, s) in SystemKind::ALL.into_iter().enumerate() {
+        let r = simulate(physics, s, &c.case, rec, true)?;
         let h = r.history.as_ref().expect("history requested");
         let u: Vec<f64> = h
             .displacement_m
@@ -196,13 +196,9 @@ fn histories(z: &Zone, physics: &Physics, files: &mut Files) -> Result<String, R
 }
 
 /// The construction of `T_new` (paper Fig. 12) and its row of the Section 7.1 table.
-fn construction(
-    z: &Zone,
-    physics: &Physics,
-    files: &mut Files,
-) -> Result<(String, Vec<String>), ReportError> {
+fn construction(z: &Zone, files: &mut Files) -> Result<(String, Vec<String>), ReportError> {
     let c = &z.section71;
-    let (u, tr, tn, flag) = section71_tnew(z, physics);
+    let (u, tr, tn, flag) = section71_tnew(z);
     let paper = (PAPER_SECTION_7_1.0 == z.name).then_some(PAPER_SECTION_7_1);
     let t = &z.tnew.period_sd_s;
     let t_max = (1.6 * tr).max(2.5).min(t[t.len() - 1]);
@@ -213,7 +209,7 @@ fn construction(
     let black = RGBColor(0, 0, 0);
     let mut series = vec![
         Series::line("mean 5 %-damped Sd of the motions", tk, sd_cm).colour(PALETTE[0]),
-        Series::vline("T_p (bare structure)", c.period_s, 0.0, y_top)
+        Series::vline("T_p (bare structure)", c.case.period_s, 0.0, y_top)
             .colour(black)
             .stroke(Stroke::Dotted, 1),
         Series::vline("T_rigid (load rigidly attached)", tr, 0.0, y_top)
@@ -304,11 +300,11 @@ fn energy(z: &Zone, n: usize) -> (Vec<Vec<String>>, Panel) {
         segs.push((format!("friction, interface {}", i + 1), Vec::new()));
     }
     segs.push(("kinetic + strain at the end".into(), Vec::new()));
-    for s in System3::ALL {
+    for s in SystemKind::ALL {
         // The rigid system is one body of the whole mass: its terms per kg of that mass,
         // times (1 + α), are per kg of structure mass like the others'.
-        let scale = if s == System3::Rigid {
-            1.0 + c.alpha_total()
+        let scale = if s == SystemKind::Rigid {
+            1.0 + c.case.alpha_total()
         } else {
             1.0
         };
@@ -346,7 +342,10 @@ fn energy(z: &Zone, n: usize) -> (Vec<Vec<String>>, Panel) {
         x: Axis::new("share of the input energy (%)").range(0.0, 100.0),
         y: Axis::new(""),
         plot: Plot::StackedBars {
-            categories: System3::ALL.iter().map(|s| s.name().to_string()).collect(),
+            categories: SystemKind::ALL
+                .iter()
+                .map(|s| s.name().to_string())
+                .collect(),
             segments: segs
                 .into_iter()
                 .enumerate()
@@ -372,7 +371,10 @@ pub(super) fn table2_section(inp: &Inputs) -> Section {
     let mut rows = Vec::new();
     for z in &inp.zones {
         let c = &z.table2;
-        let (single, stack) = (c.mean_peak(System3::Single), c.mean_peak(System3::Stack));
+        let (single, stack) = (
+            c.mean_peak(SystemKind::SingleBlock),
+            c.mean_peak(SystemKind::Stack),
+        );
         let reductions: Vec<f64> = c
             .runs
             .iter()

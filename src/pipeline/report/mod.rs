@@ -15,7 +15,7 @@
 //!
 //! Panels and lines are picked from the grid's own axes, so any grid (other block counts
 //! included) gives a report. Every simulation uses the study's physics
-//! ([`crate::study::sweep::Physics`]). The directory is replaced as a whole
+//! ([`crate::study::physics::Physics`]). The directory is replaced as a whole
 //! ([`crate::store::report`]).
 //!
 //! Fingerprint: the fit's and the motions' (which carry everything upstream), `ida.h5`'s with an
@@ -31,7 +31,6 @@ mod select;
 mod text;
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
-use crate::dynamics::{ModelError, SimError};
 use crate::grid::Grid;
 use crate::motion::Record;
 use crate::report::chart::{self, ChartError, Figure};
@@ -41,14 +40,15 @@ use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::fit::{FitReport, ZoneFit, read_fit};
 use crate::store::motions::{ZoneSpectra, read_zone_spectra};
 use crate::store::report::write_report_dir;
-use crate::store::tnew::{ZoneTnew, read_band_flags, read_zone_tnew};
+use crate::store::tnew::{ZoneTnew, read_band_flags};
 use crate::study::cases::{PAPER_SECTION_7_1, PAPER_TABLE_2, PAPER_TABLE_3, SECTION_7_1, TABLE_2};
-use crate::study::sweep::Physics;
+use crate::study::physics::{CaseError, Physics, SystemKind};
+use crate::study::tnew::BAND_FLAGS;
 use cases::{section71_section, table2_section};
 use fit::fit_section;
 use grid::{drr_section, tnew_section};
 use motions::motions_section;
-use runs::{CaseRun, System3, section71_tnew};
+use runs::{CaseRun, section71_tnew};
 use select::Selection;
 use text::{fixed, joined, num};
 use thiserror::Error;
@@ -58,13 +58,10 @@ const REPORT_VERSION: &str = "report-2";
 
 #[derive(Debug, Error)]
 pub enum ReportError {
-    #[error("the report's case {case}: {source}")]
-    Model { case: String, source: ModelError },
-    #[error("the report's case {case} under {motion}: {source}")]
-    Simulation {
-        case: String,
+    #[error("the report's {source}, under {motion}")]
+    Case {
         motion: String,
-        source: SimError,
+        source: Box<CaseError>,
     },
     #[error("zone {zone} has no motions")]
     NoMotions { zone: String },
@@ -125,6 +122,7 @@ impl<'a> Inputs<'a> {
         );
         let fit = read_fit(&fyaml)?.ok_or_else(|| StoreError::corrupt(&fyaml, "is missing"))?;
         let n = grid.blocks();
+        fit.check_blocks(&fyaml, n)?;
         let mut zones = Vec::new();
         for (zc, motions) in study.cfg.zones.iter().zip(motions) {
             if motions.is_empty() {
@@ -133,13 +131,22 @@ impl<'a> Inputs<'a> {
                 }
                 .into());
             }
-            let (axes, tnew) = read_zone_tnew(&th5, &zc.name, n)?;
-            if axes != *grid {
-                return Err(StoreError::corrupt(
+            let tnew = super::tnew::read_zone(study, &zc.name)?;
+            let band_flags = read_band_flags(&th5, &zc.name)?;
+            let spectra = read_zone_spectra(&mh5, &zc.name)?;
+            let why = if !same_flags(&band_flags, &BAND_FLAGS) {
+                Some((
                     &th5,
-                    format!("zone_{}: its grid differs from the config's", zc.name),
-                )
-                .into());
+                    "T_new_band's flag_values/flag_meanings are not this version's",
+                ))
+            } else if spectra.periods_s != study.cfg.motions.matching.check_grid_s() {
+                Some((&mh5, "its check periods are not the config's"))
+            } else {
+                None
+            };
+            if let Some((file, why)) = why {
+                let why = format!("zone_{}: {why}", zc.name);
+                return Err(StoreError::corrupt(file, why).into());
             }
             let zf = fit
                 .zones
@@ -149,8 +156,8 @@ impl<'a> Inputs<'a> {
                 .ok_or_else(|| StoreError::corrupt(&fyaml, format!("has no zone {}", zc.name)))?;
             zones.push(Zone {
                 name: zc.name.clone(),
-                spectra: read_zone_spectra(&mh5, &zc.name)?,
-                band_flags: read_band_flags(&th5, &zc.name)?,
+                spectra,
+                band_flags,
                 section71: CaseRun::new(&physics, &SECTION_7_1, n, &motions)?,
                 table2: CaseRun::new(&physics, &TABLE_2, n, &motions)?,
                 motions,
@@ -166,6 +173,15 @@ impl<'a> Inputs<'a> {
             zones,
         })
     }
+}
+
+/// Whether stored `(code, word)` flags are `want`.
+fn same_flags(stored: &[(u8, String)], want: &[(u8, &str)]) -> bool {
+    stored.len() == want.len()
+        && stored
+            .iter()
+            .zip(want)
+            .all(|(a, b)| a.0 == b.0 && a.1 == b.1)
 }
 
 /// The report's files as they are made.
@@ -189,7 +205,7 @@ fn summary(inp: &Inputs) -> String {
     let ph = &inp.physics;
     let mut rows = Vec::new();
     for z in &inp.zones {
-        let (u, _, tn, _) = section71_tnew(z, ph);
+        let (u, _, tn, _) = section71_tnew(z);
         let p71 = (PAPER_SECTION_7_1.0 == z.name).then_some(PAPER_SECTION_7_1);
         rows.push(vec![
             "Section 7.1 case: T_new (s)".into(),
@@ -204,7 +220,8 @@ fn summary(inp: &Inputs) -> String {
             format!("{:.2}", u * 100.0),
         ]);
         let c = &z.table2;
-        let red = 100.0 * (1.0 - c.mean_peak(System3::Stack) / c.mean_peak(System3::Single));
+        let red =
+            100.0 * (1.0 - c.mean_peak(SystemKind::Stack) / c.mean_peak(SystemKind::SingleBlock));
         let p2 = PAPER_TABLE_2.iter().find(|p| p.0 == z.name);
         rows.push(vec![
             "Table 2 case: reduction of the peak by the stack (%)".into(),

@@ -3,119 +3,75 @@
 
 use super::text::{mean, num, nums};
 use super::{ReportError, Zone};
-use crate::dynamics::{ExactOptions, Ground, Response, System, SystemSpec};
+use crate::case::Case;
+use crate::dynamics::{ExactOptions, Ground, Response};
 use crate::motion::Record;
-use crate::study::cases::NamedCase;
-use crate::study::sweep::Physics;
-use crate::study::tnew::{TnewFlag, period_at_displacement};
+use crate::study::cases::PaperCase;
+use crate::study::physics::{Physics, SystemKind};
+use crate::study::tnew::{TnewFlag, t_new};
 use rayon::prelude::*;
 
+/// System `kind` of `case` under `rec`, by the study's physics; `history` keeps the time history.
 pub(super) fn simulate(
+    physics: &Physics,
+    kind: SystemKind,
+    case: &Case,
     rec: &Record,
-    spec: &SystemSpec,
     history: bool,
 ) -> Result<Response, ReportError> {
-    let case = format!(
-        "T_p {} s, α {:?}, μ {:?}",
-        spec.period_s, spec.alpha, spec.mu
-    );
     let accel = rec.accel_mps2(1.0);
     let ground = Ground {
         dt_s: rec.dt_s,
         accel_mps2: &accel,
     };
-    let sys = System::new(spec).map_err(|source| ReportError::Model {
-        case: case.clone(),
-        source,
-    })?;
-    crate::dynamics::simulate_exact(
-        &sys,
-        &ground,
-        &ExactOptions {
-            history,
-            ..ExactOptions::default()
-        },
-    )
-    .map_err(|source| ReportError::Simulation {
-        case,
-        motion: rec.name.clone(),
-        source,
-    })
-}
-
-/// The three systems of a case (docs/model.md, "Derived quantities").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum System3 {
-    Stack,
-    Single,
-    Rigid,
-}
-
-impl System3 {
-    pub(super) const ALL: [System3; 3] = [System3::Stack, System3::Single, System3::Rigid];
-
-    pub(super) fn name(self) -> &'static str {
-        match self {
-            System3::Stack => "stack",
-            System3::Single => "single block",
-            System3::Rigid => "rigidly attached",
-        }
-    }
-
-    pub(super) fn spec(self, physics: &Physics, tp: f64, alpha: &[f64], mu: &[f64]) -> SystemSpec {
-        let total: f64 = alpha.iter().sum();
-        match self {
-            System3::Stack => physics.stack(tp, alpha, mu),
-            System3::Single => physics.single(tp, total, mu[0]),
-            System3::Rigid => physics.rigid(tp, total),
-        }
-    }
+    let opts = ExactOptions {
+        history,
+        ..ExactOptions::default()
+    };
+    physics
+        .simulate(kind, case, &ground, &opts)
+        .map_err(|source| ReportError::Case {
+            motion: rec.name.clone(),
+            source: Box::new(source),
+        })
 }
 
 /// A named case of the paper, as run on this study's motions.
 pub(super) struct CaseRun {
-    pub(super) period_s: f64,
-    pub(super) alpha: Vec<f64>,
-    pub(super) mu: Vec<f64>,
-    /// Per motion: stack, single block, rigid.
+    pub(super) case: Case,
+    /// Per motion, the responses of the systems in [`SystemKind::ALL`] order.
     pub(super) runs: Vec<[Response; 3]>,
 }
 
 impl CaseRun {
     pub(super) fn new(
         physics: &Physics,
-        case: &NamedCase,
+        named: &PaperCase,
         blocks: usize,
         motions: &[Record],
     ) -> Result<Self, ReportError> {
-        let (alpha, mu) = case.for_blocks(blocks);
-        let tp = case.period_s;
+        let case = named.case(blocks);
         let runs = motions
             .par_iter()
             .map(|rec| -> Result<[Response; 3], ReportError> {
-                let run = |s: System3| simulate(rec, &s.spec(physics, tp, &alpha, &mu), false);
+                let run = |kind| simulate(physics, kind, &case, rec, false);
                 Ok([
-                    run(System3::Stack)?,
-                    run(System3::Single)?,
-                    run(System3::Rigid)?,
+                    run(SystemKind::Stack)?,
+                    run(SystemKind::SingleBlock)?,
+                    run(SystemKind::Rigid)?,
                 ])
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Self {
-            period_s: tp,
-            alpha,
-            mu,
-            runs,
-        })
+        Ok(Self { case, runs })
     }
 
-    pub(super) fn alpha_total(&self) -> f64 {
-        self.alpha.iter().sum()
-    }
-
-    /// Mean over the motions of the peak structure displacement of system `s`, m.
-    pub(super) fn mean_peak(&self, s: System3) -> f64 {
-        mean(self.runs.iter().map(|r| r[s as usize].peak_displacement_m))
+    /// Mean over the motions of the peak structure displacement of system `kind`, m.
+    pub(super) fn mean_peak(&self, kind: SystemKind) -> f64 {
+        mean(
+            self.runs
+                .iter()
+                .map(|r| r[kind as usize].peak_displacement_m),
+        )
     }
 
     pub(super) fn slides(&self) -> bool {
@@ -136,24 +92,21 @@ impl CaseRun {
     }
 
     pub(super) fn describe(&self) -> String {
+        let c = &self.case;
         format!(
             "T_p = {} s, α = {}, μ = {}",
-            num(self.period_s),
-            nums(&self.alpha),
-            nums(&self.mu)
+            num(c.period_s),
+            nums(&c.alpha),
+            nums(&c.mu)
         )
     }
 }
 
 /// The Section 7.1 case's `T_new` in one zone: the mean peak displacement, `T_rigid`, `T_new`.
-pub(super) fn section71_tnew(z: &Zone, physics: &Physics) -> (f64, f64, f64, TnewFlag) {
+pub(super) fn section71_tnew(z: &Zone) -> (f64, f64, f64, TnewFlag) {
     let c = &z.section71;
-    let u = c.mean_peak(System3::Stack);
-    let tr = physics.rigid(c.period_s, c.alpha_total()).period_s;
-    let (tn, flag) = if c.slides() {
-        period_at_displacement(&z.tnew.period_sd_s, &z.tnew.sd_mean_m, u, tr)
-    } else {
-        (tr, TnewFlag::NoSlip)
-    };
+    let u = c.mean_peak(SystemKind::Stack);
+    let tr = c.case.t_rigid_s();
+    let (tn, flag) = t_new(&z.tnew.period_sd_s, &z.tnew.sd_mean_m, u, tr, c.slides());
     (u, tr, tn, flag)
 }

@@ -1,0 +1,183 @@
+//! The physics of a case (docs/model.md, "Derived quantities"): what the damping ratio refers to
+//! ([`DampingBasis`]), the settings every case of a study shares ([`Physics`]), and the three
+//! systems a case is run as ([`SystemKind`]): the stack, the whole stack as one block, and the
+//! stack rigidly attached. All three share one viscous damper and, on a yielding structure, one
+//! yield force. The one place these systems are built, for the sweep, the T_new stage, the
+//! report and the IDA stage.
+
+use crate::case::Case;
+use crate::dynamics::{
+    ExactOptions, Ground, ModelError, Response, SimError, System, SystemSpec, Yielding,
+    simulate_exact,
+};
+use thiserror::Error;
+
+pub use crate::dynamics::DampingBasis;
+
+/// The three systems of a case.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SystemKind {
+    /// The structure with its stack of blocks.
+    Stack,
+    /// The whole stack as one block of mass ratio `α` sliding on interface 1.
+    SingleBlock,
+    /// The stack rigidly attached: a one-body system of mass `m_p(1+α)` on the structure's
+    /// spring and damper (paper Eqs. 10–13), `T_rigid = T_p·sqrt(1+α)`.
+    Rigid,
+}
+
+impl SystemKind {
+    pub const ALL: [SystemKind; 3] = [
+        SystemKind::Stack,
+        SystemKind::SingleBlock,
+        SystemKind::Rigid,
+    ];
+
+    /// For people: `stack`, `single block`, `rigidly attached`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SystemKind::Stack => "stack",
+            SystemKind::SingleBlock => "single block",
+            SystemKind::Rigid => "rigidly attached",
+        }
+    }
+
+    /// As stored in files: `stack`, `single_block`, `rigid`.
+    pub fn key(self) -> &'static str {
+        match self {
+            SystemKind::Stack => "stack",
+            SystemKind::SingleBlock => "single_block",
+            SystemKind::Rigid => "rigid",
+        }
+    }
+}
+
+/// A system of a case that cannot be built or run.
+#[derive(Debug, Error)]
+pub enum CaseError {
+    #[error("case {case}, {} system: {source}", kind.name())]
+    Model {
+        case: Case,
+        kind: SystemKind,
+        source: ModelError,
+    },
+    #[error("case {case}, {} system: {source}", kind.name())]
+    Simulation {
+        case: Case,
+        kind: SystemKind,
+        source: SimError,
+    },
+}
+
+/// The settings every case of a study shares.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Physics {
+    /// Viscous damping ratio `ζ`, of the system named by `basis`.
+    pub damping: f64,
+    pub basis: DampingBasis,
+    /// Static friction coefficients are this × the kinetic ones (≥ 1).
+    pub mu_static_ratio: f64,
+}
+
+impl Physics {
+    /// 5 % of the rigidly loaded structure, static friction equal to kinetic (the paper's).
+    pub const DEFAULT: Physics = Physics {
+        damping: 0.05,
+        basis: DampingBasis::Rigid,
+        mu_static_ratio: 1.0,
+    };
+
+    /// Damping ratio of the bare structure that gives the study's `c` for a stack of total mass
+    /// ratio `alpha_total`.
+    pub fn structure_damping(&self, alpha_total: f64) -> f64 {
+        match self.basis {
+            DampingBasis::Structure => self.damping,
+            DampingBasis::Rigid => self.damping * (1.0 + alpha_total).sqrt(),
+        }
+    }
+
+    /// Refuses a damping that would need a bare-structure ratio of 1 or more (critical damping)
+    /// for a stack of total mass ratio `alpha_total`.
+    pub fn check(&self, alpha_total: f64) -> Result<(), String> {
+        let bare = self.structure_damping(alpha_total);
+        if bare < 1.0 {
+            return Ok(());
+        }
+        Err(format!(
+            "damping {} of the rigidly loaded system needs a bare-structure ratio of {bare:.3} for \
+             α = {alpha_total}; it must stay below 1 (use a smaller damping, or the `structure` \
+             basis)",
+            self.damping
+        ))
+    }
+
+    /// System `kind` of `case` on the elastic structure.
+    pub fn spec(&self, kind: SystemKind, case: &Case) -> SystemSpec {
+        let total = case.alpha_total();
+        match kind {
+            SystemKind::Stack => self.stack(case.period_s, &case.alpha, &case.mu),
+            SystemKind::SingleBlock => self.stack(case.period_s, &[total], &case.mu[..1]),
+            SystemKind::Rigid => {
+                let root = (1.0 + total).sqrt();
+                SystemSpec {
+                    period_s: case.t_rigid_s(),
+                    damping_ratio: self.structure_damping(total) / root,
+                    mass_kg: 1.0,
+                    alpha: Vec::new(),
+                    mu: Vec::new(),
+                    mu_static: None,
+                }
+            }
+        }
+    }
+
+    fn stack(&self, period_s: f64, alpha: &[f64], mu: &[f64]) -> SystemSpec {
+        let mut spec = SystemSpec::new(period_s, alpha, mu);
+        spec.damping_ratio = self.structure_damping(alpha.iter().sum());
+        spec.mu_static = Some(mu.iter().map(|m| m * self.mu_static_ratio).collect());
+        spec
+    }
+
+    /// System `kind` of `case`, on a structure that yields as `yielding` says (its strength
+    /// ratio on the bare structure's mass `m_p`) or elastic. Every kind has the same yield force
+    /// `F_y = C_y·m_p·g`, so the rigid system, one body of mass `m_p(1+α)`, has the strength
+    /// ratio `C_y/(1+α)` on its own mass.
+    pub fn system(
+        &self,
+        kind: SystemKind,
+        case: &Case,
+        yielding: Option<Yielding>,
+    ) -> Result<System, ModelError> {
+        let system = System::new(&self.spec(kind, case))?;
+        match yielding {
+            None => Ok(system),
+            Some(y) if kind == SystemKind::Rigid => system.with_yielding(Yielding {
+                strength_ratio: y.strength_ratio / (1.0 + case.alpha_total()),
+                ..y
+            }),
+            Some(y) => system.with_yielding(y),
+        }
+    }
+
+    /// System `kind` of `case` on the elastic structure under `ground`, by the exact integrator.
+    pub fn simulate(
+        &self,
+        kind: SystemKind,
+        case: &Case,
+        ground: &Ground,
+        opts: &ExactOptions,
+    ) -> Result<Response, CaseError> {
+        let system = self
+            .system(kind, case, None)
+            .map_err(|source| CaseError::Model {
+                case: case.clone(),
+                kind,
+                source,
+            })?;
+        simulate_exact(&system, ground, opts).map_err(|source| CaseError::Simulation {
+            case: case.clone(),
+            kind,
+            source,
+        })
+    }
+}
