@@ -34,7 +34,6 @@ pub mod pipeline;
 pub mod report;
 pub mod sdof;
 pub mod simulation;
-pub mod simulation_building;
 pub mod spectrum;
 pub mod store;
 pub mod study;

@@ -16,7 +16,7 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Simulate one case: a structure and its stack under one ground motion.
-    Simulate(cmd::simulate::Args),
+    Simulate(Box<cmd::simulate::Args>),
     /// Response spectra (Sd, PSV, PSA) of records, exact between samples.
     Spectrum(cmd::spectrum::Args),
     /// Match records to a target spectrum (wavelet adjustment) and write them as .AT2 files.
@@ -55,7 +55,7 @@ fn main() -> std::process::ExitCode {
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
-        Command::Simulate(args) => cmd::simulate::run(args),
+        Command::Simulate(args) => cmd::simulate::run(*args),
         Command::Spectrum(args) => cmd::spectrum::run(args),
         Command::Match(args) => cmd::matching::run(args),
         Command::Motions(args) => cmd::stage::run(args, StageId::Motions),

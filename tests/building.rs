@@ -55,7 +55,13 @@ fn one_storey_equals_the_sdof_integrator() {
             &[0.2, 0.1],
             Some(&[0.25, 0.12]),
         ),
-        case(DampingBasis::Rigid, Some((0.15, 0.05)), &[1.0], &[0.3], None),
+        case(
+            DampingBasis::Rigid,
+            Some((0.15, 0.05)),
+            &[1.0],
+            &[0.3],
+            None,
+        ),
         case(
             DampingBasis::Structure,
             Some((0.2, 0.0)),

@@ -9,7 +9,8 @@
 //! displacement and hysteretic energy. The case and its checks: `slidestack::simulation`.
 
 use anyhow::Result;
-use slidestack::simulation::{Settings, Summary};
+use slidestack::simulation::building::{BuildingSummary, history_layout};
+use slidestack::simulation::{Model, Outcome, Settings, Summary};
 use slidestack::store::{HistoryLayout, write_history};
 use std::path::PathBuf;
 
@@ -25,6 +26,11 @@ pub struct Args {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// For a building case: write an SVG figure of the stacks sliding against them rigidly
+    /// attached (peak floor displacement and drift over the height, roof displacement and slips
+    /// over time).
+    #[arg(long)]
+    figure: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -37,19 +43,120 @@ pub fn run(args: Args) -> Result<()> {
     for w in sim.warnings(&accel) {
         eprintln!("simulate: warning: {w}");
     }
-    let (summary, history) = sim.run(&accel)?;
+    if args.figure.is_some() && !matches!(sim.model, Model::Building { .. }) {
+        return Err(super::BadInput(
+            "--figure draws a building case: the case needs `building`".into(),
+        )
+        .into());
+    }
+    let (outcome, history) = sim.run(&accel)?;
     if let (Some(path), Some(h)) = (&sim.history, &history) {
-        write_history(path, h, &HistoryLayout::one_storey(h.interfaces))?;
+        let layout = match &sim.model {
+            Model::OneStorey { .. } => HistoryLayout::one_storey(h.interfaces),
+            Model::Building { building, .. } => history_layout(building),
+        };
+        write_history(path, h, &layout)?;
+    }
+    if let Some(path) = &args.figure
+        && let Some(fig) = sim.building_figure(&accel)?
+    {
+        let svg = slidestack::report::chart::render(&fig)?;
+        slidestack::store::atomic::write_bytes(path, svg.as_bytes())?;
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        println!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
-        print_table(&summary);
+        match &outcome {
+            Outcome::OneStorey(s) => print_table(s),
+            Outcome::Building(b) => print_building(b),
+        }
         if let Some(p) = &sim.history {
             println!("history written to {}", p.display());
         }
+        if let Some(p) = &args.figure {
+            println!("figure written to {}", p.display());
+        }
     }
     Ok(())
+}
+
+fn print_building(o: &BuildingSummary) {
+    let list = |v: &[f64], prec: usize| {
+        v.iter()
+            .map(|x| format!("{x:.prec$}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let b = &o.building;
+    println!(
+        "record            {} ({} samples, dt {} s, scale {})",
+        o.record, o.npts, o.dt_s, o.scale
+    );
+    println!(
+        "building          {} storeys, T_1 {} s (modes [{}] s), damping {} ({} basis), {}",
+        b.storeys,
+        b.period_s,
+        list(&o.modes_s, 4),
+        o.damping,
+        o.damping_basis.name(),
+        b.structure.name()
+    );
+    println!(
+        "integrator        {}",
+        match o.rk4_substeps {
+            Some(n) => format!("rk4, {n} sub-steps"),
+            None => "exact".to_string(),
+        }
+    );
+    println!("floor  peak u (m)   peak |a| (g)");
+    for j in 0..b.storeys {
+        println!(
+            "{:>5}  {:<11.6}  {:.4}",
+            j + 1,
+            o.floor_peak_displacement_m[j],
+            o.floor_peak_abs_accel_g[j]
+        );
+    }
+    println!("storey  peak drift (m)  residual drift (m)  ductility");
+    for i in 0..b.storeys {
+        let mu = o
+            .storey_ductility
+            .as_ref()
+            .map_or("–".to_string(), |d| format!("{:.4}", d[i]));
+        println!(
+            "{:>6}  {:<14.6}  {:<18.6}  {mu}",
+            i + 1,
+            o.storey_peak_drift_m[i],
+            o.storey_residual_drift_m[i]
+        );
+    }
+    for (i, s) in o.stacks.iter().enumerate() {
+        println!(
+            "stack {} on floor {}: alpha [{}], mu [{}]; peak slip [{}] m, residual [{}] m, \
+             peak |a| [{}] g",
+            i + 1,
+            s.floor,
+            list(&s.alpha, 3),
+            list(&s.mu, 3),
+            list(&s.peak_slip_m, 5),
+            list(&s.residual_slip_m, 5),
+            list(&s.peak_abs_accel_g, 4)
+        );
+    }
+    println!(
+        "switches          {}, yield/unloading events {}",
+        o.switches, o.yield_events
+    );
+    let e = &o.energy;
+    println!(
+        "energy (J/kg)     input {:.6}, kinetic {:.6}, strain {:.6}, damping {:.6}, friction \
+         {:.6}, hysteretic {:.6}",
+        e.input, e.kinetic, e.strain, e.damping, e.friction, e.hysteretic
+    );
+    println!(
+        "energy balance    |residual|/input = {:.2e}",
+        o.energy_balance_error
+    );
 }
 
 fn print_table(o: &Summary) {

@@ -4,8 +4,8 @@
 //! modal one otherwise), and the [`BuildingSummary`] `--json` prints.
 
 use crate::dynamics::building::{
-    Building, BuildingResponse, BuildingSpec, StackSpec, StoreyYielding,
-    simulate_building, simulate_building_rk4,
+    Building, BuildingResponse, BuildingSpec, StackSpec, StoreyYielding, simulate_building,
+    simulate_building_rk4,
 };
 use crate::dynamics::{
     DampingBasis, Energy, ExactOptions, G, Ground, History, simulate_exact, simulate_rk4,
@@ -117,6 +117,20 @@ pub fn building_spec(
             post_yield_ratio: r,
         }),
     };
+    for (key, values) in [
+        ("floor_masses", &b.floor_masses),
+        ("storey_stiffnesses", &b.storey_stiffnesses),
+        ("yield_strength_ratios", &b.yield_strength_ratios),
+    ] {
+        if let Some(v) = values
+            && v.len() != n
+        {
+            return Err(format!(
+                "building.{key} lists {} values but the building has {n} storeys",
+                v.len()
+            ));
+        }
+    }
     let stacks = stacks
         .iter()
         .enumerate()
@@ -332,17 +346,15 @@ pub fn building_figure(
     let level: Vec<f64> = (1..=n).map(|j| j as f64).collect();
     let profile =
         |values: &[f64], scale: f64| -> Vec<f64> { values.iter().map(|v| v * scale).collect() };
-    let pair = |a: &[f64], s: &[f64], label: &str| {
+    // The legend is the figure's: only the first panel names the two systems.
+    let pair = |a: &[f64], s: &[f64], named: bool| {
+        let name = |n: &str| if named { n.to_string() } else { String::new() };
         vec![
+            Series::line(name("stacks sliding"), profile(s, 100.0), level.clone())
+                .colour(PALETTE[0])
+                .stroke(Stroke::Solid, 2),
             Series::line(
-                format!("stacks sliding: {label}"),
-                profile(s, 100.0),
-                level.clone(),
-            )
-            .colour(PALETTE[0])
-            .stroke(Stroke::Solid, 2),
-            Series::line(
-                format!("stacks attached: {label}"),
+                name("stacks rigidly attached"),
                 profile(a, 100.0),
                 level.clone(),
             )
@@ -358,7 +370,7 @@ pub fn building_figure(
             pair(
                 &attached.floor_peak_displacement_m,
                 &sliding.floor_peak_displacement_m,
-                "u",
+                true,
             ),
         ),
         Panel::xy(
@@ -368,7 +380,7 @@ pub fn building_figure(
             pair(
                 &attached.storey_peak_drift_m,
                 &sliding.storey_peak_drift_m,
-                "δ",
+                false,
             ),
         ),
     ];
@@ -384,11 +396,11 @@ pub fn building_figure(
             Axis::new("time t (s)"),
             Axis::new("u_N (cm)"),
             vec![
-                Series::line("stacks sliding", hs.time_s.clone(), roof(hs))
-                    .colour(PALETTE[0])
-                    .stroke(Stroke::Solid, 1),
-                Series::line("stacks attached", ha.time_s.clone(), roof(ha))
+                Series::line("", ha.time_s.clone(), roof(ha))
                     .colour(PALETTE[1])
+                    .stroke(Stroke::Dashed, 1),
+                Series::line("", hs.time_s.clone(), roof(hs))
+                    .colour(PALETTE[0])
                     .stroke(Stroke::Solid, 1),
             ],
         ));

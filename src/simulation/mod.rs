@@ -5,6 +5,9 @@
 //! The physics of the case comes from [`Physics`], as for the study's stages; the yielding model
 //! is docs/model.md, "Yielding structure".
 
+pub mod building;
+
+use crate::dynamics::building::Building;
 use crate::dynamics::{
     Energy, ExactOptions, G, Ground, History, Response, SimError, System, SystemSpec, Yielding,
     simulate_exact, simulate_rk4,
@@ -102,6 +105,21 @@ pub struct Settings {
     /// Write the time history to this .h5 or .csv file.
     #[arg(long)]
     pub history: Option<PathBuf>,
+    /// A shear building of several storeys (case files only; docs/model.md, "A multi-storey
+    /// building"). With it the stacks are given under `stacks`, and the one-storey keys
+    /// (`period`, `alpha`, `mu`, `mu_static`, `structure`, `yield_strength_ratio`,
+    /// `post_yield_ratio`) do not apply.
+    #[arg(skip)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub building: Option<building::BuildingSettings>,
+    /// The stacks on a building's floors (case files only).
+    #[arg(skip)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stacks: Option<Vec<building::StackSettings>>,
+    /// The case file these settings were read from, for messages.
+    #[arg(skip)]
+    #[serde(skip)]
+    pub file: Option<PathBuf>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -112,6 +130,9 @@ pub enum SimulationError {
     Yaml { file: String, message: String },
     #[error("invalid case: {0}")]
     Invalid(String),
+    /// A key of a case file, named with the file.
+    #[error("{file}: {message}")]
+    Key { file: String, message: String },
     #[error(transparent)]
     Record(#[from] RecordError),
     #[error("simulation of {record} failed")]
@@ -136,10 +157,13 @@ impl Settings {
     /// Reads a case file (the keys of [`Settings`]).
     pub fn read(path: &Path) -> Result<Self, SimulationError> {
         let text = read_yaml_text(path)?;
-        serde_yaml::from_str(&text).map_err(|e| SimulationError::Yaml {
-            file: path.display().to_string(),
-            message: crate::limits::excerpt_message(&e.to_string()),
-        })
+        let mut settings: Settings =
+            serde_yaml::from_str(&text).map_err(|e| SimulationError::Yaml {
+                file: path.display().to_string(),
+                message: crate::limits::excerpt_message(&e.to_string()),
+            })?;
+        settings.file = Some(path.to_path_buf());
+        Ok(settings)
     }
 
     /// These settings where given, `base`'s elsewhere: the one place settings from two sources
@@ -156,13 +180,22 @@ impl Settings {
                 merged.insert(key, value);
             }
         }
-        serde_yaml::from_value(serde_yaml::Value::Mapping(merged))
-            .map_err(|e| SimulationError::Invalid(e.to_string()))
+        let file = self.file.or(base.file);
+        let mut merged: Settings = serde_yaml::from_value(serde_yaml::Value::Mapping(merged))
+            .map_err(|e| SimulationError::Invalid(e.to_string()))?;
+        merged.file = file;
+        Ok(merged)
     }
 
     /// The simulation with its defaults, checked: the system built, the record read, the history
     /// format known, all before any simulation.
     pub fn resolve(self) -> Result<Simulation, SimulationError> {
+        if self.building.is_some() {
+            return self.resolve_building();
+        }
+        if self.stacks.is_some() {
+            return Err(self.key_error("`stacks` needs `building` (the floors they stand on)"));
+        }
         let alpha = self.alpha.unwrap_or_else(|| vec![0.5, 0.5]);
         let physics = Physics {
             damping: self.damping.unwrap_or(Physics::DEFAULT.damping),
@@ -207,8 +240,73 @@ impl Settings {
             record,
             scale,
             physics,
-            system,
-            structure,
+            model: Model::OneStorey { system, structure },
+            integrator: self.integrator.unwrap_or(Integrator::Exact),
+            rk4_substeps: self.rk4_substeps.unwrap_or(10),
+            history: self.history,
+        })
+    }
+
+    /// A message about the case file's keys, with the file's name when they came from one.
+    fn key_error(&self, message: impl Into<String>) -> SimulationError {
+        let message = message.into();
+        match &self.file {
+            Some(f) => SimulationError::Key {
+                file: f.display().to_string(),
+                message,
+            },
+            None => SimulationError::Invalid(message),
+        }
+    }
+
+    /// [`Settings::resolve`] for a case with `building`.
+    fn resolve_building(self) -> Result<Simulation, SimulationError> {
+        let one_storey_keys = [
+            ("period", self.period.is_some()),
+            ("alpha", self.alpha.is_some()),
+            ("mu", self.mu.is_some()),
+            ("mu_static", self.mu_static.is_some()),
+            ("structure", self.structure.is_some()),
+            ("yield_strength_ratio", self.yield_strength_ratio.is_some()),
+            ("post_yield_ratio", self.post_yield_ratio.is_some()),
+        ];
+        if let Some((key, _)) = one_storey_keys.iter().find(|(_, given)| *given) {
+            return Err(self.key_error(format!(
+                "{key} (a key or flag of a one-storey case) does not apply to a case with \
+                 `building` (the building's keys go under `building`, each stack's under `stacks`)"
+            )));
+        }
+        let physics = Physics {
+            damping: self.damping.unwrap_or(Physics::DEFAULT.damping),
+            basis: self.damping_basis.unwrap_or(Physics::DEFAULT.basis),
+            ..Physics::DEFAULT
+        };
+        let settings = self.building.clone().unwrap_or_else(|| unreachable!());
+        let stacks = self.stacks.clone().unwrap_or_default();
+        let spec = building::building_spec(&settings, &stacks, physics.damping, physics.basis)
+            .map_err(|m| self.key_error(m))?;
+        let b = Building::new(&spec).map_err(|e| self.key_error(e.to_string()))?;
+        let scale = self.scale.unwrap_or(1.0);
+        if !(scale.is_finite() && scale > 0.0 && scale <= MAX_SCALE) {
+            return Err(self.key_error(format!(
+                "`scale` must be finite, > 0 and ≤ {MAX_SCALE:e}, got {scale}"
+            )));
+        }
+        if let Some(p) = &self.history {
+            crate::store::HistoryFormat::from_path(p).map_err(|e| self.key_error(e.to_string()))?;
+        }
+        let record = match &self.record {
+            Some(path) => motion::read_record(path)?,
+            None => motion::builtin(),
+        };
+        Ok(Simulation {
+            record,
+            scale,
+            physics,
+            model: Model::Building {
+                building: Box::new(b),
+                settings,
+            },
             integrator: self.integrator.unwrap_or(Integrator::Exact),
             rk4_substeps: self.rk4_substeps.unwrap_or(10),
             history: self.history,
@@ -247,14 +345,36 @@ fn yielding(
     }
 }
 
+/// What a simulation runs.
+#[derive(Debug, Clone)]
+pub enum Model {
+    /// One storey (the paper's structure) with its stack.
+    OneStorey {
+        system: System,
+        structure: StructureKind,
+    },
+    /// A building with stacks on its floors.
+    Building {
+        building: Box<Building>,
+        settings: building::BuildingSettings,
+    },
+}
+
+/// What a simulation gives: the one `--json` object of one storey or of a building.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum Outcome {
+    OneStorey(Box<Summary>),
+    Building(Box<building::BuildingSummary>),
+}
+
 /// A checked simulation: one case under one record, ready to run.
 #[derive(Debug, Clone)]
 pub struct Simulation {
     pub record: Record,
     pub scale: f64,
     pub physics: Physics,
-    pub system: System,
-    pub structure: StructureKind,
+    pub model: Model,
     pub integrator: Integrator,
     pub rk4_substeps: usize,
     /// Where the time history goes, if asked for.
@@ -262,6 +382,14 @@ pub struct Simulation {
 }
 
 impl Simulation {
+    /// The one-storey system; `None` for a building.
+    pub fn system(&self) -> Option<&System> {
+        match &self.model {
+            Model::OneStorey { system, .. } => Some(system),
+            Model::Building { .. } => None,
+        }
+    }
+
     /// The record scaled, in m/s².
     pub fn accel_mps2(&self) -> Vec<f64> {
         self.record.accel_mps2(self.scale)
@@ -270,7 +398,12 @@ impl Simulation {
     /// What the integrator says of the system against this record's step before it runs
     /// (`dynamics::accuracy_warnings`).
     pub fn warnings(&self, accel_mps2: &[f64]) -> Vec<String> {
-        crate::dynamics::accuracy_warnings(&self.system, &self.ground(accel_mps2))
+        match &self.model {
+            Model::OneStorey { system, .. } => {
+                crate::dynamics::accuracy_warnings(system, &self.ground(accel_mps2))
+            }
+            Model::Building { .. } => Vec::new(),
+        }
     }
 
     fn ground<'a>(&self, accel_mps2: &'a [f64]) -> Ground<'a> {
@@ -282,30 +415,97 @@ impl Simulation {
 
     /// Runs the case on `accel_mps2` (from [`Simulation::accel_mps2`]); the time history is kept
     /// when the settings name a history file.
-    pub fn run(&self, accel_mps2: &[f64]) -> Result<(Summary, Option<History>), SimulationError> {
-        let ground = self.ground(accel_mps2);
+    pub fn run(&self, accel_mps2: &[f64]) -> Result<(Outcome, Option<History>), SimulationError> {
         let history = self.history.is_some();
-        let response = match self.integrator {
-            Integrator::Exact => simulate_exact(
-                &self.system,
-                &ground,
-                &ExactOptions {
-                    history,
-                    ..ExactOptions::default()
-                },
-            ),
-            Integrator::Rk4 => simulate_rk4(&self.system, &ground, self.rk4_substeps, history),
+        let failed = |source| SimulationError::Simulation {
+            record: self.record.name.clone(),
+            source,
+        };
+        match &self.model {
+            Model::OneStorey { system, structure } => {
+                let ground = self.ground(accel_mps2);
+                let response = match self.integrator {
+                    Integrator::Exact => simulate_exact(
+                        system,
+                        &ground,
+                        &ExactOptions {
+                            history,
+                            ..ExactOptions::default()
+                        },
+                    ),
+                    Integrator::Rk4 => simulate_rk4(system, &ground, self.rk4_substeps, history),
+                }
+                .map_err(failed)?;
+                let summary = self.summary(system, *structure, &response);
+                Ok((Outcome::OneStorey(Box::new(summary)), response.history))
+            }
+            Model::Building { building, settings } => {
+                let mut r = self.run_building(building, accel_mps2, history)?;
+                let summary = building::building_summary(
+                    building,
+                    settings,
+                    (
+                        &self.record.name,
+                        self.record.dt_s,
+                        self.record.accel_g.len(),
+                        self.scale,
+                    ),
+                    (self.physics.damping, self.physics.basis),
+                    (self.integrator, self.rk4_substeps),
+                    &r,
+                );
+                Ok((Outcome::Building(Box::new(summary)), r.history.take()))
+            }
         }
+    }
+
+    /// The figure of a building case (`simulate --figure`): its stacks sliding against them
+    /// rigidly attached ([`Building::with_stacks_attached`]), both run with their histories
+    /// ([`building::building_figure`]). `None` for a one-storey case.
+    pub fn building_figure(
+        &self,
+        accel_mps2: &[f64],
+    ) -> Result<Option<crate::report::chart::Figure>, SimulationError> {
+        let Model::Building { building: b, .. } = &self.model else {
+            return Ok(None);
+        };
+        let sliding = self.run_building(b, accel_mps2, true)?;
+        let attached = self.run_building(&b.with_stacks_attached(), accel_mps2, true)?;
+        let title = format!(
+            "{} storeys, T_1 = {} s, under {} × {}",
+            b.storeys(),
+            b.spec().period_s,
+            self.record.name,
+            self.scale
+        );
+        Ok(Some(building::building_figure(
+            b, &sliding, &attached, &title,
+        )))
+    }
+
+    /// A building on `accel_mps2` with this simulation's integrator (the one-storey ones where
+    /// the building is one storey with at most one stack).
+    pub fn run_building(
+        &self,
+        b: &Building,
+        accel_mps2: &[f64],
+        history: bool,
+    ) -> Result<crate::dynamics::building::BuildingResponse, SimulationError> {
+        building::run_building(
+            b,
+            self.record.dt_s,
+            accel_mps2,
+            self.integrator,
+            self.rk4_substeps,
+            history,
+        )
         .map_err(|source| SimulationError::Simulation {
             record: self.record.name.clone(),
             source,
-        })?;
-        let summary = self.summary(&response);
-        Ok((summary, response.history))
+        })
     }
 
-    fn summary(&self, r: &Response) -> Summary {
-        let sys = &self.system;
+    fn summary(&self, sys: &System, structure: StructureKind, r: &Response) -> Summary {
         let e = &r.energy;
         let hyst = sys.hysteresis();
         Summary {
@@ -326,7 +526,7 @@ impl Simulation {
             mu_static: sys.mu_static().to_vec(),
             integrator: self.integrator,
             rk4_substeps: (self.integrator == Integrator::Rk4).then_some(self.rk4_substeps),
-            structure: self.structure,
+            structure,
             yield_strength_ratio: hyst.map(|h| h.strength_ratio),
             post_yield_ratio: hyst.map(|h| h.post_yield_ratio),
             yield_displacement_m: hyst.map(|h| h.yield_displacement_m),
@@ -435,8 +635,8 @@ mod tests {
             ..Settings::default()
         };
         let case = flags.over(file).unwrap().resolve().unwrap();
-        assert_eq!(case.system.period_s(), 0.5);
-        assert_eq!(case.system.mu_kinetic(), &[0.3]);
+        assert_eq!(case.system().unwrap().period_s(), 0.5);
+        assert_eq!(case.system().unwrap().mu_kinetic(), &[0.3]);
         assert_eq!(case.scale, 1.0);
         assert_eq!(case.integrator, Integrator::Exact);
         assert_eq!(case.physics.basis, DampingBasis::Rigid);
@@ -447,7 +647,9 @@ mod tests {
         let yaml = "record: r.AT2\nperiod: 2.0\nalpha: [1.0]\nmu: [0.3]\nmu_static: [0.4]\n\
                     damping: 0.02\ndamping_basis: structure\nscale: 2.0\nintegrator: rk4\n\
                     rk4_substeps: 20\nstructure: bilinear\nyield_strength_ratio: 0.3\n\
-                    post_yield_ratio: 0.05\nhistory: h.csv\n";
+                    post_yield_ratio: 0.05\nhistory: h.csv\n\
+                    building: {storeys: 2, period: 0.5}\n\
+                    stacks: [{floor: roof, alpha: [1.0], mu: [0.2]}]\n";
         let file: Settings = serde_yaml::from_str(yaml).unwrap();
         let value = |s: &Settings| serde_yaml::to_value(s).unwrap();
         // The file sets every key (a new one must be added here too).
@@ -499,9 +701,12 @@ mod tests {
     fn the_summary_is_the_simulation_of_the_system() {
         let case = Settings::default().resolve().unwrap();
         let accel = case.accel_mps2();
-        let (summary, history) = case.run(&accel).unwrap();
+        let (outcome, history) = case.run(&accel).unwrap();
+        let Outcome::OneStorey(summary) = outcome else {
+            panic!("a one-storey case")
+        };
         let direct = simulate_exact(
-            &case.system,
+            case.system().unwrap(),
             &Ground {
                 dt_s: case.record.dt_s,
                 accel_mps2: &accel,
