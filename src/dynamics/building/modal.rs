@@ -405,6 +405,25 @@ pub fn mode_terms(lambda: Cx, tau: f64) -> [Cx; 4] {
     [e, p1.scale(tau), p2.scale(t2), p3.scale(t2 * tau)]
 }
 
+/// `[e^{λτ}, τφ₁(λτ), τ²φ₂(λτ)]`, what a value and a slope need: the closed forms from
+/// `|λτ| = 1/2` on (each `φ_{k−1} − 1/(k−1)!` is at least `|x|/k!`, a few ulps lost), below it
+/// the Taylor series of `φ₂` (13 terms: the next is below 1e-16 of it for `|x| < 1/2`) and the
+/// recurrence. Agrees with [`mode_terms`] to a few ulps (tested).
+#[inline]
+pub fn value_terms(lambda: Cx, tau: f64) -> [Cx; 3] {
+    let x = lambda.scale(tau);
+    let [e, p1, p2] = if x.norm_sqr() < 0.25 {
+        let p2 = horner(x, &INV_FACTORIAL[2..15]);
+        let p1 = Cx(1.0, 0.0).add(x.mul(p2));
+        [Cx(1.0, 0.0).add(x.mul(p1)), p1, p2]
+    } else {
+        let e = x.exp();
+        let p1 = Cx(e.0 - 1.0, e.1).div(x);
+        [e, p1, p1.sub(Cx(1.0, 0.0)).div(x)]
+    };
+    [e, p1.scale(tau), p2.scale(tau * tau)]
+}
+
 /// `1/k!` for `k = 0 … 19`.
 const INV_FACTORIAL: [f64; 20] = {
     let mut out = [1.0; 20];
@@ -465,7 +484,7 @@ impl super::super::search::Smooth for ModalFn<'_> {
         let (mut f, mut df, _) = self.poly_eval(t);
         for (r, c) in self.c.iter().enumerate() {
             let l = self.modes.lambda[r];
-            let [e, p1, p2, _] = mode_terms(l, t);
+            let [e, p1, p2] = value_terms(l, t);
             let pc = self.piece;
             let y = e.mul(pc.y0[r]).add(p1.mul(pc.b0[r])).add(p2.mul(pc.b1[r]));
             let dy = l
@@ -521,6 +540,7 @@ mod tests {
     /// largest term.
     #[test]
     fn mode_terms_match_the_phi_functions() {
+        // Both sides of each switch: |x| = 1/2 (value terms) and 1 (mode terms).
         use crate::numeric::{phi1, phi2, phi3};
         for (re, im) in [
             (-0.3, 0.9),
@@ -530,6 +550,8 @@ mod tests {
             (-0.999, 0.04),
             (-1.001, 0.0),
             (-0.05, 1.2),
+            (-0.49, 0.05),
+            (-0.3, -0.41),
             (-3.0, 25.0),
             (-40.0, 0.0),
         ] {
@@ -541,6 +563,14 @@ mod tests {
                 assert!(
                     err <= 4.0 * f64::EPSILON * want.abs().max(1e-300),
                     "{x:?}: {got:?} vs {want:?}"
+                );
+            }
+            let [e, p1, p2] = value_terms(x, 1.0);
+            for (got, want) in [e, p1, p2].iter().zip(&want[..3]) {
+                let err = got.sub(*want).abs();
+                assert!(
+                    err <= 8.0 * f64::EPSILON * want.abs().max(1e-300),
+                    "{x:?}: value terms {got:?} vs {want:?}"
                 );
             }
         }
