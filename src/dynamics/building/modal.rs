@@ -639,6 +639,37 @@ mod tests {
         }
     }
 
+    /// A mode at critical damping makes the state matrix defective (a double eigenvalue with one
+    /// eigenvector): refused with the reason, not run. Overdamped and nearly critical modes are
+    /// represented (real eigenvalues) and reproduce the state.
+    #[test]
+    fn a_critically_damped_mode_is_refused_and_overdamped_ones_run() {
+        use super::super::model::modal_damping;
+        let m = [1.0, 1.0];
+        let k = [800.0, 400.0];
+        let c = modal_damping(&m, &k, 1.0);
+        let e = StateModes::new(&m, &k, &c).unwrap_err();
+        assert!(
+            matches!(e, ModalError::Defective { .. }) && e.to_string().contains("critical"),
+            "{e}"
+        );
+        for zeta in [0.999, 1.001, 1.5] {
+            let c = modal_damping(&m, &k, zeta);
+            let sm = StateModes::new(&m, &k, &c).unwrap();
+            let z = [0.01, -0.02, 0.3, 0.1];
+            let mut piece = Piece::default();
+            sm.piece(&z, &[0.0; 2], 0.0, &mut piece);
+            for i in 0..4 {
+                let back = ModalPoint::dot(&sm, sm.row(i), &piece.y0);
+                assert!(
+                    (back - z[i]).abs() < 1e-12,
+                    "ζ {zeta}, {i}: {back} vs {}",
+                    z[i]
+                );
+            }
+        }
+    }
+
     /// A piece against an independent integration of `ż = A·z + (0, p₀ + p₁τ)`: RK4 at a very
     /// small step (error ~h⁴, far below the tolerance).
     #[test]
