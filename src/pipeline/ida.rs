@@ -23,6 +23,7 @@ use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write
 use crate::store::motions::read_zone_target;
 use crate::study::config::StudyConfig;
 use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
+use crate::study::physics::Physics;
 use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -182,19 +183,44 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             vars: zone_vars(cfg, &axes, motions[z].len(), slice, c_y),
         });
     }
-    let c_y_rule = match (&cfg.structure.c_y, &cfg.structure.design) {
+    let c_y_rule = c_y_rule(cfg);
+    let settings = settings_attrs(cfg, &physics, &c_y_rule);
+    let meta = IdaMeta {
+        fingerprint: fp,
+        motions_fingerprint: study.fingerprint(StageId::Motions)?,
+        config_sha256: &study.config_sha256,
+        fit_flags: &FIT_STATUS_FLAGS,
+        settings: &settings,
+    };
+    let path = study.path(me.output());
+    write_ida(&path, &meta, &axes, &zones)?;
+    s.reporter.info(me, &format!("verified {}", path.display()));
+    Ok(Outcome::Wrote(vec![path]))
+}
+
+/// How the structure's strength is set, in words.
+fn c_y_rule(cfg: &IdaConfig) -> String {
+    match (&cfg.structure.c_y, &cfg.structure.design) {
         (Some(c), _) => format!("C_y = {c}"),
         (None, Some(d)) => format!(
             "C_y = (Z/2)(I/R)(Sa/g)(T_p) of the zone's IS 1893 target, I = {}, R = {}",
             d.importance, d.response_reduction
         ),
         (None, None) => String::new(),
-    };
+    }
+}
+
+/// The settings `ida.h5` states as file attributes.
+fn settings_attrs<'a>(
+    cfg: &IdaConfig,
+    physics: &Physics,
+    c_y_rule: &'a str,
+) -> Vec<(&'static str, Attr<'a>)> {
     let t = &cfg.tracing;
-    let mut settings: Vec<(&str, Attr)> = super::sweep::physics_attrs(&physics).to_vec();
+    let mut settings: Vec<(&str, Attr)> = super::sweep::physics_attrs(physics).to_vec();
     settings.extend([
         ("mu_static_ratio", Attr::F64(physics.mu_static_ratio)),
-        ("c_y_rule", Attr::Str(&c_y_rule)),
+        ("c_y_rule", Attr::Str(c_y_rule)),
         (
             "post_yield_ratio",
             Attr::F64(cfg.structure.post_yield_ratio),
@@ -220,17 +246,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             ),
         ),
     ]);
-    let meta = IdaMeta {
-        fingerprint: fp,
-        motions_fingerprint: study.fingerprint(StageId::Motions)?,
-        config_sha256: &study.config_sha256,
-        fit_flags: &FIT_STATUS_FLAGS,
-        settings: &settings,
-    };
-    let path = study.path(me.output());
-    write_ida(&path, &meta, &axes, &zones)?;
-    s.reporter.info(me, &format!("verified {}", path.display()));
-    Ok(Outcome::Wrote(vec![path]))
+    settings
 }
 
 /// The axes `ida.h5` has for the `ida:` section `cfg`.
