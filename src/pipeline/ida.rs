@@ -59,13 +59,7 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
 
 /// Every zone's target spectrum as `motions.h5` stores it: the one its motions were matched to.
 fn stored_targets(study: &Study) -> Result<Vec<TargetSpectrum>, StoreError> {
-    let path = study.path(StageId::Motions.output());
-    study
-        .cfg
-        .zones
-        .iter()
-        .map(|z| read_zone_target(&path, &z.name))
-        .collect()
+    super::motions::read_zones(study, read_zone_target)
 }
 
 /// One unit's result.
@@ -535,7 +529,7 @@ pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineE
 /// SVG of [`figure_of`].
 pub fn figure(study: &Study) -> Result<String, PipelineError> {
     let fig = figure_of(study)?;
-    crate::report::chart::render(&fig).map_err(|e| {
+    crate::render::chart::render(&fig).map_err(|e| {
         let path = study.path(StageId::Ida.output());
         PipelineError::Store(crate::store::StoreError::corrupt(&path, e.to_string()))
     })
@@ -544,8 +538,8 @@ pub fn figure(study: &Study) -> Result<String, PipelineError> {
 /// The first case's ductility against intensity, one panel per zone: every record's curve
 /// (faint) and the 16–50–84 % fractiles of the stack and of the rigidly attached load.
 /// Collapsed values (`+∞`) are drawn at the collapse ductility.
-pub fn figure_of(study: &Study) -> Result<crate::report::chart::Figure, PipelineError> {
-    use crate::report::chart::{Axis, Figure, Panel, Series, Stroke};
+pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, PipelineError> {
+    use crate::render::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Ida)?;
     let cap = section(study)?.collapse_ductility;
     let clip = |v: f64| if v.is_infinite() { cap } else { v };

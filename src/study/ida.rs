@@ -369,23 +369,9 @@ impl IdaConfig {
         }
         for (i, l) in self.limit_states.iter().enumerate() {
             let key = format!("limit_states[{i}]");
-            if l.name.is_empty()
-                || !l
-                    .name
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-            {
-                return err(
-                    &format!("{key}.name"),
-                    format!("`{}` must be letters, digits, `_` or `-`", l.name),
-                );
-            }
-            if self.limit_states[..i].iter().any(|o| o.name == l.name) {
-                return err(
-                    &format!("{key}.name"),
-                    format!("`{}` appears twice", l.name),
-                );
-            }
+            let earlier = self.limit_states[..i].iter().map(|o| o.name.as_str());
+            super::config::check_name(&l.name, earlier)
+                .map_err(|why| (format!("ida.{key}.name"), why))?;
             match (l.ductility, l.slip_m) {
                 (Some(v), None) if v.is_finite() && v > 0.0 => {}
                 (None, Some(v)) if v.is_finite() && v > 0.0 => {}

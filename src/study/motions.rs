@@ -19,13 +19,13 @@
 //! false.
 
 use super::config::{MotionsConfig, Seeds, StudyConfig};
-use crate::motion::matching::{
+use crate::ground_motion::matching::{
     MatchError, MatchSettings, Matched, match_record, match_record_scaled,
 };
-use crate::motion::record::{parse_record, read_record_file};
-pub use crate::motion::set::{UnmatchedRecord, ZoneMotions};
-use crate::motion::stochastic::StochasticError;
-use crate::motion::{Record, RecordError};
+use crate::ground_motion::record::{parse_record, read_record_file};
+pub use crate::ground_motion::set::{UnmatchedRecord, ZoneMotions};
+use crate::ground_motion::stochastic::StochasticError;
+use crate::ground_motion::{Record, RecordError};
 use crate::spectrum::TargetSpectrum;
 use crate::store::fingerprint::sha256_hex;
 use rayon::prelude::*;
