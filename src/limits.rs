@@ -201,6 +201,22 @@ pub fn yaml_depth(text: &str) -> usize {
     deepest
 }
 
+/// A name that becomes part of an HDF5 path or a coordinate (a zone, a limit state): letters,
+/// digits, `_` or `-`, and not one of `earlier`'s; `Err(why)`.
+pub fn check_name<'a>(
+    name: &str,
+    mut earlier: impl Iterator<Item = &'a str>,
+) -> Result<(), String> {
+    let word = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
+    if name.is_empty() || !name.chars().all(word) {
+        return Err(format!("`{name}` must be letters, digits, `_` or `-`"));
+    }
+    if earlier.any(|o| o == name) {
+        return Err(format!("`{name}` appears twice"));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -377,7 +377,8 @@ impl StudyConfig {
         for (i, z) in self.zones.iter().enumerate() {
             let key = format!("zones[{i}]");
             let earlier = self.zones[..i].iter().map(|o| o.name.as_str());
-            check_name(&z.name, earlier).map_err(|why| (format!("{key}.name"), why))?;
+            crate::limits::check_name(&z.name, earlier)
+                .map_err(|why| (format!("{key}.name"), why))?;
             let (lo, hi) = self.motions.matching.check_range_s;
             self.target(i)
                 .check_covers(lo, hi)
@@ -515,22 +516,6 @@ impl StudyConfig {
             dt_s: r.dt_s,
         }
     }
-}
-
-/// A name that becomes part of an HDF5 path or a coordinate (a zone, a limit state): letters,
-/// digits, `_` or `-`, and not one of `earlier`'s; `Err(why)`.
-pub(crate) fn check_name<'a>(
-    name: &str,
-    mut earlier: impl Iterator<Item = &'a str>,
-) -> Result<(), String> {
-    let word = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
-    if name.is_empty() || !name.chars().all(word) {
-        return Err(format!("`{name}` must be letters, digits, `_` or `-`"));
-    }
-    if earlier.any(|o| o == name) {
-        return Err(format!("`{name}` appears twice"));
-    }
-    Ok(())
 }
 
 fn validate_grid(g: &GridConfig) -> Result<(), (String, String)> {

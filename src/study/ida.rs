@@ -370,7 +370,7 @@ impl IdaConfig {
         for (i, l) in self.limit_states.iter().enumerate() {
             let key = format!("limit_states[{i}]");
             let earlier = self.limit_states[..i].iter().map(|o| o.name.as_str());
-            super::config::check_name(&l.name, earlier)
+            crate::limits::check_name(&l.name, earlier)
                 .map_err(|why| (format!("ida.{key}.name"), why))?;
             match (l.ductility, l.slip_m) {
                 (Some(v), None) if v.is_finite() && v > 0.0 => {}
