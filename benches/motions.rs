@@ -9,8 +9,8 @@
 //!
 //! `cargo bench --bench motions`; `SLIDESTACK_BENCH_QUICK=1` runs three records only.
 
-use slidestack::motion::matching::{MatchSettings, log_space, match_record};
-use slidestack::motion::read_record;
+use slidestack::ground_motion::matching::{MatchSettings, log_space, match_record};
+use slidestack::ground_motion::read_record;
 use slidestack::spectrum::TargetSpectrum;
 use slidestack::spectrum::response::{response_spectrum, sampled_peak};
 use std::hint::black_box;

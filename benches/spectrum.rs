@@ -10,8 +10,8 @@
 //! `cargo bench --bench spectrum`; the ratio of the two medians is the figure of merit.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use slidestack::motion::matching::log_space;
-use slidestack::motion::read_record;
+use slidestack::ground_motion::matching::log_space;
+use slidestack::ground_motion::read_record;
 use slidestack::spectrum::response::{response_spectrum, sampled_peak};
 use std::hint::black_box;
 

@@ -1,11 +1,11 @@
 //! slidestack: seismic response of a linear structure carrying stacks of sliding rigid blocks.
 //!
 //! * [`dynamics`]: the structure-and-stack model, the exact and RK4 integrators, energy.
-//! * [`motion`]: ground-motion records, processing, spectral matching, stochastic motions.
+//! * [`ground_motion`]: ground-motion records, processing, spectral matching, stochastic motions.
 //! * [`sdof`]: one linear SDOF step, exact for piecewise-linear load, stable at every period.
 //! * [`spectrum`]: response spectra and target spectra (IS 1893, ASCE 7, tables).
 //! * [`fit`]: the design equation for T_new: forms, argmin problems, metrics.
-//! * [`report`]: SVG figures and the HTML report.
+//! * [`render`]: SVG charts and HTML pages from plain series (the report stage draws with it).
 //! * [`limits`]: the limits every input is checked against, with their reasons.
 //! * [`case`]: a case, one structure and its stack.
 //! * [`grid`]: the study's case grid (axes and indexing).
@@ -25,13 +25,13 @@ pub mod design;
 pub mod dynamics;
 pub mod fit;
 pub mod grid;
+pub mod ground_motion;
 pub mod ida;
 pub mod limits;
 pub mod match_files;
-pub mod motion;
 mod numeric;
 pub mod pipeline;
-pub mod report;
+pub mod render;
 pub mod sdof;
 pub mod simulation;
 pub mod spectrum;

@@ -7,8 +7,38 @@
 /// every simulation crosses every sample.
 pub const MAX_SAMPLES: usize = 1 << 24;
 
-/// Bytes of one input file read whole (a record or a config): 1 GiB.
+/// Bytes of one input file read whole (a record, a config, a target table): 1 GiB.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Why an input file was not read.
+#[derive(Debug)]
+pub enum InputFileError {
+    Io(std::io::Error),
+    /// Its size, bytes, above [`MAX_FILE_BYTES`].
+    TooLarge(u64),
+}
+
+/// The bytes of an input file (a record, a config, a target table), refused above
+/// [`MAX_FILE_BYTES`] before they are read.
+pub fn read_input_file(path: &std::path::Path) -> Result<Vec<u8>, InputFileError> {
+    let bytes = std::fs::metadata(path).map_err(InputFileError::Io)?.len();
+    if bytes > MAX_FILE_BYTES {
+        return Err(InputFileError::TooLarge(bytes));
+    }
+    std::fs::read(path).map_err(InputFileError::Io)
+}
+
+/// The text of an input file's bytes, a leading byte-order mark dropped; not UTF-8, the error
+/// reading them as text would give.
+pub fn input_text(bytes: &[u8]) -> Result<&str, std::io::Error> {
+    let text = std::str::from_utf8(bytes).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        )
+    })?;
+    Ok(text.strip_prefix('\u{feff}').unwrap_or(text))
+}
 
 /// Sample interval of a record, s: 10 µs … 1 s. Accelerograms are sampled at 0.001–0.05 s; a
 /// step outside this range is a unit or header mistake, and a step of 1e-15 s would make every
@@ -183,6 +213,22 @@ pub fn yaml_depth(text: &str) -> usize {
         deepest = deepest.max(indents.len() + flow_max);
     }
     deepest
+}
+
+/// A name that becomes part of an HDF5 path or a coordinate (a zone, a limit state): letters,
+/// digits, `_` or `-`, and not one of `earlier`'s; `Err(why)`.
+pub fn check_name<'a>(
+    name: &str,
+    mut earlier: impl Iterator<Item = &'a str>,
+) -> Result<(), String> {
+    let word = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
+    if name.is_empty() || !name.chars().all(word) {
+        return Err(format!("`{name}` must be letters, digits, `_` or `-`"));
+    }
+    if earlier.any(|o| o == name) {
+        return Err(format!("`{name}` appears twice"));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

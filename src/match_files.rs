@@ -1,10 +1,10 @@
 //! Record files matched to a target spectrum, as `slidestack match` does it: each record matched
-//! ([`crate::motion::matching`]), the ones that meet the acceptance written as PEER `.AT2` files
+//! ([`crate::ground_motion::matching`]), the ones that meet the acceptance written as PEER `.AT2` files
 //! (values in g, the record's base name), and `summary.csv` with one row per record (iterations,
 //! worst misfit, PGA before and after, final velocity and displacement, Arias intensity ratio).
 
-use crate::motion::matching::{MatchError, MatchReport, MatchSettings, match_record};
-use crate::motion::{Record, RecordError, checked_at2};
+use crate::ground_motion::matching::{MatchError, MatchReport, MatchSettings, match_record};
+use crate::ground_motion::{Record, RecordError, checked_at2};
 use crate::spectrum::{TargetError, TargetSpectrum};
 use crate::store::StoreError;
 use crate::store::atomic::write_bytes;

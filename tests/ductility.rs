@@ -7,7 +7,7 @@ mod common;
 
 use common::{eleven_records, fixture};
 use slidestack::dynamics::{ExactOptions, G, Ground, System, SystemSpec, Yielding, simulate_exact};
-use slidestack::motion::read_record;
+use slidestack::ground_motion::read_record;
 use slidestack::spectrum::ductility::{DuctilityOptions, constant_ductility_spectrum};
 use slidestack::spectrum::response_spectrum;
 

@@ -10,9 +10,9 @@ mod common;
 
 use common::{ELEVEN, fixture};
 use slidestack::dynamics::G;
-use slidestack::motion::matching::{MatchSettings, Matched, match_record};
-use slidestack::motion::process::drift;
-use slidestack::motion::{Record, StochasticModel, read_record};
+use slidestack::ground_motion::matching::{MatchSettings, Matched, match_record};
+use slidestack::ground_motion::process::drift;
+use slidestack::ground_motion::{Record, StochasticModel, read_record};
 use slidestack::spectrum::{TargetSpectrum, response_spectrum};
 use slidestack::study::config::{MotionsConfig, RecordSeeds, SeedsConfig};
 use slidestack::study::motions::{MotionsError, match_zone};

@@ -4,9 +4,9 @@
 mod common;
 
 use common::{ELEVEN, eleven_records, fixture};
-use slidestack::motion::matching::MatchSettings;
-use slidestack::motion::process::drift;
-use slidestack::motion::read_record;
+use slidestack::ground_motion::matching::MatchSettings;
+use slidestack::ground_motion::process::drift;
+use slidestack::ground_motion::read_record;
 use slidestack::study::config::{MotionsConfig, RecordSeeds, SeedsConfig};
 use slidestack::study::motions::match_zone;
 use std::process::Command;
@@ -336,9 +336,9 @@ fn stochastic_mean_spectrum_peaks_near_the_filter_frequency() {
     // T = 1/f_mid = 0.17 s. Bound: within a factor 1.5 either side (the filter's damping of 0.21
     // and its drift over the strong phase spread the peak); the peak is also well above the
     // long-period end (ratio > 5 at 2 s).
-    let model = slidestack::motion::StochasticModel::default();
+    let model = slidestack::ground_motion::StochasticModel::default();
     let motions = model.simulate_set(99, 100, "s").unwrap();
-    let periods = slidestack::motion::matching::log_space(0.03, 2.0, 120);
+    let periods = slidestack::ground_motion::matching::log_space(0.03, 2.0, 120);
     let mut mean = vec![0.0; periods.len()];
     for m in &motions {
         let s = slidestack::spectrum::response_spectrum(&m.accel_mps2(1.0), m.dt_s, &periods, 0.05)

@@ -4,8 +4,8 @@
 mod common;
 
 use common::{Rng, fixture, real_records};
-use slidestack::motion::process::{BaselineCorrection, drift, refine};
-use slidestack::motion::{
+use slidestack::ground_motion::process::{BaselineCorrection, drift, refine};
+use slidestack::ground_motion::{
     ReadOptions, Record, RecordError, Units, checked_at2, format_at2, read_record, read_record_with,
 };
 use std::path::{Path, PathBuf};

@@ -10,7 +10,7 @@
 use resvg::{tiny_skia, usvg};
 use slidestack::dynamics::{ExactOptions, Ground, System, simulate_exact};
 use slidestack::pipeline::Study;
-use slidestack::report::chart::areas;
+use slidestack::render::chart::areas;
 use slidestack::store::fit::read_fit;
 use slidestack::store::motions::read_zone_motions;
 use slidestack::store::tnew::read_zone_tnew;

@@ -2,7 +2,6 @@
 //! `T_new` and the design spectral accelerations of one structure from a finished study
 //! ([`slidestack::design`]).
 
-use super::BadInput;
 use anyhow::Result;
 use slidestack::design::{Answer, Query, design};
 use std::path::PathBuf;
@@ -41,13 +40,7 @@ pub fn run(args: Args) -> Result<()> {
         mu: args.mu,
         extrapolate: args.extrapolate,
     };
-    let a = design(&args.study, &q).map_err(|e| -> anyhow::Error {
-        if e.is_bad_input() {
-            BadInput(e.to_string()).into()
-        } else {
-            e.into()
-        }
-    })?;
+    let a = design(&args.study, &q)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&a)?);
     } else {

@@ -9,8 +9,8 @@
 
 use super::{BadInput, RecordArgs};
 use anyhow::Result;
+use slidestack::ground_motion::matching::MatchSettings;
 use slidestack::match_files::{MatchedFile, all_accepted, match_files, read_settings};
-use slidestack::motion::matching::MatchSettings;
 use slidestack::spectrum::TargetSpectrum;
 use std::path::PathBuf;
 
@@ -36,22 +36,14 @@ pub fn run(args: Args) -> Result<()> {
         .parse()
         .map_err(|e| BadInput(format!("invalid --target `{}`: {e}", args.target)))?;
     let settings = match &args.settings {
-        Some(p) => read_settings(p).map_err(bad_input)?,
+        Some(p) => read_settings(p)?,
         None => MatchSettings::default(),
     };
     let records = args.records.read()?;
-    let files = match_files(&records, &target, &settings, &args.out).map_err(bad_input)?;
+    let files = match_files(&records, &target, &settings, &args.out)?;
     print_table(&files);
     all_accepted(&files, &settings)?;
     Ok(())
-}
-
-fn bad_input(e: slidestack::match_files::MatchFilesError) -> anyhow::Error {
-    if e.is_bad_input() {
-        BadInput(e.to_string()).into()
-    } else {
-        e.into()
-    }
 }
 
 fn print_table(files: &[MatchedFile]) {

@@ -13,7 +13,7 @@ pub mod sweep;
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use slidestack::motion::{ReadOptions, Record, Units, read_record_with};
+use slidestack::ground_motion::{ReadOptions, Record, Units, read_record_with};
 use slidestack::pipeline::lock::{LockError, LockMode};
 use slidestack::pipeline::{
     Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, Study,
@@ -110,13 +110,17 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
         c.downcast_ref::<PipelineError>()
             .is_some_and(PipelineError::is_bad_input)
             || c.is::<slidestack::study::config::ConfigError>()
-            || c.is::<slidestack::motion::RecordError>()
+            || c.is::<slidestack::ground_motion::RecordError>()
             || c.is::<slidestack::spectrum::PeriodsError>()
             || c.is::<slidestack::dynamics::ModelError>()
             || c.downcast_ref::<slidestack::dynamics::SimError>()
                 .is_some_and(slidestack::dynamics::SimError::is_bad_input)
             || c.downcast_ref::<slidestack::simulation::SimulationError>()
                 .is_some_and(slidestack::simulation::SimulationError::is_bad_input)
+            || c.downcast_ref::<slidestack::design::DesignError>()
+                .is_some_and(slidestack::design::DesignError::is_bad_input)
+            || c.downcast_ref::<slidestack::match_files::MatchFilesError>()
+                .is_some_and(slidestack::match_files::MatchFilesError::is_bad_input)
             || c.is::<BadInput>()
     });
     if bad_input { 2 } else { 1 }

@@ -86,10 +86,10 @@ pub fn simulate_exact(
     ground.validate()?;
     let (dt, accel) = (ground.dt_s, ground.accel_mps2);
     let r = match (sys.hysteresis().is_some(), long_periods(sys, dt)) {
-        (true, true) => Exact::<true, true>::new(sys, dt, *opts).run(accel)?,
-        (true, false) => Exact::<true, false>::new(sys, dt, *opts).run(accel)?,
-        (false, true) => Exact::<false, true>::new(sys, dt, *opts).run(accel)?,
-        (false, false) => Exact::<false, false>::new(sys, dt, *opts).run(accel)?,
+        (true, true) => ExactRun::<true, true>::new(sys, dt, *opts).run(accel)?,
+        (true, false) => ExactRun::<true, false>::new(sys, dt, *opts).run(accel)?,
+        (false, true) => ExactRun::<false, true>::new(sys, dt, *opts).run(accel)?,
+        (false, false) => ExactRun::<false, false>::new(sys, dt, *opts).run(accel)?,
     };
     r.check_finite()?;
     Ok(r)
@@ -97,18 +97,19 @@ pub fn simulate_exact(
 
 /// Whether some structure cluster of `sys` takes [`sdof::piece`] at `dt`: the slowest are those
 /// of the whole stack, on the elastic and on the post-yield branch (`ω_n·dt` falls with `ω_n`).
-/// As a constant of [`Exact`] it leaves every other run's code as it was.
+/// As a constant of [`ExactRun`] it leaves every other run's code as it was.
 fn long_periods(sys: &System, dt: f64) -> bool {
     let mass: f64 = sys.masses().iter().sum();
-    let slowest = |k: f64| Cluster0::new(mass, k, sys.damping(), dt).sdof_form;
+    let slowest = |k: f64| StructureCluster::new(mass, k, sys.damping(), dt).sdof_form;
     slowest(sys.stiffness()) || (sys.hysteresis().is_some() && slowest(Spring::new(sys).k_post))
 }
 
-/// Coefficients of the structure's cluster when its top body is `e0`. With a post-yield
-/// stiffness of zero (`omega2 = 0`) the free motion is `1` and `e^{−(c/M)τ}`: `osc` is then
-/// `{ decay: c/M, omega: 0 }`, whose wave `c·e^{−aτ}` is that exponential.
+/// Coefficients of the structure's cluster (the structure and the bodies stuck to it, up to a top
+/// body). With a post-yield stiffness of zero (`omega2 = 0`) the free motion is `1` and
+/// `e^{−(c/M)τ}`: `osc` is then `{ decay: c/M, omega: 0 }`, whose wave `c·e^{−aτ}` is that
+/// exponential.
 #[derive(Debug, Clone, Copy)]
-struct Cluster0 {
+struct StructureCluster {
     mass: f64,
     osc: Osc,
     omega2: f64,
@@ -118,7 +119,7 @@ struct Cluster0 {
     /// The energy integrals over a whole sample interval.
     integrals_dt: PieceIntegrals,
     /// Whether `ω_n·dt < SDOF_FORM_OMEGA_STEP`: the state and integrals of a piece then come
-    /// from [`sdof::piece`] ([`Exact::stable_piece`]).
+    /// from [`sdof::piece`] ([`ExactRun::stable_piece`]).
     sdof_form: bool,
 }
 
@@ -130,7 +131,7 @@ struct Cluster0 {
 /// "Long periods").
 const SDOF_FORM_OMEGA_STEP: f64 = 5e-3;
 
-impl Cluster0 {
+impl StructureCluster {
     /// The cluster of mass `mass` (kg) on a spring of stiffness `stiffness` (N/m, `≥ 0`) and
     /// the damper `damping` (N·s/m), with its sample-interval basis for `dt` (s).
     fn new(mass: f64, stiffness: f64, damping: f64, dt: f64) -> Self {
@@ -148,7 +149,7 @@ impl Cluster0 {
             }
         };
         let basis_dt = Basis::at(osc, dt);
-        Cluster0 {
+        StructureCluster {
             mass,
             osc,
             omega2,
@@ -366,18 +367,20 @@ struct Event {
     g: Tracked,
 }
 
-/// The integrator; `Y` is whether the structure yields (its spring and plastic clusters are read
-/// only then), `L` whether some cluster takes [`sdof::piece`] ([`long_periods`]).
-struct Exact<'s, const Y: bool, const L: bool> {
+/// One run of the integrator; `YIELDS` is whether the structure yields (its spring and plastic
+/// clusters are read only then), `LONG_PERIODS` whether some cluster takes [`sdof::piece`]
+/// ([`long_periods`]).
+struct ExactRun<'s, const YIELDS: bool, const LONG_PERIODS: bool> {
     sys: &'s System,
     dt: f64,
     opts: ExactOptions,
     n: usize,
-    cluster0: Vec<Cluster0>,
-    /// The structure's cluster on the post-yield stiffness, by top body (empty unless `Y`).
-    cluster_plastic: Vec<Cluster0>,
+    /// The structure's cluster on the elastic stiffness, by top body.
+    structure_elastic: Vec<StructureCluster>,
+    /// The structure's cluster on the post-yield stiffness, by top body (empty unless `YIELDS`).
+    structure_plastic: Vec<StructureCluster>,
     spring: Spring,
-    /// `∫F_s du` so far, J (only with `Y`; the linear structure's is `½k·u²`).
+    /// `∫F_s du` so far, J (only with `YIELDS`; the linear structure's is `½k·u²`).
     spring_work: f64,
     /// `mass_prefix[j] = Σ_{i<j} m_i`.
     mass_prefix: Vec<f64>,
@@ -398,7 +401,7 @@ struct Exact<'s, const Y: bool, const L: bool> {
     /// The structure's displacement and its cluster's absolute acceleration over the piece.
     u0: Tracked,
     a0: Tracked,
-    /// [`Exact::break_bounds`] of the current mode; `None` after a new mode is selected.
+    /// [`ExactRun::break_bounds`] of the current mode; `None` after a new mode is selected.
     bounds: Option<BreakBounds>,
     /// Constant absolute acceleration of each free cluster, m/s².
     accel_free: Vec<f64>,
@@ -408,7 +411,7 @@ struct Exact<'s, const Y: bool, const L: bool> {
     energy: Energy,
 }
 
-impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
+impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG_PERIODS> {
     fn new(sys: &'s System, dt: f64, opts: ExactOptions) -> Self {
         let n = sys.blocks();
         let m = sys.masses();
@@ -418,13 +421,13 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
         }
         let k = sys.stiffness();
         let c = sys.damping();
-        let cluster0 = (0..=n)
-            .map(|e0| Cluster0::new(mass_prefix[e0 + 1], k, c, dt))
+        let structure_elastic = (0..=n)
+            .map(|top| StructureCluster::new(mass_prefix[top + 1], k, c, dt))
             .collect();
         let spring = Spring::new(sys);
-        let cluster_plastic = if Y {
+        let structure_plastic = if YIELDS {
             (0..=n)
-                .map(|e0| Cluster0::new(mass_prefix[e0 + 1], spring.k_post, c, dt))
+                .map(|top| StructureCluster::new(mass_prefix[top + 1], spring.k_post, c, dt))
                 .collect()
         } else {
             Vec::new()
@@ -454,8 +457,8 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
             dt,
             opts,
             n,
-            cluster0,
-            cluster_plastic,
+            structure_elastic,
+            structure_plastic,
             spring,
             spring_work: 0.0,
             mass_prefix,
@@ -513,14 +516,14 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
                 let h = self.dt - tau;
                 let osc = self.osc();
                 let basis_h = if tau == 0.0 {
-                    self.cl().basis_dt
+                    self.structure_cluster().basis_dt
                 } else {
                     Basis::at(osc, h)
                 };
                 // Both break events at once: A₀ certified inside its bounds over the piece.
                 let breaks_clear = self.breaks_clear(&basis_h);
                 // Both yield events at once: u certified inside the elastic range.
-                let yields_clear = Y && self.yields_clear(&basis_h);
+                let yields_clear = YIELDS && self.yields_clear(&basis_h);
                 let mut first: Option<(f64, usize)> = None;
                 for (e, ev) in self.events.iter().enumerate() {
                     if breaks_clear && matches!(ev.kind, EventKind::Break(_))
@@ -570,7 +573,7 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
                     self.sys.stiffness(),
                     self.x[0],
                 );
-                if Y {
+                if YIELDS {
                     // Recoverable plus hysteretic: all the spring's work so far.
                     strain = self.spring_work;
                 }
@@ -595,21 +598,21 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
 
     /// The structure's cluster on its current branch.
     #[inline]
-    fn cl(&self) -> &Cluster0 {
-        if Y && self.spring.plastic() {
-            &self.cluster_plastic[self.top[0]]
+    fn structure_cluster(&self) -> &StructureCluster {
+        if YIELDS && self.spring.plastic() {
+            &self.structure_plastic[self.top[0]]
         } else {
-            &self.cluster0[self.top[0]]
+            &self.structure_elastic[self.top[0]]
         }
     }
 
     fn osc(&self) -> Osc {
-        self.cl().osc
+        self.structure_cluster().osc
     }
 
     /// The structure's restoring force at its current displacement, N.
     fn restoring_force(&self) -> f64 {
-        if Y {
+        if YIELDS {
             self.spring.force(self.x[0])
         } else {
             self.sys.stiffness() * self.x[0]
@@ -647,18 +650,18 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
             self.cluster_of[j] = nc - 1;
             self.top[nc - 1] = j;
         }
-        let e0 = self.top[0];
-        let cl = *self.cl();
-        let f_top0 = if e0 < n { self.force[e0] } else { 0.0 };
-        let osc = cl.osc;
-        self.disp[0] = self.structure_wave(&cl, f_top0, ga, slope);
+        let top = self.top[0];
+        let cluster = *self.structure_cluster();
+        let f_above = if top < n { self.force[top] } else { 0.0 };
+        let osc = cluster.osc;
+        self.disp[0] = self.structure_wave(&cluster, f_above, ga, slope);
         self.vel[0] = self.disp[0].deriv(osc);
         self.u0 = Tracked {
             f: self.disp[0],
             d1: self.vel[0],
-            amps: Osc::amplitudes(cl.natural, self.disp[0].amplitude()),
+            amps: Osc::amplitudes(cluster.natural, self.disp[0].amplitude()),
         };
-        self.a0 = Tracked::new(self.accel0_wave(), osc, cl.natural);
+        self.a0 = Tracked::new(self.accel0_wave(), osc, cluster.natural);
         for cidx in 1..nc {
             let (bj, ej) = (self.bottom[cidx], self.top[cidx]);
             let mass = self.mass_prefix[ej + 1] - self.mass_prefix[bj];
@@ -673,7 +676,7 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
             self.vel[cidx] = self.disp[cidx].deriv(osc);
         }
         self.events.clear();
-        let (upper, lower) = self.mode_bounds(e0, f_top0);
+        let (upper, lower) = self.mode_bounds(top, f_above);
         // g = bound − A₀ above, A₀ − bound below.
         for (bound, sign) in [(upper, -1.0), (lower, 1.0)] {
             if let Some((value, i)) = bound {
@@ -695,11 +698,11 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
             g.p[0] += g0_state - (g.p[0] + g.c);
             self.events.push(Event {
                 kind: EventKind::SlipStop(i),
-                g: Tracked::new(g, osc, cl.natural),
+                g: Tracked::new(g, osc, cluster.natural),
             });
         }
-        if Y {
-            self.push_structure_events(osc, cl.natural);
+        if YIELDS {
+            self.push_structure_events(osc, cluster.natural);
         }
     }
 
@@ -741,16 +744,22 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
     /// stiffness (`r = 0`): `ü + a·u̇ = p0 + p1·τ`, `a = c/M`, whose velocity is
     /// `A + Bτ + (v₀ − A)·e^{−aτ}` with `B = p1/a`, `A = (p0 − B)/a`; without damping either,
     /// a cubic.
-    fn structure_wave(&self, cl: &Cluster0, f_top0: f64, ga: f64, slope: f64) -> Wave {
-        let p0 = if Y {
-            self.plastic_load(cl, f_top0, ga)
+    fn structure_wave(
+        &self,
+        cluster: &StructureCluster,
+        f_above: f64,
+        ga: f64,
+        slope: f64,
+    ) -> Wave {
+        let p0 = if YIELDS {
+            self.plastic_load(cluster, f_above, ga)
         } else {
-            -f_top0 / cl.mass - ga
+            -f_above / cluster.mass - ga
         };
         let p1 = -slope;
-        if Y && cl.omega2 == 0.0 {
+        if YIELDS && cluster.omega2 == 0.0 {
             let (x0, v0) = (self.x[0], self.v[0]);
-            let a = cl.osc.decay;
+            let a = cluster.osc.decay;
             if a == 0.0 {
                 return Wave {
                     p: [x0, v0, 0.5 * p0, p1 / 6.0],
@@ -767,10 +776,10 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
                 d: 0.0,
             };
         }
-        let b = p1 / cl.omega2;
-        let a = (p0 - 2.0 * cl.osc.decay * b) / cl.omega2;
+        let b = p1 / cluster.omega2;
+        let a = (p0 - 2.0 * cluster.osc.decay * b) / cluster.omega2;
         let c = self.x[0] - a;
-        let d = (self.v[0] - b + cl.osc.decay * c) / cl.osc.omega;
+        let d = (self.v[0] - b + cluster.osc.decay * c) / cluster.osc.omega;
         Wave {
             p: [a, b, 0.0, 0.0],
             c,
@@ -778,10 +787,10 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
         }
     }
 
-    /// `p₀` of [`Exact::structure_wave`] for a yielding structure: `−(f_top0 + f_off)/M − a_g`,
+    /// `p₀` of [`ExactRun::structure_wave`] for a yielding structure: `−(f_above + f_off)/M − a_g`,
     /// m/s².
-    fn plastic_load(&self, cl: &Cluster0, f_top0: f64, ga: f64) -> f64 {
-        -(f_top0 + self.spring.line().1) / cl.mass - ga
+    fn plastic_load(&self, cluster: &StructureCluster, f_above: f64, ga: f64) -> f64 {
+        -(f_above + self.spring.line().1) / cluster.mass - ga
     }
 
     /// The structure cluster's piece ending at `b` in a cancellation-free φ-function form, or
@@ -789,28 +798,28 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
     /// [`decay_piece`] (beyond, the wave's terms of order `p₀/a²` no longer exceed its values);
     /// at long periods (`ω_n·dt` below `SDOF_FORM_OMEGA_STEP`), [`sdof::piece`].
     fn stable_piece(&self, ga: f64, slope: f64, b: &Basis) -> Option<Piece> {
-        let cl = self.cl();
-        if L && cl.sdof_form {
-            return Some(self.sdof_piece(cl, ga, slope, b));
+        let cluster = self.structure_cluster();
+        if LONG_PERIODS && cluster.sdof_form {
+            return Some(self.sdof_piece(cluster, ga, slope, b));
         }
-        if !Y || cl.omega2 != 0.0 || cl.osc.decay * b.tau > 1.0 {
+        if !YIELDS || cluster.omega2 != 0.0 || cluster.osc.decay * b.tau > 1.0 {
             return None;
         }
         Some(decay_piece(
-            cl.osc.decay,
-            (self.plastic_load(cl, self.f_top0(), ga), -slope),
+            cluster.osc.decay,
+            (self.plastic_load(cluster, self.f_above(), ga), -slope),
             (self.x[0], self.v[0]),
             b.tau,
             self.opts.energy_balance,
         ))
     }
 
-    /// The [`sdof::piece`] branch of [`Exact::stable_piece`], kept out of line: the study's grid
+    /// The [`sdof::piece`] branch of [`ExactRun::stable_piece`], kept out of line: the study's grid
     /// never takes it.
     #[cold]
     #[inline(never)]
-    fn sdof_piece(&self, cl: &Cluster0, ga: f64, slope: f64, b: &Basis) -> Piece {
-        let (omega_n, zeta, p0) = self.sdof_params(cl, ga);
+    fn sdof_piece(&self, cluster: &StructureCluster, ga: f64, slope: f64, b: &Basis) -> Piece {
+        let (omega_n, zeta, p0) = self.sdof_params(cluster, ga);
         sdof::piece(
             omega_n,
             zeta,
@@ -829,7 +838,7 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
     #[cold]
     #[inline(never)]
     fn sdof_peak(&self, ga: f64, slope: f64, h: f64) -> (f64, f64) {
-        let (omega_n, zeta, p0) = self.sdof_params(self.cl(), ga);
+        let (omega_n, zeta, p0) = self.sdof_params(self.structure_cluster(), ga);
         let (x0, v0, p1) = (self.x[0], self.v[0], -slope);
         let at = |t: f64| sdof::Step::new(omega_n, zeta, t).step(x0, v0, -p0, -(p0 + p1 * t));
         let mut best = (at(h).0.abs(), h);
@@ -871,58 +880,62 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
     }
 
     /// `(ω_n, ζ, p₀)` of the structure cluster's equation `ü + 2ζω_nu̇ + ω_n²u = p₀ + p₁τ`
-    /// (the load of [`Exact::structure_wave`]).
-    fn sdof_params(&self, cl: &Cluster0, ga: f64) -> (f64, f64, f64) {
-        let p0 = if Y {
-            self.plastic_load(cl, self.f_top0(), ga)
+    /// (the load of [`ExactRun::structure_wave`]).
+    fn sdof_params(&self, cluster: &StructureCluster, ga: f64) -> (f64, f64, f64) {
+        let p0 = if YIELDS {
+            self.plastic_load(cluster, self.f_above(), ga)
         } else {
-            -self.f_top0() / cl.mass - ga
+            -self.f_above() / cluster.mass - ga
         };
-        let omega_n = cl.omega2.sqrt();
-        (omega_n, cl.osc.decay / omega_n, p0)
+        let omega_n = cluster.omega2.sqrt();
+        (omega_n, cluster.osc.decay / omega_n, p0)
     }
 
     /// The friction force on the structure cluster's top body from the body above, N (0 when the
     /// whole stack is in the cluster).
-    fn f_top0(&self) -> f64 {
-        let e0 = self.top[0];
-        if e0 < self.n { self.force[e0] } else { 0.0 }
+    fn f_above(&self) -> f64 {
+        let top = self.top[0];
+        if top < self.n { self.force[top] } else { 0.0 }
     }
 
     /// A whole sample interval on which, with every interface stuck, nothing can happen: the
     /// acceleration stays inside its break bounds and neither the displacement nor the
     /// acceleration can exceed its peak so far, each certified by the curvature bound on the
     /// values at the two ends. Then the piece needs only its energy and new state
-    /// ([`Exact::settle`]), the same as the general path would give, and this returns `true`;
+    /// ([`ExactRun::settle`]), the same as the general path would give, and this returns `true`;
     /// otherwise it changes nothing and returns `false`.
     fn quiet_interval(&mut self, ga: f64, slope: f64) -> bool {
         let n = self.n;
         // The cluster arrays are those of the current mode (built at the last piece).
-        if self.top[0] != n || (Y && self.spring.plastic()) {
+        if self.top[0] != n || (YIELDS && self.spring.plastic()) {
             return false;
         }
-        let cl = self.cluster0[n];
-        let (h, b) = (self.dt, cl.basis_dt);
-        let u = self.structure_wave(&cl, 0.0, ga, slope);
+        let cluster = self.structure_elastic[n];
+        let (h, b) = (self.dt, cluster.basis_dt);
+        let u = self.structure_wave(&cluster, 0.0, ga, slope);
         let (u_lo, u_hi) = (u.p[0] + u.c, u.eval(&b));
-        let amp2 = cl.natural * cl.natural * u.amplitude();
+        let amp2 = cluster.natural * cluster.natural * u.amplitude();
         let curv_u = u.deriv_abs_bound(2, h, 1.0, amp2) * h * h / 8.0;
         if u_lo.abs().max(u_hi.abs()) + curv_u > self.out.peak_displacement_m {
             return false;
         }
-        if Y && let Branch::Elastic { lo, hi, .. } = self.spring.branch
+        if YIELDS
+            && let Branch::Elastic { lo, hi, .. } = self.spring.branch
             && (u_lo.min(u_hi) - curv_u < lo || u_lo.max(u_hi) + curv_u > hi)
         {
             return false;
         }
-        let vel = u.deriv(cl.osc);
-        let (c_m, k_m) = (self.sys.damping() / cl.mass, self.sys.stiffness() / cl.mass);
+        let vel = u.deriv(cluster.osc);
+        let (c_m, k_m) = (
+            self.sys.damping() / cluster.mass,
+            self.sys.stiffness() / cluster.mass,
+        );
         let mut acc = vel.combine(-c_m, &u, -k_m);
-        if Y {
-            acc = acc.plus_constant(-self.spring.line().1 / cl.mass);
+        if YIELDS {
+            acc = acc.plus_constant(-self.spring.line().1 / cluster.mass);
         }
         let (a_lo, a_hi) = (acc.p[0] + acc.c, acc.eval(&b));
-        let amp_acc2 = cl.natural * cl.natural * acc.amplitude();
+        let amp_acc2 = cluster.natural * cluster.natural * acc.amplitude();
         let curv_a = acc.deriv_abs_bound(2, h, 1.0, amp_acc2) * h * h / 8.0;
         let floor = self
             .out
@@ -943,27 +956,27 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
         true
     }
 
-    /// [`Exact::break_bounds`] of the current mode, computed once per mode.
-    fn mode_bounds(&mut self, e0: usize, f_top0: f64) -> BreakBounds {
+    /// [`ExactRun::break_bounds`] of the current mode, computed once per mode.
+    fn mode_bounds(&mut self, top: usize, f_above: f64) -> BreakBounds {
         if self.bounds.is_none() {
-            self.bounds = Some(self.break_bounds(e0, f_top0));
+            self.bounds = Some(self.break_bounds(top, f_above));
         }
         self.bounds.unwrap_or_default()
     }
 
-    /// Every interface inside the structure's cluster (top body `e0`, friction `f_top0` from
-    /// above) carries `m_above·A₀(τ) + f_top0`, so its static limit bounds A₀ to an interval; the
+    /// Every interface inside the structure's cluster (top body `top`, friction `f_above` from
+    /// above) carries `m_above·A₀(τ) + f_above`, so its static limit bounds A₀ to an interval; the
     /// tightest bounds above and below, with their interfaces, are the only ones that can be
     /// reached first. Bounds equal to within a tenth of the break tolerance (equal μ up to
     /// round-off) count as a tie, won by the lowest interface: a stack that moves as one slips at
     /// its base. Constant within a mode.
-    fn break_bounds(&self, e0: usize, f_top0: f64) -> BreakBounds {
+    fn break_bounds(&self, top: usize, f_above: f64) -> BreakBounds {
         let tie = 0.1 * BREAK_TOLERANCE;
         let (mut upper, mut lower): BreakBounds = (None, None);
-        for i in 0..e0 {
-            let m_above = self.mass_prefix[e0 + 1] - self.mass_prefix[i + 1];
+        for i in 0..top {
+            let m_above = self.mass_prefix[top + 1] - self.mass_prefix[i + 1];
             let room = self.lim_s[i] * (1.0 + BREAK_TOLERANCE);
-            let (hi, lo) = ((room - f_top0) / m_above, (-room - f_top0) / m_above);
+            let (hi, lo) = ((room - f_above) / m_above, (-room - f_above) / m_above);
             if upper.is_none_or(|(h, _)| hi < h - tie * h.abs()) {
                 upper = Some((hi, i));
             }
@@ -1004,14 +1017,14 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
     /// Absolute acceleration of the structure's cluster: `(F − c·u̇ − k·u)/M`, or with a
     /// yielding structure `(F − c·u̇ − k_b·u − f_off)/M`.
     fn accel0_wave(&self) -> Wave {
-        let e0 = self.top[0];
-        let mass = self.cluster0[e0].mass;
-        let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
-        if Y {
+        let top = self.top[0];
+        let mass = self.structure_elastic[top].mass;
+        let f_above = if top < self.n { self.force[top] } else { 0.0 };
+        if YIELDS {
             let (kb, off) = self.spring.line();
             return self.vel[0]
                 .combine(-self.sys.damping() / mass, &self.disp[0], -kb / mass)
-                .plus_constant(-(f_top0 + off) / mass);
+                .plus_constant(-(f_above + off) / mass);
         }
         self.vel[0]
             .combine(
@@ -1019,16 +1032,16 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
                 &self.disp[0],
                 -self.sys.stiffness() / mass,
             )
-            .plus_constant(-f_top0 / mass)
+            .plus_constant(-f_above / mass)
     }
 
     /// Moves the state to the end of the current piece, accumulating peaks and energy over it.
     fn advance(&mut self, t_start: f64, ga: f64, slope: f64, b: &Basis) {
         let osc = self.osc();
-        let e0 = self.top[0];
+        let top = self.top[0];
         let b0 = Basis::ZERO;
         // Peaks of the structure's displacement and its cluster's absolute acceleration.
-        let (best, at) = if L && self.cl().sdof_form {
+        let (best, at) = if LONG_PERIODS && self.structure_cluster().sdof_form {
             self.sdof_peak(ga, slope, b.tau)
         } else {
             peak_abs(&self.u0, osc, &b0, b, self.out.peak_displacement_m, self.dt)
@@ -1039,17 +1052,17 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
         }
         // Bodies of the structure's cluster share its acceleration: search above the smallest
         // of their peaks; a result above it is this piece's maximum.
-        let floor = self.out.peak_abs_accel_mps2[..=e0]
+        let floor = self.out.peak_abs_accel_mps2[..=top]
             .iter()
             .copied()
             .fold(f64::INFINITY, f64::min);
         let (best_acc, _) = peak_abs(&self.a0, osc, &b0, b, floor, self.dt);
         if best_acc > floor {
-            for p in &mut self.out.peak_abs_accel_mps2[..=e0] {
+            for p in &mut self.out.peak_abs_accel_mps2[..=top] {
                 *p = p.max(best_acc);
             }
         }
-        for j in e0 + 1..=self.n {
+        for j in top + 1..=self.n {
             let a = self.accel_free[self.cluster_of[j]].abs();
             let p = &mut self.out.peak_abs_accel_mps2[j];
             *p = p.max(a);
@@ -1068,9 +1081,9 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
         // integrals from a cancellation-free form.
         let stable = self.stable_piece(ga, slope, b);
         if self.opts.energy_balance {
-            let cl = *self.cl();
-            let pi = if *b == cl.basis_dt {
-                cl.integrals_dt
+            let cluster = *self.structure_cluster();
+            let pi = if *b == cluster.basis_dt {
+                cluster.integrals_dt
             } else {
                 PieceIntegrals::new(osc, b)
             };
@@ -1093,13 +1106,13 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
             self.energy.damping += self.sys.damping()
                 * match stable {
                     Some(d) => d.int_v2,
-                    None if Y && cl.omega2 == 0.0 => {
+                    None if YIELDS && cluster.omega2 == 0.0 => {
                         integral_of_square_decay(&self.vel[0], osc.decay, end)
                     }
                     None => integral_of_square_with(&self.vel[0], b, &pi),
                 };
         }
-        if Y {
+        if YIELDS {
             // ∫F_s du over the piece, F_s = k_b·u + f_off on one branch.
             let (kb, off) = self.spring.line();
             let u0 = self.x[0];
@@ -1228,7 +1241,7 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
 
     fn fill_state_energy(&self, e: &mut Energy) {
         e.set_state(self.sys.masses(), &self.v, self.sys.stiffness(), self.x[0]);
-        if Y {
+        if YIELDS {
             let f = self.spring.force(self.x[0]);
             e.strain = f * f / (2.0 * self.spring.k);
             e.hysteretic = self.spring_work - e.strain;
@@ -1241,12 +1254,12 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
         h.ground_accel_mps2.push(ga);
         h.displacement_m.extend_from_slice(&self.x);
         h.velocity_mps.extend_from_slice(&self.v);
-        let e0 = self.top[0];
-        let mass = self.cluster0[e0].mass;
-        let f_top0 = if e0 < self.n { self.force[e0] } else { 0.0 };
-        let a0 = (-f_top0 - self.sys.damping() * self.v[0] - self.restoring_force()) / mass;
+        let top = self.top[0];
+        let mass = self.structure_elastic[top].mass;
+        let f_above = if top < self.n { self.force[top] } else { 0.0 };
+        let a0 = (-f_above - self.sys.damping() * self.v[0] - self.restoring_force()) / mass;
         for j in 0..=self.n {
-            h.abs_accel_mps2.push(if j <= e0 {
+            h.abs_accel_mps2.push(if j <= top {
                 a0
             } else {
                 self.accel_free[self.cluster_of[j]]
@@ -1268,7 +1281,7 @@ impl<'s, const Y: bool, const L: bool> Exact<'s, Y, L> {
             self.out.residual_slip_m[i] = self.x[i + 1] - self.x[i];
         }
         self.out.residual_displacement_m = self.x[0];
-        if Y {
+        if YIELDS {
             self.out.ductility = Some(self.out.peak_displacement_m / self.spring.u_y);
         }
         self.out.energy = e;

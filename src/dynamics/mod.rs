@@ -66,6 +66,13 @@ pub struct Ground<'a> {
     pub accel_mps2: &'a [f64],
 }
 
+impl<'a> Ground<'a> {
+    /// `accel_mps2` (m/s²) sampled every `dt_s` (s).
+    pub fn new(dt_s: f64, accel_mps2: &'a [f64]) -> Self {
+        Self { dt_s, accel_mps2 }
+    }
+}
+
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SimError {
     #[error(

@@ -255,13 +255,7 @@ impl<'s> Rk4<'s> {
             ..Response::default()
         };
         let mut history = want_history.then(|| History::with_capacity(steps + 1, nb));
-        let nr = 2 + n + usize::from(self.hysteresis.is_some());
-        let mut kx = vec![vec![0.0; nb]; 4];
-        let mut kv = vec![vec![0.0; nb]; 4];
-        let mut ke = vec![vec![0.0; nr]; 4];
-        let mut xs = vec![0.0; nb];
-        let mut vs = vec![0.0; nb];
-        let mut abs = vec![0.0; nb];
+        let mut stages = Stages::new(nb, 2 + n + usize::from(self.hysteresis.is_some()));
         let mut s_before = vec![0.0; n];
         let mut switches = 0u64;
         let mut prev = self.contacts.clone();
@@ -287,77 +281,24 @@ impl<'s> Rk4<'s> {
                     && sub == 0
                     && let Some(hist) = history.as_mut()
                 {
-                    self.accelerations(&self.x, &self.v, acc_g[0], &mut kv[0], &mut abs);
-                    record(hist, 0.0, acc_g[0], &self.x, &self.v, &abs, &self.contacts);
+                    let st = &mut stages;
+                    self.accelerations(&self.x, &self.v, acc_g[0], &mut st.kv[0], &mut st.abs);
+                    record(
+                        hist,
+                        0.0,
+                        acc_g[0],
+                        &self.x,
+                        &self.v,
+                        &st.abs,
+                        &self.contacts,
+                    );
                 }
                 for i in 0..n {
                     s_before[i] = self.v[i + 1] - self.v[i];
                 }
-                // Classical RK4 over [t, t+h].
-                let stage_frac = [0.0, 0.5, 0.5, 1.0];
-                for st in 0..4 {
-                    let ag = ag_at(k, frac0 + stage_frac[st] / substeps as f64);
-                    if st == 0 {
-                        xs.copy_from_slice(&self.x);
-                        vs.copy_from_slice(&self.v);
-                    } else {
-                        let w = stage_frac[st] * h;
-                        for j in 0..nb {
-                            xs[j] = self.x[j] + w * kx[st - 1][j];
-                            vs[j] = self.v[j] + w * kv[st - 1][j];
-                        }
-                    }
-                    kx[st].copy_from_slice(&vs);
-                    let (kv_st, abs_ref) = (&mut kv[st], &mut abs);
-                    self.accelerations(&xs, &vs, ag, kv_st, abs_ref);
-                    if st == 0 {
-                        for j in 0..nb {
-                            out.peak_abs_accel_mps2[j] =
-                                out.peak_abs_accel_mps2[j].max(abs[j].abs());
-                        }
-                    }
-                    self.rates(&xs, &vs, ag, &mut ke[st]);
-                }
-                for j in 0..nb {
-                    self.x[j] += h / 6.0 * (kx[0][j] + 2.0 * kx[1][j] + 2.0 * kx[2][j] + kx[3][j]);
-                    self.v[j] += h / 6.0 * (kv[0][j] + 2.0 * kv[1][j] + 2.0 * kv[2][j] + kv[3][j]);
-                }
-                let de =
-                    |r: usize| h / 6.0 * (ke[0][r] + 2.0 * ke[1][r] + 2.0 * ke[2][r] + ke[3][r]);
-                self.energy.input += de(0);
-                self.energy.damping += de(1);
-                for i in 0..n {
-                    let w = de(2 + i);
-                    self.energy.friction_per_interface[i] += w;
-                    self.energy.friction += w;
-                }
-                if self.hysteresis.is_some() {
-                    self.spring_work += de(2 + n);
-                    let u = self.x[0];
-                    let f = self.restoring(u);
-                    let plastic = f != self.anchor.1 + self.sys.stiffness() * (u - self.anchor.0);
-                    if plastic != self.plastic {
-                        out.yield_events += 1;
-                        self.plastic = plastic;
-                    }
-                    self.anchor = (u, f);
-                }
-                // Interfaces whose relative velocity changed sign are at rest next sub-step.
-                for i in 0..n {
-                    if let Contact::Slip(d) = self.contacts[i] {
-                        out.slip_time_s[i] += h;
-                        let s = self.v[i + 1] - self.v[i];
-                        if f64::from(d) * s <= 0.0 || s_before[i] * s < 0.0 {
-                            self.contacts[i] = Contact::Stick;
-                        }
-                    }
-                    out.peak_slip_m[i] = out.peak_slip_m[i].max((self.x[i + 1] - self.x[i]).abs());
-                }
-                let u = self.x[0].abs();
-                if u > out.peak_displacement_m {
-                    out.peak_displacement_m = u;
-                    out.peak_displacement_time_s = t + h;
-                }
+                let ag = |stage_frac: f64| ag_at(k, frac0 + stage_frac / substeps as f64);
+                self.step(h, ag, &mut stages, &mut out.peak_abs_accel_mps2);
+                self.after_step(h, t, &s_before, &mut out);
             }
             let mut e = self.energy.clone();
             self.fill_state_energy(&mut e);
@@ -368,14 +309,15 @@ impl<'s> Rk4<'s> {
             }
             if let Some(hist) = history.as_mut() {
                 let t1 = (k + 1) as f64 * dt;
-                self.accelerations(&self.x, &self.v, acc_g[k + 1], &mut kv[0], &mut abs);
+                let st = &mut stages;
+                self.accelerations(&self.x, &self.v, acc_g[k + 1], &mut st.kv[0], &mut st.abs);
                 record(
                     hist,
                     t1,
                     acc_g[k + 1],
                     &self.x,
                     &self.v,
-                    &abs,
+                    &st.abs,
                     &self.contacts,
                 );
             }
@@ -396,11 +338,119 @@ impl<'s> Rk4<'s> {
         out
     }
 
+    /// One classical RK4 step of length `h` over the current contact pattern, of the state and
+    /// the energy integrals; `ag(f)` is the ground acceleration a fraction `f` of the step in.
+    /// The absolute accelerations at the step's start raise `peak_abs_accel_mps2`.
+    fn step(
+        &mut self,
+        h: f64,
+        ag: impl Fn(f64) -> f64,
+        st: &mut Stages,
+        peak_abs_accel_mps2: &mut [f64],
+    ) {
+        let nb = self.n + 1;
+        let stage_frac = [0.0, 0.5, 0.5, 1.0];
+        for s in 0..4 {
+            let ag = ag(stage_frac[s]);
+            if s == 0 {
+                st.xs.copy_from_slice(&self.x);
+                st.vs.copy_from_slice(&self.v);
+            } else {
+                let w = stage_frac[s] * h;
+                for j in 0..nb {
+                    st.xs[j] = self.x[j] + w * st.kx[s - 1][j];
+                    st.vs[j] = self.v[j] + w * st.kv[s - 1][j];
+                }
+            }
+            st.kx[s].copy_from_slice(&st.vs);
+            self.accelerations(&st.xs, &st.vs, ag, &mut st.kv[s], &mut st.abs);
+            if s == 0 {
+                for j in 0..nb {
+                    peak_abs_accel_mps2[j] = peak_abs_accel_mps2[j].max(st.abs[j].abs());
+                }
+            }
+            self.rates(&st.xs, &st.vs, ag, &mut st.ke[s]);
+        }
+        let (kx, kv) = (&st.kx, &st.kv);
+        for j in 0..nb {
+            self.x[j] += h / 6.0 * (kx[0][j] + 2.0 * kx[1][j] + 2.0 * kx[2][j] + kx[3][j]);
+            self.v[j] += h / 6.0 * (kv[0][j] + 2.0 * kv[1][j] + 2.0 * kv[2][j] + kv[3][j]);
+        }
+        let ke = &st.ke;
+        let de = |r: usize| h / 6.0 * (ke[0][r] + 2.0 * ke[1][r] + 2.0 * ke[2][r] + ke[3][r]);
+        self.energy.input += de(0);
+        self.energy.damping += de(1);
+        for i in 0..self.n {
+            let w = de(2 + i);
+            self.energy.friction_per_interface[i] += w;
+            self.energy.friction += w;
+        }
+        if self.hysteresis.is_some() {
+            self.spring_work += de(2 + self.n);
+        }
+    }
+
+    /// After a step of length `h` that started at `t` with relative velocities `s_before`: the
+    /// structure's branch, the interfaces that come to rest, the peaks and slip times.
+    fn after_step(&mut self, h: f64, t: f64, s_before: &[f64], out: &mut Response) {
+        if self.hysteresis.is_some() {
+            let u = self.x[0];
+            let f = self.restoring(u);
+            let plastic = f != self.anchor.1 + self.sys.stiffness() * (u - self.anchor.0);
+            if plastic != self.plastic {
+                out.yield_events += 1;
+                self.plastic = plastic;
+            }
+            self.anchor = (u, f);
+        }
+        // Interfaces whose relative velocity changed sign are at rest next sub-step.
+        for i in 0..self.n {
+            if let Contact::Slip(d) = self.contacts[i] {
+                out.slip_time_s[i] += h;
+                let s = self.v[i + 1] - self.v[i];
+                if f64::from(d) * s <= 0.0 || s_before[i] * s < 0.0 {
+                    self.contacts[i] = Contact::Stick;
+                }
+            }
+            out.peak_slip_m[i] = out.peak_slip_m[i].max((self.x[i + 1] - self.x[i]).abs());
+        }
+        let u = self.x[0].abs();
+        if u > out.peak_displacement_m {
+            out.peak_displacement_m = u;
+            out.peak_displacement_time_s = t + h;
+        }
+    }
+
     fn fill_state_energy(&self, e: &mut Energy) {
         e.set_state(self.sys.masses(), &self.v, self.sys.stiffness(), self.x[0]);
         if let Some(h) = &self.hysteresis {
             e.strain = h.recoverable_energy(self.restoring(self.x[0]));
             e.hysteretic = self.spring_work - e.strain;
+        }
+    }
+}
+
+/// The scratch of an RK4 step: each stage's slopes of the displacements, velocities and energy
+/// integrals, the state a stage is evaluated at, and the absolute accelerations there.
+struct Stages {
+    kx: Vec<Vec<f64>>,
+    kv: Vec<Vec<f64>>,
+    ke: Vec<Vec<f64>>,
+    xs: Vec<f64>,
+    vs: Vec<f64>,
+    abs: Vec<f64>,
+}
+
+impl Stages {
+    /// For `bodies` bodies and `rates` energy rates.
+    fn new(bodies: usize, rates: usize) -> Self {
+        Self {
+            kx: vec![vec![0.0; bodies]; 4],
+            kv: vec![vec![0.0; bodies]; 4],
+            ke: vec![vec![0.0; rates]; 4],
+            xs: vec![0.0; bodies],
+            vs: vec![0.0; bodies],
+            abs: vec![0.0; bodies],
         }
     }
 }

@@ -1,5 +1,5 @@
 //! Digital Butterworth filter sections (the high-pass baseline correction of
-//! [`crate::motion::process`]).
+//! [`crate::ground_motion::process`]).
 
 use std::f64::consts::PI;
 

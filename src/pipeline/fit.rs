@@ -19,6 +19,7 @@ use crate::fit::{
     DesignBox, FitError, Form, Sample, check_box, cross_validate, feature_names, fit, metrics,
     paper_equation, uncertainty,
 };
+use crate::grid::Grid;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::fit::{FitReport, FormFit, NotFitted, ZoneFit, write_fit};
 use crate::study::tnew::samples;
@@ -131,14 +132,8 @@ fn recommend(forms: &[FormFit]) -> (Form, String) {
     }
 }
 
-/// Builds `fit.h5` and `fit.yaml`.
-pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
-    let start = std::time::Instant::now();
-    let study = &s.study;
-    let me = StageId::Fit;
-    let grid = study.grid(me)?;
-    let n = grid.blocks();
-    let features = feature_names(n);
+/// The box of the box check: [`BOX_MARGIN`] beyond the grid's range of every feature.
+fn design_box(grid: &Grid) -> DesignBox {
     let range = |v: &[f64]| {
         v.iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
@@ -148,7 +143,58 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let mut ranges = vec![range(&grid.periods_s)];
     ranges.extend(grid.mu.iter().map(|v| range(v)));
     ranges.extend(grid.alpha.iter().map(|v| range(v)));
-    let bx = DesignBox::beyond(&ranges, BOX_MARGIN);
+    DesignBox::beyond(&ranges, BOX_MARGIN)
+}
+
+/// One line on a fitted form: its metrics, cross-validated ones, solver and box check.
+fn describe(f: &FormFit) -> String {
+    let (m, cv, b) = (&f.all_cases, &f.cross_validated, &f.box_check);
+    format!(
+        "{:<7} R² {:.4}  R {:.4}  RMSE {:.4} s  MAE {:.4} s  relative RMS {:.3}, max {:.2}   \
+         ({FOLDS}-fold CV: R² {:.4}, RMSE {:.4} s)   {} {}   box {}",
+        f.form.name(),
+        m.r2,
+        m.r,
+        m.rmse,
+        m.mae,
+        m.relative_rmse,
+        m.max_relative_error,
+        cv.r2,
+        cv.rmse,
+        match f.solver.method {
+            crate::fit::Method::TrustRegion => "trust region",
+            crate::fit::Method::NelderMead => "Nelder–Mead fallback",
+        },
+        if f.solver.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        if b.passed {
+            format!(
+                "passed (T_new/T_p ≥ {:.3}, T_new/T_rigid ≤ {:.3})",
+                b.min_t_new_over_t_p, b.max_t_new_over_t_rigid
+            )
+        } else {
+            format!(
+                "FAILED at {} of {} points ({} not finite)",
+                b.outside + b.non_finite,
+                b.points,
+                b.non_finite
+            )
+        }
+    )
+}
+
+/// Builds `fit.h5` and `fit.yaml`.
+pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+    let start = std::time::Instant::now();
+    let study = &s.study;
+    let me = StageId::Fit;
+    let grid = study.grid(me)?;
+    let n = grid.blocks();
+    let features = feature_names(n);
+    let bx = design_box(grid);
     let mut zone_data = Vec::new();
     for zc in &study.cfg.zones {
         let t = super::tnew::read_zone(study, &zc.name)?;
@@ -181,46 +227,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             }
         }
         for f in &forms {
-            let (m, cv, b) = (&f.all_cases, &f.cross_validated, &f.box_check);
-            s.reporter.info(
-                me,
-                &format!(
-                    "zone {zone}: {:<7} R² {:.4}  R {:.4}  RMSE {:.4} s  MAE {:.4} s  relative \
-                     RMS {:.3}, max {:.2}   ({FOLDS}-fold CV: R² {:.4}, RMSE {:.4} s)   {} {}   \
-                     box {}",
-                    f.form.name(),
-                    m.r2,
-                    m.r,
-                    m.rmse,
-                    m.mae,
-                    m.relative_rmse,
-                    m.max_relative_error,
-                    cv.r2,
-                    cv.rmse,
-                    match f.solver.method {
-                        crate::fit::Method::TrustRegion => "trust region",
-                        crate::fit::Method::NelderMead => "Nelder–Mead fallback",
-                    },
-                    if f.solver.converged {
-                        "converged"
-                    } else {
-                        "NOT converged"
-                    },
-                    if b.passed {
-                        format!(
-                            "passed (T_new/T_p ≥ {:.3}, T_new/T_rigid ≤ {:.3})",
-                            b.min_t_new_over_t_p, b.max_t_new_over_t_rigid
-                        )
-                    } else {
-                        format!(
-                            "FAILED at {} of {} points ({} not finite)",
-                            b.outside + b.non_finite,
-                            b.points,
-                            b.non_finite
-                        )
-                    }
-                ),
-            );
+            s.reporter
+                .info(me, &format!("zone {zone}: {}", describe(f)));
         }
         for nf in &not_fitted {
             s.reporter.warn(

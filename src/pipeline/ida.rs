@@ -23,6 +23,7 @@ use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write
 use crate::store::motions::read_zone_target;
 use crate::study::config::StudyConfig;
 use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
+use crate::study::physics::Physics;
 use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -58,13 +59,7 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
 
 /// Every zone's target spectrum as `motions.h5` stores it: the one its motions were matched to.
 fn stored_targets(study: &Study) -> Result<Vec<TargetSpectrum>, StoreError> {
-    let path = study.path(StageId::Motions.output());
-    study
-        .cfg
-        .zones
-        .iter()
-        .map(|z| read_zone_target(&path, &z.name))
-        .collect()
+    super::motions::read_zones(study, read_zone_target)
 }
 
 /// One unit's result.
@@ -182,19 +177,44 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             vars: zone_vars(cfg, &axes, motions[z].len(), slice, c_y),
         });
     }
-    let c_y_rule = match (&cfg.structure.c_y, &cfg.structure.design) {
+    let c_y_rule = c_y_rule(cfg);
+    let settings = settings_attrs(cfg, &physics, &c_y_rule);
+    let meta = IdaMeta {
+        fingerprint: fp,
+        motions_fingerprint: study.fingerprint(StageId::Motions)?,
+        config_sha256: &study.config_sha256,
+        fit_flags: &FIT_STATUS_FLAGS,
+        settings: &settings,
+    };
+    let path = study.path(me.output());
+    write_ida(&path, &meta, &axes, &zones)?;
+    s.reporter.info(me, &format!("verified {}", path.display()));
+    Ok(Outcome::Wrote(vec![path]))
+}
+
+/// How the structure's strength is set, in words.
+fn c_y_rule(cfg: &IdaConfig) -> String {
+    match (&cfg.structure.c_y, &cfg.structure.design) {
         (Some(c), _) => format!("C_y = {c}"),
         (None, Some(d)) => format!(
             "C_y = (Z/2)(I/R)(Sa/g)(T_p) of the zone's IS 1893 target, I = {}, R = {}",
             d.importance, d.response_reduction
         ),
         (None, None) => String::new(),
-    };
+    }
+}
+
+/// The settings `ida.h5` states as file attributes.
+fn settings_attrs<'a>(
+    cfg: &IdaConfig,
+    physics: &Physics,
+    c_y_rule: &'a str,
+) -> Vec<(&'static str, Attr<'a>)> {
     let t = &cfg.tracing;
-    let mut settings: Vec<(&str, Attr)> = super::sweep::physics_attrs(&physics).to_vec();
+    let mut settings: Vec<(&str, Attr)> = super::sweep::physics_attrs(physics).to_vec();
     settings.extend([
         ("mu_static_ratio", Attr::F64(physics.mu_static_ratio)),
-        ("c_y_rule", Attr::Str(&c_y_rule)),
+        ("c_y_rule", Attr::Str(c_y_rule)),
         (
             "post_yield_ratio",
             Attr::F64(cfg.structure.post_yield_ratio),
@@ -220,17 +240,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             ),
         ),
     ]);
-    let meta = IdaMeta {
-        fingerprint: fp,
-        motions_fingerprint: study.fingerprint(StageId::Motions)?,
-        config_sha256: &study.config_sha256,
-        fit_flags: &FIT_STATUS_FLAGS,
-        settings: &settings,
-    };
-    let path = study.path(me.output());
-    write_ida(&path, &meta, &axes, &zones)?;
-    s.reporter.info(me, &format!("verified {}", path.display()));
-    Ok(Outcome::Wrote(vec![path]))
+    settings
 }
 
 /// The axes `ida.h5` has for the `ida:` section `cfg`.
@@ -519,7 +529,7 @@ pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineE
 /// SVG of [`figure_of`].
 pub fn figure(study: &Study) -> Result<String, PipelineError> {
     let fig = figure_of(study)?;
-    crate::report::chart::render(&fig).map_err(|e| {
+    crate::render::chart::render(&fig).map_err(|e| {
         let path = study.path(StageId::Ida.output());
         PipelineError::Store(crate::store::StoreError::corrupt(&path, e.to_string()))
     })
@@ -528,8 +538,8 @@ pub fn figure(study: &Study) -> Result<String, PipelineError> {
 /// The first case's ductility against intensity, one panel per zone: every record's curve
 /// (faint) and the 16–50–84 % fractiles of the stack and of the rigidly attached load.
 /// Collapsed values (`+∞`) are drawn at the collapse ductility.
-pub fn figure_of(study: &Study) -> Result<crate::report::chart::Figure, PipelineError> {
-    use crate::report::chart::{Axis, Figure, Panel, Series, Stroke};
+pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, PipelineError> {
+    use crate::render::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Ida)?;
     let cap = section(study)?.collapse_ductility;
     let clip = |v: f64| if v.is_infinite() { cap } else { v };

@@ -13,7 +13,7 @@
 use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::dynamics::Ground;
 use crate::grid::Grid;
-use crate::motion::Record;
+use crate::ground_motion::Record;
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
@@ -106,13 +106,7 @@ fn all_units(grid: &Grid, motions: &[Vec<Record>]) -> Vec<Unit> {
 
 /// The kept motions of every zone, from `motions.h5`.
 pub fn load_motions(study: &Study) -> Result<Vec<Vec<Record>>, StoreError> {
-    let path = study.path(StageId::Motions.output());
-    study
-        .cfg
-        .zones
-        .iter()
-        .map(|z| read_zone_motions(&path, &z.name))
-        .collect()
+    super::motions::read_zones(study, read_zone_motions)
 }
 
 struct Units<'a> {
@@ -256,10 +250,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
         .try_for_each(|&u| -> Result<(), PipelineError> {
             let rec = &motions[u.zone][u.motion];
             let accel = rec.accel_mps2(1.0);
-            let ground = Ground {
-                dt_s: rec.dt_s,
-                accel_mps2: &accel,
-            };
+            let ground = Ground::new(rec.dt_s, &accel);
             let r = run_unit(
                 grid,
                 &physics,

@@ -1,6 +1,6 @@
 //! One linear SDOF step, `ü + 2ζωu̇ + ω²u = p(τ)` with `p` linear over the step, exact and
 //! stable for every `ω·h` (down to `ω = 0`, the free mass). Used by the response spectra
-//! (`spectrum::response`), the spectral matcher (`motion::matching`) and the exact integrator's
+//! (`spectrum::response`), the spectral matcher (`ground_motion::matching`) and the exact integrator's
 //! structure cluster at long periods (`dynamics::exact`; `docs/model.md`, "Long periods").
 //!
 //! With the state `x = (u, u̇)`, `M = [[0, 1], [−ω², −2ζω]]` and `b = (0, 1)`, the exact solution

@@ -12,7 +12,7 @@ use crate::dynamics::{
     Energy, ExactOptions, G, Ground, History, Response, SimError, System, SystemSpec, Yielding,
     simulate_exact, simulate_rk4,
 };
-use crate::motion::{self, Record, RecordError};
+use crate::ground_motion::{self, Record, RecordError};
 use crate::study::config::{ConfigError, read_yaml_text};
 use crate::study::physics::{DampingBasis, Physics};
 use serde::{Deserialize, Serialize};
@@ -233,8 +233,8 @@ impl Settings {
                 .map_err(|e| SimulationError::Invalid(e.to_string()))?;
         }
         let record = match &self.record {
-            Some(path) => motion::read_record(path)?,
-            None => motion::builtin(),
+            Some(path) => ground_motion::read_record(path)?,
+            None => ground_motion::builtin(),
         };
         Ok(Simulation {
             record,

@@ -21,7 +21,7 @@ use std::str::FromStr;
 use thiserror::Error;
 
 use crate::dynamics::G;
-use crate::limits::MAX_FILE_BYTES;
+use crate::limits::{InputFileError, MAX_FILE_BYTES, input_text, read_input_file};
 
 /// The damping ratio of target (design) spectra, and so of the record spectra compared with
 /// them: 5 %.
@@ -364,14 +364,10 @@ impl TargetSpectrum {
     /// dropped. `source` names the table in its SPEC string and labels, `file` in errors, which
     /// give `file:line`.
     pub fn from_table_text(bytes: &[u8], source: &str, file: &str) -> Result<Self, TargetError> {
-        let text = std::str::from_utf8(bytes).map_err(|_| TargetError::Io {
+        let text = input_text(bytes).map_err(|source| TargetError::Io {
             file: file.to_string(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::InvalidData,
-                "stream did not contain valid UTF-8",
-            ),
+            source,
         })?;
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let (periods_s, sa_g) = parse_table(text, file)?;
         Ok(TargetSpectrum::Table {
             source: source.to_string(),
@@ -402,15 +398,10 @@ impl TargetSpectrum {
 /// The bytes of a target table file, refused above [`MAX_FILE_BYTES`] before they are read.
 pub fn read_table_bytes(path: &Path) -> Result<Vec<u8>, TargetError> {
     let file = path.display().to_string();
-    let io = |source| TargetError::Io {
-        file: file.clone(),
-        source,
-    };
-    let bytes = std::fs::metadata(path).map_err(io)?.len();
-    if bytes > MAX_FILE_BYTES {
-        return Err(TargetError::TableTooLarge { file, bytes });
-    }
-    std::fs::read(path).map_err(io)
+    read_input_file(path).map_err(|e| match e {
+        InputFileError::Io(source) => TargetError::Io { file, source },
+        InputFileError::TooLarge(bytes) => TargetError::TableTooLarge { file, bytes },
+    })
 }
 
 /// ASCE 7-16 §11.4.6: `SDS(0.4 + 0.6T/T0)` below `T0 = 0.2·SD1/SDS`, `SDS` up to

@@ -138,88 +138,142 @@ fn chunk_of(shape: &[usize]) -> Vec<usize> {
     c
 }
 
+/// The coordinates of one zone's group, each a dimension scale.
+struct Coordinates {
+    system: hdf5::Dataset,
+    record: hdf5::Dataset,
+    case: hdf5::Dataset,
+    block: hdf5::Dataset,
+    run: hdf5::Dataset,
+    sa: hdf5::Dataset,
+    demand: hdf5::Dataset,
+    limit: hdf5::Dataset,
+    fractile: hdf5::Dataset,
+}
+
 fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hdf5::Result<()> {
     let g = f.create_group(&format!("zone_{}", z.name))?;
     attr_str(&g, "target", &z.target)?;
+    let dims = write_coordinates(&g, axes, z)?;
+    write_cases(&g, axes, &z.vars, &dims)?;
+    write_runs(&g, &z.vars, &dims)?;
+    write_fits(&g, &z.vars, &dims, meta)
+}
+
+/// A variable over the coordinates `dims`, chunked by [`chunk_of`].
+fn put(
+    g: &hdf5::Group,
+    name: &str,
+    data: &ArrayD<f64>,
+    dims: &[&hdf5::Dataset],
+    units: &str,
+    long: &str,
+) -> hdf5::Result<()> {
+    let ds = write_var(g, name, data.view(), &chunk_of(data.shape()), units, long)?;
+    for (i, d) in dims.iter().enumerate() {
+        attach_scale(&ds, d, i)?;
+    }
+    Ok(())
+}
+
+/// A CF flag variable over the coordinates `dims`.
+fn put_flags(
+    g: &hdf5::Group,
+    name: &str,
+    data: &ArrayD<u8>,
+    dims: &[&hdf5::Dataset],
+    long: &str,
+    flags: &[(u8, &str)],
+) -> hdf5::Result<()> {
+    let ds = write_flags(g, name, data.view(), &chunk_of(data.shape()), long, flags)?;
+    for (i, d) in dims.iter().enumerate() {
+        attach_scale(&ds, d, i)?;
+    }
+    Ok(())
+}
+
+fn write_coordinates(g: &hdf5::Group, axes: &IdaAxes, z: &ZoneIda) -> hdf5::Result<Coordinates> {
     let system = strings_scale(
-        &g,
+        g,
         "system",
         &axes.systems,
         "stack: the sliding stack; rigid: the same load rigidly attached",
     )?;
     let record = strings_scale(
-        &g,
+        g,
         "record",
         &z.records,
         "ground motion (matched, see motions.h5)",
     )?;
     let case = coordinate(
-        &g,
+        g,
         "case",
         &indices(axes.case_period_s.len()),
         "1",
         "case index (ida.cases of the config)",
     )?;
     let block = coordinate(
-        &g,
+        g,
         "block",
         &indices(axes.case_alpha.first().map_or(0, Vec::len)),
         "1",
         "block (0 = bottom) or interface under it",
     )?;
     let run = coordinate(
-        &g,
+        g,
         "run",
         &indices(axes.runs),
         "1",
         "run of a trace, in the order made (hunt, bracket, fill)",
     )?;
     let sa = coordinate(
-        &g,
+        g,
         "Sa",
         &axes.sa_grid_g,
         "g",
         "Sa(T_p, 5 %) of the scaled motion: the common intensity grid",
     )?;
     let demand = strings_scale(
-        &g,
+        g,
         "demand",
         &axes.demands,
         "engineering demand (units in the name; ductility = u_m/u_y)",
     )?;
     let limit = strings_scale(
-        &g,
+        g,
         "limit_state",
         &axes.limit_states,
         "limit state of the fragility fits",
     )?;
     let fractile = coordinate(
-        &g,
+        g,
         "fractile",
         &axes.fractiles,
         "1",
         "fractile over the records",
     )?;
     let ds = write_strings(
-        &g,
+        g,
         "limit_state_definition",
         &axes.limit_state_definitions,
         "exceeded when (a collapse exceeds every limit state)",
     )?;
     attach_scale(&ds, &limit, 0)?;
-    let v = &z.vars;
-    let put = |name: &str,
-               data: &ArrayD<f64>,
-               dims: &[&hdf5::Dataset],
-               units: &str,
-               long: &str|
-     -> hdf5::Result<()> {
-        let ds = write_var(&g, name, data.view(), &chunk_of(data.shape()), units, long)?;
-        for (i, d) in dims.iter().enumerate() {
-            attach_scale(&ds, d, i)?;
-        }
-        Ok(())
-    };
+    Ok(Coordinates {
+        system,
+        record,
+        case,
+        block,
+        run,
+        sa,
+        demand,
+        limit,
+        fractile,
+    })
+}
+
+/// The cases and their strengths, and each record's intensity.
+fn write_cases(g: &hdf5::Group, axes: &IdaAxes, v: &IdaVars, d: &Coordinates) -> hdf5::Result<()> {
     let shape = (
         axes.case_alpha.len(),
         axes.case_alpha.first().map_or(0, Vec::len),
@@ -228,42 +282,52 @@ fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hd
     let mu = ndarray::Array2::from_shape_fn(shape, |(c, b)| axes.case_mu[c][b]).into_dyn();
     let periods = ndarray::Array1::from(axes.case_period_s.clone()).into_dyn();
     put(
+        g,
         "case_T_p",
         &periods,
-        &[&case],
+        &[&d.case],
         "s",
         "period of the bare structure",
     )?;
     put(
+        g,
         "case_alpha",
         &alpha,
-        &[&case, &block],
+        &[&d.case, &d.block],
         "1",
         "mass ratio m_i/m_p of each block",
     )?;
     put(
+        g,
         "case_mu",
         &mu,
-        &[&case, &block],
+        &[&d.case, &d.block],
         "1",
         "kinetic friction coefficient of the interface under each block",
     )?;
     put(
+        g,
         "c_y",
         &v.c_y,
-        &[&case],
+        &[&d.case],
         "1",
         "yield strength ratio F_y/(m_p g) of the structure",
     )?;
     put(
+        g,
         "record_Sa",
         &v.record_sa_g,
-        &[&record, &case],
+        &[&d.record, &d.case],
         "g",
         "Sa(T_p, 5 %) of the unscaled motion",
-    )?;
-    let sys_run = [&system, &record, &case, &run];
+    )
+}
+
+/// The traced runs, the curves on the common grid and their fractiles.
+fn write_runs(g: &hdf5::Group, v: &IdaVars, d: &Coordinates) -> hdf5::Result<()> {
+    let sys_run = [&d.system, &d.record, &d.case, &d.run];
     put(
+        g,
         "run_Sa",
         &v.run_sa_g,
         &sys_run,
@@ -271,59 +335,60 @@ fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hd
         "intensity of each traced run",
     )?;
     put(
+        g,
         "run_demand",
         &v.run_demand,
-        &[&system, &record, &case, &run, &demand],
+        &[&d.system, &d.record, &d.case, &d.run, &d.demand],
         "demand",
         "demands of each traced run (units in the demand names)",
     )?;
-    for (name, data, long) in [
-        (
-            "run_collapsed",
-            &v.run_collapsed,
-            "the run reached the collapse ductility",
-        ),
-        (
-            "run_slip_exceeded",
-            &v.run_slip_exceeded,
-            "some block's peak slip reached slip_limit_m",
-        ),
-    ] {
-        let ds = write_flags(
-            &g,
-            name,
-            data.view(),
-            &chunk_of(data.shape()),
-            long,
-            &YES_NO,
-        )?;
-        for (i, d) in sys_run.iter().enumerate() {
-            attach_scale(&ds, d, i)?;
-        }
-    }
+    put_flags(
+        g,
+        "run_collapsed",
+        &v.run_collapsed,
+        &sys_run,
+        "the run reached the collapse ductility",
+        &YES_NO,
+    )?;
+    put_flags(
+        g,
+        "run_slip_exceeded",
+        &v.run_slip_exceeded,
+        &sys_run,
+        "some block's peak slip reached slip_limit_m",
+        &YES_NO,
+    )?;
     put(
+        g,
         "collapse_Sa",
         &v.collapse_sa_g,
-        &[&system, &record, &case],
+        &[&d.system, &d.record, &d.case],
         "g",
         "lowest collapsing intensity of the trace (NaN: no collapse up to the cap)",
     )?;
     put(
+        g,
         "curve",
         &v.curve,
-        &[&system, &record, &case, &sa, &demand],
+        &[&d.system, &d.record, &d.case, &d.sa, &d.demand],
         "demand",
         "IDA curve on the common grid (linear between runs; +inf from the collapse on; NaN above the last run)",
     )?;
     put(
+        g,
         "fractile_curve",
         &v.fractile_curve,
-        &[&system, &case, &fractile, &sa, &demand],
+        &[&d.system, &d.case, &d.fractile, &d.sa, &d.demand],
         "demand",
         "fractiles of the curves over the records (type 7; collapsed records count as +inf)",
-    )?;
-    let fr = [&system, &case, &limit, &sa];
+    )
+}
+
+/// The stripes, the fragility fits and their intervals.
+fn write_fits(g: &hdf5::Group, v: &IdaVars, d: &Coordinates, meta: &IdaMeta) -> hdf5::Result<()> {
+    let fr = [&d.system, &d.case, &d.limit, &d.sa];
     put(
+        g,
         "exceed_fraction",
         &v.exceed_fraction,
         &fr,
@@ -331,13 +396,14 @@ fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hd
         "fraction of the records whose curve exceeds the limit state (the stripe data of the fit)",
     )?;
     put(
+        g,
         "fragility_curve",
         &v.fragility_curve,
         &fr,
         "1",
         "fitted lognormal fragility Phi(ln(Sa/theta)/beta)",
     )?;
-    let fit = [&system, &case, &limit];
+    let fit = [&d.system, &d.case, &d.limit];
     for (name, data, units, long) in [
         (
             "theta",
@@ -371,20 +437,16 @@ fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hd
             "95 % Wald interval of beta, upper end",
         ),
     ] {
-        put(name, data, &fit, units, long)?;
+        put(g, name, data, &fit, units, long)?;
     }
-    let ds = write_flags(
-        &g,
+    put_flags(
+        g,
         "fit_status",
-        v.fit_status.view(),
-        &chunk_of(v.fit_status.shape()),
+        &v.fit_status,
+        &fit,
         "how the fragility fit ended",
         meta.fit_flags,
-    )?;
-    for (i, d) in fit.iter().enumerate() {
-        attach_scale(&ds, d, i)?;
-    }
-    Ok(())
+    )
 }
 
 /// Zone `zone` of `ida.h5` with the axes stored with it; every variable has the shape its

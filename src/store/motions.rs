@@ -24,9 +24,9 @@ use super::h5::{
     write_stage_file, write_strings,
 };
 use super::{H5Context, StoreError};
-use crate::motion::Record;
-use crate::motion::matching::MatchReport;
-use crate::motion::set::ZoneMotions;
+use crate::ground_motion::Record;
+use crate::ground_motion::matching::MatchReport;
+use crate::ground_motion::set::ZoneMotions;
 use crate::spectrum::{TargetError, TargetSpectrum};
 use std::path::Path;
 

@@ -20,13 +20,14 @@ use super::ida::IdaConfig;
 use super::physics::{DampingBasis, Physics};
 use crate::grid::Grid;
 use crate::grid::linear_range;
+use crate::ground_motion::matching::{MatchError, MatchSettings};
+use crate::ground_motion::stochastic::{StochasticError, StochasticModel};
+use crate::ground_motion::{ReadOptions, Units};
 use crate::limits::{
-    MAX_ALPHA, MAX_AXIS_VALUES, MAX_BLOCKS, MAX_CASE_RESULTS, MAX_FILE_BYTES, MAX_MOTIONS, MAX_MU,
-    MAX_YAML_DEPTH, PERIOD_RANGE_S, excerpt_message, yaml_depth,
+    InputFileError, MAX_ALPHA, MAX_AXIS_VALUES, MAX_BLOCKS, MAX_CASE_RESULTS, MAX_FILE_BYTES,
+    MAX_MOTIONS, MAX_MU, MAX_YAML_DEPTH, PERIOD_RANGE_S, excerpt_message, input_text,
+    read_input_file, yaml_depth,
 };
-use crate::motion::matching::{MatchError, MatchSettings};
-use crate::motion::stochastic::{StochasticError, StochasticModel};
-use crate::motion::{ReadOptions, Units};
 use crate::spectrum::target::read_table_bytes;
 use crate::spectrum::{TargetError, TargetSpectrum};
 use crate::store::fingerprint::sha256_hex;
@@ -289,33 +290,24 @@ pub fn read_yaml_text(path: &Path) -> Result<String, ConfigError> {
 /// The bytes of a YAML file, refused above [`MAX_FILE_BYTES`] before they are read.
 fn read_yaml_bytes(path: &Path) -> Result<Vec<u8>, ConfigError> {
     let file = path.display().to_string();
-    let io = |source| ConfigError::Io {
-        file: file.clone(),
-        source,
-    };
-    let bytes = std::fs::metadata(path).map_err(io)?.len();
-    if bytes > MAX_FILE_BYTES {
-        return Err(ConfigError::Invalid {
-            file: file.clone(),
+    read_input_file(path).map_err(|e| match e {
+        InputFileError::Io(source) => ConfigError::Io { file, source },
+        InputFileError::TooLarge(bytes) => ConfigError::Invalid {
+            file,
             key: "(file)".into(),
             why: format!("{bytes} bytes: a YAML file may have at most {MAX_FILE_BYTES}"),
-        });
-    }
-    std::fs::read(path).map_err(io)
+        },
+    })
 }
 
 /// The text of the YAML file `path`'s bytes: UTF-8, a byte-order mark dropped, nesting at most
 /// [`MAX_YAML_DEPTH`] deep.
 fn yaml_text(bytes: &[u8], path: &Path) -> Result<String, ConfigError> {
     let file = path.display().to_string();
-    let text = std::str::from_utf8(bytes).map_err(|_| ConfigError::Io {
+    let text = input_text(bytes).map_err(|source| ConfigError::Io {
         file: file.clone(),
-        source: std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            "stream did not contain valid UTF-8",
-        ),
+        source,
     })?;
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let depth = yaml_depth(text);
     if depth > MAX_YAML_DEPTH {
         return Err(ConfigError::Invalid {
@@ -360,9 +352,15 @@ impl StudyConfig {
         cfg.validate().map_err(|(key, why)| invalid(key, why))?;
         if let Some(r) = &cfg.motions.seeds.records {
             for f in &r.files {
-                let bytes = std::fs::read(f).map_err(|source| ConfigError::Io {
-                    file: f.display().to_string(),
-                    source,
+                let bytes = read_input_file(f).map_err(|e| match e {
+                    InputFileError::Io(source) => ConfigError::Io {
+                        file: f.display().to_string(),
+                        source,
+                    },
+                    InputFileError::TooLarge(bytes) => invalid(
+                        "motions.seeds.records.files".into(),
+                        format!("{}: {bytes} bytes; at most {MAX_FILE_BYTES}", f.display()),
+                    ),
                 })?;
                 cfg.loaded.record_sha256.push(sha256_hex(&bytes));
             }
@@ -378,23 +376,9 @@ impl StudyConfig {
         }
         for (i, z) in self.zones.iter().enumerate() {
             let key = format!("zones[{i}]");
-            if z.name.is_empty()
-                || !z
-                    .name
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-            {
-                return err(
-                    &format!("{key}.name"),
-                    format!("`{}` must be letters, digits, `_` or `-`", z.name),
-                );
-            }
-            if self.zones[..i].iter().any(|o| o.name == z.name) {
-                return err(
-                    &format!("{key}.name"),
-                    format!("`{}` appears twice", z.name),
-                );
-            }
+            let earlier = self.zones[..i].iter().map(|o| o.name.as_str());
+            crate::limits::check_name(&z.name, earlier)
+                .map_err(|why| (format!("{key}.name"), why))?;
             let (lo, hi) = self.motions.matching.check_range_s;
             self.target(i)
                 .check_covers(lo, hi)

@@ -155,6 +155,18 @@ impl IdaConfig {
         physics: &Physics,
         targets: &[(String, TargetSpectrum)],
     ) -> Result<(), (String, String)> {
+        self.validate_structure(targets)?;
+        self.validate_cases(physics, targets)?;
+        self.validate_tracing()?;
+        self.validate_curves()?;
+        self.validate_limit_states()
+    }
+
+    /// `structure`: one strength, by `c_y` or by design (IS 1893 targets only), and `r`.
+    fn validate_structure(
+        &self,
+        targets: &[(String, TargetSpectrum)],
+    ) -> Result<(), (String, String)> {
         let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
         let s = &self.structure;
         match (s.c_y, &s.design) {
@@ -201,6 +213,16 @@ impl IdaConfig {
                 format!("{r} must be in [0, 1)"),
             );
         }
+        Ok(())
+    }
+
+    /// `cases`: how many, and each one's period, stack and systems.
+    fn validate_cases(
+        &self,
+        physics: &Physics,
+        targets: &[(String, TargetSpectrum)],
+    ) -> Result<(), (String, String)> {
+        let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
         if self.cases.is_empty() || self.cases.len() > MAX_IDA_CASES {
             return err(
                 "cases",
@@ -260,6 +282,12 @@ impl IdaConfig {
                 })?;
             }
         }
+        Ok(())
+    }
+
+    /// `tracing`: its intensities, and the runs a trace may take.
+    fn validate_tracing(&self) -> Result<(), (String, String)> {
+        let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
         let t = &self.tracing;
         if !(t.first_sa_g.is_finite() && t.first_sa_g > 0.0) {
             return err(
@@ -301,6 +329,12 @@ impl IdaConfig {
                 ),
             );
         }
+        Ok(())
+    }
+
+    /// The curves and their end: `grid_points`, `collapse_ductility`, `slip_limit_m`, `pad_s`.
+    fn validate_curves(&self) -> Result<(), (String, String)> {
+        let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
         if self.grid_points < 2 || self.grid_points > MAX_IDA_GRID_POINTS {
             return err(
                 "grid_points",
@@ -324,28 +358,20 @@ impl IdaConfig {
                 format!("{} must be in [0, {MAX_IDA_PAD_S}]", self.pad_s),
             );
         }
+        Ok(())
+    }
+
+    /// `limit_states`: at least one, named once each, with one finite threshold.
+    fn validate_limit_states(&self) -> Result<(), (String, String)> {
+        let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
         if self.limit_states.is_empty() {
             return err("limit_states", "needs at least one limit state".into());
         }
         for (i, l) in self.limit_states.iter().enumerate() {
             let key = format!("limit_states[{i}]");
-            if l.name.is_empty()
-                || !l
-                    .name
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-            {
-                return err(
-                    &format!("{key}.name"),
-                    format!("`{}` must be letters, digits, `_` or `-`", l.name),
-                );
-            }
-            if self.limit_states[..i].iter().any(|o| o.name == l.name) {
-                return err(
-                    &format!("{key}.name"),
-                    format!("`{}` appears twice", l.name),
-                );
-            }
+            let earlier = self.limit_states[..i].iter().map(|o| o.name.as_str());
+            crate::limits::check_name(&l.name, earlier)
+                .map_err(|why| (format!("ida.{key}.name"), why))?;
             match (l.ductility, l.slip_m) {
                 (Some(v), None) if v.is_finite() && v > 0.0 => {}
                 (None, Some(v)) if v.is_finite() && v > 0.0 => {}

@@ -19,13 +19,13 @@
 //! false.
 
 use super::config::{MotionsConfig, Seeds, StudyConfig};
-use crate::motion::matching::{
+use crate::ground_motion::matching::{
     MatchError, MatchSettings, Matched, match_record, match_record_scaled,
 };
-use crate::motion::record::{parse_record, read_record_file};
-pub use crate::motion::set::{UnmatchedRecord, ZoneMotions};
-use crate::motion::stochastic::StochasticError;
-use crate::motion::{Record, RecordError};
+use crate::ground_motion::record::{parse_record, read_record_file};
+pub use crate::ground_motion::set::{UnmatchedRecord, ZoneMotions};
+use crate::ground_motion::stochastic::StochasticError;
+use crate::ground_motion::{Record, RecordError};
 use crate::spectrum::TargetSpectrum;
 use crate::store::fingerprint::sha256_hex;
 use rayon::prelude::*;
@@ -140,136 +140,16 @@ pub fn match_zone(
         Seeds::Stochastic(s) => s.count,
         Seeds::Records(_) => seeds.len(),
     };
-    // Seeds are matched in order, a batch at a time, until `wanted` are accepted: spares are
-    // only matched when needed, and which seeds are tried does not depend on the thread count.
-    let mut matched: Vec<Matched> = Vec::new();
-    loop {
-        let accepted = matched.iter().filter(|m| m.report.converged).count();
-        if accepted >= wanted || matched.len() == seeds.len() {
-            break;
-        }
-        let from = matched.len();
-        let to = (from + wanted - accepted).min(seeds.len());
-        let batch = seeds[from..to]
-            .par_iter()
-            .map(|s| match_record(&s.accel_g, s.dt_s, target, settings))
-            .collect::<Result<Vec<_>, _>>()?;
-        matched.extend(batch);
-    }
+    let mut matched = match_in_order(seeds, wanted, target, settings)?;
     let seeds = &seeds[..matched.len()];
-    let unmatched_record = |i: usize, m: &Matched| UnmatchedRecord {
-        name: seeds[i].name.clone(),
-        worst_period_s: m.report.worst_period_s,
-        worst_ratio: m.report.worst_ratio,
-        iterations: m.report.iterations,
-        after_set_scale: false,
+    let (kept, mut unmatched) = keep(name, seeds, &matched, wanted, cfg)?;
+    let set = SetChecks {
+        target_psa_g: &target_psa_g,
+        kept: &kept,
+        upper: settings.upper,
+        set_mean_min: cfg.set_mean_min,
     };
-    let mut kept: Vec<usize> = (0..seeds.len())
-        .filter(|&i| matched[i].report.converged)
-        .take(wanted)
-        .collect();
-    let mut unmatched: Vec<UnmatchedRecord> = Vec::new();
-    if kept.len() < wanted {
-        let short: Vec<usize> = (0..seeds.len())
-            .filter(|&i| !matched[i].report.converged)
-            .take(wanted - kept.len())
-            .collect();
-        unmatched = short
-            .iter()
-            .map(|&i| unmatched_record(i, &matched[i]))
-            .collect();
-        if !cfg.allow_unmatched {
-            return Err(Unmatched {
-                zone: name.to_string(),
-                lower: settings.lower,
-                upper: settings.upper,
-                records: unmatched,
-            }
-            .into());
-        }
-        kept.extend(short);
-        kept.sort_unstable();
-    }
-
-    let n = periods_s.len();
-    let ratio_min = |m: &[f64]| {
-        m.iter()
-            .zip(&target_psa_g)
-            .map(|(a, q)| a / q)
-            .fold(f64::INFINITY, f64::min)
-    };
-    let set_scale_of = |matched: &[Matched]| {
-        if kept.is_empty() {
-            return 1.0;
-        }
-        let psa: Vec<Vec<f64>> = kept
-            .iter()
-            .map(|&i| matched[i].check_psa_g.clone())
-            .collect();
-        (cfg.set_mean_min / ratio_min(&mean(&psa, n))).max(1.0)
-    };
-    let above = |m: &Matched, scale: f64| {
-        m.check_psa_g
-            .iter()
-            .zip(&target_psa_g)
-            .any(|(a, q)| a * scale / q > settings.upper * (1.0 + 1e-12))
-    };
-    // A motion matched again is aimed at the target after the scale, with half the tolerance
-    // (and fallbacks above half the room to the bound): what the scale may still add when the
-    // set is scaled anew stays inside the band.
-    let tight = MatchSettings {
-        tolerance: 0.5 * settings.tolerance,
-        retry_misfit: 0.5 * settings.tolerance + 0.25 * (settings.upper - 1.0),
-        ..settings.clone()
-    };
-    let mut set_scale = set_scale_of(&matched);
-    for round in 0..SET_SCALE_ROUNDS {
-        if !kept
-            .iter()
-            .any(|&i| matched[i].report.converged && above(&matched[i], set_scale))
-        {
-            break;
-        }
-        // The first round tightens every motion not yet within half the tolerance (what lowers
-        // the mean and so raises the scale), later ones the motions still pushed out.
-        let first = round == 0;
-        let out: Vec<usize> = kept
-            .iter()
-            .copied()
-            .filter(|&i| {
-                let m = &matched[i];
-                m.report.converged
-                    && if first {
-                        m.report.worst_misfit > tight.tolerance || above(m, set_scale)
-                    } else {
-                        above(m, set_scale)
-                    }
-            })
-            .collect();
-        let again = out
-            .par_iter()
-            .map(|&i| {
-                let m = &matched[i];
-                let factor = m.report.target_factor / set_scale;
-                match_record_scaled(&m.accel_g, seeds[i].dt_s, target, factor, &tight)
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        for (&i, mut m) in out.iter().zip(again) {
-            let old = &matched[i].report;
-            m.report.scale *= old.scale;
-            m.report.iterations += old.iterations;
-            m.report.attempts += old.attempts;
-            m.report.stalls += old.stalls;
-            m.report.pga_before_g = old.pga_before_g;
-            m.report.arias_ratio *= old.arias_ratio;
-            // Kept only if it still meets the band against its own (scaled) target.
-            if m.report.converged {
-                matched[i] = m;
-            }
-        }
-        set_scale = set_scale_of(&matched);
-    }
-
+    let set_scale = set.scale_and_rematch(&mut matched, seeds, target, settings)?;
     let psa_g: Vec<Vec<f64>> = kept
         .iter()
         .map(|&i| {
@@ -280,16 +160,15 @@ pub fn match_zone(
                 .collect()
         })
         .collect();
-    let mean_psa_g = mean(&psa_g, n);
-    let mean_ratio_min = ratio_min(&mean_psa_g);
-    let mut pushed_out = Vec::new();
+    let mean_psa_g = mean(&psa_g, periods_s.len());
+    let mean_ratio_min = set.ratio_min(&mean_psa_g);
     for (k, &i) in kept.iter().enumerate() {
         let in_band = psa_g[k].iter().zip(&target_psa_g).all(|(a, q)| {
             a / q >= settings.lower * (1.0 - 1e-12) && a / q <= settings.upper * (1.0 + 1e-12)
         });
         if !in_band && matched[i].report.converged {
             let (w, r) = worst(&matched[i].check_psa_g, set_scale, &target_psa_g);
-            pushed_out.push(UnmatchedRecord {
+            unmatched.push(UnmatchedRecord {
                 name: seeds[i].name.clone(),
                 worst_period_s: periods_s[w],
                 worst_ratio: r,
@@ -298,7 +177,6 @@ pub fn match_zone(
             });
         }
     }
-    unmatched.extend(pushed_out);
     let all_within_band = unmatched.is_empty();
     let motions = kept
         .iter()
@@ -326,4 +204,182 @@ pub fn match_zone(
         unmatched,
         periods_s,
     })
+}
+
+/// The seeds matched in order, a batch at a time, until `wanted` are accepted: spares are only
+/// matched when needed, and which seeds are tried does not depend on the thread count.
+fn match_in_order(
+    seeds: &[Record],
+    wanted: usize,
+    target: &TargetSpectrum,
+    settings: &MatchSettings,
+) -> Result<Vec<Matched>, MatchError> {
+    let mut matched: Vec<Matched> = Vec::new();
+    loop {
+        let accepted = matched.iter().filter(|m| m.report.converged).count();
+        if accepted >= wanted || matched.len() == seeds.len() {
+            return Ok(matched);
+        }
+        let from = matched.len();
+        let to = (from + wanted - accepted).min(seeds.len());
+        let batch = seeds[from..to]
+            .par_iter()
+            .map(|s| match_record(&s.accel_g, s.dt_s, target, settings))
+            .collect::<Result<Vec<_>, _>>()?;
+        matched.extend(batch);
+    }
+}
+
+/// The indices of the motions kept: the first `wanted` accepted ones, completed, when the config
+/// allows it, by the first that were not (returned flagged); `Unmatched` when it does not.
+fn keep(
+    name: &str,
+    seeds: &[Record],
+    matched: &[Matched],
+    wanted: usize,
+    cfg: &MotionsConfig,
+) -> Result<(Vec<usize>, Vec<UnmatchedRecord>), Unmatched> {
+    let mut kept: Vec<usize> = (0..seeds.len())
+        .filter(|&i| matched[i].report.converged)
+        .take(wanted)
+        .collect();
+    if kept.len() >= wanted {
+        return Ok((kept, Vec::new()));
+    }
+    let short: Vec<usize> = (0..seeds.len())
+        .filter(|&i| !matched[i].report.converged)
+        .take(wanted - kept.len())
+        .collect();
+    let unmatched: Vec<UnmatchedRecord> = short
+        .iter()
+        .map(|&i| UnmatchedRecord {
+            name: seeds[i].name.clone(),
+            worst_period_s: matched[i].report.worst_period_s,
+            worst_ratio: matched[i].report.worst_ratio,
+            iterations: matched[i].report.iterations,
+            after_set_scale: false,
+        })
+        .collect();
+    if !cfg.allow_unmatched {
+        return Err(Unmatched {
+            zone: name.to_string(),
+            lower: cfg.matching.lower,
+            upper: cfg.matching.upper,
+            records: unmatched,
+        });
+    }
+    kept.extend(short);
+    kept.sort_unstable();
+    Ok((kept, unmatched))
+}
+
+/// The set checks of a zone's kept motions against its target on the check grid (module doc).
+struct SetChecks<'a> {
+    target_psa_g: &'a [f64],
+    kept: &'a [usize],
+    upper: f64,
+    set_mean_min: f64,
+}
+
+impl SetChecks<'_> {
+    /// `min_T spectrum/target`.
+    fn ratio_min(&self, psa_g: &[f64]) -> f64 {
+        psa_g
+            .iter()
+            .zip(self.target_psa_g)
+            .map(|(a, q)| a / q)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The smallest factor (≥ 1) that lifts the kept motions' mean to `set_mean_min` of the
+    /// target.
+    fn scale(&self, matched: &[Matched]) -> f64 {
+        if self.kept.is_empty() {
+            return 1.0;
+        }
+        let psa: Vec<Vec<f64>> = self
+            .kept
+            .iter()
+            .map(|&i| matched[i].check_psa_g.clone())
+            .collect();
+        (self.set_mean_min / self.ratio_min(&mean(&psa, self.target_psa_g.len()))).max(1.0)
+    }
+
+    /// Whether `m`, times `scale`, lies above the band somewhere.
+    fn above(&self, m: &Matched, scale: f64) -> bool {
+        m.check_psa_g
+            .iter()
+            .zip(self.target_psa_g)
+            .any(|(a, q)| a * scale / q > self.upper * (1.0 + 1e-12))
+    }
+
+    /// The set scale, after matching again (at most [`SET_SCALE_ROUNDS`] rounds) the kept
+    /// motions it pushes above the band; each such motion replaces its match in `matched` when
+    /// it still meets the band.
+    fn scale_and_rematch(
+        &self,
+        matched: &mut [Matched],
+        seeds: &[Record],
+        target: &TargetSpectrum,
+        settings: &MatchSettings,
+    ) -> Result<f64, MatchError> {
+        // A motion matched again is aimed at the target after the scale, with half the
+        // tolerance (and fallbacks above half the room to the bound): what the scale may still
+        // add when the set is scaled anew stays inside the band.
+        let tight = MatchSettings {
+            tolerance: 0.5 * settings.tolerance,
+            retry_misfit: 0.5 * settings.tolerance + 0.25 * (settings.upper - 1.0),
+            ..settings.clone()
+        };
+        let mut set_scale = self.scale(matched);
+        for round in 0..SET_SCALE_ROUNDS {
+            if !self
+                .kept
+                .iter()
+                .any(|&i| matched[i].report.converged && self.above(&matched[i], set_scale))
+            {
+                break;
+            }
+            // The first round tightens every motion not yet within half the tolerance (what
+            // lowers the mean and so raises the scale), later ones the motions still pushed out.
+            let first = round == 0;
+            let out: Vec<usize> = self
+                .kept
+                .iter()
+                .copied()
+                .filter(|&i| {
+                    let m = &matched[i];
+                    m.report.converged
+                        && if first {
+                            m.report.worst_misfit > tight.tolerance || self.above(m, set_scale)
+                        } else {
+                            self.above(m, set_scale)
+                        }
+                })
+                .collect();
+            let again = out
+                .par_iter()
+                .map(|&i| {
+                    let m = &matched[i];
+                    let factor = m.report.target_factor / set_scale;
+                    match_record_scaled(&m.accel_g, seeds[i].dt_s, target, factor, &tight)
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            for (&i, mut m) in out.iter().zip(again) {
+                let old = &matched[i].report;
+                m.report.scale *= old.scale;
+                m.report.iterations += old.iterations;
+                m.report.attempts += old.attempts;
+                m.report.stalls += old.stalls;
+                m.report.pga_before_g = old.pga_before_g;
+                m.report.arias_ratio *= old.arias_ratio;
+                // Kept only if it still meets the band against its own (scaled) target.
+                if m.report.converged {
+                    matched[i] = m;
+                }
+            }
+            set_scale = self.scale(matched);
+        }
+        Ok(set_scale)
+    }
 }

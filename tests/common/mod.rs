@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 #![allow(clippy::needless_range_loop)]
 
-use slidestack::motion::{Record, read_record};
+use slidestack::ground_motion::{Record, read_record};
 use std::path::{Path, PathBuf};
 
 pub fn fixture(name: &str) -> PathBuf {

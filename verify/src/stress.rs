@@ -12,7 +12,7 @@
 //! * Sampling: `dt` 0.0005–0.05 s (at `T_p` = 0.01 s that is five structural periods per
 //!   sample); records of 6–300 s.
 //! * Ground motions, all built in code ([`GroundMotion`]): a zero record; the built-in stochastic
-//!   generator ([`slidestack::motion::stochastic`]) with fixed seeds, scaled by 1e-12, by 1e3 or to a
+//!   generator ([`slidestack::ground_motion::stochastic`]) with fixed seeds, scaled by 1e-12, by 1e3 or to a
 //!   peak ground acceleration, 20–300 s long; a ramp to exactly `μ·g` and back (the demand grazes
 //!   the limit); a ramp to exactly `μ·g` held for 99 s (friction balances the ground's push
 //!   exactly, so a loose block coasts); steps (changes over one sample) to a constant and a ±0.4 g
@@ -122,8 +122,8 @@ pub use survey::{SurveyPoint, limit_survey, survey_markdown};
 use slidestack::dynamics::{
     Contact, ExactOptions, Ground, Response, SimError, System, SystemSpec, simulate_exact,
 };
-use slidestack::motion::StochasticModel;
-use slidestack::report::sci;
+use slidestack::ground_motion::StochasticModel;
+use slidestack::render::sci;
 use std::fmt::Write as _;
 
 /// How a case's ground acceleration is built: synthetic signals in code, or the built-in

@@ -29,8 +29,8 @@ use serde::{Deserialize, Serialize};
 use slidestack::dynamics::{
     ExactOptions, Ground, Response, System, SystemSpec, simulate_exact, simulate_rk4,
 };
-use slidestack::motion::{self, Record, read_record};
-use slidestack::report::{self, Series, sci};
+use slidestack::ground_motion::{self, Record, read_record};
+use slidestack::render::{self, Series, sci};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -313,7 +313,7 @@ fn run_case(
         switches: Some(exact.switches),
     }];
 
-    let fine = motion::process::refine(record, REFINE);
+    let fine = ground_motion::process::refine(record, REFINE);
     let fine_accel = fine.accel_mps2(1.0);
     let fine_ground = Ground {
         dt_s: fine.dt_s,
@@ -549,7 +549,7 @@ impl Table {
     }
 
     fn html(&self) -> String {
-        report::table(&self.header, &self.rows)
+        render::table(&self.header, &self.rows)
     }
 }
 
@@ -766,14 +766,14 @@ fn markdown(machine: &str, args: &Args, opensees: Option<&str>, t: &Tables) -> S
 fn html(machine: &str, t: &Tables, svg_history: &str, svg_peak: &str) -> String {
     let summary = format!(
         "<p>Machine: {}</p><ul>{}</ul>{}",
-        report::escape(machine),
+        render::escape(machine),
         t.overall
             .iter()
-            .map(|l| format!("<li>{}</li>", report::escape(l)))
+            .map(|l| format!("<li>{}</li>", render::escape(l)))
             .collect::<String>(),
         t.summary.html()
     );
-    report::page(
+    render::page(
         "slidestack: work-precision of the integrators",
         &[
             ("Summary".to_string(), summary),
@@ -881,7 +881,7 @@ fn charts(cases: &[CaseResult]) -> (String, String) {
                 vec![y],
             ));
         }
-        report::chart_log_log(
+        render::chart_log_log(
             &format!("{what} error against time (geometric means over the cases)"),
             "CPU time per simulation / exact integrator's",
             &format!("{what} error / peak"),

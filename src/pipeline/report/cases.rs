@@ -4,8 +4,8 @@
 use super::runs::{section71_tnew, simulate};
 use super::text::{fixed, mean, nums, sig};
 use super::{Files, Inputs, ReportError, Zone};
-use crate::report::chart::{Axis, Figure, Mark, PALETTE, Panel, Plot, Segment, Series, Stroke};
-use crate::report::page::{Section, para, table_with_id};
+use crate::render::chart::{Axis, Figure, Mark, PALETTE, Panel, Plot, Segment, Series, Stroke};
+use crate::render::page::{Section, para, table_with_id};
 use crate::study::cases::{PAPER_SECTION_7_1, PAPER_TABLE_2, SECTION_7_1};
 use crate::study::physics::{Physics, SystemKind};
 use crate::study::tnew::TnewFlag;

@@ -2,109 +2,24 @@
 //! their standard errors, and the residuals of every fitted form.
 
 use super::text::{fixed, mean, paper_equation_name, sig};
-use super::{Files, Inputs, ReportError};
-use crate::fit::Fitted;
-use crate::report::chart::{Axis, Figure, Mark, PALETTE, Panel, Series, Stroke};
-use crate::report::page::{Section, para, table_with_id};
+use super::{Files, Inputs, ReportError, Zone};
+use crate::fit::{Fitted, Sample};
+use crate::grid::Grid;
+use crate::render::chart::{Axis, Figure, Mark, PALETTE, Panel, Series, Stroke};
+use crate::render::page::{Section, para, table_with_id};
+use crate::store::fit::FormFit;
 use crate::study::cases::PAPER_TABLE_3;
 use crate::study::tnew::samples;
 use plotters::style::RGBColor;
 
 pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, ReportError> {
-    let grid = inp.grid;
-    let f3 = |v: f64| fixed(v, 3);
-    let mut table3 = Vec::new();
     let mut body = para(&format!(
         "Table 3 of the paper next to ours: the paper's fit quality of its Eqs. 16–17, those \
          equations as printed evaluated on our T_new, and each form fitted here (features {}; \
          5-fold cross-validated columns from fits that did not see the predicted cases).",
         inp.fit.features.join(", ")
     ));
-    let mut coef_tables = String::new();
-    for z in &inp.zones {
-        let zf = &z.fit;
-        if let Some((_, p)) = PAPER_TABLE_3.iter().find(|p| p.0 == z.name) {
-            let mut row = vec![z.name.clone(), "paper Table 3".into()];
-            row.extend(p.iter().map(|&v| f3(v)));
-            row.extend(["–".to_string(), "–".to_string()]);
-            table3.push(row);
-        }
-        if let Some(m) = &zf.published {
-            table3.push(vec![
-                z.name.clone(),
-                format!(
-                    "paper's equation ({}) as printed, on our T_new",
-                    paper_equation_name(&z.name)
-                ),
-                f3(m.r2),
-                f3(m.r),
-                f3(m.rmse),
-                f3(m.mse),
-                f3(m.mae),
-                "–".into(),
-                "–".into(),
-            ]);
-        }
-        for ff in &zf.forms {
-            let (m, cv) = (&ff.all_cases, &ff.cross_validated);
-            let rec = if ff.form == zf.recommended {
-                ", recommended"
-            } else {
-                ""
-            };
-            table3.push(vec![
-                z.name.clone(),
-                format!("{} form, fitted here{rec}", ff.form.name()),
-                f3(m.r2),
-                f3(m.r),
-                f3(m.rmse),
-                f3(m.mse),
-                f3(m.mae),
-                f3(cv.r2),
-                f3(cv.rmse),
-            ]);
-        }
-        if let Some(ff) = zf.recommended_fit() {
-            let rows: Vec<Vec<String>> = ff
-                .coefficients
-                .iter()
-                .enumerate()
-                .map(|(i, (name, v))| {
-                    let se = ff.standard_errors.get(i).copied().unwrap_or(f64::NAN);
-                    vec![
-                        name.clone(),
-                        sig(*v, 6),
-                        if se.is_finite() {
-                            sig(se, 3)
-                        } else {
-                            "not estimated".into()
-                        },
-                        if se.is_finite() && *v != 0.0 {
-                            format!("{:.1}", 100.0 * se / v.abs())
-                        } else {
-                            "–".into()
-                        },
-                    ]
-                })
-                .collect();
-            coef_tables += &para(&format!(
-                "Zone {}: coefficients of the recommended {} form ({} cases).",
-                z.name,
-                ff.form.name(),
-                zf.cases
-            ));
-            coef_tables += &table_with_id(
-                &format!("coefficients_{}", z.name),
-                &[
-                    "coefficient",
-                    "value",
-                    "standard error",
-                    "standard error / |value| (%)",
-                ],
-                &rows,
-            );
-        }
-    }
+    let table3: Vec<Vec<String>> = inp.zones.iter().flat_map(table3_rows).collect();
     body += &table_with_id(
         "table3",
         &[
@@ -120,7 +35,9 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
         ],
         &table3,
     );
-    body += &coef_tables;
+    for z in &inp.zones {
+        body += &coefficients(z);
+    }
     body += &para(
         "Residuals (computed − predicted T_new) of every fitted form against T_p, the \
          recommended one first; each case coloured by its T_new band category (the categories \
@@ -128,128 +45,233 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
          T_p.",
     );
     for z in &inp.zones {
-        let v = &z.tnew.vars;
-        let tn: Vec<f64> = v.t_new.iter().copied().collect();
-        let tr: Vec<f64> = v.t_rigid.iter().copied().collect();
-        let band: Vec<u8> = v.band.iter().copied().collect();
-        let data = samples(grid, &tr, &tn);
-        let bands: Vec<u8> = (0..tn.len())
-            .filter(|&c| tn[c].is_finite())
-            .map(|c| band[c])
-            .collect();
-        let mut forms: Vec<_> = z.fit.forms.iter().collect();
-        forms.sort_by_key(|f| f.form != z.fit.recommended);
-        let mut panels = Vec::new();
-        for ff in forms {
-            let f = Fitted {
-                form: ff.form,
-                params: ff.coefficients.iter().map(|c| c.1).collect(),
-            };
-            let resid: Vec<f64> = data.iter().map(|s| s.t_new_s - f.predict(s)).collect();
-            let mut series = Vec::new();
-            // The categories side by side within each T_p column, so none hides another.
-            let present: Vec<&(u8, String)> = z
-                .band_flags
-                .iter()
-                .filter(|(code, _)| bands.contains(code))
-                .collect();
-            let step = grid
-                .periods_s
-                .windows(2)
-                .map(|w| w[1] - w[0])
-                .fold(f64::INFINITY, f64::min);
-            let step = if step.is_finite() { step } else { 0.1 };
-            let dodge = 0.6 * step / present.len().max(1) as f64;
-            for (k, (code, word)) in present.iter().enumerate() {
-                let shift = (k as f64 - (present.len() - 1) as f64 / 2.0) * dodge;
-                let (xs, ys): (Vec<f64>, Vec<f64>) = data
-                    .iter()
-                    .zip(&resid)
-                    .zip(&bands)
-                    .filter(|(_, b)| *b == code)
-                    .map(|((s, r), _)| (s.t_p_s() + shift, *r))
-                    .unzip();
-                series.push(
-                    Series::points(word.clone(), xs, ys)
-                        .mark(Mark::Points {
-                            radius: 2,
-                            opacity: 0.45,
-                        })
-                        .colour(PALETTE[*code as usize % PALETTE.len()]),
-                );
-            }
-            let (mut m, mut lo, mut hi) = (Vec::new(), Vec::new(), Vec::new());
-            for &t in &grid.periods_s {
-                let mut r: Vec<f64> = data
-                    .iter()
-                    .zip(&resid)
-                    .filter(|(s, _)| s.t_p_s() == t)
-                    .map(|(_, r)| *r)
-                    .collect();
-                r.sort_by(f64::total_cmp);
-                let q = |p: f64| {
-                    r.get(((r.len() as f64 - 1.0) * p).round() as usize)
-                        .copied()
-                        .unwrap_or(f64::NAN)
-                };
-                m.push(mean(r.iter().copied()));
-                lo.push(q(0.05));
-                hi.push(q(0.95));
-            }
-            let black = RGBColor(0, 0, 0);
-            series.push(
-                Series::line("mean per T_p", grid.periods_s.clone(), m)
-                    .colour(black)
-                    .stroke(Stroke::Solid, 2),
-            );
-            series.push(
-                Series::line("5th / 95th percentile per T_p", grid.periods_s.clone(), lo)
-                    .colour(black)
-                    .stroke(Stroke::Dashed, 1),
-            );
-            series.push(
-                Series::line("5th / 95th percentile per T_p", grid.periods_s.clone(), hi)
-                    .colour(black)
-                    .stroke(Stroke::Dashed, 1),
-            );
-            let metrics = &ff.all_cases;
-            panels.push(Panel::xy(
-                format!(
-                    "{} form{}: RMSE {:.3} s, R² {:.3}",
-                    ff.form.name(),
-                    if ff.form == z.fit.recommended {
-                        " (recommended)"
-                    } else {
-                        ""
-                    },
-                    metrics.rmse,
-                    metrics.r2
-                ),
-                Axis::new("T_p (s)"),
-                Axis::new("computed − predicted T_new (s)"),
-                series,
-            ));
-        }
-        let cols = panels.len().min(2);
-        let fig = Figure::grid(
-            format!(
-                "Zone {}: residuals of the design equations for T_new",
-                z.name
-            ),
-            panels,
-            cols,
-        )
-        .panel_px(460, 340);
-        body += &files.figure(
-            &format!("residuals_{}.svg", z.name),
-            &fig,
-            &format!(
-                "Zone {}: computed − predicted T_new against T_p for every fitted form, the \
-                 recommended ({}) first.",
-                z.name,
-                z.fit.recommended.name()
-            ),
-        )?;
+        body += &residuals(z, inp.grid, files)?;
     }
     Ok(Section::new("fit", "Design equations (Table 3)", body))
+}
+
+/// A zone's rows of Table 3: the paper's, its equation on our `T_new`, each fitted form.
+fn table3_rows(z: &Zone) -> Vec<Vec<String>> {
+    let f3 = |v: f64| fixed(v, 3);
+    let zf = &z.fit;
+    let mut rows = Vec::new();
+    if let Some((_, p)) = PAPER_TABLE_3.iter().find(|p| p.0 == z.name) {
+        let mut row = vec![z.name.clone(), "paper Table 3".into()];
+        row.extend(p.iter().map(|&v| f3(v)));
+        row.extend(["–".to_string(), "–".to_string()]);
+        rows.push(row);
+    }
+    if let Some(m) = &zf.published {
+        rows.push(vec![
+            z.name.clone(),
+            format!(
+                "paper's equation ({}) as printed, on our T_new",
+                paper_equation_name(&z.name)
+            ),
+            f3(m.r2),
+            f3(m.r),
+            f3(m.rmse),
+            f3(m.mse),
+            f3(m.mae),
+            "–".into(),
+            "–".into(),
+        ]);
+    }
+    for ff in &zf.forms {
+        let (m, cv) = (&ff.all_cases, &ff.cross_validated);
+        let rec = if ff.form == zf.recommended {
+            ", recommended"
+        } else {
+            ""
+        };
+        rows.push(vec![
+            z.name.clone(),
+            format!("{} form, fitted here{rec}", ff.form.name()),
+            f3(m.r2),
+            f3(m.r),
+            f3(m.rmse),
+            f3(m.mse),
+            f3(m.mae),
+            f3(cv.r2),
+            f3(cv.rmse),
+        ]);
+    }
+    rows
+}
+
+/// The recommended form's coefficients with their standard errors (nothing without one).
+fn coefficients(z: &Zone) -> String {
+    let zf = &z.fit;
+    let Some(ff) = zf.recommended_fit() else {
+        return String::new();
+    };
+    let rows: Vec<Vec<String>> = ff
+        .coefficients
+        .iter()
+        .enumerate()
+        .map(|(i, (name, v))| {
+            let se = ff.standard_errors.get(i).copied().unwrap_or(f64::NAN);
+            vec![
+                name.clone(),
+                sig(*v, 6),
+                if se.is_finite() {
+                    sig(se, 3)
+                } else {
+                    "not estimated".into()
+                },
+                if se.is_finite() && *v != 0.0 {
+                    format!("{:.1}", 100.0 * se / v.abs())
+                } else {
+                    "–".into()
+                },
+            ]
+        })
+        .collect();
+    para(&format!(
+        "Zone {}: coefficients of the recommended {} form ({} cases).",
+        z.name,
+        ff.form.name(),
+        zf.cases
+    )) + &table_with_id(
+        &format!("coefficients_{}", z.name),
+        &[
+            "coefficient",
+            "value",
+            "standard error",
+            "standard error / |value| (%)",
+        ],
+        &rows,
+    )
+}
+
+/// A zone's figure of the residuals of every fitted form, the recommended one first.
+fn residuals(z: &Zone, grid: &Grid, files: &mut Files) -> Result<String, ReportError> {
+    let v = &z.tnew.vars;
+    let tn: Vec<f64> = v.t_new.iter().copied().collect();
+    let tr: Vec<f64> = v.t_rigid.iter().copied().collect();
+    let band: Vec<u8> = v.band.iter().copied().collect();
+    let data = samples(grid, &tr, &tn);
+    let bands: Vec<u8> = (0..tn.len())
+        .filter(|&c| tn[c].is_finite())
+        .map(|c| band[c])
+        .collect();
+    let mut forms: Vec<_> = z.fit.forms.iter().collect();
+    forms.sort_by_key(|f| f.form != z.fit.recommended);
+    let panels: Vec<Panel> = forms
+        .into_iter()
+        .map(|ff| residual_panel(z, ff, grid, &data, &bands))
+        .collect();
+    let cols = panels.len().min(2);
+    let fig = Figure::grid(
+        format!(
+            "Zone {}: residuals of the design equations for T_new",
+            z.name
+        ),
+        panels,
+        cols,
+    )
+    .panel_px(460, 340);
+    files.figure(
+        &format!("residuals_{}.svg", z.name),
+        &fig,
+        &format!(
+            "Zone {}: computed − predicted T_new against T_p for every fitted form, the \
+             recommended ({}) first.",
+            z.name,
+            z.fit.recommended.name()
+        ),
+    )
+}
+
+/// One form's residuals against `T_p` over the cases `data` (band codes `bands`): the cases by
+/// band, side by side within each `T_p` column so none hides another, with the mean and the
+/// 5th/95th percentiles per `T_p`.
+fn residual_panel(z: &Zone, ff: &FormFit, grid: &Grid, data: &[Sample], bands: &[u8]) -> Panel {
+    let f = Fitted {
+        form: ff.form,
+        params: ff.coefficients.iter().map(|c| c.1).collect(),
+    };
+    let resid: Vec<f64> = data.iter().map(|s| s.t_new_s - f.predict(s)).collect();
+    let mut series = Vec::new();
+    let present: Vec<&(u8, String)> = z
+        .band_flags
+        .iter()
+        .filter(|(code, _)| bands.contains(code))
+        .collect();
+    let step = grid
+        .periods_s
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(f64::INFINITY, f64::min);
+    let step = if step.is_finite() { step } else { 0.1 };
+    let dodge = 0.6 * step / present.len().max(1) as f64;
+    for (k, (code, word)) in present.iter().enumerate() {
+        let shift = (k as f64 - (present.len() - 1) as f64 / 2.0) * dodge;
+        let (xs, ys): (Vec<f64>, Vec<f64>) = data
+            .iter()
+            .zip(&resid)
+            .zip(bands)
+            .filter(|(_, b)| *b == code)
+            .map(|((s, r), _)| (s.t_p_s() + shift, *r))
+            .unzip();
+        series.push(
+            Series::points(word.clone(), xs, ys)
+                .mark(Mark::Points {
+                    radius: 2,
+                    opacity: 0.45,
+                })
+                .colour(PALETTE[*code as usize % PALETTE.len()]),
+        );
+    }
+    let (mut m, mut lo, mut hi) = (Vec::new(), Vec::new(), Vec::new());
+    for &t in &grid.periods_s {
+        let mut r: Vec<f64> = data
+            .iter()
+            .zip(&resid)
+            .filter(|(s, _)| s.t_p_s() == t)
+            .map(|(_, r)| *r)
+            .collect();
+        r.sort_by(f64::total_cmp);
+        let q = |p: f64| {
+            r.get(((r.len() as f64 - 1.0) * p).round() as usize)
+                .copied()
+                .unwrap_or(f64::NAN)
+        };
+        m.push(mean(r.iter().copied()));
+        lo.push(q(0.05));
+        hi.push(q(0.95));
+    }
+    let black = RGBColor(0, 0, 0);
+    series.push(
+        Series::line("mean per T_p", grid.periods_s.clone(), m)
+            .colour(black)
+            .stroke(Stroke::Solid, 2),
+    );
+    series.push(
+        Series::line("5th / 95th percentile per T_p", grid.periods_s.clone(), lo)
+            .colour(black)
+            .stroke(Stroke::Dashed, 1),
+    );
+    series.push(
+        Series::line("5th / 95th percentile per T_p", grid.periods_s.clone(), hi)
+            .colour(black)
+            .stroke(Stroke::Dashed, 1),
+    );
+    let metrics = &ff.all_cases;
+    Panel::xy(
+        format!(
+            "{} form{}: RMSE {:.3} s, R² {:.3}",
+            ff.form.name(),
+            if ff.form == z.fit.recommended {
+                " (recommended)"
+            } else {
+                ""
+            },
+            metrics.rmse,
+            metrics.r2
+        ),
+        Axis::new("T_p (s)"),
+        Axis::new("computed − predicted T_new (s)"),
+        series,
+    )
 }

@@ -5,8 +5,8 @@ use super::select::{Selection, case_index, label_of};
 use super::text::{num, paper_figure};
 use super::{Files, Inputs, ReportError};
 use crate::grid::Grid;
-use crate::report::chart::{Axis, Figure, Mark, Panel, Series, Stroke};
-use crate::report::page::{Section, para, table_with_id};
+use crate::render::chart::{Axis, Figure, Mark, Panel, Series, Stroke};
+use crate::render::page::{Section, para, table_with_id};
 use crate::study::tnew::BandCounts;
 use plotters::style::RGBColor;
 

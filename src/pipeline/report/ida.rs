@@ -5,7 +5,7 @@
 use super::{Files, PipelineError, ReportError};
 use crate::pipeline::Study;
 use crate::pipeline::ida::{figure_of, fragility_table, median_ductility};
-use crate::report::page::{Section, para, table_with_id};
+use crate::render::page::{Section, para, table_with_id};
 
 fn g3(x: f64) -> String {
     if x.is_finite() {

@@ -32,9 +32,9 @@ mod text;
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::grid::Grid;
-use crate::motion::Record;
-use crate::report::chart::{self, ChartError, Figure};
-use crate::report::page::{Section, document, figure, list, para, table_with_id};
+use crate::ground_motion::Record;
+use crate::render::chart::{self, ChartError, Figure};
+use crate::render::page::{Section, document, figure, list, para, table_with_id};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::fit::{FitReport, ZoneFit, read_fit};

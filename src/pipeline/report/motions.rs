@@ -1,8 +1,8 @@
 //! The matched motions against their target (paper Figs 4–5).
 
 use super::{Files, Inputs, ReportError};
-use crate::report::chart::{Axis, FAINT, Figure, PALETTE, Panel, Series, Stroke};
-use crate::report::page::{Section, para};
+use crate::render::chart::{Axis, FAINT, Figure, PALETTE, Panel, Series, Stroke};
+use crate::render::page::{Section, para};
 use plotters::style::RGBColor;
 
 pub(super) fn motions_section(inp: &Inputs, files: &mut Files) -> Result<Section, ReportError> {

@@ -5,7 +5,7 @@ use super::text::{mean, num, nums};
 use super::{ReportError, Zone};
 use crate::case::Case;
 use crate::dynamics::{ExactOptions, Ground, Response};
-use crate::motion::Record;
+use crate::ground_motion::Record;
 use crate::study::cases::PaperCase;
 use crate::study::physics::{Physics, SystemKind};
 use crate::study::tnew::{TnewFlag, t_new};
@@ -20,10 +20,7 @@ pub(super) fn simulate(
     history: bool,
 ) -> Result<Response, ReportError> {
     let accel = rec.accel_mps2(1.0);
-    let ground = Ground {
-        dt_s: rec.dt_s,
-        accel_mps2: &accel,
-    };
+    let ground = Ground::new(rec.dt_s, &accel);
     let opts = ExactOptions {
         history,
         ..ExactOptions::default()

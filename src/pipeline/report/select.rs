@@ -4,7 +4,7 @@
 
 use super::text::num;
 use crate::grid::Grid;
-use crate::report::chart::{PALETTE, Stroke};
+use crate::render::chart::{PALETTE, Stroke};
 use plotters::style::RGBColor;
 
 /// At most this many panels over the mass ratios, and lines of friction pairs per panel.

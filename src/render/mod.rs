@@ -1,5 +1,6 @@
-//! Figures (SVG, with plotters) and HTML pages of reports. Knows nothing of how the numbers were
-//! computed: every function takes plain series, tables and text, and returns text.
+//! Rendering: figures (SVG, with plotters) and HTML pages from plain series, tables and text,
+//! returned as text. Knows nothing of how the numbers were computed, nor of the report stage
+//! (`pipeline::report`) or its files (`store::report`), which use it.
 //!
 //! * [`mod@chart`]: panels, series, legends outside the plot areas; [`chart::render`] a figure.
 //! * [`mod@page`]: tables, figures and sections of an HTML page.

@@ -24,7 +24,9 @@ use std::str::FromStr;
 use thiserror::Error;
 
 use crate::dynamics::G;
-use crate::limits::{DT_RANGE_S, MAX_FILE_BYTES, MAX_SAMPLES, excerpt};
+use crate::limits::{
+    DT_RANGE_S, InputFileError, MAX_FILE_BYTES, MAX_SAMPLES, excerpt, input_text, read_input_file,
+};
 
 /// Relative tolerance for "the same time step": the uniform-sampling check of two-column files
 /// and the agreement between a file's step and [`ReadOptions::dt_s`].
@@ -249,29 +251,20 @@ pub fn read_record_with(path: &Path, opts: &ReadOptions) -> Result<Record, Recor
 /// The bytes of a record file, refused above [`MAX_FILE_BYTES`] before they are read.
 pub fn read_record_file(path: &Path) -> Result<Vec<u8>, RecordError> {
     let file = path.display().to_string();
-    let io = |source| RecordError::Io {
-        file: file.clone(),
-        source,
-    };
-    let bytes = std::fs::metadata(path).map_err(io)?.len();
-    if bytes > MAX_FILE_BYTES {
-        return Err(RecordError::TooLarge { file, bytes });
-    }
-    std::fs::read(path).map_err(io)
+    read_input_file(path).map_err(|e| match e {
+        InputFileError::Io(source) => RecordError::Io { file, source },
+        InputFileError::TooLarge(bytes) => RecordError::TooLarge { file, bytes },
+    })
 }
 
 /// The record in the bytes of the file `path` (its name and extension tell the format), as
 /// [`read_record_with`] reads it.
 pub fn parse_record(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
     let file = path.display().to_string();
-    let text = std::str::from_utf8(bytes).map_err(|_| RecordError::Io {
+    let text = input_text(bytes).map_err(|source| RecordError::Io {
         file: file.clone(),
-        source: std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            "stream did not contain valid UTF-8",
-        ),
+        source,
     })?;
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let is_at2 = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("at2"))

@@ -1025,9 +1025,9 @@ mod tests {
         let mut a: Vec<f64> = (0..3000)
             .map(|k| 0.3 * (0.05 * k as f64).sin() + 0.01 + 2e-6 * k as f64)
             .collect();
-        let (v0, d0) = crate::motion::process::drift(&a, dt);
+        let (v0, d0) = crate::ground_motion::process::drift(&a, dt);
         bring_to_rest(&mut a, dt);
-        let (v, d) = crate::motion::process::drift(&a, dt);
+        let (v, d) = crate::ground_motion::process::drift(&a, dt);
         assert!(
             v.abs() < 1e-12 * v0.abs() && d.abs() < 1e-12 * d0.abs(),
             "{v} {d}"
