@@ -16,7 +16,7 @@ use slidestack::dynamics::building::{
     Building, BuildingSpec, DampingBasis, StackSpec, StoreyYielding, simulate_building,
 };
 use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, Yielding, simulate_exact};
-use slidestack::motion::read_record;
+use slidestack::ground_motion::read_record;
 use std::hint::black_box;
 
 #[path = "../tests/common/mod.rs"]

@@ -60,7 +60,7 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(path) = &args.figure
         && let Some(fig) = sim.building_figure(&accel)?
     {
-        let svg = slidestack::report::chart::render(&fig)?;
+        let svg = slidestack::render::chart::render(&fig)?;
         slidestack::store::atomic::write_bytes(path, svg.as_bytes())?;
     }
     if args.json {

@@ -11,7 +11,7 @@ use crate::dynamics::{
     DampingBasis, Energy, ExactOptions, G, Ground, History, simulate_exact, simulate_rk4,
 };
 use crate::limits::MAX_STOREYS;
-use crate::report::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
+use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
 use crate::simulation::{Integrator, StructureKind};
 use crate::store::HistoryLayout;
 use serde::{Deserialize, Serialize};

@@ -296,8 +296,8 @@ impl Settings {
             crate::store::HistoryFormat::from_path(p).map_err(|e| self.key_error(e.to_string()))?;
         }
         let record = match &self.record {
-            Some(path) => motion::read_record(path)?,
-            None => motion::builtin(),
+            Some(path) => ground_motion::read_record(path)?,
+            None => ground_motion::builtin(),
         };
         Ok(Simulation {
             record,
@@ -465,7 +465,7 @@ impl Simulation {
     pub fn building_figure(
         &self,
         accel_mps2: &[f64],
-    ) -> Result<Option<crate::report::chart::Figure>, SimulationError> {
+    ) -> Result<Option<crate::render::chart::Figure>, SimulationError> {
         let Model::Building { building: b, .. } = &self.model else {
             return Ok(None);
         };
