@@ -41,12 +41,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::closed_form::{
-    Basis, Osc, PieceIntegrals, Wave, hermite_range, integral_of_square_decay,
-    integral_of_square_with,
+    Basis, Osc, PieceIntegrals, Wave, integral_of_square_decay, integral_of_square_with,
 };
 use super::contact::{Contact, ContactSelector};
 use super::model::System;
 use super::response::{Energy, History, Response};
+use super::search::{self, Node, Smooth};
 use super::{Ground, SimError};
 use crate::sdof::{self, Piece, decay_piece};
 
@@ -304,48 +304,72 @@ impl Tracked {
         }
     }
 
-    /// Bound of `|f⁽ᵏ⁾|` over `[b.tau, t1]`.
-    #[inline]
-    fn bound(&self, k: usize, b: &Basis, t1: f64) -> f64 {
-        self.f.deriv_abs_bound(k, t1, b.exp, self.amps[k])
+    /// This function over a piece whose free motion is `osc`, for the certified searches.
+    fn over(&self, osc: Osc) -> OverPiece<'_> {
+        OverPiece { g: self, osc }
     }
 
-    /// Whether `lower ≤ f ≤ upper` on `[lo, hi]` is certified from the values and slopes of `f`
-    /// at the ends, by the better of the curvature bound (`max|f''|·w²/8` beyond the end values)
-    /// and the Hermite bound (`max|f⁗|·w⁴/384` beyond the cubic Hermite interpolant). The
-    /// curvature bound is tried first; the Hermite bound costs a quadratic solve.
-    fn range_within(&self, lo: Node, hi: Node, lower: f64, upper: f64) -> bool {
-        let ((blo, f_lo, s_lo), (bhi, f_hi, s_hi)) = (lo, hi);
-        let w = bhi.tau - blo.tau;
-        let curv = self.bound(2, blo, bhi.tau) * w * w / 8.0;
-        if f_lo.min(f_hi) - curv >= lower && f_lo.max(f_hi) + curv <= upper {
-            return true;
+    /// The node at `b`.
+    fn node(&self, osc: Osc, b: Basis) -> Node<Basis> {
+        let (f, df) = self.over(osc).eval(&b);
+        Node { at: b, f, df }
+    }
+
+    /// The node at the start of a piece, from the wave itself (`eval` at τ = 0, bit for bit,
+    /// without the arithmetic).
+    fn start(&self) -> Node<Basis> {
+        Node {
+            at: Basis::ZERO,
+            f: self.f.p[0] + self.f.c,
+            df: self.d1.p[0] + self.d1.c,
         }
-        let quart = self.bound(4, blo, bhi.tau) * (w * w) * (w * w) / 384.0;
-        let (h_lo, h_hi) = hermite_range(f_lo, f_hi, s_lo * w, s_hi * w);
-        (f_lo.min(f_hi) - curv).max(h_lo - quart) >= lower
-            && (f_lo.max(f_hi) + curv).min(h_hi + quart) <= upper
-    }
-
-    /// Whether `f'` keeps one sign on `[lo, hi]` (its end values share a sign and exceed the
-    /// chord bound `max|f'''|·w²/8`): then `f` is monotone and its extremes are the end values.
-    fn monotone(&self, (blo, _, s_lo): Node, (bhi, _, s_hi): Node) -> bool {
-        let w = bhi.tau - blo.tau;
-        s_lo * s_hi > 0.0 && s_lo.abs().min(s_hi.abs()) > self.bound(3, blo, bhi.tau) * w * w / 8.0
-    }
-
-    /// The basis at `b` with `f` and `f'` there.
-    fn node(&self, b: Basis) -> (Basis, f64, f64) {
-        if b.tau == 0.0 {
-            // `eval` at τ = 0, bit for bit, without the arithmetic.
-            return (b, self.f.p[0] + self.f.c, self.d1.p[0] + self.d1.c);
-        }
-        (b, self.f.eval(&b), self.d1.eval(&b))
     }
 }
 
-/// A point of a piece: its basis, the function's value and slope there.
-type Node<'a> = (&'a Basis, f64, f64);
+/// A [`Tracked`] function over one piece: what [`search`] needs of it.
+#[derive(Clone, Copy)]
+struct OverPiece<'a> {
+    g: &'a Tracked,
+    osc: Osc,
+}
+
+impl Smooth for OverPiece<'_> {
+    type At = Basis;
+
+    fn at(&self, tau: f64) -> Basis {
+        Basis::at(self.osc, tau)
+    }
+
+    fn tau(at: &Basis) -> f64 {
+        at.tau
+    }
+
+    fn eval(&self, b: &Basis) -> (f64, f64) {
+        let (f, d1) = (&self.g.f, &self.g.d1);
+        if b.tau == 0.0 {
+            return (f.p[0] + f.c, d1.p[0] + d1.c);
+        }
+        (f.eval(b), d1.eval(b))
+    }
+
+    fn slope(&self, b: &Basis) -> f64 {
+        self.g.d1.eval(b)
+    }
+
+    fn second(&self, b: &Basis) -> f64 {
+        let d2 = self.g.d1.deriv(self.osc);
+        if b.tau == 0.0 {
+            return d2.p[0] + d2.c;
+        }
+        d2.eval(b)
+    }
+
+    /// Bound of `|f⁽ᵏ⁾|` over `[b.tau, t1]`.
+    #[inline]
+    fn bound(&self, k: usize, b: &Basis, t1: f64) -> f64 {
+        self.g.f.deriv_abs_bound(k, t1, b.exp, self.g.amps[k])
+    }
+}
 
 /// The tightest bounds on the structure cluster's absolute acceleration above and below
 /// (m/s²), each with the interface whose static limit sets it.
@@ -537,7 +561,9 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
                     } else {
                         Basis::at(osc, limit)
                     };
-                    if let Some(t) = first_violation(&ev.g, osc, &b_end, self.dt)
+                    let g = ev.g.over(osc);
+                    if let Some(t) =
+                        search::first_violation(&g, &ev.g.start(), &ev.g.node(osc, b_end), self.dt)
                         && first.is_none_or(|f| t < f.0)
                     {
                         first = Some((t, e));
@@ -996,9 +1022,9 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             return true;
         }
         let (lo, hi) = accel_limits(bounds);
-        let (n0, n1) = (self.a0.node(Basis::ZERO), self.a0.node(*b));
-        self.a0
-            .range_within((&n0.0, n0.1, n0.2), (&n1.0, n1.1, n1.2), lo, hi)
+        let osc = self.osc();
+        let (n0, n1) = (self.a0.node(osc, Basis::ZERO), self.a0.node(osc, *b));
+        search::range_within(&self.a0.over(osc), &n0, &n1, lo, hi)
     }
 
     /// Whether a yielding structure in its elastic branch stays inside its elastic range over
@@ -1007,11 +1033,11 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         let Branch::Elastic { lo, hi, .. } = self.spring.branch else {
             return false;
         };
-        let (n0, n1) = (self.u0.node(Basis::ZERO), self.u0.node(*b));
+        let osc = self.osc();
+        let (mut n0, n1) = (self.u0.node(osc, Basis::ZERO), self.u0.node(osc, *b));
         // The state, not the wave, at τ = 0: the events are anchored to it.
-        let x0 = self.x[0];
-        self.u0
-            .range_within((&n0.0, x0, n0.2), (&n1.0, n1.1, n1.2), lo, hi)
+        n0.f = self.x[0];
+        search::range_within(&self.u0.over(osc), &n0, &n1, lo, hi)
     }
 
     /// Absolute acceleration of the structure's cluster: `(F − c·u̇ − k·u)/M`, or with a
@@ -1044,7 +1070,14 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         let (best, at) = if LONG_PERIODS && self.structure_cluster().sdof_form {
             self.sdof_peak(ga, slope, b.tau)
         } else {
-            peak_abs(&self.u0, osc, &b0, b, self.out.peak_displacement_m, self.dt)
+            let (n0, n1) = (self.u0.node(osc, b0), self.u0.node(osc, *b));
+            search::peak_abs(
+                &self.u0.over(osc),
+                &n0,
+                &n1,
+                self.out.peak_displacement_m,
+                self.dt,
+            )
         };
         if best > self.out.peak_displacement_m {
             self.out.peak_displacement_m = best;
@@ -1056,7 +1089,8 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             .iter()
             .copied()
             .fold(f64::INFINITY, f64::min);
-        let (best_acc, _) = peak_abs(&self.a0, osc, &b0, b, floor, self.dt);
+        let (n0, n1) = (self.a0.node(osc, b0), self.a0.node(osc, *b));
+        let (best_acc, _) = search::peak_abs(&self.a0.over(osc), &n0, &n1, floor, self.dt);
         if best_acc > floor {
             for p in &mut self.out.peak_abs_accel_mps2[..=top] {
                 *p = p.max(best_acc);
@@ -1288,183 +1322,4 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         self.out.history = history;
         Ok(self.out)
     }
-}
-
-/// Earliest `τ ∈ (0, h]` where the switching function goes negative, refined to a few ulps of
-/// the sample interval `dt`; `None` if it stays non-negative. `b_end` is the basis at `h`.
-fn first_violation(g: &Tracked, osc: Osc, b_end: &Basis, dt: f64) -> Option<f64> {
-    let h = b_end.tau;
-    let g0 = g.f.p[0] + g.f.c;
-    if g0 < 0.0 {
-        return Some(0.0);
-    }
-    let mut start = Basis::ZERO;
-    if g0 == 0.0 {
-        // Starts on the boundary (a fresh slip): certify an initial stretch from the Taylor
-        // bound g(τ) ≥ g'(0)τ + g''(0)τ²/2 − G₃τ³/6.
-        let g1 = g.d1.p[0] + g.d1.c;
-        let d2 = g.d1.deriv(osc);
-        let g2 = d2.p[0] + d2.c;
-        let g3 = g.bound(3, &Basis::ZERO, h);
-        let tc = taylor_clearance(g1, g2, g3);
-        if tc <= 0.0 {
-            return Some(0.0);
-        }
-        let lo = (0.999 * tc).min(h);
-        if lo >= h {
-            return None;
-        }
-        start = Basis::at(osc, lo);
-    }
-    let min_width = 4.0 * f64::EPSILON * dt;
-    let (lo, hi) = (g.node(start), g.node(*b_end));
-    let (a, b) = search(
-        g,
-        osc,
-        (&lo.0, lo.1, lo.2),
-        (&hi.0, hi.1, hi.2),
-        min_width,
-        0,
-    )?;
-    Some(refine(|t| g.f.eval(&Basis::at(osc, t)), a, b, min_width))
-}
-
-/// Largest `τ_c` with `g₁τ + g₂τ²/2 − g₃τ³/6 > 0` on `(0, τ_c)`; 0 if there is none.
-fn taylor_clearance(g1: f64, g2: f64, g3: f64) -> f64 {
-    if g1 < 0.0 || (g1 == 0.0 && g2 <= 0.0) {
-        return 0.0;
-    }
-    // Positive root of −(g₃/6)τ² + (g₂/2)τ + g₁ = 0.
-    let (qa, qb, qc) = (g3 / 6.0, g2 / 2.0, g1);
-    if qa == 0.0 {
-        return if qb >= 0.0 { f64::INFINITY } else { -qc / qb };
-    }
-    (qb + (qb * qb + 4.0 * qa * qc).sqrt()) / (2.0 * qa)
-}
-
-/// Bracket `(a, b)` with `g(a) ≥ 0 > g(b)` around the earliest sign change in `[lo, hi]`.
-fn search(
-    g: &Tracked,
-    osc: Osc,
-    lo: Node,
-    hi: Node,
-    min_width: f64,
-    depth: u32,
-) -> Option<(f64, f64)> {
-    let (blo, _, _) = lo;
-    let (bhi, ghi, _) = hi;
-    if g.range_within(lo, hi, 0.0, f64::INFINITY) {
-        return None;
-    }
-    let width = bhi.tau - blo.tau;
-    if g.monotone(lo, hi) {
-        // A single root if the end values differ in sign, the earliest; none otherwise.
-        return (ghi < 0.0).then_some((blo.tau, bhi.tau));
-    }
-    if width <= min_width || depth > 80 {
-        return (ghi < 0.0).then_some((blo.tau, bhi.tau));
-    }
-    let (bm, gm, sm) = g.node(Basis::at(osc, blo.tau + 0.5 * width));
-    let mid = (&bm, gm, sm);
-    search(g, osc, lo, mid, min_width, depth + 1)
-        .or_else(|| search(g, osc, mid, hi, min_width, depth + 1))
-}
-
-/// Shrinks a bracket `g(a) ≥ 0 > g(b)` (Illinois regula falsi with bisection safeguard) and
-/// returns its right end: the first representable time at which the function is negative.
-fn refine(g: impl Fn(f64) -> f64, mut a: f64, mut b: f64, min_width: f64) -> f64 {
-    let mut ga = g(a);
-    let mut gb = g(b);
-    if gb >= 0.0 {
-        return b;
-    }
-    let mut side = 0;
-    for _ in 0..200 {
-        if b - a <= min_width {
-            break;
-        }
-        let mut t = (a * gb - b * ga) / (gb - ga);
-        if !(t > a && t < b) {
-            t = 0.5 * (a + b);
-        }
-        let gt = g(t);
-        if gt < 0.0 {
-            b = t;
-            gb = gt;
-            if side == -1 {
-                ga *= 0.5;
-            }
-            side = -1;
-        } else {
-            a = t;
-            ga = gt;
-            if side == 1 {
-                gb *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    b
-}
-
-/// Peak `|f|` over `[b0.tau, b1.tau]` if it exceeds `best`, with its time; else `(best, _)`.
-/// Branch and bound: a sub-interval is dropped when [`Tracked::range_within`] shows
-/// `|f| ≤ best` on it or [`Tracked::monotone`] shows its end values are its extremes; where `f'`
-/// changes sign once (certified by the bound on `f'''`), the extremum is refined.
-fn peak_abs(p: &Tracked, osc: Osc, b0: &Basis, b1: &Basis, best: f64, dt: f64) -> (f64, f64) {
-    let mut best = (best, 0.0);
-    let (lo, hi) = (p.node(*b0), p.node(*b1));
-    for (b, v, _) in [lo, hi] {
-        if v.abs() > best.0 {
-            best = (v.abs(), b.tau);
-        }
-    }
-    let min_width = 4.0 * f64::EPSILON * dt;
-    let (lo, hi) = ((&lo.0, lo.1, lo.2), (&hi.0, hi.1, hi.2));
-    peak_rec(p, osc, lo, hi, &mut best, min_width, 0);
-    best
-}
-
-/// One node of the branch and bound: the interval between two bases (with `f` and `f'` there),
-/// so that each split evaluates the exponential and trigonometric functions once, at the midpoint.
-fn peak_rec(
-    p: &Tracked,
-    osc: Osc,
-    lo: Node,
-    hi: Node,
-    best: &mut (f64, f64),
-    min_width: f64,
-    depth: u32,
-) {
-    let (blo, _, slo) = lo;
-    let (bhi, _, shi) = hi;
-    if p.range_within(lo, hi, -best.0, best.0) || p.monotone(lo, hi) {
-        // Nothing above `best`, or monotone: the end values, already counted, are the extremes.
-        return;
-    }
-    let width = bhi.tau - blo.tau;
-    if slo * shi < 0.0 {
-        let jerk_bound = p.bound(3, blo, bhi.tau);
-        let c_lo = p.d1.deriv(osc).eval(blo);
-        if c_lo.abs() > jerk_bound * width {
-            // f' is monotone here: its single zero is the only interior extremum.
-            let g = |t: f64| p.d1.eval(&Basis::at(osc, t)) * slo.signum();
-            let t = refine(g, blo.tau, bhi.tau, min_width);
-            let v = p.f.eval(&Basis::at(osc, t)).abs();
-            if v > best.0 {
-                *best = (v, t);
-            }
-            return;
-        }
-    }
-    if width <= min_width || depth > 60 {
-        return;
-    }
-    let (bm, fm, sm) = p.node(Basis::at(osc, blo.tau + 0.5 * width));
-    if fm.abs() > best.0 {
-        *best = (fm.abs(), bm.tau);
-    }
-    let mid = (&bm, fm, sm);
-    peak_rec(p, osc, lo, mid, best, min_width, depth + 1);
-    peak_rec(p, osc, mid, hi, best, min_width, depth + 1);
 }

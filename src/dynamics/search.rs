@@ -22,6 +22,10 @@ pub(crate) trait Smooth {
     fn tau(at: &Self::At) -> f64;
     /// `(f, f')` at the point.
     fn eval(&self, at: &Self::At) -> (f64, f64);
+    /// `f'` at the point (what a search for an extremum refines).
+    fn slope(&self, at: &Self::At) -> f64 {
+        self.eval(at).1
+    }
     /// `f''` at the point.
     fn second(&self, at: &Self::At) -> f64;
     /// An upper bound of `|f⁽ᵏ⁾|` over `[tau(lo), t1]`, `k ∈ {2, 3, 4}`.
@@ -214,7 +218,7 @@ fn peak_rec<S: Smooth>(
         if c_lo.abs() > jerk * width {
             // f' is monotone here: its single zero is the only interior extremum.
             let sign = lo.df.signum();
-            let t = refine(|t| s.eval(&s.at(t)).1 * sign, t_lo, t_hi, min_width);
+            let t = refine(|t| s.slope(&s.at(t)) * sign, t_lo, t_hi, min_width);
             let v = s.eval(&s.at(t)).0.abs();
             if v > best.0 {
                 *best = (v, t);
