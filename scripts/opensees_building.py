@@ -72,9 +72,19 @@ The OpenSees model
       converges, as in scripts/opensees_stack.py (which says why).
     * Outputs, read after every converged step (peaks over the steps, so a peak between steps
       is missed; slidestack's peaks are exact over time): floor displacement and absolute
-      acceleration (``nodeAccel`` + a_g(t)), storey drifts, each interface's slip (block
-      minus body below, so including the spring's elastic part of at most F_b/k_s); residual
-      drift and slip at the record's end; ``modes_s`` the bare building's periods (numpy).
+      acceleration, storey drifts, each interface's slip (block minus body below, so including
+      the spring's elastic part of at most F_b/k_s); residual drift and slip at the record's
+      end; ``modes_s`` the bare building's periods (numpy). A floor's absolute acceleration is
+      the mass-weighted mean of ``nodeAccel`` + a_g(t) over the floor and the blocks stuck to
+      it (every interface between them below its friction limit after the step): the limit
+      s → ∞ of "the floor and its stuck blocks move together". The floor node's own
+      acceleration is not used for it: a sticking interface's spring rings at its stick
+      frequency after every jump of the friction force above it (a block reversing), Newmark's
+      average acceleration rule does not damp that ringing, and its amplitude is set by the
+      force jump, not by s, so the node's peak converges to the exact peak plus the ringing
+      (7.8 % high on the roof of the ``yielding`` comparison case; docs/opensees-building.md,
+      "The roof's acceleration and the stick springs' ringing"). That node value is reported
+      as ``floor_peak_node_abs_accel_g``.
 
 Protocol
     IN.json:  {"cases": [{"id": str, "dt_s": float, "accel_g": [float, ...], "scale": float,
@@ -87,7 +97,7 @@ Protocol
                           "stacks": [{"floor": int, "alpha": [...], "mu": [...]}],
                           "runs": [{"steps_per_sample": int, "stick_stiffness": float,
                                     "friction": "elasticpp" | "flatslider"}],
-                          "repeats": int, "history": bool}]}
+                          "repeats": int, "history": bool, "step_history": bool}]}
         Defaults as slidestack's: scale 1, damping 0.05, damping_basis rigid, floor_masses and
         storey_stiffnesses all 1, structure elastic, post_yield_ratio 0 (epp), no stacks,
         friction elasticpp, repeats 1. ``storeys`` may be left out (the lists' length).
@@ -100,18 +110,27 @@ Protocol
                                     "modes_s": [...],
                                     "floor_peak_displacement_m": [...],
                                     "floor_peak_abs_accel_g": [...],
+                                    "floor_peak_node_abs_accel_g": [...],
                                     "storey_peak_drift_m": [...],
                                     "storey_residual_drift_m": [...],
                                     "stacks": [{"floor": int, "peak_slip_m": [...],
                                                 "residual_slip_m": [...]}],
                                     "steps": int, "split_steps": int,
-                                    "floor_u_m": [[...], ...]  (with "history": true)}]}]}
+                                    "floor_u_m": [[...], ...]  (with "history": true),
+                                    "step_history": {"columns": [str, ...],
+                                                     "rows": [[...], ...]}
+                                        (with "step_history": true)}]}]}
     Lists are floor 1 / storey 1 / interface 1 first. ``wall_s`` and ``cpu_s`` are medians over
     ``repeats`` of one analysis (model build + analysis + reading the state after every step,
     no JSON I/O): ``time.perf_counter`` and the CPU time of the thread that runs OpenSees
     (``time.thread_time``), which other load on the machine barely changes. ``floor_u_m`` has
-    one row per record sample (t = 0 first), one value per floor. A failed run has ``ok:
-    false``, its message and null values; no number is made up.
+    one row per record sample (t = 0 first), one value per floor. ``step_history``, for
+    debugging, has one row per converged step (after it; t = 0 not included) with the columns
+    ``step_columns`` names: time, ground acceleration, per floor its displacement, its node's
+    absolute acceleration and the reported one (with its stuck blocks), per block its slip,
+    absolute acceleration, interface force (N) and 1/0 for sticking/slipping (large: 25 numbers
+    per step for the comparison case). A failed run has ``ok: false``, its message and null
+    values; no number is made up.
 
 --check (docs/opensees-building.md, "Verification")
     1. The assembled damping matrix (``printA`` at two step sizes, K and M known) against
@@ -316,8 +335,9 @@ class Building:
 # --------------------------------------------------------------------------- the model
 
 def build(ops, bld: Building, dt: float, accel_g, stick_stiffness: float, friction: str,
-          dashpots: bool = True) -> None:
-    """Defines the model, ground motion and analysis in a wiped OpenSees domain."""
+          dashpots: bool = True) -> list:
+    """Defines the model, ground motion and analysis in a wiped OpenSees domain. Returns the
+    element tag of each block's interface below it (None where μ = 0: no element)."""
     if friction not in FRICTIONS:
         raise ValueError(f"friction must be one of {FRICTIONS}, got {friction!r}")
     if not (math.isfinite(stick_stiffness) and stick_stiffness > 0):
@@ -375,6 +395,7 @@ def build(ops, bld: Building, dt: float, accel_g, stick_stiffness: float, fricti
                 ops.uniaxialMaterial("Elastic", tag + 1, 0.0, c)
                 zero_length(0 if j < 0 else j + 1, i + 1, tag + 1)
     gravity = []
+    friction_tags: list = [None] * len(bld.block_m)
     for k, (m, below, mu, lim) in enumerate(zip(bld.block_m, bld.block_below, bld.block_mu,
                                                  bld.block_limit, strict=True)):
         ks = stick_stiffness * bld.omega1 ** 2 * bld.floor_m[bld.block_floor[k] - 1]
@@ -389,11 +410,13 @@ def build(ops, bld: Building, dt: float, accel_g, stick_stiffness: float, fricti
             ops.element("flatSliderBearing", tag + 3, below, bld.block_node(k), tag, ks,
                         "-P", tag + 1, "-Mz", tag + 2, "-orient", 0, 1, 0, -1, 0, 0)
             tag += 3
+            friction_tags[k] = tag
             gravity.append((bld.block_node(k), m * G))
         elif lim > 0.0:
             tag += 1
             ops.uniaxialMaterial("ElasticPP", tag, ks, lim / ks)
             zero_length(below, bld.block_node(k), tag)
+            friction_tags[k] = tag
     ops.constraints("Plain")
     ops.numberer("Plain")
     ops.system("FullGeneral")
@@ -424,21 +447,53 @@ def build(ops, bld: Building, dt: float, accel_g, stick_stiffness: float, fricti
     a0 = -G * bld.scale * float(accel_g[0])
     for nd in list(range(1, n + 1)) + [bld.block_node(k) for k in range(len(bld.block_m))]:
         ops.setNodeAccel(nd, 1, a0, "-commit")
+    return friction_tags
+
+
+def stuck_test(ops, bld: Building, friction_tags, friction: str):
+    """stuck(k): whether block k's interface below it carries less than its friction limit
+    after the step (sticks), from its element's force. No element (μ = 0): never stuck."""
+    if friction == "flatslider":
+        def stuck(k: int) -> bool:
+            tag = friction_tags[k]
+            if tag is None:
+                return False
+            q = ops.eleResponse(tag, "basicForce")  # [axial, shear, moment]; axial < 0
+            return abs(q[1]) < (1.0 - 1e-9) * bld.block_mu[k] * -q[0]
+    else:
+        def stuck(k: int) -> bool:
+            tag = friction_tags[k]
+            return tag is not None and abs(ops.eleForce(tag)[1]) < (1.0 - 1e-9) * bld.block_limit[k]
+    return stuck
 
 
 def analyse(ops, bld: Building, dt: float, accel_g, steps_per_sample: int,
-            history: bool = False) -> dict:
-    """Runs the built model over the record, reading the state after every converged step."""
+            history: bool = False, friction_tags=None, friction: str = "elasticpp",
+            step_history: bool = False) -> dict:
+    """Runs the built model over the record, reading the state after every converged step.
+
+    A floor's absolute acceleration is that of the floor and the blocks stuck to it (their
+    mass-weighted mean, ``friction_tags`` from ``build`` telling which interfaces stick): the
+    penalty spring of a sticking interface rings at its stick frequency after every jump of
+    the friction force on the blocks above, undamped by Newmark's average acceleration rule and
+    with an amplitude that does not shrink as s grows; the floor node's own acceleration
+    carries that ringing, the stuck cluster's does not (docs/opensees-building.md, "The roof's
+    acceleration and the stick springs' ringing"). The node's own is reported too."""
     if steps_per_sample < 1:
         raise ValueError(f"steps_per_sample must be >= 1, got {steps_per_sample}")
     n = bld.n
     nb = len(bld.block_m)
     floors = range(1, n + 1)
     blocks = [(bld.block_node(k), bld.block_below[k]) for k in range(nb)]
+    if friction_tags is None:
+        friction_tags = [None] * nb
+    stuck = stuck_test(ops, bld, friction_tags, friction)
+    on_floor = [[st["blocks"] for st in bld.stacks if st["floor"] == j] for j in floors]
     ag = [G * bld.scale * float(a) for a in accel_g]
     last = len(ag) - 1
     peak_u = [0.0] * n
     peak_a = [0.0] * n
+    peak_an = [0.0] * n
     peak_d = [0.0] * n
     peak_s = [0.0] * nb
     u = [0.0] * n
@@ -446,21 +501,36 @@ def analyse(ops, bld: Building, dt: float, accel_g, steps_per_sample: int,
     h = dt / steps_per_sample
     count = {"steps": 0, "split": 0}
     node_disp, node_accel, get_time = ops.nodeDisp, ops.nodeAccel, ops.getTime
+    steps_rows = [] if step_history else None
 
     def read() -> None:
         count["steps"] += 1
-        x = get_time() / dt
+        t = get_time()
+        x = t / dt
         i = min(int(x), last - 1)
         a_g = ag[i] + (ag[i + 1] - ag[i]) * (x - i)
         below = 0.0
+        row = [t, a_g] if step_history else None
         for j in floors:
             uj = node_disp(j, 1)
             u[j - 1] = uj
             if abs(uj) > peak_u[j - 1]:
                 peak_u[j - 1] = abs(uj)
-            a = abs(node_accel(j, 1) + a_g)
+            a_node = node_accel(j, 1) + a_g
+            mass, mom = bld.floor_m[j - 1], bld.floor_m[j - 1] * a_node
+            for chain in on_floor[j - 1]:
+                for k in chain:  # bottom-up: stuck to the floor while every interface below is
+                    if not stuck(k):
+                        break
+                    mass += bld.block_m[k]
+                    mom += bld.block_m[k] * (node_accel(blocks[k][0], 1) + a_g)
+            a = abs(mom / mass)
             if a > peak_a[j - 1]:
                 peak_a[j - 1] = a
+            if abs(a_node) > peak_an[j - 1]:
+                peak_an[j - 1] = abs(a_node)
+            if step_history:
+                row += [uj, a_node, mom / mass]
             d = abs(uj - below)
             if d > peak_d[j - 1]:
                 peak_d[j - 1] = d
@@ -469,6 +539,15 @@ def analyse(ops, bld: Building, dt: float, accel_g, steps_per_sample: int,
             s = abs(node_disp(nd, 1) - node_disp(bl, 1))
             if s > peak_s[k]:
                 peak_s[k] = s
+        if step_history:
+            for k, (nd, bl) in enumerate(blocks):
+                tag = friction_tags[k]
+                force = 0.0 if tag is None else (
+                    ops.eleResponse(tag, "basicForce")[1] if friction == "flatslider"
+                    else ops.eleForce(tag)[1])
+                row += [node_disp(nd, 1) - node_disp(bl, 1), node_accel(nd, 1) + a_g, force,
+                        1.0 if stuck(k) else 0.0]
+            steps_rows.append(row)
 
     def step(size: float, depth: int) -> None:
         if ops.analyze(1, size) == 0:
@@ -491,6 +570,7 @@ def analyse(ops, bld: Building, dt: float, accel_g, steps_per_sample: int,
     slip = [node_disp(nd, 1) - node_disp(bl, 1) for nd, bl in blocks]
     return {"floor_peak_displacement_m": peak_u,
             "floor_peak_abs_accel_g": [a / G for a in peak_a],
+            "floor_peak_node_abs_accel_g": [a / G for a in peak_an],
             "storey_peak_drift_m": peak_d,
             "storey_residual_drift_m": drift,
             "stacks": [{"floor": s["floor"],
@@ -498,21 +578,44 @@ def analyse(ops, bld: Building, dt: float, accel_g, steps_per_sample: int,
                         "residual_slip_m": [slip[k] for k in s["blocks"]]}
                        for s in bld.stacks],
             "steps": count["steps"], "split_steps": count["split"],
-            **({"floor_u_m": hist} if history else {})}
+            **({"floor_u_m": hist} if history else {}),
+            **({"step_history": {"columns": step_columns(bld), "rows": steps_rows}}
+               if step_history else {})}
+
+
+def step_columns(bld: Building) -> list[str]:
+    """The columns of ``step_history``: time, ground acceleration, per floor its displacement,
+    its node's absolute acceleration and the absolute acceleration of it with its stuck blocks
+    (the one reported), per block (stacks in order, each bottom-up) its slip on the body below,
+    its absolute acceleration, its interface's force and whether that interface sticks."""
+    cols = ["time_s", "ground_accel_mps2"]
+    for j in range(1, bld.n + 1):
+        cols += [f"floor{j}_disp_m", f"floor{j}_node_abs_accel_mps2", f"floor{j}_abs_accel_mps2"]
+    names = [""] * len(bld.block_m)
+    for si, st in enumerate(bld.stacks):
+        for b, k in enumerate(st["blocks"]):
+            names[k] = f"stack{si + 1}_block{b + 1}"
+    for name in names:
+        cols += [f"{name}_slip_m", f"{name}_abs_accel_mps2", f"{name}_interface_force_n",
+                 f"{name}_interface_stuck"]
+    return cols
 
 
 NULLS = ("wall_s", "cpu_s", "floor_peak_displacement_m", "floor_peak_abs_accel_g",
+         "floor_peak_node_abs_accel_g",
          "storey_peak_drift_m", "storey_residual_drift_m", "stacks", "steps", "split_steps")
 
 
 def simulate(ops, bld: Building, dt: float, accel_g, steps_per_sample: int,
-             stick_stiffness: float, friction: str = "elasticpp", history: bool = False) -> dict:
+             stick_stiffness: float, friction: str = "elasticpp", history: bool = False,
+             step_history: bool = False) -> dict:
     """One analysis: {"ok", "message", "wall_s", "cpu_s", outputs…}."""
     logged = oss.log_size()
     w0, c0 = time.perf_counter(), time.thread_time()
     try:
-        build(ops, bld, dt, accel_g, stick_stiffness, friction)
-        out = analyse(ops, bld, dt, accel_g, steps_per_sample, history)
+        tags = build(ops, bld, dt, accel_g, stick_stiffness, friction)
+        out = analyse(ops, bld, dt, accel_g, steps_per_sample, history, tags, friction,
+                      step_history)
     except Exception as e:  # noqa: BLE001 - OpenSeesError, bad input: reported, not raised
         ops.wipe()
         tail = oss.log_tail(logged)
@@ -535,13 +638,14 @@ def run_case(ops, case: dict) -> dict:
     dt, accel = float(case["dt_s"]), case["accel_g"]
     repeats = max(1, int(case.get("repeats", 1)))
     history = bool(case.get("history", False))
+    step_history = bool(case.get("step_history", False))
     runs = []
     for r in case["runs"]:
         sps, s = int(r["steps_per_sample"]), float(r["stick_stiffness"])
         fr = r.get("friction", "elasticpp")
         walls, cpus, res = [], [], None
         for _ in range(repeats):
-            res = simulate(ops, bld, dt, accel, sps, s, fr, history)
+            res = simulate(ops, bld, dt, accel, sps, s, fr, history, step_history)
             if not res["ok"]:
                 break
             walls.append(res["wall_s"])
