@@ -178,6 +178,27 @@ fn the_history_has_every_floor_and_block() {
     let f = hdf5::File::open(&h5).unwrap();
     assert_eq!(f.dataset("displacement").unwrap().shape(), vec![1999, 6]);
     assert_eq!(f.dataset("contact").unwrap().shape(), vec![1999, 3]);
+    // The RK4 reference writes the same layout.
+    let rk4 = dir.path().join("rk4.csv");
+    let out = run(&[
+        "simulate",
+        "--config",
+        "configs/building.yaml",
+        "--integrator",
+        "rk4",
+        "--history",
+        rk4.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&rk4).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').count();
+    assert_eq!(header, 2 + 3 * 6 + 3);
+    assert!(lines.all(|l| l.split(',').count() == header));
 }
 
 /// `--figure` draws a building case and writes nothing for a one-storey case, which it refuses.

@@ -16,58 +16,17 @@ struct State {
     given: Vec<Contact>,
 }
 
-/// Forces and relative accelerations of a full pattern, computed cluster by cluster (no QP):
-/// a cluster's acceleration is its net known force over its mass; a stuck interface carries
-/// whatever moves the bodies above it (within the cluster) with that acceleration.
+/// Forces and relative accelerations of a full pattern on a chain: [`evaluate_tree`] with
+/// every interface on the body below it.
 fn evaluate(st: &State, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
-    let n = pattern.len();
-    let mut force = vec![0.0; n];
-    for i in 0..n {
-        if let Contact::Slip(d) = pattern[i] {
-            force[i] = -st.lim_k[i] * f64::from(d);
-        }
-    }
-    let mut accel = vec![0.0; n + 1];
-    let mut lo = 0;
-    while lo <= n {
-        let mut hi = lo;
-        while hi < n && pattern[hi] == Contact::Stick {
-            hi += 1;
-        }
-        let below = if lo > 0 { force[lo - 1] } else { 0.0 };
-        let above = if hi < n { force[hi] } else { 0.0 };
-        let mass: f64 = st.masses[lo..=hi].iter().sum();
-        let ext: f64 = st.external[lo..=hi].iter().sum();
-        let a = (ext + below - above) / mass;
-        for j in lo..=hi {
-            accel[j] = a;
-        }
-        for i in lo..hi {
-            force[i] = (i + 1..=hi)
-                .map(|j| st.masses[j] * a - st.external[j])
-                .sum::<f64>()
-                + above;
-        }
-        lo = hi + 1;
-    }
-    let rel = (0..n).map(|i| accel[i + 1] - accel[i]).collect();
-    (force, rel)
+    let below: Vec<usize> = (0..pattern.len()).collect();
+    evaluate_tree(st, &below, pattern)
 }
 
 /// Is the pattern Coulomb-consistent, with slack `tol` (relative)?
 fn consistent(st: &State, pattern: &[Contact], tol: f64) -> bool {
-    let (force, rel) = evaluate(st, pattern);
-    pattern
-        .iter()
-        .enumerate()
-        .all(|(i, c)| match (st.given[i], *c) {
-            (Contact::Stick, Contact::Stick) => force[i].abs() <= st.lim_s[i] * (1.0 + tol),
-            (Contact::Stick, Contact::Slip(d)) => {
-                let scale = st.lim_s[i] / st.masses[i].min(st.masses[i + 1]) + 1e-300;
-                f64::from(d) * rel[i] > -tol * scale
-            }
-            (g, c) => g == c,
-        })
+    let below: Vec<usize> = (0..pattern.len()).collect();
+    consistent_tree(st, &below, pattern, tol)
 }
 
 fn all_patterns(given: &[Contact]) -> Vec<Vec<Contact>> {
@@ -245,11 +204,12 @@ struct Tree {
     below: Vec<usize>,
 }
 
-/// Forces and relative accelerations of a full pattern on a tree, cluster by cluster: a
+/// Forces and relative accelerations of a full pattern, cluster by cluster (no QP): a
 /// cluster's acceleration is its net known force over its mass; a stuck interface carries what
 /// moves the part of its cluster above it (and what that part's slipping interfaces pull).
-fn evaluate_tree(t: &Tree, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
-    let (st, n) = (&t.st, pattern.len());
+/// Interface `i` lies under body `i + 1` and above `below[i]`.
+fn evaluate_tree(st: &State, below: &[usize], pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
+    let n = pattern.len();
     let mut force = vec![0.0; n];
     for i in 0..n {
         if let Contact::Slip(d) = pattern[i] {
@@ -260,7 +220,7 @@ fn evaluate_tree(t: &Tree, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
     let mut cluster: Vec<usize> = (0..=n).collect();
     for i in 0..n {
         if pattern[i] == Contact::Stick {
-            cluster[i + 1] = cluster[t.below[i]];
+            cluster[i + 1] = cluster[below[i]];
         }
     }
     let net = |b: usize, force: &[f64]| {
@@ -269,7 +229,7 @@ fn evaluate_tree(t: &Tree, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
             e += force[b - 1];
         }
         for i in 0..n {
-            if t.below[i] == b && pattern[i] != Contact::Stick {
+            if below[i] == b && pattern[i] != Contact::Stick {
                 e -= force[i];
             }
         }
@@ -294,7 +254,7 @@ fn evaluate_tree(t: &Tree, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
         }
         let mut subtree = vec![i + 1];
         for j in i + 1..n {
-            if pattern[j] == Contact::Stick && subtree.contains(&t.below[j]) {
+            if pattern[j] == Contact::Stick && subtree.contains(&below[j]) {
                 subtree.push(j + 1);
             }
         }
@@ -303,20 +263,19 @@ fn evaluate_tree(t: &Tree, pattern: &[Contact]) -> (Vec<f64>, Vec<f64>) {
             .map(|&b| st.masses[b] * accel[b] - net(b, &force))
             .sum();
     }
-    let rel = (0..n).map(|i| accel[i + 1] - accel[t.below[i]]).collect();
+    let rel = (0..n).map(|i| accel[i + 1] - accel[below[i]]).collect();
     (force, rel)
 }
 
-fn consistent_tree(t: &Tree, pattern: &[Contact], tol: f64) -> bool {
-    let (force, rel) = evaluate_tree(t, pattern);
-    let st = &t.st;
+fn consistent_tree(st: &State, below: &[usize], pattern: &[Contact], tol: f64) -> bool {
+    let (force, rel) = evaluate_tree(st, below, pattern);
     pattern
         .iter()
         .enumerate()
         .all(|(i, c)| match (st.given[i], *c) {
             (Contact::Stick, Contact::Stick) => force[i].abs() <= st.lim_s[i] * (1.0 + tol),
             (Contact::Stick, Contact::Slip(d)) => {
-                let scale = st.lim_s[i] / st.masses[i + 1].min(st.masses[t.below[i]]) + 1e-300;
+                let scale = st.lim_s[i] / st.masses[i + 1].min(st.masses[below[i]]) + 1e-300;
                 f64::from(d) * rel[i] > -tol * scale
             }
             (g, c) => g == c,
@@ -388,7 +347,7 @@ fn select_tree(t: &Tree) -> Vec<Contact> {
             &mut force,
         )
         .unwrap();
-    let (f_ref, _) = evaluate_tree(t, &contacts);
+    let (f_ref, _) = evaluate_tree(st, &t.below, &contacts);
     let scale = st
         .lim_s
         .iter()
@@ -416,11 +375,11 @@ fn several_stacks_on_a_floor_get_the_unique_consistent_pattern() {
         let patterns = all_patterns(&t.st.given);
         let loose: Vec<_> = patterns
             .iter()
-            .filter(|p| consistent_tree(&t, p, 1e-9))
+            .filter(|p| consistent_tree(&t.st, &t.below, p, 1e-9))
             .collect();
         let strict = patterns
             .iter()
-            .filter(|p| consistent_tree(&t, p, -1e-12))
+            .filter(|p| consistent_tree(&t.st, &t.below, p, -1e-12))
             .count();
         if loose.len() != 1 || strict != 1 {
             skipped += 1;
@@ -456,7 +415,7 @@ fn several_stacks_with_a_static_gap_get_a_consistent_pattern() {
         let t = random_tree(&mut rng, true);
         let chosen = select_tree(&t);
         assert!(
-            consistent_tree(&t, &chosen, 1e-9),
+            consistent_tree(&t.st, &t.below, &chosen, 1e-9),
             "chosen {chosen:?} inconsistent for {:?} below {:?}",
             t.st.given,
             t.below

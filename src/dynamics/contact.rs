@@ -55,6 +55,69 @@ pub enum ContactError {
     NoConvergence { first: usize, last: usize },
 }
 
+/// What an event-driven integrator gives the stick/slip switch ([`switch_contacts`]).
+pub(crate) trait Contacts {
+    /// The interfaces' states now, and the buffer for those before the switch.
+    fn states(&mut self) -> (&mut [Contact], &mut [Contact]);
+    /// `s_k = v(body above) − v(body below)` of interface `k`, m/s.
+    fn relative_velocity(&self, k: usize) -> f64;
+    /// Friction force of interface `k`, N (on the body above).
+    fn force(&self, k: usize) -> f64;
+    /// Every group of bodies joined by the interfaces that just stopped takes one
+    /// momentum-weighted velocity.
+    fn merge_stopped(&mut self);
+    /// The Coulomb-consistent mode at the current state, ground acceleration `ga` (m/s²).
+    fn select(&mut self, ga: f64) -> Result<(), super::SimError>;
+}
+
+/// The stick/slip switch of both exact integrators, at an event that stopped interface
+/// `stopped` or broke interface `broke` loose: every slipping interface whose relative velocity
+/// has reached or crossed zero sticks momentarily (its group merged), the new mode is selected,
+/// and a break that the selection left unchanged (the force pinned at its limit with a relative
+/// acceleration below round-off, where the event proved the demand exceeds it) slips against
+/// its force. Returns the number of interfaces whose state changed.
+pub(crate) fn switch_contacts(
+    c: &mut impl Contacts,
+    stopped: Option<usize>,
+    broke: Option<usize>,
+    ga: f64,
+) -> Result<u64, super::SimError> {
+    let n = {
+        let (now, before) = c.states();
+        before.copy_from_slice(now);
+        now.len()
+    };
+    let mut any = false;
+    for k in 0..n {
+        let Contact::Slip(dir) = c.states().0[k] else {
+            continue;
+        };
+        let s = f64::from(dir) * c.relative_velocity(k);
+        if s <= 0.0 || stopped == Some(k) {
+            c.states().0[k] = Contact::Stick;
+            any = true;
+        }
+    }
+    if any {
+        c.merge_stopped();
+    }
+    c.select(ga)?;
+    if let Some(k) = broke {
+        let (now, before) = c.states();
+        if now == before {
+            let f = c.force(k);
+            c.states().0[k] = Contact::Slip(if f > 0.0 { -1 } else { 1 });
+            c.select(ga)?;
+        }
+    }
+    let (now, before) = c.states();
+    Ok(now
+        .iter()
+        .zip(before.iter())
+        .filter(|(a, b)| a != b)
+        .count() as u64)
+}
+
 /// Reusable workspace for [`ContactSelector::select`]; allocation happens once, in `new`.
 #[derive(Debug, Clone)]
 pub struct ContactSelector {

@@ -43,7 +43,7 @@
 use super::closed_form::{
     Basis, Osc, PieceIntegrals, Wave, integral_of_square_decay, integral_of_square_with,
 };
-use super::contact::{Contact, ContactSelector};
+use super::contact::{Contact, ContactSelector, Contacts, switch_contacts};
 use super::model::System;
 use super::response::{Energy, History, Response};
 use super::search::{self, Node, Smooth};
@@ -645,25 +645,6 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         }
     }
 
-    /// External forces at the current state and the Coulomb-consistent mode.
-    fn select(&mut self, ga: f64) -> Result<(), SimError> {
-        self.bounds = None;
-        let m = self.sys.masses();
-        for j in 0..=self.n {
-            self.external[j] = -m[j] * ga;
-        }
-        self.external[0] -= self.sys.damping() * self.v[0] + self.restoring_force();
-        self.selector.select(
-            m,
-            &self.external,
-            &self.lim_s,
-            &self.lim_k,
-            &mut self.contacts,
-            &mut self.force,
-        )?;
-        Ok(())
-    }
-
     /// Clusters, their closed-form motion from the current state, and the switching functions.
     fn build(&mut self, ga: f64, slope: f64) {
         let n = self.n;
@@ -1190,7 +1171,6 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             EventKind::Yield(dir) => {
                 self.spring.branch = Branch::Plastic(dir);
                 self.out.yield_events += 1;
-                return Ok(());
             }
             EventKind::Unload => {
                 if let Branch::Plastic(dir) = self.spring.branch
@@ -1203,74 +1183,13 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
                 }
                 self.spring.unload(self.x[0]);
                 self.out.yield_events += 1;
-                return Ok(());
             }
-            EventKind::SlipStop(_) | EventKind::Break(_) => {}
-        }
-        self.before.copy_from_slice(&self.contacts);
-        // Every slipping interface whose relative velocity has reached or crossed zero sticks
-        // momentarily; each group of bodies so joined takes its momentum-weighted velocity.
-        let mut stopped = false;
-        for i in 0..self.n {
-            let Contact::Slip(dir) = self.contacts[i] else {
-                continue;
-            };
-            let s = f64::from(dir) * (self.v[i + 1] - self.v[i]);
-            if s <= 0.0 || kind == EventKind::SlipStop(i) {
-                self.contacts[i] = Contact::Stick;
-                stopped = true;
+            EventKind::SlipStop(i) => {
+                self.out.switches += switch_contacts(self, Some(i), None, ga)?
             }
+            EventKind::Break(i) => self.out.switches += switch_contacts(self, None, Some(i), ga)?,
         }
-        if stopped {
-            self.merge_stopped();
-        }
-        self.select(ga)?;
-        if let EventKind::Break(i) = kind
-            && self.contacts == self.before
-        {
-            // The event proved the demand exceeds the static limit; a selection that changes
-            // nothing (the force pinned at the limit with a relative acceleration below
-            // round-off) is resolved here: the interface slips against its force.
-            self.contacts[i] = Contact::Slip(if self.force[i] > 0.0 { -1 } else { 1 });
-            self.select(ga)?;
-        }
-        let changed = self
-            .contacts
-            .iter()
-            .zip(&self.before)
-            .filter(|(a, b)| a != b)
-            .count();
-        self.out.switches += changed as u64;
         Ok(())
-    }
-
-    /// Gives every run of bodies joined by stuck interfaces one momentum-weighted velocity; the
-    /// kinetic energy this removes (round-off small after an exact root) is friction work of the
-    /// lowest interface that just stopped in the run.
-    fn merge_stopped(&mut self) {
-        let m = self.sys.masses();
-        let mut j0 = 0;
-        while j0 <= self.n {
-            let mut j1 = j0;
-            while j1 < self.n && self.contacts[j1] == Contact::Stick {
-                j1 += 1;
-            }
-            let first_stopped = (j0..j1).find(|&i| self.before[i] != Contact::Stick);
-            if let Some(i) = first_stopped {
-                let mass = self.mass_prefix[j1 + 1] - self.mass_prefix[j0];
-                let momentum: f64 = (j0..=j1).map(|j| m[j] * self.v[j]).sum();
-                let vm = momentum / mass;
-                let loss: f64 = (j0..=j1)
-                    .map(|j| 0.5 * m[j] * (self.v[j] - vm) * (self.v[j] - vm))
-                    .sum();
-                self.energy.friction_per_interface[i] += loss;
-                self.energy.friction += loss;
-                for j in j0..=j1 {
-                    self.v[j] = vm;
-                }
-            }
-            j0 = j1 + 1;
-        }
     }
 
     fn fill_state_energy(&self, e: &mut Energy) {
@@ -1321,5 +1240,67 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         self.out.energy = e;
         self.out.history = history;
         Ok(self.out)
+    }
+}
+
+impl<const YIELDS: bool, const LONG_PERIODS: bool> Contacts for ExactRun<'_, YIELDS, LONG_PERIODS> {
+    fn states(&mut self) -> (&mut [Contact], &mut [Contact]) {
+        (&mut self.contacts, &mut self.before)
+    }
+
+    fn relative_velocity(&self, i: usize) -> f64 {
+        self.v[i + 1] - self.v[i]
+    }
+
+    fn force(&self, i: usize) -> f64 {
+        self.force[i]
+    }
+
+    /// External forces at the current state and the Coulomb-consistent mode.
+    fn select(&mut self, ga: f64) -> Result<(), SimError> {
+        self.bounds = None;
+        let m = self.sys.masses();
+        for j in 0..=self.n {
+            self.external[j] = -m[j] * ga;
+        }
+        self.external[0] -= self.sys.damping() * self.v[0] + self.restoring_force();
+        self.selector.select(
+            m,
+            &self.external,
+            &self.lim_s,
+            &self.lim_k,
+            &mut self.contacts,
+            &mut self.force,
+        )?;
+        Ok(())
+    }
+
+    /// Gives every run of bodies joined by stuck interfaces one momentum-weighted velocity; the
+    /// kinetic energy this removes (round-off small after an exact root) is friction work of the
+    /// lowest interface that just stopped in the run.
+    fn merge_stopped(&mut self) {
+        let m = self.sys.masses();
+        let mut j0 = 0;
+        while j0 <= self.n {
+            let mut j1 = j0;
+            while j1 < self.n && self.contacts[j1] == Contact::Stick {
+                j1 += 1;
+            }
+            let first_stopped = (j0..j1).find(|&i| self.before[i] != Contact::Stick);
+            if let Some(i) = first_stopped {
+                let mass = self.mass_prefix[j1 + 1] - self.mass_prefix[j0];
+                let momentum: f64 = (j0..=j1).map(|j| m[j] * self.v[j]).sum();
+                let vm = momentum / mass;
+                let loss: f64 = (j0..=j1)
+                    .map(|j| 0.5 * m[j] * (self.v[j] - vm) * (self.v[j] - vm))
+                    .sum();
+                self.energy.friction_per_interface[i] += loss;
+                self.energy.friction += loss;
+                for j in j0..=j1 {
+                    self.v[j] = vm;
+                }
+            }
+            j0 = j1 + 1;
+        }
     }
 }

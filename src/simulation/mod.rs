@@ -190,102 +190,15 @@ impl Settings {
     /// The simulation with its defaults, checked: the system built, the record read, the history
     /// format known, all before any simulation.
     pub fn resolve(self) -> Result<Simulation, SimulationError> {
-        if self.building.is_some() {
-            return self.resolve_building();
-        }
-        if self.stacks.is_some() {
-            return Err(self.key_error("`stacks` needs `building` (the floors they stand on)"));
-        }
-        let alpha = self.alpha.unwrap_or_else(|| vec![0.5, 0.5]);
         let physics = Physics {
             damping: self.damping.unwrap_or(Physics::DEFAULT.damping),
             basis: self.damping_basis.unwrap_or(Physics::DEFAULT.basis),
             ..Physics::DEFAULT
         };
-        let total: f64 = alpha.iter().sum();
-        if total.is_finite() && total <= crate::limits::MAX_ALPHA {
-            physics.check(total).map_err(SimulationError::Invalid)?;
-        }
-        let spec = SystemSpec {
-            period_s: self.period.unwrap_or(1.0),
-            damping_ratio: physics.structure_damping(total),
-            mass_kg: 1.0,
-            alpha,
-            mu: self.mu.unwrap_or_else(|| vec![0.2, 0.1]),
-            mu_static: self.mu_static,
+        let model = match &self.building {
+            Some(b) => self.building_model(b, &physics)?,
+            None => self.one_storey_model(&physics)?,
         };
-        let scale = self.scale.unwrap_or(1.0);
-        if !(scale.is_finite() && scale > 0.0 && scale <= MAX_SCALE) {
-            return Err(SimulationError::Invalid(format!(
-                "`scale` must be finite, > 0 and ≤ {MAX_SCALE:e}, got {scale}"
-            )));
-        }
-        if let Some(p) = &self.history {
-            crate::store::HistoryFormat::from_path(p)
-                .map_err(|e| SimulationError::Invalid(e.to_string()))?;
-        }
-        let structure = self.structure.unwrap_or(StructureKind::Elastic);
-        let yielding = yielding(structure, self.yield_strength_ratio, self.post_yield_ratio)?;
-        let mut system = System::new(&spec).map_err(|e| SimulationError::Invalid(e.to_string()))?;
-        if let Some(y) = yielding {
-            system = system
-                .with_yielding(y)
-                .map_err(|e| SimulationError::Invalid(e.to_string()))?;
-        }
-        let record = match &self.record {
-            Some(path) => ground_motion::read_record(path)?,
-            None => ground_motion::builtin(),
-        };
-        Ok(Simulation {
-            record,
-            scale,
-            physics,
-            model: Model::OneStorey { system, structure },
-            integrator: self.integrator.unwrap_or(Integrator::Exact),
-            rk4_substeps: self.rk4_substeps.unwrap_or(10),
-            history: self.history,
-        })
-    }
-
-    /// A message about the case file's keys, with the file's name when they came from one.
-    fn key_error(&self, message: impl Into<String>) -> SimulationError {
-        let message = message.into();
-        match &self.file {
-            Some(f) => SimulationError::Key {
-                file: f.display().to_string(),
-                message,
-            },
-            None => SimulationError::Invalid(message),
-        }
-    }
-
-    /// [`Settings::resolve`] for a case with `building`.
-    fn resolve_building(self) -> Result<Simulation, SimulationError> {
-        let one_storey_keys = [
-            ("period", self.period.is_some()),
-            ("alpha", self.alpha.is_some()),
-            ("mu", self.mu.is_some()),
-            ("mu_static", self.mu_static.is_some()),
-            ("structure", self.structure.is_some()),
-            ("yield_strength_ratio", self.yield_strength_ratio.is_some()),
-            ("post_yield_ratio", self.post_yield_ratio.is_some()),
-        ];
-        if let Some((key, _)) = one_storey_keys.iter().find(|(_, given)| *given) {
-            return Err(self.key_error(format!(
-                "{key} (a key or flag of a one-storey case) does not apply to a case with \
-                 `building` (the building's keys go under `building`, each stack's under `stacks`)"
-            )));
-        }
-        let physics = Physics {
-            damping: self.damping.unwrap_or(Physics::DEFAULT.damping),
-            basis: self.damping_basis.unwrap_or(Physics::DEFAULT.basis),
-            ..Physics::DEFAULT
-        };
-        let settings = self.building.clone().unwrap_or_else(|| unreachable!());
-        let stacks = self.stacks.clone().unwrap_or_default();
-        let spec = building::building_spec(&settings, &stacks, physics.damping, physics.basis)
-            .map_err(|m| self.key_error(m))?;
-        let b = Building::new(&spec).map_err(|e| self.key_error(e.to_string()))?;
         let scale = self.scale.unwrap_or(1.0);
         if !(scale.is_finite() && scale > 0.0 && scale <= MAX_SCALE) {
             return Err(self.key_error(format!(
@@ -303,13 +216,82 @@ impl Settings {
             record,
             scale,
             physics,
-            model: Model::Building {
-                building: Box::new(b),
-                settings,
-            },
+            model,
             integrator: self.integrator.unwrap_or(Integrator::Exact),
             rk4_substeps: self.rk4_substeps.unwrap_or(10),
             history: self.history,
+        })
+    }
+
+    /// The one-storey system of these settings.
+    fn one_storey_model(&self, physics: &Physics) -> Result<Model, SimulationError> {
+        if self.stacks.is_some() {
+            return Err(self.key_error("`stacks` needs `building` (the floors they stand on)"));
+        }
+        let alpha = self.alpha.clone().unwrap_or_else(|| vec![0.5, 0.5]);
+        let total: f64 = alpha.iter().sum();
+        if total.is_finite() && total <= crate::limits::MAX_ALPHA {
+            physics.check(total).map_err(SimulationError::Invalid)?;
+        }
+        let spec = SystemSpec {
+            period_s: self.period.unwrap_or(1.0),
+            damping_ratio: physics.structure_damping(total),
+            mass_kg: 1.0,
+            alpha,
+            mu: self.mu.clone().unwrap_or_else(|| vec![0.2, 0.1]),
+            mu_static: self.mu_static.clone(),
+        };
+        let structure = self.structure.unwrap_or(StructureKind::Elastic);
+        let yielding = yielding(structure, self.yield_strength_ratio, self.post_yield_ratio)?;
+        let mut system = System::new(&spec).map_err(|e| SimulationError::Invalid(e.to_string()))?;
+        if let Some(y) = yielding {
+            system = system
+                .with_yielding(y)
+                .map_err(|e| SimulationError::Invalid(e.to_string()))?;
+        }
+        Ok(Model::OneStorey { system, structure })
+    }
+
+    /// A message about the case file's keys, with the file's name when they came from one.
+    fn key_error(&self, message: impl Into<String>) -> SimulationError {
+        let message = message.into();
+        match &self.file {
+            Some(f) => SimulationError::Key {
+                file: f.display().to_string(),
+                message,
+            },
+            None => SimulationError::Invalid(message),
+        }
+    }
+
+    /// The building of these settings (`building` given).
+    fn building_model(
+        &self,
+        settings: &building::BuildingSettings,
+        physics: &Physics,
+    ) -> Result<Model, SimulationError> {
+        let one_storey_keys = [
+            ("period", self.period.is_some()),
+            ("alpha", self.alpha.is_some()),
+            ("mu", self.mu.is_some()),
+            ("mu_static", self.mu_static.is_some()),
+            ("structure", self.structure.is_some()),
+            ("yield_strength_ratio", self.yield_strength_ratio.is_some()),
+            ("post_yield_ratio", self.post_yield_ratio.is_some()),
+        ];
+        if let Some((key, _)) = one_storey_keys.iter().find(|(_, given)| *given) {
+            return Err(self.key_error(format!(
+                "{key} (a key or flag of a one-storey case) does not apply to a case with \
+                 `building` (the building's keys go under `building`, each stack's under `stacks`)"
+            )));
+        }
+        let stacks = self.stacks.clone().unwrap_or_default();
+        let spec = building::building_spec(settings, &stacks, physics.damping, physics.basis)
+            .map_err(|m| self.key_error(m))?;
+        let b = Building::new(&spec).map_err(|e| self.key_error(e.to_string()))?;
+        Ok(Model::Building {
+            building: Box::new(b),
+            settings: settings.clone(),
         })
     }
 }

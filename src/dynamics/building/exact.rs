@@ -23,7 +23,7 @@
 // Parallel per-body and per-interface arrays read best with index loops.
 #![allow(clippy::needless_range_loop)]
 
-use super::super::contact::{Contact, ContactSelector};
+use super::super::contact::{Contact, ContactSelector, Contacts, switch_contacts};
 use super::super::exact::{BREAK_TOLERANCE, ExactOptions};
 use super::super::response::{Energy, History};
 use super::super::search::{self, Node};
@@ -376,16 +376,7 @@ impl<'b> Integrator<'b> {
                 }
             })
             .collect();
-        let out = BuildingResponse {
-            floor_peak_displacement_m: vec![0.0; n],
-            floor_peak_abs_accel_mps2: vec![0.0; n],
-            storey_peak_drift_m: vec![0.0; n],
-            storey_residual_drift_m: vec![0.0; n],
-            block_peak_abs_accel_mps2: vec![0.0; nb],
-            peak_slip_m: vec![0.0; nb],
-            residual_slip_m: vec![0.0; nb],
-            ..BuildingResponse::default()
-        };
+        let out = BuildingResponse::zeroed(n, nb);
         Self {
             b,
             dt,
@@ -613,38 +604,6 @@ impl<'b> Integrator<'b> {
             };
             out[j] = -self.b.masses()[j] * ga - damper - below + above;
         }
-    }
-
-    /// The Coulomb-consistent mode at the current state, floor by floor.
-    fn select(&mut self, ga: f64) -> Result<(), SimError> {
-        let mut ext = vec![0.0; self.n];
-        self.floor_forces(ga, &mut ext);
-        let n = self.n;
-        for (f, fc) in self.floors.iter_mut().enumerate() {
-            if fc.interfaces.is_empty() {
-                continue;
-            }
-            fc.external[0] = ext[f];
-            for (l, &k) in fc.interfaces.iter().enumerate() {
-                fc.external[l + 1] = -self.b.masses()[n + k] * ga;
-                fc.contacts[l] = self.contacts[k];
-            }
-            fc.selector.select_tree(
-                &fc.below,
-                &fc.masses,
-                &fc.external,
-                &fc.lim_s,
-                &fc.lim_k,
-                &mut fc.contacts,
-                &mut fc.force,
-            )?;
-            for (l, &k) in fc.interfaces.iter().enumerate() {
-                self.contacts[k] = fc.contacts[l];
-                self.force[k] = fc.force[l];
-            }
-        }
-        self.mode = None;
-        Ok(())
     }
 
     /// The piece from the current state: the mode (set up again after a switch), the floors'
@@ -1130,7 +1089,6 @@ impl<'b> Integrator<'b> {
                 self.storeys[i].branch = Branch::Plastic(dir);
                 self.out.yield_events += 1;
                 self.mode = None;
-                return Ok(());
             }
             EventKind::Unload(i) => {
                 if let Branch::Plastic(dir) = self.storeys[i].branch {
@@ -1145,43 +1103,12 @@ impl<'b> Integrator<'b> {
                 self.storeys[i].unload(d);
                 self.out.yield_events += 1;
                 self.mode = None;
-                return Ok(());
             }
-            EventKind::SlipStop(_) | EventKind::Break(_) => {}
-        }
-        self.before.copy_from_slice(&self.contacts);
-        let n = self.n;
-        let mut stopped = false;
-        for k in 0..self.b.blocks() {
-            let Contact::Slip(dir) = self.contacts[k] else {
-                continue;
-            };
-            let s = f64::from(dir) * (self.v[n + k] - self.v[self.b.below(k)]);
-            if s <= 0.0 || kind == EventKind::SlipStop(k) {
-                self.contacts[k] = Contact::Stick;
-                stopped = true;
+            EventKind::SlipStop(k) => {
+                self.out.switches += switch_contacts(self, Some(k), None, ga)?
             }
+            EventKind::Break(k) => self.out.switches += switch_contacts(self, None, Some(k), ga)?,
         }
-        if stopped {
-            self.merge_stopped();
-        }
-        self.select(ga)?;
-        if let EventKind::Break(k) = kind
-            && self.contacts == self.before
-        {
-            // The event proved the demand exceeds the static limit; a selection that changes
-            // nothing (force pinned at the limit, relative acceleration below round-off) is
-            // resolved here: the interface slips against its force.
-            self.contacts[k] = Contact::Slip(if self.force[k] > 0.0 { -1 } else { 1 });
-            self.select(ga)?;
-        }
-        let changed = self
-            .contacts
-            .iter()
-            .zip(&self.before)
-            .filter(|(a, b)| a != b)
-            .count();
-        self.out.switches += changed as u64;
         Ok(())
     }
 
@@ -1211,58 +1138,6 @@ impl<'b> Integrator<'b> {
         };
         for j in members {
             self.v[j] = vm;
-        }
-    }
-
-    /// Every group of bodies joined by stuck interfaces that just stopped takes one
-    /// momentum-weighted velocity; the kinetic energy this removes (round-off small after an
-    /// exact root) is friction work of the lowest interface that just stopped in it.
-    fn merge_stopped(&mut self) {
-        let (n, nb) = (self.n, self.b.blocks());
-        // Union-find over bodies through stuck interfaces.
-        let mut parent: Vec<usize> = (0..self.bodies).collect();
-        fn root(p: &mut [usize], mut a: usize) -> usize {
-            while p[a] != a {
-                p[a] = p[p[a]];
-                a = p[a];
-            }
-            a
-        }
-        for k in 0..nb {
-            if self.contacts[k] == Contact::Stick {
-                let (a, c) = (root(&mut parent, n + k), root(&mut parent, self.b.below(k)));
-                parent[a.max(c)] = a.min(c);
-            }
-        }
-        let m = self.b.masses();
-        let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
-        for j in 0..self.bodies {
-            let r = root(&mut parent, j);
-            groups.entry(r).or_default().push(j);
-        }
-        let mut roots: Vec<usize> = groups.keys().copied().collect();
-        roots.sort_unstable();
-        for r in roots {
-            let members = &groups[&r];
-            let first_stopped = (0..nb).find(|&k| {
-                self.before[k] != Contact::Stick
-                    && self.contacts[k] == Contact::Stick
-                    && members.contains(&(n + k))
-            });
-            let Some(k) = first_stopped else {
-                continue;
-            };
-            let mass: f64 = members.iter().map(|&j| m[j]).sum();
-            let vm = members.iter().map(|&j| m[j] * self.v[j]).sum::<f64>() / mass;
-            let loss: f64 = members
-                .iter()
-                .map(|&j| 0.5 * m[j] * (self.v[j] - vm) * (self.v[j] - vm))
-                .sum();
-            self.energy.friction_per_interface[k] += loss;
-            self.energy.friction += loss;
-            for &j in members {
-                self.v[j] = vm;
-            }
         }
     }
 
@@ -1322,5 +1197,103 @@ impl<'b> Integrator<'b> {
         self.out.energy = e;
         self.out.history = history;
         Ok(self.out)
+    }
+}
+
+impl Contacts for Integrator<'_> {
+    fn states(&mut self) -> (&mut [Contact], &mut [Contact]) {
+        (&mut self.contacts, &mut self.before)
+    }
+
+    fn relative_velocity(&self, k: usize) -> f64 {
+        self.v[self.n + k] - self.v[self.b.below(k)]
+    }
+
+    fn force(&self, k: usize) -> f64 {
+        self.force[k]
+    }
+
+    /// The Coulomb-consistent mode at the current state, floor by floor.
+    fn select(&mut self, ga: f64) -> Result<(), SimError> {
+        let mut ext = vec![0.0; self.n];
+        self.floor_forces(ga, &mut ext);
+        let n = self.n;
+        for (f, fc) in self.floors.iter_mut().enumerate() {
+            if fc.interfaces.is_empty() {
+                continue;
+            }
+            fc.external[0] = ext[f];
+            for (l, &k) in fc.interfaces.iter().enumerate() {
+                fc.external[l + 1] = -self.b.masses()[n + k] * ga;
+                fc.contacts[l] = self.contacts[k];
+            }
+            fc.selector.select_tree(
+                &fc.below,
+                &fc.masses,
+                &fc.external,
+                &fc.lim_s,
+                &fc.lim_k,
+                &mut fc.contacts,
+                &mut fc.force,
+            )?;
+            for (l, &k) in fc.interfaces.iter().enumerate() {
+                self.contacts[k] = fc.contacts[l];
+                self.force[k] = fc.force[l];
+            }
+        }
+        self.mode = None;
+        Ok(())
+    }
+
+    /// Every group of bodies joined by stuck interfaces that just stopped takes one
+    /// momentum-weighted velocity; the kinetic energy this removes (round-off small after an
+    /// exact root) is friction work of the lowest interface that just stopped in it.
+    fn merge_stopped(&mut self) {
+        let (n, nb) = (self.n, self.b.blocks());
+        // Union-find over bodies through stuck interfaces.
+        let mut parent: Vec<usize> = (0..self.bodies).collect();
+        fn root(p: &mut [usize], mut a: usize) -> usize {
+            while p[a] != a {
+                p[a] = p[p[a]];
+                a = p[a];
+            }
+            a
+        }
+        for k in 0..nb {
+            if self.contacts[k] == Contact::Stick {
+                let (a, c) = (root(&mut parent, n + k), root(&mut parent, self.b.below(k)));
+                parent[a.max(c)] = a.min(c);
+            }
+        }
+        let m = self.b.masses();
+        let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
+        for j in 0..self.bodies {
+            let r = root(&mut parent, j);
+            groups.entry(r).or_default().push(j);
+        }
+        let mut roots: Vec<usize> = groups.keys().copied().collect();
+        roots.sort_unstable();
+        for r in roots {
+            let members = &groups[&r];
+            let first_stopped = (0..nb).find(|&k| {
+                self.before[k] != Contact::Stick
+                    && self.contacts[k] == Contact::Stick
+                    && members.contains(&(n + k))
+            });
+            let Some(k) = first_stopped else {
+                continue;
+            };
+            let mass: f64 = members.iter().map(|&j| m[j]).sum();
+            let vm = members.iter().map(|&j| m[j] * self.v[j]).sum::<f64>() / mass;
+            let loss: f64 = members
+                .iter()
+                .map(|&j| 0.5 * m[j] * (self.v[j] - vm) * (self.v[j] - vm))
+                .sum();
+            self.energy.friction_per_interface[k] += loss;
+            self.energy.friction += loss;
+            for &j in members {
+                self.v[j] = vm;
+            }
+        }
     }
 }

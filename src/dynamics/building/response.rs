@@ -35,6 +35,21 @@ pub struct BuildingResponse {
 }
 
 impl BuildingResponse {
+    /// A response of `storeys` floors and `blocks` blocks with every peak at zero, to be filled
+    /// by an integrator.
+    pub fn zeroed(storeys: usize, blocks: usize) -> Self {
+        Self {
+            floor_peak_displacement_m: vec![0.0; storeys],
+            floor_peak_abs_accel_mps2: vec![0.0; storeys],
+            storey_peak_drift_m: vec![0.0; storeys],
+            storey_residual_drift_m: vec![0.0; storeys],
+            block_peak_abs_accel_mps2: vec![0.0; blocks],
+            peak_slip_m: vec![0.0; blocks],
+            residual_slip_m: vec![0.0; blocks],
+            ..Self::default()
+        }
+    }
+
     /// The one-storey integrator's response in a building's terms (floor 1 = the structure,
     /// one stack), for [`super::Building::one_storey`].
     pub fn from_one_storey(r: Response) -> Self {

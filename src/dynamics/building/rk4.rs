@@ -443,17 +443,8 @@ impl<'b> Rk4<'b> {
         let dt = ground.dt_s;
         let h = dt / substeps as f64;
         let steps = acc_g.len() - 1;
-        let mut out = BuildingResponse {
-            floor_peak_displacement_m: vec![0.0; n],
-            floor_peak_abs_accel_mps2: vec![0.0; n],
-            storey_peak_drift_m: vec![0.0; n],
-            storey_residual_drift_m: vec![0.0; n],
-            block_peak_abs_accel_mps2: vec![0.0; blocks],
-            peak_slip_m: vec![0.0; blocks],
-            residual_slip_m: vec![0.0; blocks],
-            ..BuildingResponse::default()
-        };
-        let mut history = want_history.then(|| History::with_capacity(steps + 1, nb));
+        let mut out = BuildingResponse::zeroed(n, blocks);
+        let mut history = want_history.then(|| History::with_layout(steps + 1, nb, blocks));
         let nr = 2 + blocks + if self.storeys.is_some() { n } else { 0 };
         let mut kx = vec![vec![0.0; nb]; 4];
         let mut kv = vec![vec![0.0; nb]; 4];
