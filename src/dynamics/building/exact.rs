@@ -2,7 +2,7 @@
 //! the multi-storey form of [`super::super::exact`].
 //!
 //! Within a mode (every interface stuck or slipping, every storey on one branch) the floors with
-//! the blocks stuck to them form one linear system, moved exactly by [`super::modal`]; every
+//! the blocks stuck to them form one linear system, moved exactly by `modal`; every
 //! other run of stuck blocks is a free mass under constant friction (a cubic). A sample interval
 //! is crossed in one piece unless a switch occurs inside it:
 //! * a slipping interface's relative velocity reaches zero;
@@ -12,7 +12,7 @@
 //! * a storey's drift reaches the end of its elastic range (yield), or its drift rate reverses
 //!   on a bounding line (unloading).
 //!
-//! Each is located by the certified search of [`super::super::search`] and refined to a few ulps
+//! Each is located by the certified search of `dynamics::search` and refined to a few ulps
 //! of time; the new mode is chosen floor by floor ([`ContactSelector::select_tree`]: at an
 //! instant the spring and damper forces are known, so the floors' contact problems are
 //! independent), by the same rule as for one storey. The peaks of every floor's displacement
