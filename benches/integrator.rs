@@ -1,5 +1,5 @@
 //! Criterion bench of the exact integrators per regime, one thread, one real record (RSN960,
-//! Northridge, 8000 samples at 0.005 s... as read): criterion's throughput is record samples, so
+//! Northridge, 1999 samples at 0.01 s): criterion's throughput is record samples, so
 //! `1e9 / (elements per second)` is the time per simulated sample, the figure the sweep prints.
 //!
 //! * `sdof/*`: the one-storey integrator (`simulate_exact`) as the sweep runs it (no energy
@@ -7,7 +7,8 @@
 //!   yielding structure, and a long period (`T_p` = 20 s, the φ-function branch);
 //! * `building/*`: the multi-storey integrator (`simulate_building`) on the same record: the
 //!   Section 7.1 case on one storey (the general modal path, against `sdof/sliding`), three
-//!   storeys with two stacks on different floors, elastic and yielding, and twenty storeys.
+//!   storeys with two stacks on different floors, elastic and yielding, and six, ten and twenty
+//!   storeys with a stack on the roof and one half-way up.
 //!
 //! `cargo bench --bench integrator`; ratios between rows of one run are the figures of merit.
 
@@ -79,6 +80,14 @@ fn integrators(c: &mut Criterion) {
         strength_ratios: vec![0.15, 0.12, 0.1],
         post_yield_ratio: 0.05,
     });
+    let storeys = |n: usize, period_s: f64| {
+        let mut b = BuildingSpec::uniform(n, period_s);
+        b.stacks = vec![
+            stack(n, &[0.5, 0.5], &[0.2, 0.1]),
+            stack(n.div_ceil(2), &[1.0], &[0.15]),
+        ];
+        b
+    };
     let mut twenty = BuildingSpec::uniform(20, 2.0);
     twenty.stacks = vec![
         stack(20, &[0.5, 0.5], &[0.2, 0.1]),
@@ -88,6 +97,8 @@ fn integrators(c: &mut Criterion) {
         ("building/1_storey_sliding", one),
         ("building/3_storeys_2_stacks", three),
         ("building/3_storeys_2_stacks_yielding", three_yielding),
+        ("building/6_storeys_2_stacks", storeys(6, 0.8)),
+        ("building/10_storeys_2_stacks", storeys(10, 1.2)),
         ("building/20_storeys_2_stacks", twenty),
     ] {
         let b = Building::new(&spec).unwrap();
