@@ -21,7 +21,8 @@
 //! give the same result on any machine thread count.
 
 use super::FitError;
-use super::problem::{Problem, Scaled, relative_offset};
+use super::Form;
+use super::problem::{Problem, Projected, Scaled, relative_offset};
 use argmin::core::{
     CostFunction, Error as ArgminError, Executor, Gradient, Hessian, IterState, KV,
     OptimizationResult, Problem as ArgminProblem, Solver, State, TerminationReason,
@@ -56,6 +57,10 @@ pub enum Method {
     TrustRegion,
     /// argmin's Nelder–Mead, from the trust region's best point (fallback).
     NelderMead,
+    /// The paper form's fallback: argmin's Nelder–Mead on its exponent weights alone, the
+    /// linear parameters projected out (variable projection), from the trust region's best
+    /// point.
+    ProjectedNelderMead,
 }
 
 /// How the solver went.
@@ -203,6 +208,57 @@ fn nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), F
     outcome(result, "Nelder–Mead")
 }
 
+/// The paper form's fallback: Nelder–Mead over its `k` exponent weights `c` only, the linear
+/// parameters `(a, B, e)` solved for at each point (variable projection: a `k`-dimensional
+/// simplex instead of a `(2k + 2)`-dimensional one, where Nelder–Mead's iterations grow fast
+/// with the dimension), scaled and stopped as [`nelder_mead`]. Every point it visits is at
+/// least as good as the full parameters with the same `c`, so its result is no worse than the
+/// start's. Returns the full parameters (linear ones by the SVD), iterations, and whether it
+/// stopped on its tolerance.
+fn projected_nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), FitError> {
+    let k = problem.k;
+    let d = problem.column_scales(p0)[k..2 * k].to_vec();
+    let projected = Projected { problem, d };
+    let q0: Vec<f64> = p0[k..2 * k]
+        .iter()
+        .zip(&projected.d)
+        .map(|(c, d)| c * d)
+        .collect();
+    let mut simplex = vec![q0.clone()];
+    for i in 0..k {
+        let mut v = q0.clone();
+        v[i] += 0.1;
+        simplex.push(v);
+    }
+    let start_cost = projected.cost(&q0).map_err(solver_error)?;
+    let solver = NelderMead::new(simplex)
+        .with_sd_tolerance(1e-12 * start_cost.max(f64::MIN_POSITIVE))
+        .map_err(solver_error)?;
+    let result = Executor::new(projected, solver)
+        .configure(|s| s.max_iters(MAX_NELDER_MEAD_ITERATIONS))
+        .timer(false)
+        .run()
+        .map_err(solver_error)?;
+    let converged = matches!(
+        result.state.get_termination_reason(),
+        Some(TerminationReason::SolverConverged)
+    );
+    let iterations = result.state.get_iter();
+    let q = result
+        .state
+        .get_best_param()
+        .ok_or_else(|| FitError::Solver("Nelder–Mead (projected): no best parameters".into()))?;
+    let c = result
+        .problem
+        .problem
+        .as_ref()
+        .map(|s| s.to_c(q))
+        .ok_or_else(|| FitError::Solver("Nelder–Mead (projected): problem not returned".into()))?;
+    let mut start = p0.to_vec();
+    start[k..2 * k].copy_from_slice(&c);
+    Ok((problem.complete_start(&start), iterations, converged))
+}
+
 /// A run of an argmin solver `S` on the scaled problem, as the executor returns it.
 type Finished<'a, S, G, J, H, R> =
     OptimizationResult<Scaled<'a>, S, IterState<Vec<f64>, G, J, H, R, f64>>;
@@ -281,8 +337,13 @@ pub(crate) fn solve(
         relative_offset: f64::NAN,
     };
     if !converged {
-        let (q, it, nm_converged) = nelder_mead(problem, &p)?;
-        report.method = Method::NelderMead;
+        let (q, it, nm_converged) = if problem.form == Form::Paper {
+            report.method = Method::ProjectedNelderMead;
+            projected_nelder_mead(problem, &p)?
+        } else {
+            report.method = Method::NelderMead;
+            nelder_mead(problem, &p)?
+        };
         report.converged = nm_converged;
         report.iterations += it;
         if problem.sse(&q) <= sse {
@@ -301,8 +362,9 @@ mod tests {
     fn falls_back_to_nelder_mead_when_the_trust_region_does_not_converge() {
         // T_new = 1 + (x₁ + x₂)²: the paper form a·x + B·e^{c·x} + e approaches it only as
         // c → 0 with B·c² fixed, a least-squares optimum at infinity, so the trust region
-        // keeps improving without converging; Nelder–Mead then takes over from its best point
-        // and the result is no worse than that point.
+        // keeps improving without converging; Nelder–Mead on the exponent weights (variable
+        // projection) then takes over from its best point and the result is no worse than
+        // that point.
         let mut data = Vec::new();
         for i in 0..60 {
             let x1 = 0.1 + 0.03 * i as f64;
@@ -316,7 +378,7 @@ mod tests {
         let problem = Problem::new(Form::Paper, &data).unwrap();
         let starts = Form::Paper.starts(2);
         let (p, report) = solve(&problem, &starts).unwrap();
-        assert_eq!(report.method, Method::NelderMead, "{report:?}");
+        assert_eq!(report.method, Method::ProjectedNelderMead, "{report:?}");
         let p0 = problem.complete_start(&starts[1]);
         let (tr, tr_sse, _, converged) = trust_region(&problem, &p0, MAX_ITERATIONS).unwrap();
         assert!(!converged, "{tr:?}");

@@ -164,6 +164,7 @@ fn describe(f: &FormFit) -> String {
         match f.solver.method {
             crate::fit::Method::TrustRegion => "trust region",
             crate::fit::Method::NelderMead => "Nelder–Mead fallback",
+            crate::fit::Method::ProjectedNelderMead => "Nelder–Mead (projected) fallback",
         },
         if f.solver.converged {
             "converged"

@@ -144,6 +144,7 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
                         match fr.solver.method {
                             Method::TrustRegion => "trust-region",
                             Method::NelderMead => "nelder-mead",
+                            Method::ProjectedNelderMead => "nelder-mead-projected",
                         },
                     )?;
                     let b = &fr.box_check;
