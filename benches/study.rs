@@ -1,6 +1,7 @@
 //! The study end to end: `slidestack run` on a config (default `configs/paper.yaml`, the paper's
 //! full grid, both zones) into a fresh directory, printing the time of each stage, cases per
-//! second and simulations per second.
+//! second and simulations per second (and, for a config with an `ida:` section, the IDA's runs
+//! per second and time per simulated sample).
 //!
 //! `cargo bench --bench study` (several minutes on 2 cores); `SLIDESTACK_BENCH_CONFIG=configs/quick.yaml`
 //! for a short run.
@@ -57,10 +58,11 @@ fn main() {
         }
         println!("| total | {} |", total.trim_end_matches(" s)"));
     }
-    if let Some(line) = text
-        .lines()
-        .find(|l| l.starts_with("sweep: ") && l.contains("cases/s"))
-    {
+    for line in text.lines().filter(|l| {
+        (l.starts_with("sweep: ") && l.contains("cases/s"))
+            || (l.starts_with("fit: ") && l.contains("cross-validated, in"))
+            || (l.starts_with("ida: ") && l.contains("runs/s"))
+    }) {
         println!("\n{line}");
     }
 }

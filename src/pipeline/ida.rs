@@ -108,6 +108,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         ),
     );
     let start = std::time::Instant::now();
+    let samples = std::sync::atomic::AtomicUsize::new(0);
     let bar = s.reporter.progress(me, units.len() as u64);
     let outs: Vec<UnitOut> = units
         .par_iter()
@@ -137,6 +138,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                         .map_err(|e| fail(kind.key(), e.to_string()))
                 })
                 .collect::<Result<Vec<_>, _>>()?;
+            let runs: usize = traces.iter().map(|t| t.runs.len()).sum();
+            samples.fetch_add(runs * padded.len(), std::sync::atomic::Ordering::Relaxed);
             bar.inc();
             Ok(UnitOut {
                 record_sa_g,
@@ -150,12 +153,14 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         .flat_map(|o| o.traces.iter().map(|t| t.runs.len()))
         .sum();
     let secs = start.elapsed().as_secs_f64();
+    let threads = rayon::current_num_threads();
     s.reporter.info(
         me,
         &format!(
-            "{runs} runs in {secs:.1} s ({:.0} runs/s, {} threads)",
+            "{runs} runs in {secs:.1} s ({:.0} runs/s); {:.0} ns per simulated record sample \
+             per thread ({threads} threads)",
             runs as f64 / secs.max(1e-9),
-            rayon::current_num_threads()
+            secs * 1e9 * threads as f64 / samples.into_inner().max(1) as f64
         ),
     );
     let axes = axes_of(cfg);
