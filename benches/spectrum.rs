@@ -34,6 +34,10 @@ fn spectrum(c: &mut Criterion) {
         .build()
         .unwrap();
     let mut g = c.benchmark_group("spectrum_100_periods_6000_samples");
+    // Elements: oscillator-samples (periods × record samples).
+    g.throughput(criterion::Throughput::Elements(
+        (periods.len() * accel.len()) as u64,
+    ));
     g.bench_function("exact", |b| {
         b.iter(|| {
             pool.install(|| black_box(response_spectrum(&accel, dt, &periods, 0.05).unwrap()))
