@@ -367,6 +367,13 @@ fn design<'py>(
     )
 }
 
+/// Panics on purpose: the tests check that a panic reaches Python as an exception (the cargo
+/// profile `python` unwinds) and leaves the interpreter running.
+#[pyfunction]
+fn _panic() {
+    panic!("a deliberate panic (slidestack._native._panic)");
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", slidestack::VERSION)?;
@@ -375,6 +382,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(match_, m)?)?;
     m.add_function(wrap_pyfunction!(design, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic, m)?)?;
     pipeline::register(m)?;
     Ok(())
 }

@@ -108,3 +108,13 @@ def test_a_bad_target_for_match():
         slidestack.match((accel, dt), "is1893:zone=IX")
     with pytest.raises(ValueError, match="invalid `settings`"):
         slidestack.match((accel, dt), "is1893:zone=V,soil=I", settings={"bogus": 1})
+
+
+def test_a_panic_is_an_exception_not_an_abort():
+    from slidestack import _native
+
+    with pytest.raises(BaseException) as e:
+        _native._panic()  # type: ignore[attr-defined]
+    assert type(e.value).__name__ == "PanicException"
+    assert "deliberate panic" in str(e.value)
+    assert slidestack.simulate()["switches"] > 0
