@@ -187,3 +187,55 @@ def test_ctrl_c_stops_a_sweep_and_leaves_it_resumable(tmp_path):
     assert not leftovers, leftovers
     assert slidestack.sweep(cfg)["outcome"] == "wrote"
     assert slidestack.status(cfg)["stages"]["sweep"] == "up_to_date"
+
+
+SWEEP_SCRIPT = """
+import sys, slidestack
+slidestack.sweep(sys.argv[1], out=sys.argv[2])
+"""
+
+
+def copy_motions(src: Path, dst: Path) -> None:
+    dst.mkdir()
+    for name in ("motions.h5", "motions.h5.sha256"):
+        (dst / name).write_bytes((src / name).read_bytes())
+
+
+def test_progress_shows_only_on_a_terminal(quick, tmp_path):
+    import pty
+
+    _, py_out, _ = quick
+    quiet = tmp_path / "quiet"
+    copy_motions(py_out, quiet)
+    p = subprocess.run(
+        [sys.executable, "-c", SWEEP_SCRIPT, str(QUICK), str(quiet)],
+        capture_output=True,
+        text=True,
+    )
+    assert p.returncode == 0, p.stderr
+    assert "units to compute" not in p.stderr and p.stdout == ""
+
+    shown = tmp_path / "shown"
+    copy_motions(py_out, shown)
+    master, slave = pty.openpty()
+    child = subprocess.Popen(
+        [sys.executable, "-c", SWEEP_SCRIPT, str(QUICK), str(shown)],
+        stdout=subprocess.DEVNULL,
+        stderr=slave,
+    )
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 65536)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    os.close(master)
+    assert child.wait() == 0
+    text = b"".join(chunks).decode(errors="replace")
+    # The CLI's lines (`sweep: …`) and its bar's counter (`N/30 units`).
+    assert "sweep: 30 of 30 units to compute" in text, text
+    assert "/30 units" in text, text
