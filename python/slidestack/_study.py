@@ -46,8 +46,13 @@ def open_study(out: Union[str, "os.PathLike[str]"]) -> Dict[str, Dict[str, "xarr
     (``pip install slidestack[study]``); imported here, so the rest of the module needs only numpy.
     Raises FileNotFoundError when ``out`` holds none of the files.
     """
-    import h5netcdf
-    import xarray as xr
+    try:
+        import h5netcdf  # type: ignore[import-untyped]
+        import xarray as xr
+    except ImportError as e:
+        raise ImportError(
+            f"open_study needs xarray and h5netcdf ({e}): pip install xarray h5netcdf"
+        ) from e
 
     out = os.fspath(out)
     study: Dict[str, Dict[str, xr.Dataset]] = {}

@@ -49,3 +49,14 @@ def test_stub_refuses_wrong_calls(tmp_path):
     assert "bad.py:3: error" in p.stdout  # a str period
     assert "bad.py:4: error" in p.stdout  # an unknown keyword
     assert "bad.py:5: error" in p.stdout  # a tuple is not an int
+
+
+def test_the_package_itself_is_strictly_typed(tmp_path):
+    package = Path(__file__).resolve().parents[1] / "slidestack"
+    p = subprocess.run(
+        [sys.executable, "-m", "mypy", "--strict", "--no-incremental", str(package)],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert p.returncode == 0, p.stdout + p.stderr
