@@ -239,3 +239,17 @@ def test_progress_shows_only_on_a_terminal(quick, tmp_path):
     # The CLI's lines (`sweep: …`) and its bar's counter (`N/30 units`).
     assert "sweep: 30 of 30 units to compute" in text, text
     assert "/30 units" in text, text
+
+
+def test_shards_and_merge_make_the_same_sweep(quick, tmp_path):
+    _, py_out, _ = quick
+    out = tmp_path / "sharded"
+    copy_motions(py_out, out)
+    assert slidestack.sweep(QUICK, out=out, shard=(1, 2))["outcome"] == "shard_done"
+    with pytest.raises(RuntimeError, match="15 of 30 units are missing"):
+        slidestack.merge(QUICK, out=out)  # shard 2 is missing
+    assert slidestack.sweep(QUICK, out=out, shard=(2, 2))["shard"] == (2, 2)
+    assert slidestack.merge(QUICK, out=out)["outcome"] == "wrote"
+    assert (out / "sweep.h5").read_bytes() == (py_out / "sweep.h5").read_bytes()
+    with pytest.raises(ValueError, match="needs 1 ≤ k ≤ n"):
+        slidestack.sweep(QUICK, out=out, shard=(3, 2))
