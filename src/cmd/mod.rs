@@ -12,13 +12,11 @@ pub mod status;
 pub mod sweep;
 
 use anyhow::{Context, Result, bail};
-use indicatif::{ProgressBar, ProgressStyle};
 use slidestack::ground_motion::{ReadOptions, Record, Units, read_record_with};
 use slidestack::pipeline::lock::{LockError, LockMode};
 use slidestack::pipeline::{
     Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, Study,
 };
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// What every study stage takes.
@@ -67,24 +65,7 @@ impl Reporter for CliReporter {
         eprintln!("{stage}: warning: {message}");
     }
     fn progress(&self, _stage: StageId, total: u64) -> Box<dyn Progress + '_> {
-        if !std::io::stderr().is_terminal() {
-            return Box::new(Bar(ProgressBar::hidden()));
-        }
-        let style =
-            ProgressStyle::with_template("{bar:40} {pos}/{len} units, {per_sec}, ETA {eta}")
-                .expect("valid template");
-        Box::new(Bar(ProgressBar::new(total).with_style(style)))
-    }
-}
-
-struct Bar(ProgressBar);
-
-impl Progress for Bar {
-    fn inc(&self) {
-        self.0.inc(1);
-    }
-    fn finish(&self) {
-        self.0.finish_and_clear();
+        slidestack::pipeline::terminal_progress(total)
     }
 }
 
@@ -121,6 +102,8 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
                 .is_some_and(slidestack::design::DesignError::is_bad_input)
             || c.downcast_ref::<slidestack::match_files::MatchFilesError>()
                 .is_some_and(slidestack::match_files::MatchFilesError::is_bad_input)
+            || c.downcast_ref::<slidestack::spectrum::batch::BatchError>()
+                .is_some_and(slidestack::spectrum::batch::BatchError::is_bad_input)
             || c.is::<BadInput>()
     });
     if bad_input { 2 } else { 1 }

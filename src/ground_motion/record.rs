@@ -57,6 +57,22 @@ impl Record {
     pub fn duration_s(&self) -> f64 {
         self.accel_g.len().saturating_sub(1) as f64 * self.dt_s
     }
+
+    /// A record from samples in memory (`accel_g` in g at step `dt_s`, s), checked as a file's
+    /// samples are: 2 to [`MAX_SAMPLES`] finite values, a step within [`DT_RANGE_S`].
+    pub fn from_samples(name: &str, dt_s: f64, accel_g: Vec<f64>) -> Result<Self, RecordError> {
+        crate::spectrum::response::validate_record(&accel_g, dt_s).map_err(|source| {
+            RecordError::Samples {
+                name: name.to_string(),
+                source,
+            }
+        })?;
+        Ok(Self {
+            name: name.to_string(),
+            dt_s,
+            accel_g,
+        })
+    }
 }
 
 /// Units of acceleration a record file may be written in.
@@ -164,6 +180,12 @@ pub enum RecordError {
         file: String,
         line: usize,
         problem: Problem,
+    },
+    /// Samples given in memory ([`Record::from_samples`]), named by their label.
+    #[error("{name}: {source}")]
+    Samples {
+        name: String,
+        source: crate::spectrum::SpectrumError,
     },
 }
 

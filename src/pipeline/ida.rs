@@ -113,6 +113,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let outs: Vec<UnitOut> = units
         .par_iter()
         .map(|&(z, m, c)| -> Result<UnitOut, PipelineError> {
+            s.check_cancelled(me)?;
             let rec = &motions[z][m];
             let case = &cfg.cases[c];
             let fail = |system: &'static str, why: String| IdaStageError::Simulation {

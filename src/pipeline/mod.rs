@@ -143,6 +143,9 @@ pub enum PipelineError {
     Report(#[from] report::ReportError),
     #[error(transparent)]
     Ida(#[from] ida::IdaStageError),
+    /// The reporter asked the run to stop ([`Reporter::cancelled`]).
+    #[error("{0}: interrupted; what it stored is kept and the next run resumes from there")]
+    Cancelled(StageId),
 }
 
 impl PipelineError {
@@ -193,6 +196,38 @@ pub trait Reporter: Sync {
     /// A counter of `total` steps (work units); the default shows nothing.
     fn progress(&self, _stage: StageId, _total: u64) -> Box<dyn Progress + '_> {
         Box::new(NoProgress)
+    }
+    /// Whether the caller wants the run stopped (the Python module's Ctrl-C). Stages ask between
+    /// work units and stop with [`PipelineError::Cancelled`], leaving the output directory as a
+    /// killed run does: every unit stored so far kept, the next run resuming from them.
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+/// A counter on standard error when it is a terminal (`{bar} {pos}/{len} units, {per_sec}, ETA
+/// {eta}`), nothing otherwise: the progress the CLI and the Python module show.
+pub fn terminal_progress(total: u64) -> Box<dyn Progress> {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return Box::new(NoProgress);
+    }
+    let style =
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} units, {per_sec}, ETA {eta}")
+            .expect("valid template");
+    Box::new(TerminalBar(
+        indicatif::ProgressBar::new(total).with_style(style),
+    ))
+}
+
+struct TerminalBar(indicatif::ProgressBar);
+
+impl Progress for TerminalBar {
+    fn inc(&self) {
+        self.0.inc(1);
+    }
+    fn finish(&self) {
+        self.0.finish_and_clear();
     }
 }
 
@@ -263,7 +298,16 @@ impl Study {
     /// Reads and validates the config (every limit is checked here, before any work) and
     /// computes every stage's expected fingerprint.
     pub fn load(config: &Path, out: Option<PathBuf>) -> Result<Self, PipelineError> {
-        let cfg = StudyConfig::load(config)?;
+        Self::with_config(StudyConfig::load(config)?, config, out)
+    }
+
+    /// The study of a config already read ([`StudyConfig::parse`]); `config` names it in
+    /// messages.
+    pub fn with_config(
+        cfg: StudyConfig,
+        config: &Path,
+        out: Option<PathBuf>,
+    ) -> Result<Self, PipelineError> {
         let out = match out {
             Some(o) => {
                 check_output_dir(&o).map_err(|why| PipelineError::Setting {
@@ -476,6 +520,14 @@ impl<'r> Session<'r> {
     pub fn exclusive(&self) -> bool {
         self.mode == LockMode::Exclusive
     }
+
+    /// `Err(Cancelled)` when the reporter asks the run to stop.
+    pub fn check_cancelled(&self, stage: StageId) -> Result<(), PipelineError> {
+        if self.reporter.cancelled() {
+            return Err(PipelineError::Cancelled(stage));
+        }
+        Ok(())
+    }
 }
 
 /// How a stage runs.
@@ -498,6 +550,7 @@ pub enum Outcome {
 
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
 pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
+    s.check_cancelled(stage)?;
     s.study.fingerprint(stage)?;
     for &up in stage.upstream() {
         s.study.require(up)?;

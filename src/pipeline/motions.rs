@@ -105,6 +105,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     }
     let mut zones = Vec::new();
     for (i, z) in cfg.zones.iter().enumerate() {
+        s.check_cancelled(me)?;
         let target = cfg.target(i);
         let start = std::time::Instant::now();
         let zm = match_zone(&z.name, target, &seeds, &cfg.motions).map_err(|e| match e {

@@ -248,6 +248,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
     let physics = study.physics();
     todo.par_iter()
         .try_for_each(|&u| -> Result<(), PipelineError> {
+            s.check_cancelled(me)?;
             let rec = &motions[u.zone][u.motion];
             let accel = rec.accel_mps2(1.0);
             let ground = Ground::new(rec.dt_s, &accel);

@@ -398,7 +398,16 @@ impl Simulation {
     /// Runs the case on `accel_mps2` (from [`Simulation::accel_mps2`]); the time history is kept
     /// when the settings name a history file.
     pub fn run(&self, accel_mps2: &[f64]) -> Result<(Outcome, Option<History>), SimulationError> {
-        let history = self.history.is_some();
+        self.run_keeping(accel_mps2, self.history.is_some())
+    }
+
+    /// [`Simulation::run`], keeping the time history when `history` (whatever the settings say:
+    /// the Python module returns it as arrays rather than writing a file).
+    pub fn run_keeping(
+        &self,
+        accel_mps2: &[f64],
+        history: bool,
+    ) -> Result<(Outcome, Option<History>), SimulationError> {
         let failed = |source| SimulationError::Simulation {
             record: self.record.name.clone(),
             source,

@@ -323,20 +323,26 @@ impl StudyConfig {
     /// Reads and validates a study file. Record files and target tables are found relative to
     /// its folder, like any file it names, and each file is read once ([`Loaded`]).
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let file = path.display().to_string();
         let bytes = read_yaml_bytes(path)?;
-        let text = yaml_text(&bytes, path)?;
+        Self::parse(&bytes, path, path.parent().unwrap_or(Path::new(".")))
+    }
+
+    /// Validates a study's YAML `bytes` as [`StudyConfig::load`] does a file's: `path` names it
+    /// in messages and the files it names are found relative to `base` (the Python module passes
+    /// a mapping this way, relative to the working directory).
+    pub fn parse(bytes: &[u8], path: &Path, base: &Path) -> Result<Self, ConfigError> {
+        let file = path.display().to_string();
+        let text = yaml_text(bytes, path)?;
         let mut cfg: StudyConfig = serde_yaml::from_str(&text).map_err(|e| ConfigError::Yaml {
             file: file.clone(),
             message: excerpt_message(&e.to_string()),
         })?;
-        cfg.loaded.config_sha256 = sha256_hex(&bytes);
+        cfg.loaded.config_sha256 = sha256_hex(bytes);
         let invalid = |key: String, why: String| ConfigError::Invalid {
             file: file.clone(),
             key,
             why,
         };
-        let base = path.parent().unwrap_or(Path::new("."));
         if let Some(r) = &mut cfg.motions.seeds.records {
             for f in &mut r.files {
                 if f.is_relative() {

@@ -1,0 +1,51 @@
+"""slidestack from Python: the same library code as the ``slidestack`` command line.
+
+Seismic response of a structure (one storey or a shear building) carrying stacks of sliding rigid
+blocks with Coulomb friction, exact event-driven simulation, response spectra, spectral matching,
+and the staged T_new study (motions -> sweep -> tnew -> fit -> report, ida, design).
+
+>>> import slidestack
+>>> r = slidestack.simulate(period=1.0, alpha=[0.5, 0.5], mu=[0.2, 0.1])
+>>> r["peak_displacement_m"]  # the numbers of ``slidestack simulate --json``
+
+Every function releases the GIL while it works. Bad input raises ``ValueError`` (or
+``FileNotFoundError``/``OSError`` for files) with the message the command line prints.
+"""
+
+from ._native import (
+    __version__,
+    design,
+    fit,
+    ida,
+    match,
+    merge,
+    motions,
+    read_record,
+    report,
+    run,
+    simulate,
+    spectrum,
+    status,
+    sweep,
+    tnew,
+)
+from ._study import open_study
+
+__all__ = [
+    "__version__",
+    "design",
+    "fit",
+    "ida",
+    "match",
+    "merge",
+    "motions",
+    "open_study",
+    "read_record",
+    "report",
+    "run",
+    "simulate",
+    "spectrum",
+    "status",
+    "sweep",
+    "tnew",
+]

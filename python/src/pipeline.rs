@@ -1,0 +1,360 @@
+//! The study's stages from Python: `run`, each stage by name, `merge` and `status`, as the CLI's
+//! subcommands run them ([`slidestack::pipeline`]).
+//!
+//! A stage runs on a thread of its own while the calling thread, GIL released, waits for it in
+//! short slices and between them lets Python run its signal handlers: Ctrl-C raises
+//! `KeyboardInterrupt` there, and the reporter then tells the stage to stop at its next work
+//! unit ([`Reporter::cancelled`]), which leaves the output directory as a killed run does.
+
+use crate::convert::{to_yaml_value, warn};
+use crate::errors::{Fault, to_py_err};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString};
+use slidestack::pipeline::lock::LockMode;
+use slidestack::pipeline::{
+    Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, StageState, Study,
+    execute, run_all, status as study_status, sweep, terminal_progress,
+};
+use slidestack::study::config::StudyConfig;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{RecvTimeoutError, channel};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// How often the waiting thread looks for Ctrl-C.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// The name a config given as a mapping has in messages.
+const DICT_CONFIG: &str = "<config dict>";
+
+/// A study file, or a mapping with its keys (paths in it relative to the working directory).
+enum ConfigArg {
+    Path(PathBuf),
+    Yaml(String),
+}
+
+impl ConfigArg {
+    fn from_py(obj: &Bound<'_, PyAny>) -> PyResult<Self> {
+        if obj.is_instance_of::<PyString>() || obj.hasattr("__fspath__")? {
+            return Ok(ConfigArg::Path(obj.extract()?));
+        }
+        if obj.is_instance_of::<PyDict>() {
+            let value = to_yaml_value(obj, "config")?;
+            let text = serde_yaml::to_string(&value)
+                .map_err(|e| PyValueError::new_err(format!("`config`: {e}")))?;
+            return Ok(ConfigArg::Yaml(text));
+        }
+        Err(PyValueError::new_err(
+            "`config` must be a path to a study file or a dict with its keys",
+        ))
+    }
+
+    fn study(&self, out: Option<PathBuf>) -> Result<Study, PipelineError> {
+        match self {
+            ConfigArg::Path(p) => Study::load(p, out),
+            ConfigArg::Yaml(text) => {
+                let name = Path::new(DICT_CONFIG);
+                let cfg = StudyConfig::parse(text.as_bytes(), name, Path::new("."))?;
+                Study::with_config(cfg, name, out)
+            }
+        }
+    }
+}
+
+/// Progress as the CLI shows it when standard error is a terminal, nothing otherwise; warnings
+/// kept for Python's `warnings`; the Ctrl-C flag.
+struct PyReporter {
+    terminal: bool,
+    cancel: AtomicBool,
+    /// The output directory is locked (the stage checks `cancel` from here on).
+    opened: AtomicBool,
+    warnings: Mutex<Vec<String>>,
+}
+
+impl Reporter for PyReporter {
+    fn info(&self, stage: StageId, message: &str) {
+        if self.terminal {
+            eprintln!("{stage}: {message}");
+        }
+    }
+    fn warn(&self, stage: StageId, message: &str) {
+        if let Ok(mut w) = self.warnings.lock() {
+            w.push(format!("{stage}: {message}"));
+        }
+    }
+    fn progress(&self, _stage: StageId, total: u64) -> Box<dyn Progress + '_> {
+        terminal_progress(total)
+    }
+    fn cancelled(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed)
+    }
+}
+
+/// Runs `work` in a session on the study of `config` (module doc: its thread, Ctrl-C).
+fn in_session<T: Send + 'static>(
+    py: Python<'_>,
+    config: ConfigArg,
+    out: Option<PathBuf>,
+    mode: LockMode,
+    wait: bool,
+    work: impl FnOnce(&Session) -> Result<T, PipelineError> + Send + 'static,
+) -> PyResult<T> {
+    let reporter = Arc::new(PyReporter {
+        terminal: std::io::stderr().is_terminal(),
+        cancel: AtomicBool::new(false),
+        opened: AtomicBool::new(false),
+        warnings: Mutex::new(Vec::new()),
+    });
+    let (tx, rx) = channel();
+    let rx = Mutex::new(rx);
+    let worker = Arc::clone(&reporter);
+    std::thread::spawn(move || {
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let study = config.study(out)?;
+            let session = Session::open(study, mode, wait, &*worker)?;
+            worker.opened.store(true, Ordering::Relaxed);
+            work(&session)
+        }));
+        let _ = tx.send(result);
+    });
+    let mut interrupt: Option<PyErr> = None;
+    let result = loop {
+        let next = py.detach(|| match rx.lock() {
+            Ok(rx) => rx.recv_timeout(SIGNAL_POLL),
+            Err(_) => Err(RecvTimeoutError::Disconnected),
+        });
+        match next {
+            Ok(r) => break r,
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(PyRuntimeError::new_err(
+                    "the stage's thread ended without a result",
+                ));
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+        }
+        if interrupt.is_none()
+            && let Err(e) = py.check_signals()
+        {
+            reporter.cancel.store(true, Ordering::Relaxed);
+            if !reporter.opened.load(Ordering::Relaxed) {
+                // Still waiting for another run's lock: the thread stops at its first check.
+                return Err(e);
+            }
+            interrupt = Some(e);
+        }
+    };
+    let warnings = reporter
+        .warnings
+        .lock()
+        .map(|w| w.clone())
+        .unwrap_or_default();
+    warn(py, &warnings)?;
+    if let Some(e) = interrupt {
+        return Err(e);
+    }
+    match result {
+        Ok(r) => r.map_err(|e| to_py_err(&e, Fault::of_pipeline(&e))),
+        Err(panic) => {
+            let why = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            Err(PyRuntimeError::new_err(format!("internal error: {why}")))
+        }
+    }
+}
+
+/// What a stage did, as a dict: `stage`, `outcome` (`up_to_date`, `wrote`, `shard_done`),
+/// `files` and, from `run`, `seconds`.
+fn outcome_dict<'py>(
+    py: Python<'py>,
+    stage: StageId,
+    outcome: &Outcome,
+    seconds: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("stage", stage.name())?;
+    let (word, files): (&str, Vec<String>) = match outcome {
+        Outcome::UpToDate(p) => ("up_to_date", vec![p.display().to_string()]),
+        Outcome::Wrote(ps) => (
+            "wrote",
+            ps.iter().map(|p| p.display().to_string()).collect(),
+        ),
+        Outcome::ShardDone { k, n } => {
+            d.set_item("shard", (k, n))?;
+            ("shard_done", Vec::new())
+        }
+    };
+    d.set_item("outcome", word)?;
+    d.set_item("files", PyList::new(py, files)?)?;
+    if let Some(s) = seconds {
+        d.set_item("seconds", s)?;
+    }
+    Ok(d)
+}
+
+/// Every stage in order (`slidestack run`): a dict of what each did, by stage name.
+#[pyfunction]
+#[pyo3(signature = (config, out=None, force=false, wait=true))]
+fn run<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    out: Option<PathBuf>,
+    force: bool,
+    wait: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = ConfigArg::from_py(config)?;
+    let done = in_session(py, config, out, LockMode::Exclusive, wait, move |s| {
+        let mut done = Vec::new();
+        run_all(s, StageOptions { force }, |stage, outcome, secs| {
+            done.push((stage, outcome.clone(), secs));
+        })?;
+        Ok(done)
+    })?;
+    let d = PyDict::new(py);
+    for (stage, outcome, secs) in &done {
+        d.set_item(
+            stage.name(),
+            outcome_dict(py, *stage, outcome, Some(*secs))?,
+        )?;
+    }
+    Ok(d)
+}
+
+fn one_stage<'py>(
+    py: Python<'py>,
+    stage: StageId,
+    config: &Bound<'py, PyAny>,
+    out: Option<PathBuf>,
+    force: bool,
+    wait: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = ConfigArg::from_py(config)?;
+    let outcome = in_session(py, config, out, LockMode::Exclusive, wait, move |s| {
+        execute(s, stage, StageOptions { force })
+    })?;
+    outcome_dict(py, stage, &outcome, None)
+}
+
+macro_rules! stage_fn {
+    ($name:ident, $id:expr, $doc:literal) => {
+        #[doc = $doc]
+        #[pyfunction]
+        #[pyo3(signature = (config, out=None, force=false, wait=true))]
+        fn $name<'py>(
+            py: Python<'py>,
+            config: &Bound<'py, PyAny>,
+            out: Option<PathBuf>,
+            force: bool,
+            wait: bool,
+        ) -> PyResult<Bound<'py, PyDict>> {
+            one_stage(py, $id, config, out, force, wait)
+        }
+    };
+}
+
+stage_fn!(
+    motions,
+    StageId::Motions,
+    "The motions stage (`slidestack motions`)."
+);
+stage_fn!(tnew, StageId::Tnew, "The tnew stage (`slidestack tnew`).");
+stage_fn!(fit, StageId::Fit, "The fit stage (`slidestack fit`).");
+stage_fn!(ida, StageId::Ida, "The ida stage (`slidestack ida`).");
+stage_fn!(
+    report,
+    StageId::Report,
+    "The report stage (`slidestack report`)."
+);
+
+/// The sweep stage (`slidestack sweep`); with `shard=(k, n)` only that shard's units.
+#[pyfunction]
+#[pyo3(name = "sweep", signature = (config, out=None, force=false, wait=true, shard=None))]
+fn sweep_<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    out: Option<PathBuf>,
+    force: bool,
+    wait: bool,
+    shard: Option<(usize, usize)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let Some((k, n)) = shard else {
+        return one_stage(py, StageId::Sweep, config, out, force, wait);
+    };
+    if k == 0 || k > n {
+        return Err(PyValueError::new_err(format!(
+            "`shard` ({k}, {n}): needs 1 ≤ k ≤ n"
+        )));
+    }
+    let config = ConfigArg::from_py(config)?;
+    let outcome = in_session(py, config, out, LockMode::Shared, wait, move |s| {
+        sweep::run_shard(s, k, n, StageOptions { force })
+    })?;
+    outcome_dict(py, StageId::Sweep, &outcome, None)
+}
+
+/// Assembles `sweep.h5` when every shard is done (`slidestack merge`).
+#[pyfunction]
+#[pyo3(signature = (config, out=None, wait=true))]
+fn merge<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    out: Option<PathBuf>,
+    wait: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = ConfigArg::from_py(config)?;
+    let outcome = in_session(py, config, out, LockMode::Exclusive, wait, sweep::merge)?;
+    outcome_dict(py, StageId::Sweep, &outcome, None)
+}
+
+/// What is on disk for every stage (`slidestack status --format env`, as a dict); takes no lock.
+#[pyfunction]
+#[pyo3(signature = (config, out=None))]
+fn status<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    out: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = ConfigArg::from_py(config)?;
+    let (dir, st) = py
+        .detach(|| {
+            let study = config.study(out)?;
+            study_status(&study).map(|st| (study.out.clone(), st))
+        })
+        .map_err(|e| to_py_err(&e, Fault::of_pipeline(&e)))?;
+    let d = PyDict::new(py);
+    d.set_item("output_dir", dir.display().to_string())?;
+    let stages = PyDict::new(py);
+    let damaged = PyDict::new(py);
+    for (stage, state) in &st.stages {
+        stages.set_item(stage.name(), state.word())?;
+        if let StageState::Damaged(why) = state {
+            damaged.set_item(stage.name(), why)?;
+        }
+    }
+    d.set_item("stages", stages)?;
+    d.set_item("damaged", damaged)?;
+    d.set_item("sweep_units", st.sweep_units)?;
+    d.set_item("sweep_units_done", st.sweep_units_done)?;
+    d.set_item("sweep_cases_per_unit", st.cases_per_unit)?;
+    d.set_item("sweep_samples_per_motion", st.samples_per_motion)?;
+    d.set_item("sweep_samples_per_unit", st.samples_per_unit)?;
+    Ok(d)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(motions, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_, m)?)?;
+    m.add_function(wrap_pyfunction!(tnew, m)?)?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(ida, m)?)?;
+    m.add_function(wrap_pyfunction!(report, m)?)?;
+    m.add_function(wrap_pyfunction!(merge, m)?)?;
+    m.add_function(wrap_pyfunction!(status, m)?)?;
+    Ok(())
+}

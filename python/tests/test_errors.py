@@ -1,0 +1,120 @@
+"""Each kind of bad input raises the Python exception of its kind with the CLI's message, and
+nothing brings the interpreter down."""
+
+import numpy as np
+import pytest
+
+import slidestack
+from conftest import ROOT, run_cli
+
+
+def cli_error(cli, *args, code=2):
+    p = run_cli(cli, *args, ok=False)
+    assert p.returncode == code, p.stderr
+    return p.stderr.strip().removeprefix("error: ")
+
+
+def test_a_bad_value_is_a_value_error_with_the_cli_message(cli):
+    want = cli_error(cli, "simulate", "--period", "-1")
+    with pytest.raises(ValueError) as e:
+        slidestack.simulate(period=-1)
+    # The CLI names the flag, the module the keyword: the same message otherwise.
+    assert str(e.value).replace("`period`", "--period") == want
+
+
+def test_a_missing_record_is_file_not_found(cli):
+    want = cli_error(cli, "simulate", "--record", "no/such.AT2")
+    with pytest.raises(FileNotFoundError) as e:
+        slidestack.simulate(record="no/such.AT2")
+    assert str(e.value) == want
+    with pytest.raises(FileNotFoundError):
+        slidestack.read_record("no/such.AT2")
+
+
+def test_a_directory_as_record_is_an_os_error():
+    with pytest.raises(OSError) as e:
+        slidestack.read_record(ROOT / "configs")
+    assert not isinstance(e.value, FileNotFoundError)
+
+
+def test_a_bad_record_file_names_file_and_line(cli, tmp_path):
+    bad = tmp_path / "bad.txt"
+    bad.write_text("0 0.1\n0.01 x\n")
+    want = cli_error(cli, "simulate", "--record", str(bad))
+    with pytest.raises(ValueError) as e:
+        slidestack.simulate(record=bad)
+    assert str(e.value) == want
+    assert f"{bad}:2" in str(e.value)
+
+
+def test_bad_samples_name_the_sample():
+    with pytest.raises(ValueError, match="sample 1 is not finite"):
+        slidestack.simulate(record=(np.array([0.0, np.nan, 0.0]), 0.01))
+    with pytest.raises(ValueError, match="time step"):
+        slidestack.spectrum([0.0, 0.1, 0.0], -0.01)
+    with pytest.raises(ValueError, match="path or an"):
+        slidestack.simulate(record=(1, 2, 3))
+
+
+def test_an_unknown_word_is_a_value_error():
+    with pytest.raises(ValueError, match="unknown variant `plastic`"):
+        slidestack.simulate(structure="plastic")
+    with pytest.raises(TypeError):
+        slidestack.simulate(perod=1.0)  # type: ignore[call-arg]
+
+
+def test_settings_that_do_not_go_together(cli):
+    want = cli_error(cli, "simulate", "--structure", "epp")
+    with pytest.raises(ValueError) as e:
+        slidestack.simulate(structure="epp")
+    assert str(e.value).replace("`structure: epp`", "--structure epp").replace(
+        "`yield_strength_ratio`", "--yield-strength-ratio"
+    ) == want
+    with pytest.raises(ValueError, match="does not apply to a case with `building`"):
+        slidestack.simulate(period=1.0, building={"storeys": 1, "period": 1.0})
+
+
+def test_spectrum_damping_and_periods(cli):
+    rec = str(ROOT / "tests/fixtures/records/RSN68_SFERN_PEL090.AT2")
+    want = cli_error(cli, "spectrum", "--record", rec, "--damping", "1.5")
+    accel, dt = slidestack.read_record(rec)
+    with pytest.raises(ValueError) as e:
+        slidestack.spectrum(accel, dt, damping=1.5)
+    assert str(e.value).replace("`damping`", "--damping") == want
+    with pytest.raises(ValueError):
+        slidestack.spectrum(accel, dt, periods="4:0.05:0.1")
+
+
+def test_study_errors(cli, tmp_path):
+    with pytest.raises(FileNotFoundError):
+        slidestack.run(tmp_path / "none.yaml")
+    with pytest.raises(FileNotFoundError):
+        slidestack.design(tmp_path, "III", 1.0, [0.5, 0.5], [0.2, 0.1])
+    bad = {"output_dir": str(tmp_path / "o"), "zones": []}
+    with pytest.raises(ValueError, match="<config dict>"):
+        slidestack.status(bad)
+    with pytest.raises(ValueError, match="is a file"):
+        slidestack.status(ROOT / "configs/quick.yaml", out=ROOT / "README.md")
+    cfg = ROOT / "configs/quick.yaml"
+    want = cli_error(cli, "tnew", str(cfg), "--out", str(tmp_path / "q"), code=1)
+    with pytest.raises(RuntimeError) as e:
+        slidestack.tnew(cfg, out=tmp_path / "q")
+    assert str(e.value) == want
+
+
+def test_a_bad_target_for_match():
+    accel, dt = slidestack.read_record(ROOT / "tests/fixtures/records/RSN68_SFERN_PEL090.AT2")
+    with pytest.raises(ValueError, match="invalid `target`"):
+        slidestack.match((accel, dt), "is1893:zone=IX")
+    with pytest.raises(ValueError, match="invalid `settings`"):
+        slidestack.match((accel, dt), "is1893:zone=V,soil=I", settings={"bogus": 1})
+
+
+def test_a_panic_is_an_exception_not_an_abort():
+    from slidestack import _native
+
+    with pytest.raises(BaseException) as e:
+        _native._panic()  # type: ignore[attr-defined]
+    assert type(e.value).__name__ == "PanicException"
+    assert "deliberate panic" in str(e.value)
+    assert slidestack.simulate()["switches"] > 0

@@ -1,0 +1,38 @@
+"""The README's notebook-style example runs and draws its figure."""
+
+import os
+import re
+import subprocess
+import sys
+
+from conftest import ROOT
+
+
+def test_the_readme_example_runs(tmp_path):
+    readme = (ROOT / "README.md").read_text()
+    section = readme[readme.index("## Python\n"):]
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    example = next(b for b in blocks if "savefig" in b)
+    out = tmp_path / "quick"
+    code = example.replace('"out/quick"', repr(str(out))).replace(
+        'fig.savefig("python-example.svg")', f"fig.savefig({str(tmp_path / 'fig.svg')!r})"
+    )
+    assert code != example
+    env = dict(os.environ, MPLBACKEND="Agg")
+    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "fig.svg").read_text().startswith("<?xml")
+    assert (out / "tnew.h5").exists()
+
+
+def test_the_three_lines(tmp_path):
+    readme = (ROOT / "README.md").read_text()
+    section = readme[readme.index("## Python\n"):]
+    prompt = re.search(r"```python\n(>>> .*?)```", section, re.S).group(1)
+    lines = prompt.strip().splitlines()
+    code = "\n".join(line[4:] for line in lines if line.startswith(">>> "))
+    shown = "\n".join(line for line in lines if not line.startswith(">>> "))
+    *body, last = code.splitlines()
+    ns: dict = {}
+    exec("\n".join(body), ns)
+    assert repr(eval(last, ns)) == shown

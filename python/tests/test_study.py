@@ -1,0 +1,255 @@
+"""The study's stages from Python: the CLI's files, open_study, h5py beside the module, Ctrl-C."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import slidestack
+from conftest import ROOT, run_cli
+
+QUICK = ROOT / "configs/quick.yaml"
+STAGE_FILES = ("motions.h5", "sweep.h5", "tnew.h5", "fit.h5", "fit.yaml")
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory, cli):
+    """configs/quick.yaml run by the module and by the CLI into two directories."""
+    base = tmp_path_factory.mktemp("quick")
+    py_out, cli_out = base / "py", base / "cli"
+    done = slidestack.run(QUICK, out=py_out)
+    run_cli(cli, "run", str(QUICK), "--out", str(cli_out))
+    return done, py_out, cli_out
+
+
+def test_run_writes_the_clis_files(quick):
+    done, py_out, cli_out = quick
+    assert list(done) == ["motions", "sweep", "tnew", "fit", "report"]
+    assert all(d["outcome"] == "wrote" for d in done.values())
+    for name in STAGE_FILES:
+        assert (py_out / name).read_bytes() == (cli_out / name).read_bytes(), name
+    again = slidestack.run(QUICK, out=py_out)
+    assert all(d["outcome"] == "up_to_date" for d in again.values())
+
+
+def test_status_is_the_clis(quick, cli):
+    _, py_out, _ = quick
+    st = slidestack.status(QUICK, out=py_out)
+    env = run_cli(cli, "status", str(QUICK), "--out", str(py_out), "--format", "env").stdout
+    want = dict(line.split("=", 1) for line in env.split())
+    for stage, word in st["stages"].items():
+        assert want[stage.upper()] == word == "up_to_date"
+    assert str(st["sweep_units"]) == want["SWEEP_UNITS"]
+    assert str(st["sweep_samples_per_unit"]) == want["SWEEP_SAMPLES_PER_UNIT"]
+
+
+def test_design_is_the_clis(quick, cli):
+    _, py_out, _ = quick
+    args = ["design", "--study", str(py_out), "--zone", "III", "--period", "1.0"]
+    import json
+
+    want = json.loads(
+        run_cli(cli, *args, "--alpha", "0.5,0.5", "--mu", "0.2,0.1", "--json").stdout
+    )
+    assert slidestack.design(py_out, "III", 1.0, [0.5, 0.5], [0.2, 0.1]) == want
+
+
+def test_a_config_dict_is_the_config_file(quick, tmp_path):
+    _, py_out, _ = quick
+    cfg = quick_dict(tmp_path / "d")
+    done = slidestack.motions(cfg)
+    assert done["outcome"] == "wrote"
+    assert (tmp_path / "d/motions.h5").exists()
+    st = slidestack.status(cfg)
+    assert st["stages"]["motions"] == "up_to_date"
+    assert st["output_dir"] == str(tmp_path / "d")
+
+
+def test_open_study(quick):
+    _, py_out, _ = quick
+    study = slidestack.open_study(py_out)
+    assert set(study) == {"motions", "sweep", "tnew", "fit"}
+    sweep = study["sweep"]["III"]
+    assert list(sweep["u_stack"].dims) == ["motion", "T_p", "alpha_1", "alpha_2", "mu_1", "mu_2"]
+    assert sweep["T_p"].attrs["units"] == "s"
+    assert sweep["T_p"].values.tolist() == [0.3, 0.6, 1.0, 1.5, 2.0]
+    tnew = study["tnew"]["V"]
+    assert list(tnew["T_new"].dims) == ["T_p", "alpha_1", "alpha_2", "mu_1", "mu_2"]
+    flagged = [v for v in tnew.data_vars if v.endswith("_meaning")]
+    assert flagged, list(tnew.data_vars)
+    with pytest.raises(FileNotFoundError):
+        slidestack.open_study(py_out / "report")
+
+
+HDF5_SCRIPT = """
+import sys
+first, out, config = sys.argv[1], sys.argv[2], sys.argv[3]
+if first == "h5py":
+    import h5py, slidestack
+else:
+    import slidestack, h5py
+import numpy as np
+with h5py.File(out + "/tnew.h5", "r") as f:
+    before = np.asarray(f["zone_III/T_new"])
+    # The module reads and rewrites the study while h5py holds a file of it open.
+    assert slidestack.status(config, out=out)["stages"]["tnew"] == "up_to_date"
+    assert slidestack.tnew(config, out=out, force=True)["outcome"] == "wrote"
+    a = slidestack.design(out, "III", 1.0, [0.5, 0.5], [0.2, 0.1])
+with h5py.File(out + "/tnew.h5", "r") as f:
+    after = np.asarray(f["zone_III/T_new"])
+assert np.array_equal(before, after, equal_nan=True)
+study = slidestack.open_study(out)
+assert np.array_equal(study["tnew"]["III"]["T_new"].values, after, equal_nan=True)
+print(h5py.version.hdf5_version, a["t_new_grid_s"])
+"""
+
+
+@pytest.mark.parametrize("first", ["h5py", "slidestack"])
+def test_h5py_and_the_module_in_one_interpreter(quick, first, tmp_path):
+    _, py_out, _ = quick
+    out = tmp_path / "copy"
+    out.mkdir()
+    for name in STAGE_FILES:
+        (out / name).write_bytes((py_out / name).read_bytes())
+    for name in os.listdir(py_out):
+        if name.endswith(".sha256"):
+            (out / name).write_bytes((py_out / name).read_bytes())
+    p = subprocess.run(
+        [sys.executable, "-c", HDF5_SCRIPT, first, str(out), str(QUICK)],
+        capture_output=True,
+        text=True,
+    )
+    assert p.returncode == 0, p.stderr
+    assert len(p.stdout.split()) == 2
+
+
+def quick_dict(out: Path, periods=None) -> dict:
+    """configs/quick.yaml as a dict (with other periods when given)."""
+    return {
+        "output_dir": str(out),
+        "zones": [
+            {"name": "III", "target": "is1893:zone=III,soil=I"},
+            {"name": "V", "target": "is1893:zone=V,soil=I"},
+        ],
+        "motions": {"seeds": {"stochastic": {"count": 3, "seed": 2016}}},
+        "grid": {
+            "period_s": periods or [0.3, 0.6, 1.0, 1.5, 2.0],
+            "alpha": [[0.1, 0.5, 1.0], [0.5, 1.0]],
+            "mu": [[0.1, 0.3], [0.05, 0.2]],
+            "damping": 0.05,
+            "damping_basis": "rigid",
+        },
+    }
+
+
+INTERRUPT_SCRIPT = """
+import sys, slidestack
+sys.stdout.write("start\\n"); sys.stdout.flush()
+slidestack.sweep(eval(sys.argv[1]))
+"""
+
+
+def test_ctrl_c_stops_a_sweep_and_leaves_it_resumable(tmp_path):
+    out = tmp_path / "big"
+    periods = [round(0.1 + 0.02 * i, 2) for i in range(96)]
+    cfg = quick_dict(out, periods)
+    slidestack.motions(cfg)
+    p = subprocess.Popen(
+        [sys.executable, "-c", INTERRUPT_SCRIPT, repr(cfg)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert p.stdout.readline() == "start\n"
+    units = out / "sweep.units"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (units.exists() and any(units.iterdir())):
+        time.sleep(0.05)
+    assert p.poll() is None, "the sweep ended before it could be interrupted"
+    p.send_signal(signal.SIGINT)
+    sent = time.monotonic()
+    _, err = p.communicate(timeout=60)
+    stopped_after = time.monotonic() - sent
+    assert p.returncode != 0
+    assert "KeyboardInterrupt" in err, err
+    # One work unit per thread may finish after the signal; a unit here takes milliseconds.
+    assert stopped_after < 5, stopped_after
+    print(f"stopped {stopped_after:.2f} s after SIGINT")
+    st = slidestack.status(cfg)
+    assert st["stages"]["sweep"] == "missing"
+    assert 0 < st["sweep_units_done"] < st["sweep_units"], st
+    # The next run resumes: it computes only the units not stored.
+    leftovers = [n for n in os.listdir(out) if ".tmp" in n]
+    assert not leftovers, leftovers
+    assert slidestack.sweep(cfg)["outcome"] == "wrote"
+    assert slidestack.status(cfg)["stages"]["sweep"] == "up_to_date"
+
+
+SWEEP_SCRIPT = """
+import sys, slidestack
+slidestack.sweep(sys.argv[1], out=sys.argv[2])
+"""
+
+
+def copy_motions(src: Path, dst: Path) -> None:
+    dst.mkdir()
+    for name in ("motions.h5", "motions.h5.sha256"):
+        (dst / name).write_bytes((src / name).read_bytes())
+
+
+def test_progress_shows_only_on_a_terminal(quick, tmp_path):
+    import pty
+
+    _, py_out, _ = quick
+    quiet = tmp_path / "quiet"
+    copy_motions(py_out, quiet)
+    p = subprocess.run(
+        [sys.executable, "-c", SWEEP_SCRIPT, str(QUICK), str(quiet)],
+        capture_output=True,
+        text=True,
+    )
+    assert p.returncode == 0, p.stderr
+    assert "units to compute" not in p.stderr and p.stdout == ""
+
+    shown = tmp_path / "shown"
+    copy_motions(py_out, shown)
+    master, slave = pty.openpty()
+    child = subprocess.Popen(
+        [sys.executable, "-c", SWEEP_SCRIPT, str(QUICK), str(shown)],
+        stdout=subprocess.DEVNULL,
+        stderr=slave,
+    )
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 65536)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    os.close(master)
+    assert child.wait() == 0
+    text = b"".join(chunks).decode(errors="replace")
+    # The CLI's lines (`sweep: …`) and its bar's counter (`N/30 units`).
+    assert "sweep: 30 of 30 units to compute" in text, text
+    assert "/30 units" in text, text
+
+
+def test_shards_and_merge_make_the_same_sweep(quick, tmp_path):
+    _, py_out, _ = quick
+    out = tmp_path / "sharded"
+    copy_motions(py_out, out)
+    assert slidestack.sweep(QUICK, out=out, shard=(1, 2))["outcome"] == "shard_done"
+    with pytest.raises(RuntimeError, match="15 of 30 units are missing"):
+        slidestack.merge(QUICK, out=out)  # shard 2 is missing
+    assert slidestack.sweep(QUICK, out=out, shard=(2, 2))["shard"] == (2, 2)
+    assert slidestack.merge(QUICK, out=out)["outcome"] == "wrote"
+    assert (out / "sweep.h5").read_bytes() == (py_out / "sweep.h5").read_bytes()
+    with pytest.raises(ValueError, match="needs 1 ≤ k ≤ n"):
+        slidestack.sweep(QUICK, out=out, shard=(3, 2))
