@@ -298,7 +298,7 @@ function chart(figId, title, xLabel, yLabel, series) {
   const fig = $(figId);
   const W = 640;
   const H = 400;
-  const m = { l: 58, r: 14, t: 30, b: 46 };
+  const m = { l: 64, r: 14, t: 30, b: 48 };
   let xs = [];
   let ys = [];
   for (const s of series) {
@@ -372,7 +372,10 @@ function chart(figId, title, xLabel, yLabel, series) {
       key.className = "key";
       key.style.borderColor = s.colour;
       key.style.borderStyle = s.points ? "solid" : (s.dash ? "dashed" : "solid");
-      if (s.points) key.classList.add("dot");
+      if (s.points) {
+        key.classList.add("dot");
+        key.style.background = s.fill || s.colour;
+      }
       li.append(key, s.label);
       legend.appendChild(li);
     }

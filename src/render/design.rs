@@ -18,12 +18,12 @@ width:100%;box-sizing:border-box}input[type=checkbox]{width:auto;margin-right:.4
 td,th{border:1px solid #ccc;padding:4px 10px;text-align:right}th{background:#f4f4f4}\
 td:first-child,th:first-child{text-align:left}output{font-variant-numeric:tabular-nums}\
 #error{color:#a00;font-weight:bold}.figs{display:grid;grid-template-columns:repeat(auto-fit,\
-minmax(300px,1fr));gap:1em}figure{margin:0}svg{width:100%;height:auto;font-size:13px}\
+minmax(300px,1fr));gap:1em}figure{margin:0}svg{width:100%;height:auto;font-size:15px}\
 svg .grid{stroke:#e4e4e4}svg .frame{fill:none;stroke:#888}svg .title{font-weight:bold}\
 ul.legend{list-style:none;padding:0;margin:.3em 0;font-size:90%}ul.legend li{display:inline-block;\
 margin-right:1.2em}.key{display:inline-block;width:2em;border-top-width:3px;vertical-align:middle;\
 margin-right:.4em}.key.dot{width:.7em;height:.7em;border-width:3px;border-radius:50%}\
-a:focus,input:focus,select:focus{outline:3px solid #f90}code{overflow-wrap:anywhere}\
+#fig-explorer{max-width:800px}a:focus,input:focus,select:focus{outline:3px solid #f90}code{overflow-wrap:anywhere}\
 @media(max-width:600px){td,th{padding:3px 5px}}";
 
 /// One row of the answers' table: a label and the `id` of its output (the JSON key of
