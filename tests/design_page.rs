@@ -119,7 +119,11 @@ fn query(q: &Question) -> String {
 /// The page's elements (`probe`'s `elements`) agree with the command's answer for `q`.
 fn check_page(q: &Question, page: &Value, cli: &Result<Value, String>) {
     let el = &page["elements"];
-    let text = |id: &str| el[id]["text"].as_str().unwrap_or_else(|| panic!("{q:?}: no #{id}"));
+    let text = |id: &str| {
+        el[id]["text"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{q:?}: no #{id}"))
+    };
     match cli {
         Ok(a) => {
             assert_eq!(text("error"), "", "{q:?}");
@@ -215,7 +219,14 @@ fn design_page_answers_as_the_command_does() {
         ("III", "-1", "1,1", "0.3,0.1", false),
     ];
     let mut ids: Vec<&str> = OUTPUTS.to_vec();
-    ids.extend(["error", "fit_form", "notes", "permalink", "period", "extrapolate"]);
+    ids.extend([
+        "error",
+        "fit_form",
+        "notes",
+        "permalink",
+        "period",
+        "extrapolate",
+    ]);
     let mut pages: Vec<Value> = questions
         .iter()
         .map(|q| json!({"url": format!("{design}{}", query(q)), "ids": ids}))
@@ -265,7 +276,10 @@ fn design_page_answers_as_the_command_does() {
         .iter()
         .map(|l| l.as_str().unwrap())
         .collect();
-    assert!(links.iter().any(|l| l.ends_with("/design.html")), "{links:?}");
+    assert!(
+        links.iter().any(|l| l.ends_with("/design.html")),
+        "{links:?}"
+    );
     let index_url = file_url(&report.join("index.html"));
     let ids: Vec<&str> = index["ids"]
         .as_array()
