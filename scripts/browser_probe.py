@@ -6,9 +6,9 @@ Usage: browser_probe.py < REQUEST.json > ANSWER.json
 REQUEST: {"pages": [{"url": URL, "ids": [ID, ...], "script": JS (optional)}, ...],
           "screenshot": {"url": URL, "path": PNG, "width": W, "height": H} (optional)}
 For each page, in order, in one browser tab: load URL, wait for its load event, run `script`
-(if any), then read each element `id`: {"text": its text, "value": its data-value attribute}
-(null when absent). ANSWER: {"pages": [{"url", "elements": {ID: ...}, "requests": [every URL
-the page asked for], "errors": [uncaught exceptions, console errors and log errors],
+(if any), then read each element `id`: {"text": its text, "value": its data-value
+attribute, "paths": how many SVG paths it holds} (null when absent). ANSWER: {"pages":
+[{"url", "elements": {ID: ...}, "requests": [every URL the page asked for], "errors": [uncaught exceptions, console errors and log errors],
 "links": [every a[href] resolved], "broken_images": [img src not loaded], "ids": [every id in
 the document]}], "browser": the version}.
 
@@ -146,7 +146,8 @@ COLLECT = """(() => {
   const elements = {};
   for (const id of ids) {
     const e = document.getElementById(id);
-    elements[id] = e === null ? null : {text: e.textContent, value: e.getAttribute('data-value')};
+    elements[id] = e === null ? null : {text: e.textContent, value: e.getAttribute('data-value'),
+                                        paths: e.querySelectorAll('path').length};
   }
   return {
     elements,

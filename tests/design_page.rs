@@ -240,6 +240,17 @@ fn design_page_answers_as_the_command_does() {
                    p.dispatchEvent(new Event('input', {bubbles: true})); \
                    const e = document.getElementById('extrapolate'); e.click(); })()",
     }));
+    // No question in the address: the worked example; then the explorer, DRR_1 of zone V for
+    // every friction pair.
+    pages.push(json!({
+        "url": design,
+        "ids": ids.iter().chain(&["fig-explorer"]).collect::<Vec<_>>(),
+        "script": "(() => { const change = (id, f) => { const e = document.getElementById(id); \
+                   f(e); e.dispatchEvent(new Event('change', {bubbles: true})); }; \
+                   change('x-quantity', e => { e.value = 'DRR_1'; }); \
+                   change('x-zone', e => { e.value = 'V'; }); \
+                   change('x-mu', e => { for (const o of e.options) o.selected = true; }); })()",
+    }));
     pages.push(json!({"url": file_url(&report.join("index.html")), "ids": ["design-link"]}));
     // Negative controls: what the probe must see.
     let bad = dir.path().join("bad.html");
@@ -252,7 +263,7 @@ fn design_page_answers_as_the_command_does() {
     pages.push(json!({"url": file_url(&bad), "ids": []}));
     let answer = probe(&json!({ "pages": pages }));
     let seen = answer["pages"].as_array().unwrap();
-    assert_eq!(seen.len(), questions.len() + 3);
+    assert_eq!(seen.len(), questions.len() + 4);
 
     for (q, page) in questions.iter().zip(seen) {
         check_page(q, page, &command(&study, q));
@@ -267,7 +278,19 @@ fn design_page_answers_as_the_command_does() {
         format!("design.html{}", query(&typed))
     );
 
-    let index = &seen[questions.len() + 1];
+    let default = &seen[questions.len() + 1];
+    check_page(&questions[0], default, &command(&study, &questions[0]));
+    check_quiet(default);
+    let explorer = &default["elements"]["fig-explorer"];
+    let legend = explorer["text"].as_str().unwrap();
+    assert!(legend.contains("Zone V: DRR_1 against T_p"), "{legend}");
+    // The line DRR = 1 and one per friction pair of the grid (2 × 2).
+    assert_eq!(explorer["paths"], 5, "{legend}");
+    for pair in ["μ_1 = 0.1, μ_2 = 0.05", "μ_1 = 0.3, μ_2 = 0.2"] {
+        assert!(legend.contains(pair), "{legend}");
+    }
+
+    let index = &seen[questions.len() + 2];
     check_quiet(index);
     assert!(index["broken_images"].as_array().unwrap().is_empty());
     let links: Vec<&str> = index["links"]
@@ -299,7 +322,7 @@ fn design_page_answers_as_the_command_does() {
         }
     }
 
-    let control = &seen[questions.len() + 2];
+    let control = &seen[questions.len() + 3];
     let requests = control["requests"].to_string();
     assert!(requests.contains("http://127.0.0.1:9/x.png"), "{requests}");
     let errors = control["errors"].to_string();

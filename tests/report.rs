@@ -174,7 +174,10 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
     for s in &svgs {
         assert!(shown.contains(s), "{s} is not shown on the page");
     }
-    assert!(shown.iter().any(|s| s == "design.html"), "no link to the design page");
+    assert!(
+        shown.iter().any(|s| s == "design.html"),
+        "no link to the design page"
+    );
     for want in [
         "spectra_III.svg",
         "history_V.svg",
