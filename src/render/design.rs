@@ -95,7 +95,7 @@ pub fn design_page(
         .iter()
         .map(|(label, id, unit)| {
             format!(
-                "<tr><th scope='row'>{}</th><td><output id='{id}' for='design'>–</output> {unit}\
+                "<tr><th scope='row'>{}</th><td><output id='{id}'>–</output> {unit}\
                  </td></tr>",
                 escape(label)
             )
