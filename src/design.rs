@@ -9,10 +9,11 @@
 //! which may have changed since). Reads only verified files of the study directory, and only a
 //! `motions.h5` that `tnew.h5` was made from.
 
-use crate::fit::{Fitted, Sample, features, paper_equation};
-use crate::grid::OutsideGrid;
+use crate::fit::{Fitted, PaperEquation, Sample, features};
+use crate::grid::{Grid, OutsideGrid};
+use crate::spectrum::target::TargetSpectrum;
 use crate::store::StoreError;
-use crate::store::fit::read_fit;
+use crate::store::fit::{ZoneFit, read_fit};
 use crate::store::h5::stored_fingerprint;
 use crate::store::motions::read_zone_target;
 use crate::store::tnew::{read_motions_fingerprint, read_zone_tnew, zones_and_blocks};
@@ -98,15 +99,57 @@ pub struct Answer {
     pub notes: Vec<String>,
 }
 
-/// Answers `q` from the finished study in `dir`.
-pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
-    let positive = |what: String, value: f64| {
-        if value.is_finite() && value > 0.0 {
-            Ok(())
-        } else {
-            Err(DesignError::Value { what, value })
+/// What the answers for one zone are computed from, and all of it: the report's design page
+/// embeds it as JSON (its script repeats [`answer`]'s arithmetic on the same numbers).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ZoneDesign {
+    pub zone: String,
+    /// The zone's target spectrum, as stored in `motions.h5`.
+    pub target: TargetSpectrum,
+    pub grid: Grid,
+    /// `T_new` (s) per case, in the grid's flat order (NaN, `null` in JSON, where none).
+    pub t_new_s: Vec<f64>,
+    /// The zone's recommended fitted form and its parameters.
+    pub fit: Option<Fitted>,
+    /// The paper's Eq. 16 or 17, for zones III and V with two blocks.
+    pub paper: Option<PaperEquation>,
+}
+
+impl ZoneDesign {
+    /// From a zone's stored `T_new` (`grid`'s flat order), its fit and its target.
+    pub fn new(
+        zone: &str,
+        target: TargetSpectrum,
+        grid: Grid,
+        t_new_s: Vec<f64>,
+        fit: Option<&ZoneFit>,
+    ) -> Self {
+        let paper = PaperEquation::of_zone(zone).filter(|_| grid.blocks() == 2);
+        Self {
+            zone: zone.to_string(),
+            target,
+            fit: fit.and_then(|z| z.recommended_fit()).map(|f| Fitted {
+                form: f.form,
+                params: f.coefficients.iter().map(|c| c.1).collect(),
+            }),
+            grid,
+            t_new_s,
+            paper,
         }
-    };
+    }
+}
+
+/// `Err` unless `value` is finite and positive.
+fn positive(what: String, value: f64) -> Result<(), DesignError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(DesignError::Value { what, value })
+    }
+}
+
+/// The question's numbers are finite and positive.
+fn check_values(q: &Query) -> Result<(), DesignError> {
     positive("`period_s`".into(), q.period_s)?;
     for (i, &a) in q.alpha.iter().enumerate() {
         positive(format!("alpha_{}", i + 1), a)?;
@@ -114,6 +157,12 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
     for (i, &m) in q.mu.iter().enumerate() {
         positive(format!("mu_{}", i + 1), m)?;
     }
+    Ok(())
+}
+
+/// Answers `q` from the finished study in `dir`.
+pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
+    check_values(q)?;
     let tnew = dir.join("tnew.h5");
     let fit_yaml = dir.join("fit.yaml");
     let motions = dir.join("motions.h5");
@@ -151,13 +200,34 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
             known: zones.join(", "),
         });
     }
+    check_counts(q, blocks)?;
+    let (grid, t) = read_zone_tnew(&tnew, &q.zone, blocks)?;
+    let target = read_zone_target(&motions, &q.zone)?;
+    let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
+    let data = ZoneDesign::new(
+        &q.zone,
+        target,
+        grid,
+        t.vars.t_new.iter().copied().collect(),
+        zone_fit,
+    );
+    answer(&data, q)
+}
+
+/// One value per block in `alpha` and `mu`.
+fn check_counts(q: &Query, blocks: usize) -> Result<(), DesignError> {
     for (what, got) in [("alpha", q.alpha.len()), ("mu", q.mu.len())] {
         if got != blocks {
             return Err(DesignError::Count { what, got, blocks });
         }
     }
-    let (grid, t) = read_zone_tnew(&tnew, &q.zone, blocks)?;
-    let target = read_zone_target(&motions, &q.zone)?;
+    Ok(())
+}
+
+/// Answers `q` (whose zone is `z`'s) from `z`, files aside.
+pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
+    check_values(q)?;
+    check_counts(q, z.grid.blocks())?;
     let alpha_total: f64 = q.alpha.iter().sum();
     let t_rigid_s = q.period_s * (1.0 + alpha_total).sqrt();
     let mut notes = Vec::new();
@@ -165,8 +235,7 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
     let mut point = vec![q.period_s];
     point.extend(&q.alpha);
     point.extend(&q.mu);
-    let values: Vec<f64> = t.vars.t_new.iter().copied().collect();
-    let t_new_grid_s = match grid.interpolate(&values, &point) {
+    let t_new_grid_s = match z.grid.interpolate(&z.t_new_s, &point) {
         Ok(Some(v)) => Some(v),
         Ok(None) => {
             notes.push(
@@ -183,21 +252,16 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         Err(outside) => return Err(DesignError::Outside(outside)),
     };
 
-    let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
-    let recommended = zone_fit.and_then(|z| z.recommended_fit());
     let x = features(q.period_s, &q.alpha, &q.mu);
-    let t_new_fit_s = recommended.map(|f| {
-        Fitted {
-            form: f.form,
-            params: f.coefficients.iter().map(|c| c.1).collect(),
-        }
-        .predict(&Sample {
+    let t_new_fit_s = z.fit.as_ref().map(|f| {
+        f.predict(&Sample {
             x: x.clone(),
             t_rigid_s,
             t_new_s: f64::NAN,
         })
     });
-    let t_new_paper_s = paper_equation(&q.zone, &x);
+    let t_new_paper_s = z.paper.and_then(|p| p.evaluate(&x));
+    let target = &z.target;
     let sa = |t: Option<f64>| t.filter(|t| t.is_finite()).map(|t| target.sa_g(t));
     Ok(Answer {
         zone: q.zone.clone(),
@@ -208,7 +272,10 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         t_rigid_s,
         t_new_grid_s,
         t_new_fit_s,
-        fit_form: recommended.map_or_else(String::new, |f| f.form.name().to_string()),
+        fit_form: z
+            .fit
+            .as_ref()
+            .map_or_else(String::new, |f| f.form.name().to_string()),
         t_new_paper_s,
         sa_tp_g: target.sa_g(q.period_s),
         sa_new_g: sa(t_new_grid_s.or(t_new_fit_s)),

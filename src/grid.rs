@@ -48,7 +48,7 @@ pub fn linear_range(from: f64, to: f64, step: f64, max: usize) -> Result<Vec<f64
 }
 
 /// The grid's axes.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Grid {
     /// Periods of the bare structure `T_p`, s, increasing.
     pub periods_s: Vec<f64>,

@@ -20,7 +20,7 @@ pub mod solver;
 pub use extrapolation::{BoxCheck, DesignBox, check_box};
 pub use forms::Form;
 pub use metrics::{Metrics, Uncertainty, metrics, uncertainty};
-pub use published::paper_equation;
+pub use published::{PaperEquation, paper_equation};
 pub use solver::{Method, SolverReport};
 
 use rayon::prelude::*;

@@ -395,6 +395,51 @@ impl TargetSpectrum {
     }
 }
 
+/// What a program evaluating [`TargetSpectrum::sa_g`] elsewhere needs (the report's design
+/// page does, in JavaScript), with the same numbers in the same operations: IS 1893 as
+/// `factor·(importance/response_reduction)·Sa/g` with the soil's branch constants, ASCE 7 by
+/// its three parameters, a table by its rows; `spec` is the SPEC string and `label` the
+/// description.
+impl serde::Serialize for TargetSpectrum {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = s.serialize_struct("TargetSpectrum", 9)?;
+        st.serialize_field("spec", &self.to_string())?;
+        st.serialize_field("label", &self.label())?;
+        match self {
+            TargetSpectrum::Is1893 {
+                zone,
+                soil,
+                scaling,
+                importance,
+                response_reduction,
+            } => {
+                st.serialize_field("kind", "is1893")?;
+                st.serialize_field("factor", &scaling.factor(*zone))?;
+                st.serialize_field("importance", importance)?;
+                st.serialize_field("response_reduction", response_reduction)?;
+                st.serialize_field("corner_s", &soil.corner_period_s())?;
+                st.serialize_field("descending_s", &soil.descending_coefficient_s())?;
+                st.serialize_field("long_g", &soil.long_period_sa_g())?;
+            }
+            TargetSpectrum::Asce7 { sds_g, sd1_g, tl_s } => {
+                st.serialize_field("kind", "asce7")?;
+                st.serialize_field("sds_g", sds_g)?;
+                st.serialize_field("sd1_g", sd1_g)?;
+                st.serialize_field("tl_s", tl_s)?;
+            }
+            TargetSpectrum::Table {
+                periods_s, sa_g, ..
+            } => {
+                st.serialize_field("kind", "table")?;
+                st.serialize_field("periods_s", periods_s)?;
+                st.serialize_field("sa_g", sa_g)?;
+            }
+        }
+        st.end()
+    }
+}
+
 /// The bytes of a target table file, refused above [`MAX_FILE_BYTES`] before they are read.
 pub fn read_table_bytes(path: &Path) -> Result<Vec<u8>, TargetError> {
     let file = path.display().to_string();

@@ -10,6 +10,7 @@
 //!   ratios, a subset of friction pairs drawn out over every pair in grey;
 //! * the band counts of `T_new`, Table 3 next to the paper's, the recommended form's
 //!   coefficients with their standard errors, and the residuals of every fitted form;
+//! * `design.html`: `slidestack design` in the browser, and an explorer of the grid's figures;
 //! * with an `ida:` section: the first IDA case's curves, the fragility fits and the median
 //!   ductility of the stack against the rigidly attached load (from `ida.h5`).
 //!
@@ -22,6 +23,7 @@
 //! `ida:` section, and the report's own version.
 
 mod cases;
+mod design;
 mod fit;
 mod grid;
 mod ida;
@@ -34,7 +36,7 @@ use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::grid::Grid;
 use crate::ground_motion::Record;
 use crate::render::chart::{self, ChartError, Figure};
-use crate::render::page::{Section, document, figure, list, para, table_with_id};
+use crate::render::page::{Section, document, escape, figure, list, para, table_with_id};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::fit::{FitReport, ZoneFit, read_fit};
@@ -54,7 +56,7 @@ use text::{fixed, joined, num};
 use thiserror::Error;
 
 /// Changes when the report's contents change.
-const REPORT_VERSION: &str = "report-2";
+const REPORT_VERSION: &str = "report-3";
 
 #[derive(Debug, Error)]
 pub enum ReportError {
@@ -276,7 +278,19 @@ fn summary(inp: &Inputs) -> String {
             ph.mu_static_ratio
         ),
     ];
-    list(&facts)
+    let example = if g.blocks() == 2 {
+        format!(
+            " (the paper's Section 9 worked example: <a href='design.html?{q}'>design.html?{q}</a>)",
+            q = escape(design::SECTION_9_QUERY)
+        )
+    } else {
+        String::new()
+    };
+    format!(
+        "<p id='design-link'><a href='design.html'>The design page</a>: T_new and the design \
+         spectral acceleration of your structure from this study, in the browser{example}; and \
+         an explorer of the grid's figures.</p>"
+    ) + &list(&facts)
         + &para("The paper's numbers next to ours (details in the sections below):")
         + &table_with_id("summary", &["quantity", "zone", "paper", "ours"], &rows)
 }
@@ -318,6 +332,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         sections.push(ida::ida_section(study, &mut files)?);
     }
     sections.push(not_shown());
+    design::design_file(&inp, &mut files)?;
     let html = document(
         &format!(
             "slidestack report: {}",

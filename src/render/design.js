@@ -1,0 +1,550 @@
+// The design page: slidestack design's answer (src/design.rs) computed in the browser from the
+// study's data embedded in the page (#study-data, the serialized ZoneDesign of each zone), and an
+// explorer of the grid's figures. Every formula below repeats the Rust one it names, with the
+// same operations in the same order, so that the numbers agree to the last digit or two.
+"use strict";
+
+const DATA = JSON.parse(document.getElementById("study-data").textContent);
+const ZONES = DATA.zones;
+const BLOCKS = ZONES[0].grid.alpha.length;
+const NS = "http://www.w3.org/2000/svg";
+const COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b",
+  "#e377c2", "#7f7f7f", "#bcbd22"];
+
+const val = (v) => (v === null ? NaN : v);
+
+// Rust's `{}` of an f64 (no exponent), for the messages that repeat the command's.
+function rustNum(x) {
+  if (!Number.isFinite(x)) return Number.isNaN(x) ? "NaN" : (x > 0 ? "inf" : "-inf");
+  const s = String(x);
+  if (!/e/.test(s)) return s;
+  const digits = Math.max(0, -Math.floor(Math.log10(Math.abs(x))) + 17);
+  return x.toFixed(Math.min(100, digits)).replace(/0+$/, "").replace(/\.$/, "");
+}
+
+// grid.rs, Grid::interpolate: multilinear in [T_p, α_1 … α_n, μ_1 … μ_n]; `outside` names the
+// first dimension out of range, `value` is null where a corner with weight has no T_new.
+function interpolate(grid, values, point) {
+  const axes = [grid.periods_s, ...grid.alpha, ...grid.mu];
+  const n = grid.alpha.length;
+  const names = ["T_p"];
+  for (let i = 1; i <= n; i++) names.push("alpha_" + i);
+  for (let i = 1; i <= n; i++) names.push("mu_" + i);
+  const brackets = [];
+  for (let d = 0; d < axes.length; d++) {
+    const axis = axes[d];
+    const x = point[d];
+    const lo = axis[0];
+    const hi = axis[axis.length - 1];
+    if (!(x >= lo && x <= hi)) return { outside: { dim: names[d], value: x, lo, hi } };
+    let p = 0;
+    while (p < axis.length && axis[p] <= x) p++;
+    const i = Math.min(Math.max(p, 1), Math.max(axis.length, 2) - 1) - 1;
+    if (axis.length === 1) brackets.push([0, 0.0]);
+    else brackets.push([i, (x - axis[i]) / (axis[i + 1] - axis[i])]);
+  }
+  const shape = axes.map((a) => a.length);
+  let total = 0.0;
+  for (let corner = 0; corner < 2 ** axes.length; corner++) {
+    let weight = 1.0;
+    let flat = 0;
+    for (let d = 0; d < brackets.length; d++) {
+      const [i, w] = brackets[d];
+      const up = Math.floor(corner / 2 ** d) % 2 === 1;
+      weight *= up ? w : 1.0 - w;
+      flat = flat * shape[d] + i + (up ? 1 : 0);
+    }
+    if (weight === 0.0) continue;
+    const v = val(values[flat]);
+    if (Number.isNaN(v)) return { value: null };
+    total += weight * v;
+  }
+  return { value: total };
+}
+
+const dot = (a, b) => {
+  let s = 0.0;
+  for (let i = 0; i < Math.min(a.length, b.length); i++) s += a[i] * b[i];
+  return s;
+};
+
+// fit/forms.rs, logistic.
+function logistic(z) {
+  const e = Math.exp(-Math.abs(z));
+  return z >= 0.0 ? 1.0 / (1.0 + e) : e / (1.0 + e);
+}
+
+// fit/forms.rs, Form::regressors and Form::evaluate (no gradient).
+function predict(fit, x, tP, tRigid) {
+  const p = fit.params;
+  if (fit.form === "paper") {
+    const k = x.length;
+    const ex = Math.exp(dot(p.slice(k, 2 * k), x));
+    return dot(p.slice(0, k), x) + p[2 * k] * ex + p[2 * k + 1];
+  }
+  if (fit.form === "bounded") {
+    const k = x.length;
+    return tP + (tRigid - tP) * logistic(dot(p.slice(0, k), x) + p[k]);
+  }
+  const z = x.map(Math.log);
+  z.push(z[0] * z[0]);
+  const k = z.length;
+  const span = tRigid - tP;
+  const s1 = logistic(dot(p.slice(0, k), z) + p[k]);
+  const s2 = logistic(dot(p.slice(k + 1, 2 * k + 1), z) + p[2 * k + 1]);
+  return tP * (1.0 - DATA.damping_depth * s2) + span * s1;
+}
+
+// fit/published.rs, PaperEquation::evaluate.
+function paperEquation(eq, x) {
+  if (!eq || x.length !== 5) return null;
+  return dot(eq.a, x) + eq.b * Math.exp(dot(eq.c, x) + eq.d) + eq.e;
+}
+
+// spectrum/target.rs, TargetSpectrum::sa_g (Soil::sa_g, asce7_sa_g, interpolate_log_log).
+function saG(t, T) {
+  if (Number.isNaN(T) || T < 0.0) return NaN;
+  if (t.kind === "is1893") {
+    let s;
+    if (T < 0.10) s = 1.0 + 15.0 * T;
+    else if (T <= t.corner_s) s = 2.5;
+    else if (T <= 4.0) s = t.descending_s / T;
+    else s = t.long_g;
+    return t.factor * (t.importance / t.response_reduction) * s;
+  }
+  if (t.kind === "asce7") {
+    const ts = t.sd1_g / t.sds_g;
+    const t0 = 0.2 * ts;
+    if (T < t0) return t.sds_g * (0.4 + 0.6 * T / t0);
+    if (T <= ts) return t.sds_g;
+    if (T <= t.tl_s) return t.sd1_g / T;
+    return t.sd1_g * t.tl_s / (T * T);
+  }
+  const ps = t.periods_s;
+  const sa = t.sa_g;
+  const n = Math.min(ps.length, sa.length);
+  if (n === 0) return NaN;
+  if (T <= ps[0]) return sa[0];
+  if (T >= ps[n - 1]) return sa[n - 1];
+  let k = 0;
+  while (k < n && ps[k] <= T) k++;
+  const [t0, t1, s0, s1] = [ps[k - 1], ps[k], sa[k - 1], sa[k]];
+  if (T === t0) return s0;
+  if (t0 === 0.0) return s0 + (s1 - s0) * T / t1;
+  return s0 * Math.pow(s1 / s0, Math.log(T / t0) / Math.log(t1 / t0));
+}
+
+const fin = (v) => (v !== null && Number.isFinite(v) ? v : null);
+
+// design.rs, answer: {answer} or {error}.
+function answer(q) {
+  const z = ZONES.find((z) => z.zone === q.zone);
+  if (!z) {
+    return { error: "zone `" + q.zone + "` is not in the study; it has " +
+      ZONES.map((z) => z.zone).join(", ") };
+  }
+  const bad = (what, v) => ({ error: what + " = " + rustNum(v) + " must be finite and > 0" });
+  if (!(Number.isFinite(q.period) && q.period > 0)) return bad("T_p", q.period);
+  for (const [name, list] of [["alpha", q.alpha], ["mu", q.mu]]) {
+    for (let i = 0; i < list.length; i++) {
+      if (!(Number.isFinite(list[i]) && list[i] > 0)) return bad(name + "_" + (i + 1), list[i]);
+    }
+    if (list.length !== BLOCKS) {
+      return { error: name + " lists " + list.length + " values but the study's stacks have " +
+        BLOCKS + " blocks" };
+    }
+  }
+  let alphaTotal = 0.0;
+  for (const a of q.alpha) alphaTotal += a;
+  const tRigid = q.period * Math.sqrt(1.0 + alphaTotal);
+  const notes = [];
+  const r = interpolate(z.grid, z.t_new_s, [q.period, ...q.alpha, ...q.mu]);
+  let tGrid = null;
+  if (r.outside) {
+    const o = r.outside;
+    const text = o.dim + " = " + rustNum(o.value) + " lies outside the grid's " + rustNum(o.lo) +
+      " … " + rustNum(o.hi);
+    if (!q.extrapolate) {
+      return { error: text + "; with `extrapolate` the fitted form answers there", outside: true };
+    }
+    notes.push(text + ": T_new from the fitted form");
+  } else if (r.value === null) {
+    notes.push("a grid point next to this structure has no T_new (no crossing of the mean " +
+      "displacement spectrum): no interpolated value");
+  } else {
+    tGrid = r.value;
+  }
+  const x = [q.period, ...q.mu, ...q.alpha];
+  const tFit = z.fit ? predict(z.fit, x, q.period, tRigid) : null;
+  const tPaper = paperEquation(z.paper, x);
+  const sa = (t) => (fin(t) === null ? null : saG(z.target, t));
+  return {
+    answer: {
+      zone: z.zone, target: z.target.spec, fit_form: z.fit ? z.fit.form : "",
+      t_rigid_s: tRigid, t_new_grid_s: tGrid, t_new_fit_s: tFit, t_new_paper_s: tPaper,
+      sa_tp_g: saG(z.target, q.period), sa_new_g: sa(tGrid !== null ? tGrid : tFit),
+      sa_new_grid_g: sa(tGrid), sa_new_fit_g: sa(tFit), sa_new_paper_g: sa(tPaper), notes,
+    },
+  };
+}
+
+// ---- the form, the URL and the outputs ----
+
+const OUTPUTS = ["t_rigid_s", "t_new_grid_s", "t_new_fit_s", "t_new_paper_s", "sa_tp_g", "sa_new_g"];
+const $ = (id) => document.getElementById(id);
+const listOf = (s) => s.split(",").map((v) => (v.trim() === "" ? NaN : Number(v)));
+
+function defaultQuery() {
+  const z = ZONES.find((z) => z.zone === "III") || ZONES[0];
+  const g = z.grid;
+  const mid = (a) => a[Math.floor((a.length - 1) / 2)];
+  if (BLOCKS === 2) {
+    // The paper's Section 9 worked example.
+    return { zone: z.zone, period: 0.7, alpha: [1, 1], mu: [0.3, 0.1], extrapolate: false };
+  }
+  return { zone: z.zone, period: mid(g.periods_s), alpha: g.alpha.map(mid), mu: g.mu.map(mid),
+    extrapolate: false };
+}
+
+function queryFromUrl() {
+  const q = defaultQuery();
+  const p = new URLSearchParams(window.location.search);
+  if (p.has("zone")) q.zone = p.get("zone");
+  if (p.has("period")) q.period = p.get("period").trim() === "" ? NaN : Number(p.get("period"));
+  if (p.has("alpha")) q.alpha = listOf(p.get("alpha"));
+  if (p.has("mu")) q.mu = listOf(p.get("mu"));
+  q.extrapolate = ["1", "true", "yes", "on"].includes((p.get("extrapolate") || "").toLowerCase());
+  return q;
+}
+
+function queryString(q) {
+  let s = "?zone=" + encodeURIComponent(q.zone) + "&period=" + q.period + "&alpha=" +
+    q.alpha.join(",") + "&mu=" + q.mu.join(",");
+  return q.extrapolate ? s + "&extrapolate=1" : s;
+}
+
+function fillForm(q) {
+  $("zone").value = q.zone;
+  $("period").value = Number.isNaN(q.period) ? "" : q.period;
+  for (let i = 0; i < BLOCKS; i++) {
+    const a = q.alpha[i];
+    const m = q.mu[i];
+    $("alpha_" + (i + 1)).value = a === undefined || Number.isNaN(a) ? "" : a;
+    $("mu_" + (i + 1)).value = m === undefined || Number.isNaN(m) ? "" : m;
+  }
+  $("extrapolate").checked = q.extrapolate;
+}
+
+function readForm() {
+  const n = (id) => ($(id).value.trim() === "" ? NaN : Number($(id).value));
+  const alpha = [];
+  const mu = [];
+  for (let i = 1; i <= BLOCKS; i++) {
+    alpha.push(n("alpha_" + i));
+    mu.push(n("mu_" + i));
+  }
+  return { zone: $("zone").value, period: n("period"), alpha, mu,
+    extrapolate: $("extrapolate").checked };
+}
+
+function show(q) {
+  const r = answer(q);
+  const a = r.answer || {};
+  for (const key of OUTPUTS) {
+    const v = fin(a[key] === undefined ? null : a[key]);
+    const el = $(key);
+    el.textContent = v === null ? "–" : v.toFixed(3);
+    if (v === null) el.removeAttribute("data-value");
+    else el.setAttribute("data-value", String(v));
+  }
+  $("fit_form").textContent = a.fit_form || "–";
+  $("error").textContent = r.error || "";
+  $("error").hidden = !r.error;
+  const notes = $("notes");
+  notes.textContent = "";
+  for (const text of (a.notes || [])) {
+    const li = document.createElement("li");
+    li.textContent = text;
+    notes.appendChild(li);
+  }
+  const link = queryString(q);
+  $("permalink").setAttribute("href", link);
+  $("permalink").textContent = "design.html" + link;
+  drawCase(q, r.answer || null);
+}
+
+// ---- figures (SVG) ----
+
+function niceTicks(lo, hi, count) {
+  const raw = (hi - lo) / count;
+  const mag = 10 ** Math.floor(Math.log10(raw));
+  const step = [1, 2, 5, 10].map((m) => m * mag).find((s) => s >= raw) || raw;
+  const ticks = [];
+  for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) {
+    ticks.push(Math.abs(v) < step * 1e-9 ? 0 : v);
+  }
+  return ticks;
+}
+
+function el(name, attrs, text) {
+  const e = document.createElementNS(NS, name);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (text !== undefined) e.textContent = text;
+  return e;
+}
+
+// A line chart into the <figure> `figId`: series {label, x, y, colour, dash, width, points}.
+function chart(figId, title, xLabel, yLabel, series) {
+  const fig = $(figId);
+  const W = 640;
+  const H = 400;
+  const m = { l: 64, r: 14, t: 30, b: 48 };
+  let xs = [];
+  let ys = [];
+  for (const s of series) {
+    s.x.forEach((x, i) => {
+      if (Number.isFinite(x) && Number.isFinite(s.y[i])) {
+        xs.push(x);
+        ys.push(s.y[i]);
+      }
+    });
+  }
+  if (xs.length === 0) {
+    xs = [0, 1];
+    ys = [0, 1];
+  }
+  let [x0, x1] = [Math.min(...xs), Math.max(...xs)];
+  let [y0, y1] = [Math.min(...ys), Math.max(...ys)];
+  if (x1 === x0) x1 = x0 + 1;
+  if (y1 === y0) y1 = y0 + 1;
+  const px = (x1 - x0) * 0.03;
+  const py = (y1 - y0) * 0.06;
+  [x0, x1, y0, y1] = [x0 - px, x1 + px, y0 - py, y1 + py];
+  const X = (x) => m.l + ((x - x0) / (x1 - x0)) * (W - m.l - m.r);
+  const Y = (y) => H - m.b - ((y - y0) / (y1 - y0)) * (H - m.t - m.b);
+  const svg = el("svg", { viewBox: "0 0 " + W + " " + H, role: "img", "aria-label": title });
+  svg.appendChild(el("text", { x: W / 2, y: 18, "text-anchor": "middle", class: "title" }, title));
+  for (const t of niceTicks(x0, x1, 8)) {
+    svg.appendChild(el("line", { x1: X(t), x2: X(t), y1: m.t, y2: H - m.b, class: "grid" }));
+    svg.appendChild(el("text", { x: X(t), y: H - m.b + 16, "text-anchor": "middle" },
+      String(+t.toPrecision(6))));
+  }
+  for (const t of niceTicks(y0, y1, 6)) {
+    svg.appendChild(el("line", { x1: m.l, x2: W - m.r, y1: Y(t), y2: Y(t), class: "grid" }));
+    svg.appendChild(el("text", { x: m.l - 6, y: Y(t) + 4, "text-anchor": "end" },
+      String(+t.toPrecision(6))));
+  }
+  svg.appendChild(el("rect", { x: m.l, y: m.t, width: W - m.l - m.r, height: H - m.t - m.b,
+    class: "frame" }));
+  svg.appendChild(el("text", { x: (m.l + W - m.r) / 2, y: H - 8, "text-anchor": "middle" },
+    xLabel));
+  svg.appendChild(el("text", { x: 14, y: (m.t + H - m.b) / 2, "text-anchor": "middle",
+    transform: "rotate(-90 14 " + (m.t + H - m.b) / 2 + ")" }, yLabel));
+  const legend = document.createElement("ul");
+  legend.className = "legend";
+  for (const s of series) {
+    const style = { stroke: s.colour, "stroke-width": s.width || 2, fill: "none" };
+    if (s.dash) style["stroke-dasharray"] = s.dash;
+    if (!s.points) {
+      let d = "";
+      let pen = false;
+      s.x.forEach((x, i) => {
+        const y = s.y[i];
+        if (Number.isFinite(x) && Number.isFinite(y)) {
+          d += (pen ? "L" : "M") + X(x).toFixed(1) + " " + Y(y).toFixed(1);
+          pen = true;
+        } else {
+          pen = false;
+        }
+      });
+      if (d) svg.appendChild(el("path", Object.assign({ d }, style)));
+    } else {
+      s.x.forEach((x, i) => {
+        if (Number.isFinite(x) && Number.isFinite(s.y[i])) {
+          svg.appendChild(el("circle", { cx: X(x), cy: Y(s.y[i]), r: 6, fill: s.fill || s.colour,
+            stroke: s.colour, "stroke-width": 2 }));
+        }
+      });
+    }
+    if (s.label) {
+      const li = document.createElement("li");
+      const key = document.createElement("span");
+      key.className = "key";
+      key.style.borderColor = s.colour;
+      key.style.borderStyle = s.points ? "solid" : (s.dash ? "dashed" : "solid");
+      if (s.points) {
+        key.classList.add("dot");
+        key.style.background = s.fill || s.colour;
+      }
+      li.append(key, s.label);
+      legend.appendChild(li);
+    }
+  }
+  fig.textContent = "";
+  fig.append(svg, legend);
+}
+
+function range(lo, hi, n) {
+  return Array.from({ length: n }, (_, i) => lo + ((hi - lo) * i) / (n - 1));
+}
+
+function drawCase(q, a) {
+  const z = ZONES.find((z) => z.zone === q.zone) || ZONES[0];
+  const g = z.grid;
+  const ok = a !== null;
+  const root = ok ? Math.sqrt(1 + q.alpha.reduce((s, v) => s + v, 0)) : NaN;
+  const tLo = Math.min(g.periods_s[0], ok ? q.period : Infinity);
+  const tHi = Math.max(g.periods_s[g.periods_s.length - 1], ok ? q.period : -Infinity);
+  const ts = range(tLo, tHi, 80);
+  const series = [
+    { label: "T_p (bare structure)", x: [tLo, tHi], y: [tLo, tHi], colour: "#000", width: 1 },
+  ];
+  if (ok) {
+    series.push({ label: "T_rigid (load rigidly attached)", x: [tLo, tHi],
+      y: [tLo * root, tHi * root], colour: "#000", width: 1, dash: "6 4" });
+    const gridLine = g.periods_s.map((t) => {
+      const r = interpolate(g, z.t_new_s, [t, ...q.alpha, ...q.mu]);
+      return r.value === undefined || r.value === null ? NaN : r.value;
+    });
+    series.push({ label: "T_new, the study's grid (this stack)", x: g.periods_s, y: gridLine,
+      colour: COLOURS[0] });
+    if (z.fit) {
+      series.push({ label: "T_new, fitted (" + z.fit.form + " form)", x: ts,
+        y: ts.map((t) => predict(z.fit, [t, ...q.mu, ...q.alpha], t, t * root)),
+        colour: COLOURS[1], dash: "8 4" });
+    }
+    if (z.paper && BLOCKS === 2) {
+      series.push({ label: "T_new, the paper's Eqs. 16–17", x: ts,
+        y: ts.map((t) => paperEquation(z.paper, [t, ...q.mu, ...q.alpha])), colour: COLOURS[2],
+        dash: "2 3" });
+    }
+    const marks = [["t_new_grid_s", COLOURS[0], "this structure: grid"],
+      ["t_new_fit_s", COLOURS[1], "this structure: fit"],
+      ["t_new_paper_s", COLOURS[2], "this structure: Eqs. 16–17"]];
+    for (const [key, colour, label] of marks) {
+      if (fin(a[key]) !== null) {
+        series.push({ label, x: [q.period], y: [a[key]], colour, points: true,
+          fill: key === "t_new_grid_s" ? colour : "#fff" });
+      }
+    }
+  }
+  chart("fig-case", "Zone " + z.zone + ": T_new against T_p", "T_p (s)", "T_new (s)", series);
+
+  const top = Math.max(4, ok ? 1.1 * Math.max(q.period, fin(a.t_new_fit_s) || 0,
+    fin(a.t_new_grid_s) || 0) : 0);
+  const tt = range(0, top, 401);
+  const spec = [{ label: z.target.label, x: tt, y: tt.map((t) => saG(z.target, t)),
+    colour: "#444" }];
+  if (ok) {
+    spec.push({ label: "at T_p", x: [q.period], y: [a.sa_tp_g], colour: "#000", points: true,
+      fill: "#fff" });
+    const tNew = fin(a.t_new_grid_s) !== null ? a.t_new_grid_s : a.t_new_fit_s;
+    if (fin(a.sa_new_g) !== null) {
+      spec.push({ label: "at T_new (" + (fin(a.t_new_grid_s) !== null ? "grid" : "fit") + ")",
+        x: [tNew], y: [a.sa_new_g], colour: COLOURS[0], points: true });
+    }
+  }
+  chart("fig-spectrum", "Zone " + z.zone + ": design spectrum", "T (s)", "Sa (g)", spec);
+}
+
+// ---- the explorer of the grid's figures ----
+
+function explorerZone() {
+  return ZONES.find((z) => z.zone === $("x-zone").value) || ZONES[0];
+}
+
+// Flat case index within a work unit (report/select.rs, case_index).
+function caseIndex(g, alphaIdx, muIdx) {
+  const lens = [...g.alpha.map((a) => a.length), ...g.mu.map((a) => a.length)];
+  return [...alphaIdx, ...muIdx].reduce((idx, i, d) => idx * lens[d] + i, 0);
+}
+
+function drawExplorer() {
+  const z = explorerZone();
+  const g = z.grid;
+  const drr = DATA.drr.find((d) => d.zone === z.zone);
+  const what = $("x-quantity").value;
+  const alphaIdx = g.alpha.map((_, i) => Number($("x-alpha_" + (i + 1)).value));
+  const muPairs = Array.from($("x-mu").selectedOptions).map((o) => o.value.split(",").map(Number));
+  const per = [...g.alpha, ...g.mu].reduce((p, a) => p * a.length, 1);
+  const column = (values, c) => g.periods_s.map((_, t) => val(values[t * per + c]));
+  const tp = g.periods_s;
+  const series = [];
+  const values = what === "T_new" ? z.t_new_s : drr[what.toLowerCase()];
+  if (what === "T_new") {
+    const root = Math.sqrt(1 + alphaIdx.reduce((s, i, b) => s + g.alpha[b][i], 0));
+    series.push({ label: "T_p (bare structure)", x: tp, y: tp, colour: "#000", width: 1 });
+    series.push({ label: "T_rigid (load rigidly attached)", x: tp, y: tp.map((t) => t * root),
+      colour: "#000", width: 1, dash: "6 4" });
+  } else {
+    series.push({ label: "DRR = 1 (nothing slides)", x: [tp[0], tp[tp.length - 1]], y: [1, 1],
+      colour: "#000", width: 1, dash: "2 3" });
+  }
+  const dashes = [null, "8 4", "2 3", "10 3 2 3"];
+  muPairs.forEach((m, k) => {
+    const label = m.map((i, b) => "μ_" + (b + 1) + " = " + g.mu[b][i]).join(", ");
+    series.push({ label, x: tp, y: column(values, caseIndex(g, alphaIdx, m)),
+      colour: COLOURS[k % COLOURS.length], dash: dashes[Math.floor(k / COLOURS.length) % 4] });
+  });
+  const alphaText = alphaIdx.map((i, b) => "α_" + (b + 1) + " = " + g.alpha[b][i]).join(", ");
+  const yLabel = what === "T_new" ? "T_new (s)" : what + " (–)";
+  chart("fig-explorer", "Zone " + z.zone + ": " + what + " against T_p, " + alphaText, "T_p (s)",
+    yLabel, series);
+}
+
+function explorerAxes() {
+  const g = explorerZone().grid;
+  for (let b = 0; b < BLOCKS; b++) {
+    const sel = $("x-alpha_" + (b + 1));
+    const keep = sel.value;
+    sel.textContent = "";
+    g.alpha[b].forEach((a, i) => sel.appendChild(new Option(String(a), String(i))));
+    sel.value = keep && Number(keep) < g.alpha[b].length ? keep : String(g.alpha[b].length - 1);
+  }
+  const mu = $("x-mu");
+  const chosen = new Set(Array.from(mu.selectedOptions).map((o) => o.value));
+  mu.textContent = "";
+  let combos = [[]];
+  for (const axis of g.mu) {
+    combos = combos.flatMap((c) => axis.map((_, i) => [...c, i]));
+  }
+  const first = chosen.size === 0;
+  const step = Math.max(1, Math.ceil(combos.length / 6));
+  combos.forEach((c, k) => {
+    const text = c.map((i, b) => "μ_" + (b + 1) + " = " + g.mu[b][i]).join(", ");
+    const o = new Option(text, c.join(","));
+    o.selected = first ? k % step === 0 : chosen.has(o.value);
+    mu.appendChild(o);
+  });
+  mu.size = Math.min(10, combos.length);
+}
+
+function start() {
+  const q = queryFromUrl();
+  fillForm(q);
+  show(q);
+  const update = () => {
+    const q = readForm();
+    show(q);
+    try {
+      history.replaceState(null, "", queryString(q));
+    } catch (e) {
+      // A browser that refuses to change a file: URL keeps the link below up to date instead.
+    }
+  };
+  $("design").addEventListener("input", update);
+  $("design").addEventListener("change", update);
+  $("design").addEventListener("submit", (e) => {
+    e.preventDefault();
+    update();
+  });
+  explorerAxes();
+  drawExplorer();
+  $("x-zone").addEventListener("change", () => {
+    explorerAxes();
+    drawExplorer();
+  });
+  $("explorer").addEventListener("change", drawExplorer);
+}
+
+start();

@@ -1,0 +1,148 @@
+//! The design page of a report (`design.html`): a form asking for one structure (zone, `T_p`,
+//! the stack's mass ratios and friction coefficients), the answers `slidestack design` gives,
+//! computed in the page by its script (`design.js`) from the study's data embedded as JSON, the
+//! case drawn on the `T_new`–`T_p` figure and on the spectrum, and an explorer of the grid's
+//! figures. Self-contained: no request leaves the page, so it works from `file://` and from any
+//! static host.
+
+use super::page::escape;
+
+const SCRIPT: &str = include_str!("design.js");
+
+const STYLE: &str = "body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;\
+line-height:1.4}fieldset{border:1px solid #ccc;margin:0 0 1em;padding:.5em 1em}\
+.inputs{display:grid;grid-template-columns:repeat(auto-fill,minmax(11em,1fr));gap:.6em 1em}\
+label{display:block;font-weight:bold;font-size:95%}input,select{font-size:1rem;padding:.3em;\
+width:100%;box-sizing:border-box}input[type=checkbox]{width:auto;margin-right:.4em}\
+.check label{display:inline;font-weight:normal}table{border-collapse:collapse;margin:1em 0}\
+td,th{border:1px solid #ccc;padding:4px 10px;text-align:right}th{background:#f4f4f4}\
+td:first-child,th:first-child{text-align:left}output{font-variant-numeric:tabular-nums}\
+#error{color:#a00;font-weight:bold}.figs{display:grid;grid-template-columns:repeat(auto-fit,\
+minmax(300px,1fr));gap:1em}figure{margin:0}svg{width:100%;height:auto;font-size:15px}\
+svg .grid{stroke:#e4e4e4}svg .frame{fill:none;stroke:#888}svg .title{font-weight:bold}\
+ul.legend{list-style:none;padding:0;margin:.3em 0;font-size:90%}ul.legend li{display:inline-block;\
+margin-right:1.2em}.key{display:inline-block;width:2em;border-top-width:3px;vertical-align:middle;\
+margin-right:.4em}.key.dot{width:.7em;height:.7em;border-width:3px;border-radius:50%}\
+#fig-explorer{max-width:800px}a:focus,input:focus,select:focus{outline:3px solid #f90}code{overflow-wrap:anywhere}\
+@media(max-width:600px){td,th{padding:3px 5px}}";
+
+/// One row of the answers' table: a label and the `id` of its output (the JSON key of
+/// `slidestack design --json`).
+const OUTPUT_ROWS: [(&str, &str, &str); 6] = [
+    ("T_rigid: stack rigidly attached", "t_rigid_s", "s"),
+    (
+        "T_new: the study's grid (interpolated)",
+        "t_new_grid_s",
+        "s",
+    ),
+    ("T_new: the fitted design equation", "t_new_fit_s", "s"),
+    ("T_new: the paper's Eqs. 16–17", "t_new_paper_s", "s"),
+    ("Design Sa at T_p", "sa_tp_g", "g"),
+    ("Design Sa at T_new (grid, else fit)", "sa_new_g", "g"),
+];
+
+fn input(id: &str, label: &str, hint: &str) -> String {
+    format!(
+        "<div><label for='{id}'>{}</label><input id='{id}' name='{id}' type='number' step='any' \
+         min='0' inputmode='decimal' aria-describedby='{id}-hint' required='required'/>\
+         <small id='{id}-hint'>{}</small></div>",
+        escape(label),
+        escape(hint)
+    )
+}
+
+/// The page of a study whose stacks have `blocks` blocks and whose zones are `zones`: `title`,
+/// an introduction (HTML) and `data`, the JSON the script reads (`zones`: each zone's
+/// `design::ZoneDesign`; `drr`: each zone's `DRR_1`, `DRR_2` per case; `damping_depth`).
+pub fn design_page(
+    title: &str,
+    intro: &str,
+    zones: &[String],
+    blocks: usize,
+    ranges: &[String],
+    data: &str,
+) -> String {
+    let zone_options: String = zones
+        .iter()
+        .map(|z| format!("<option value='{0}'>{0}</option>", escape(z)))
+        .collect();
+    let hint = |i: usize| ranges.get(i).map_or("", String::as_str);
+    let mut inputs = format!(
+        "<div><label for='zone'>Zone</label><select id='zone' name='zone'>{zone_options}</select>\
+         </div>{}",
+        input("period", "T_p: period of the bare structure (s)", hint(0))
+    );
+    for i in 1..=blocks {
+        inputs += &input(
+            &format!("alpha_{i}"),
+            &format!("α_{i}: mass ratio of block {i} (m_{i}/m_p)"),
+            hint(i),
+        );
+    }
+    for i in 1..=blocks {
+        let below = if i == 1 {
+            "the structure".to_string()
+        } else {
+            format!("block {}", i - 1)
+        };
+        inputs += &input(
+            &format!("mu_{i}"),
+            &format!("μ_{i}: friction, block {i} on {below}"),
+            hint(blocks + i),
+        );
+    }
+    let rows: String = OUTPUT_ROWS
+        .iter()
+        .map(|(label, id, unit)| {
+            format!(
+                "<tr><th scope='row'>{}</th><td><output id='{id}'>–</output> {unit}\
+                 </td></tr>",
+                escape(label)
+            )
+        })
+        .collect();
+    let alpha_selects: String = (1..=blocks)
+        .map(|i| {
+            format!(
+                "<div><label for='x-alpha_{i}'>α_{i}</label><select id='x-alpha_{i}'>\
+                 </select></div>"
+            )
+        })
+        .collect();
+    // `</` cannot end the data's script element early (JSON allows `<\/` for `</`).
+    let data = data.replace("</", "<\\/");
+    format!(
+        "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'/>\
+         <meta name='viewport' content='width=device-width, initial-scale=1'/>\
+         <title>{t}</title><style>{STYLE}</style></head><body>\
+         <p><a href='index.html'>← the full report</a></p><h1>{t}</h1>{intro}\
+         <main><form id='design' action='#' novalidate='novalidate'><fieldset>\
+         <legend>Your structure</legend><div class='inputs'>{inputs}</div>\
+         <p class='check'><input id='extrapolate' name='extrapolate' type='checkbox'/>\
+         <label for='extrapolate'>Extrapolate outside the study's grid (answers from the fitted \
+         form)</label></p></fieldset></form>\
+         <p id='error' role='alert' hidden='hidden'></p>\
+         <table id='answers' aria-live='polite'><caption>The answers (as <code>slidestack design \
+         --json</code> gives them)</caption>{rows}<tr><th scope='row'>Fitted form</th>\
+         <td><output id='fit_form'>–</output></td></tr></table><ul id='notes'></ul>\
+         <p>A link to this answer: <a id='permalink' href='design.html'>design.html</a></p>\
+         <div class='figs'><figure id='fig-case'></figure><figure id='fig-spectrum'></figure>\
+         </div>\
+         <section aria-labelledby='explorer-h'><h2 id='explorer-h'>Explore the grid (Figs 10–11 \
+         and 16–17)</h2><p>Any mass ratios and any friction pairs of the study's grid: the mean \
+         over the motions of DRR_1 = u_stack/u_rigid, DRR_2 = u_single/u_rigid, or T_new, \
+         against T_p. Select several friction pairs with Ctrl or Shift (or Space on the list).\
+         </p><form id='explorer' action='#'><div class='inputs'>\
+         <div><label for='x-zone'>Zone</label><select id='x-zone'>{zone_options}</select></div>\
+         <div><label for='x-quantity'>Quantity</label><select id='x-quantity'>\
+         <option value='T_new'>T_new (Figs 16–17)</option>\
+         <option value='DRR_1'>DRR_1, the stack (Figs 10–11)</option>\
+         <option value='DRR_2'>DRR_2, a single block (Figs 10–11)</option></select></div>\
+         {alpha_selects}<div><label for='x-mu'>Friction pairs</label>\
+         <select id='x-mu' multiple='multiple'></select></div></div></form>\
+         <figure id='fig-explorer'></figure></section></main>\
+         <script type='application/json' id='study-data'>{data}</script>\
+         <script>{SCRIPT}</script></body></html>\n",
+        t = escape(title),
+    )
+}

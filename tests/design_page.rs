@@ -1,0 +1,331 @@
+//! The report's design page (`report/design.html`) in a real headless Chromium
+//! (`scripts/browser_probe.py`; `scripts/install-deps.sh --test` installs Debian's
+//! `chromium-headless-shell`): for a dozen questions given in the address (inside the grid, on
+//! its edges and corners, outside it with and without extrapolation, bad input) and one typed
+//! into the form, every output element against `slidestack design --json` for the same
+//! question, on a study whose zones have each kind of target spectrum (IS 1893, ASCE 7, a table);
+//! no request leaves the page's own file and no JavaScript error is logged; `index.html`'s links
+//! and images resolve. A page with an outside image and a thrown error shows that the probe sees
+//! both.
+//!
+//! Tolerances: the page's text is the command's value printed to 3 decimals, compared as text
+//! (the printed precision); the page's full value (`data-value`) within 1e-12 relative, since
+//! the browser's `exp` and `ln` may differ from Rust's in the last bit and a few operations
+//! follow (the values agree exactly on the cases seen).
+
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+const OUTPUTS: [&str; 6] = [
+    "t_rigid_s",
+    "t_new_grid_s",
+    "t_new_fit_s",
+    "t_new_paper_s",
+    "sa_tp_g",
+    "sa_new_g",
+];
+
+/// A question: zone, `T_p`, `α`, `μ`, extrapolate.
+type Question = (&'static str, &'static str, &'static str, &'static str, bool);
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The probe's answer for `request` (its module doc).
+fn probe(request: &Value) -> Value {
+    let python = root().join(".venv-test/bin/python");
+    assert!(
+        python.exists(),
+        "{} is missing: run scripts/install-deps.sh --test",
+        python.display()
+    );
+    let mut child = Command::new(python)
+        .arg(root().join("scripts/browser_probe.py"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    serde_json::to_writer(child.stdin.take().unwrap(), request).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "browser_probe.py: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn file_url(path: &Path) -> String {
+    format!("file://{}", path.display())
+}
+
+/// The study: configs/quick.yaml's grid with zones III and V (IS 1893), US (ASCE 7) and TB (a
+/// table beside the config).
+fn run_study(dir: &Path) -> PathBuf {
+    let quick = std::fs::read_to_string(root().join("configs/quick.yaml")).unwrap();
+    let zones = "zones:\n  - { name: III, target: \"is1893:zone=III,soil=I\" }\n  \
+                 - { name: V, target: \"is1893:zone=V,soil=I\" }\n  \
+                 - { name: US, target: \"asce7:sds=1.0,sd1=0.6,tl=8\" }\n  \
+                 - { name: TB, target: \"table:tb.txt\" }\n";
+    let start = quick.find("zones:").unwrap();
+    let end = quick.find("motions:").unwrap();
+    let cfg = format!("{}{zones}{}", &quick[..start], &quick[end..]);
+    std::fs::write(dir.join("design-page.yaml"), cfg).unwrap();
+    // Starts at T = 0 (the linear segment), then log-log.
+    std::fs::write(
+        dir.join("tb.txt"),
+        "# period_s sa_g\n0 0.2\n0.1 0.45\n0.5 0.5\n1 0.3\n2 0.12\n4 0.05\n12 0.01\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .args(["run", "design-page.yaml", "--out"])
+        .arg(&out)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
+/// `slidestack design --json` for `q`: `Ok(json)` or `Err(stderr)` (exit code 2).
+fn command(study: &Path, q: &Question) -> Result<Value, String> {
+    let (zone, period, alpha, mu, extrapolate) = *q;
+    let mut c = Command::new(env!("CARGO_BIN_EXE_slidestack"));
+    c.args(["design", "--study"]).arg(study).args([
+        "--zone", zone, "--period", period, "--alpha", alpha, "--mu", mu, "--json",
+    ]);
+    if extrapolate {
+        c.arg("--extrapolate");
+    }
+    let o = c.output().unwrap();
+    if o.status.success() {
+        Ok(serde_json::from_slice(&o.stdout).unwrap())
+    } else {
+        assert_eq!(o.status.code(), Some(2), "{q:?}");
+        Err(String::from_utf8_lossy(&o.stderr).trim().to_string())
+    }
+}
+
+fn query(q: &Question) -> String {
+    let (zone, period, alpha, mu, extrapolate) = *q;
+    let e = if extrapolate { "&extrapolate=1" } else { "" };
+    format!("?zone={zone}&period={period}&alpha={alpha}&mu={mu}{e}")
+}
+
+/// The page's elements (`probe`'s `elements`) agree with the command's answer for `q`.
+fn check_page(q: &Question, page: &Value, cli: &Result<Value, String>) {
+    let el = &page["elements"];
+    let text = |id: &str| {
+        el[id]["text"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{q:?}: no #{id}"))
+    };
+    match cli {
+        Ok(a) => {
+            assert_eq!(text("error"), "", "{q:?}");
+            for id in OUTPUTS {
+                match a[id].as_f64() {
+                    None => {
+                        assert_eq!(text(id), "–", "{q:?}: #{id}");
+                        assert!(el[id]["value"].is_null(), "{q:?}: #{id}");
+                    }
+                    Some(v) => {
+                        assert_eq!(text(id), format!("{v:.3}"), "{q:?}: #{id}");
+                        let full: f64 = el[id]["value"].as_str().unwrap().parse().unwrap();
+                        assert!(
+                            (full - v).abs() <= 1e-12 * v.abs().max(1.0),
+                            "{q:?}: #{id} {full} vs {v}"
+                        );
+                    }
+                }
+            }
+            assert_eq!(text("fit_form"), a["fit_form"].as_str().unwrap(), "{q:?}");
+            let notes: Vec<&str> = a["notes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|n| n.as_str().unwrap())
+                .collect();
+            assert_eq!(text("notes"), notes.concat(), "{q:?}");
+        }
+        Err(stderr) => {
+            // The refusal's reason as the command words it, from the value on (before it the
+            // command names its flag, the page its input; after `;` its advice names its flag).
+            let reason = stderr
+                .split_once(" = ")
+                .map(|(_, r)| r.split(';').next().unwrap())
+                .unwrap_or_else(|| panic!("{q:?}: {stderr}"));
+            assert!(
+                text("error").contains(reason),
+                "{q:?}: page `{}`, command `{stderr}`",
+                text("error")
+            );
+            for id in OUTPUTS {
+                assert_eq!(text(id), "–", "{q:?}: #{id}");
+            }
+        }
+    }
+}
+
+/// Every request of `page` is for a local file (or the page's own data), and nothing was
+/// logged as an error.
+fn check_quiet(page: &Value) {
+    let url = page["url"].as_str().unwrap();
+    for r in page["requests"].as_array().unwrap() {
+        let r = r.as_str().unwrap();
+        assert!(
+            r.starts_with("file://") || r.starts_with("data:") || r.starts_with("about:"),
+            "{url} requested {r}"
+        );
+    }
+    assert!(
+        page["errors"].as_array().unwrap().is_empty(),
+        "{url}: {}",
+        page["errors"]
+    );
+}
+
+#[test]
+fn design_page_answers_as_the_command_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = run_study(dir.path());
+    let report = study.join("report");
+    let design = file_url(&report.join("design.html"));
+    let questions: [Question; 14] = [
+        // Section 9's worked example, both zones of the paper.
+        ("III", "0.7", "1,1", "0.3,0.1", false),
+        ("V", "0.7", "1,1", "0.3,0.1", false),
+        // Between grid values in every dimension.
+        ("III", "1.3", "0.3,0.7", "0.2,0.1", false),
+        // A grid point; the lower corner; the upper corner; an edge.
+        ("V", "0.6", "0.5,1", "0.1,0.2", false),
+        ("III", "0.3", "0.1,0.5", "0.1,0.05", false),
+        ("V", "2", "1,1", "0.3,0.2", false),
+        ("III", "1", "0.75,0.5", "0.3,0.12", false),
+        // The other targets: ASCE 7 (every branch of it between 0.3 and 2 s: the plateau,
+        // SD1/T) and the table.
+        ("US", "0.45", "0.2,0.8", "0.15,0.1", false),
+        ("TB", "1.7", "1,0.6", "0.25,0.07", false),
+        // Outside: refused, then extrapolated (one and several dimensions out).
+        ("III", "3", "1,1", "0.3,0.1", false),
+        ("III", "3", "1,1", "0.3,0.1", true),
+        ("V", "0.2", "2,1", "0.05,0.3", true),
+        ("TB", "0.7", "1,1", "0.5,0.1", false),
+        // Bad input: refused by both.
+        ("III", "-1", "1,1", "0.3,0.1", false),
+    ];
+    let mut ids: Vec<&str> = OUTPUTS.to_vec();
+    ids.extend([
+        "error",
+        "fit_form",
+        "notes",
+        "permalink",
+        "period",
+        "extrapolate",
+    ]);
+    let mut pages: Vec<Value> = questions
+        .iter()
+        .map(|q| json!({"url": format!("{design}{}", query(q)), "ids": ids}))
+        .collect();
+    // Typed into the form: the worked example, then T_p 1.3 s and extrapolation ticked.
+    let typed: Question = ("III", "1.3", "1,1", "0.3,0.1", true);
+    pages.push(json!({
+        "url": format!("{design}{}", query(&questions[0])),
+        "ids": ids,
+        "script": "(() => { const p = document.getElementById('period'); p.value = '1.3'; \
+                   p.dispatchEvent(new Event('input', {bubbles: true})); \
+                   const e = document.getElementById('extrapolate'); e.click(); })()",
+    }));
+    // No question in the address: the worked example; then the explorer, DRR_1 of zone V for
+    // every friction pair.
+    pages.push(json!({
+        "url": design,
+        "ids": ids.iter().chain(&["fig-explorer"]).collect::<Vec<_>>(),
+        "script": "(() => { const change = (id, f) => { const e = document.getElementById(id); \
+                   f(e); e.dispatchEvent(new Event('change', {bubbles: true})); }; \
+                   change('x-quantity', e => { e.value = 'DRR_1'; }); \
+                   change('x-zone', e => { e.value = 'V'; }); \
+                   change('x-mu', e => { for (const o of e.options) o.selected = true; }); })()",
+    }));
+    pages.push(json!({"url": file_url(&report.join("index.html")), "ids": ["design-link"]}));
+    // Negative controls: what the probe must see.
+    let bad = dir.path().join("bad.html");
+    std::fs::write(
+        &bad,
+        "<!DOCTYPE html><html><body><img src='http://127.0.0.1:9/x.png' alt=''/>\
+         <script>undefinedFunction();</script></body></html>",
+    )
+    .unwrap();
+    pages.push(json!({"url": file_url(&bad), "ids": []}));
+    let answer = probe(&json!({ "pages": pages }));
+    let seen = answer["pages"].as_array().unwrap();
+    assert_eq!(seen.len(), questions.len() + 4);
+
+    for (q, page) in questions.iter().zip(seen) {
+        check_page(q, page, &command(&study, q));
+        check_quiet(page);
+    }
+    let typed_page = &seen[questions.len()];
+    check_page(&typed, typed_page, &command(&study, &typed));
+    check_quiet(typed_page);
+    // The link to this answer follows the form.
+    assert_eq!(
+        typed_page["elements"]["permalink"]["text"],
+        format!("design.html{}", query(&typed))
+    );
+
+    let default = &seen[questions.len() + 1];
+    check_page(&questions[0], default, &command(&study, &questions[0]));
+    check_quiet(default);
+    let explorer = &default["elements"]["fig-explorer"];
+    let legend = explorer["text"].as_str().unwrap();
+    assert!(legend.contains("Zone V: DRR_1 against T_p"), "{legend}");
+    // The line DRR = 1 and one per friction pair of the grid (2 × 2).
+    assert_eq!(explorer["paths"], 5, "{legend}");
+    for pair in ["μ_1 = 0.1, μ_2 = 0.05", "μ_1 = 0.3, μ_2 = 0.2"] {
+        assert!(legend.contains(pair), "{legend}");
+    }
+
+    let index = &seen[questions.len() + 2];
+    check_quiet(index);
+    assert!(index["broken_images"].as_array().unwrap().is_empty());
+    let links: Vec<&str> = index["links"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert!(
+        links.iter().any(|l| l.ends_with("/design.html")),
+        "{links:?}"
+    );
+    let index_url = file_url(&report.join("index.html"));
+    let ids: Vec<&str> = index["ids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i.as_str().unwrap())
+        .collect();
+    for link in &links {
+        let (file, fragment) = link.split_once('#').unwrap_or((link, ""));
+        let path = file
+            .strip_prefix("file://")
+            .unwrap_or_else(|| panic!("index.html links outside the report: {link}"));
+        let path = path.split('?').next().unwrap();
+        assert!(Path::new(path).is_file(), "broken link {link}");
+        if file == index_url && !fragment.is_empty() {
+            assert!(ids.contains(&fragment), "no #{fragment} in index.html");
+        }
+    }
+
+    let control = &seen[questions.len() + 3];
+    let requests = control["requests"].to_string();
+    assert!(requests.contains("http://127.0.0.1:9/x.png"), "{requests}");
+    let errors = control["errors"].to_string();
+    assert!(errors.contains("undefinedFunction"), "{errors}");
+    assert_eq!(control["broken_images"].as_array().unwrap().len(), 1);
+}
