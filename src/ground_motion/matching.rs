@@ -17,7 +17,7 @@
 //!
 //! Units: accelerations and spectral values in g. Nothing here reads files.
 
-use super::process::{BaselineCorrection, ProcessError};
+use super::process::{BaselineCorrection, PreparedBaseline, ProcessError};
 use crate::limits::{MAX_PERIODS, PERIOD_RANGE_S};
 use crate::sdof::{self, free_displacement};
 pub use crate::spectrum::log_space;
@@ -26,6 +26,7 @@ use crate::spectrum::{SpectrumError, TARGET_DAMPING, TargetError, TargetSpectrum
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 use thiserror::Error;
+
 
 /// Matching settings. Defaults: the acceptance of the study (every period of 200 log-spaced
 /// check periods in 0.05–4 s within ±10 % of the target).
@@ -376,14 +377,15 @@ impl Probe {
     }
 }
 
-/// Oscillators stepped together through one wavelet.
-const PROBE_LANES: usize = 8;
+/// Oscillators stepped together through one wavelet: four AVX2 registers, enough independent
+/// recurrences to hide the latency of one step.
+const PROBE_LANES: usize = 16;
 
 /// Column `j` of the linearised system: the pseudo-acceleration of every probe's oscillator at
 /// its time in response to the wavelet `samples` starting at sample `first` (zero elsewhere).
 /// Equal to [`response_at`] probe by probe up to round-off (the free vibration after the
-/// wavelet is taken in closed form here): eight oscillators advance together through the
-/// wavelet, each state kept at its probe's sample.
+/// wavelet is taken in closed form here): sixteen oscillators advance together through the
+/// wavelet, from one probe's sample to the next, each state kept at its probe's sample.
 fn wavelet_column(grid: &Grid, probes: &[Probe], first: usize, samples: &[f64], out: &mut [f64]) {
     #[cfg(target_arch = "x86_64")]
     {
@@ -419,14 +421,12 @@ fn wavelet_column_generic(
     let last = first + samples.len() - 1;
     for (chunk, out) in probes.chunks(L).zip(out.chunks_mut(L)) {
         let lanes = chunk.len();
-        // The sample at which each lane's state is kept: its probe's, or the wavelet's end.
-        let mut cap = [first as f64; L];
-        let mut end = first;
-        for (l, p) in chunk.iter().enumerate() {
-            let c = p.k.clamp(first, last);
-            cap[l] = c as f64;
-            end = end.max(c);
-        }
+        // The sample at which each lane's state is kept: its probe's, or the wavelet's end;
+        // the lanes visited in the order of those samples.
+        let cap: [usize; L] =
+            std::array::from_fn(|l| chunk.get(l).map_or(first, |p| p.k.clamp(first, last)));
+        let mut order: [usize; L] = std::array::from_fn(|l| l);
+        order[..lanes].sort_by_key(|&l| cap[l]);
         let s = |f: fn(&sdof::Step) -> f64| -> [f64; L] {
             std::array::from_fn(|l| chunk.get(l).map_or(0.0, |p| f(&grid.steps[p.grid])))
         };
@@ -434,17 +434,20 @@ fn wavelet_column_generic(
         let (vu, vv, vg0, vg1) = (s(|s| s.vu), s(|s| s.vv), s(|s| s.vg0), s(|s| s.vg1));
         let (mut u, mut v) = ([0.0f64; L], [0.0f64; L]);
         let (mut ku, mut kv) = ([0.0f64; L], [0.0f64; L]);
-        for (i, w) in samples[..=end - first].windows(2).enumerate() {
-            let (a0, a1) = (w[0], w[1]);
-            let pos = (first + i + 1) as f64;
-            for l in 0..L {
-                let (u0, v0) = (u[l], v[l]);
-                u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * a0 + ug1[l] * a1;
-                v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * a0 + vg1[l] * a1;
-                let here = pos == cap[l];
-                ku[l] = if here { u[l] } else { ku[l] };
-                kv[l] = if here { v[l] } else { kv[l] };
+        // Every lane sits at sample `at`; advanced to the next lane's sample, whose state is kept.
+        let mut at = first;
+        for &l in &order[..lanes] {
+            for w in samples[at - first..=cap[l] - first].windows(2) {
+                let (a0, a1) = (w[0], w[1]);
+                for l in 0..L {
+                    let (u0, v0) = (u[l], v[l]);
+                    u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * a0 + ug1[l] * a1;
+                    v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * a0 + vg1[l] * a1;
+                }
             }
+            at = cap[l];
+            ku[l] = u[l];
+            kv[l] = v[l];
         }
         for l in 0..lanes {
             let p = &chunk[l];
@@ -755,11 +758,13 @@ fn build_step(grid: &Grid, n: usize, cons: &[Constraint], settings: &MatchSettin
     }
 }
 
-/// `accel + gain·Σ b_j·f_j`, baseline-corrected and brought to rest as the settings ask.
+/// `accel + gain·Σ b_j·f_j`, baseline-corrected (`baseline`, the settings' correction prepared
+/// for the record) and brought to rest as the settings ask.
 fn trial(
     accel: &[f64],
     step: &Step,
     gain: f64,
+    baseline: &PreparedBaseline,
     settings: &MatchSettings,
     dt_s: f64,
 ) -> Result<Vec<f64>, MatchError> {
@@ -769,7 +774,7 @@ fn trial(
             *a += gain * bj * w;
         }
     }
-    let mut trial = settings.baseline.apply(&trial, dt_s)?;
+    let mut trial = baseline.apply(&trial)?;
     if settings.end_at_rest {
         bring_to_rest(&mut trial, dt_s);
     }
@@ -832,6 +837,7 @@ struct Attempt {
 /// smallest worst misfit on the check grid seen.
 fn attempt(
     grid: &Grid,
+    baseline: &PreparedBaseline,
     start: &[f64],
     settings: &MatchSettings,
     strategy: &Strategy,
@@ -862,7 +868,7 @@ fn attempt(
             let mut gain = gain_now;
             let mut accepted = false;
             for tried in 0..4 {
-                let trial = trial(&accel, &step, gain, settings, grid.dt_s)?;
+                let trial = trial(&accel, &step, gain, baseline, settings, grid.dt_s)?;
                 let eval = grid.evaluate(&trial)?;
                 if eval.sum_sq < now.sum_sq {
                     if eval.worst < best.1.worst {
@@ -935,6 +941,7 @@ pub fn match_record_scaled(
     let (lo, hi) = settings.check_range_s;
     target.check_covers(lo, hi)?;
     let mut grid = Grid::new(settings, target, dt_s)?;
+    let baseline = settings.baseline.prepare(accel_g.len(), dt_s)?;
     grid.target_g.iter_mut().for_each(|q| *q *= target_factor);
 
     let mut start = accel_g.to_vec();
@@ -956,7 +963,7 @@ pub fn match_record_scaled(
         {
             break;
         }
-        let a = attempt(&grid, &start, settings, &strategy)?;
+        let a = attempt(&grid, &baseline, &start, settings, &strategy)?;
         attempts += 1;
         iterations += a.iterations;
         stalls += a.stalls;
