@@ -498,8 +498,11 @@ impl PolynomialFit {
             .map(|(k, (&a, &t))| {
                 let at = k * m..(k + 1) * m;
                 let (mut q, mut dq, mut d2q) = (0.0, 0.0, 0.0);
-                for (((cj, p), dp), d2p) in
-                    c.iter().zip(&self.p[at.clone()]).zip(&self.dp[at.clone()]).zip(&self.d2p[at])
+                for (((cj, p), dp), d2p) in c
+                    .iter()
+                    .zip(&self.p[at.clone()])
+                    .zip(&self.dp[at.clone()])
+                    .zip(&self.d2p[at])
                 {
                     q += cj * p;
                     dq += 2.0 * cj * dp;
@@ -524,7 +527,11 @@ pub struct PreparedBaseline {
 impl PreparedBaseline {
     /// [`BaselineCorrection::apply`] on `accel`, which must have the length prepared for.
     pub fn apply(&self, accel: &[f64]) -> Result<Vec<f64>, ProcessError> {
-        assert_eq!(accel.len(), self.n, "record of another length than prepared");
+        assert_eq!(
+            accel.len(),
+            self.n,
+            "record of another length than prepared"
+        );
         match &self.poly {
             Some(fit) => {
                 check_series(accel, self.dt_s)?;

@@ -145,6 +145,38 @@ pub fn response_spectrum(
     })
 }
 
+/// [`response_spectrum`] on this thread, eight periods at a time in order, each group's peaks
+/// handed to `keep_going` with the index of its first period; stops with `None` as soon as that
+/// says no. The peaks computed are the same bits as [`response_spectrum`]'s.
+pub fn response_spectrum_while(
+    accel_mps2: &[f64],
+    dt_s: f64,
+    periods_s: &[f64],
+    damping: f64,
+    mut keep_going: impl FnMut(usize, &[Peak]) -> bool,
+) -> Result<Option<ResponseSpectrum>, SpectrumError> {
+    validate_record(accel_mps2, dt_s)?;
+    for &t in periods_s {
+        validate_oscillator(t, damping)?;
+    }
+    let reach = Reach::new(accel_mps2, dt_s);
+    let mut peaks = Vec::with_capacity(periods_s.len());
+    for (i, chunk) in periods_s.chunks(LANES).enumerate() {
+        let mut lanes = [periods_s[0]; LANES];
+        lanes[..chunk.len()].copy_from_slice(chunk);
+        let group = peaks_in_lanes(accel_mps2, &reach, dt_s, &lanes, damping);
+        if !keep_going(i * LANES, &group[..chunk.len()]) {
+            return Ok(None);
+        }
+        peaks.extend_from_slice(&group[..chunk.len()]);
+    }
+    Ok(Some(ResponseSpectrum {
+        damping,
+        periods_s: periods_s.to_vec(),
+        peaks,
+    }))
+}
+
 /// Peak response of one oscillator.
 pub fn peak_response(
     accel_mps2: &[f64],
