@@ -904,7 +904,7 @@ struct Attempt {
     stalls: usize,
 }
 
-/// One attempt from the pre-scaled record `start`: passes of damped Newton steps. When the full
+/// One attempt from the pre-scaled record `start` (its evaluation `start_eval`): passes of damped Newton steps. When the full
 /// step does not lower `Σ (ln spectrum/target)²` over the match grid, the gain is halved (at
 /// most three times); a step that lowers nothing even then is a stall and ends its pass, the
 /// next (denser) pass starting afresh at full gain. The motion kept is the one with the
@@ -912,12 +912,12 @@ struct Attempt {
 fn attempt(
     grid: &Grid,
     baseline: &PreparedBaseline,
-    start: &[f64],
+    (start, start_eval): (&[f64], &Evaluation),
     settings: &MatchSettings,
     strategy: &Strategy,
 ) -> Result<Attempt, MatchError> {
     let mut accel = start.to_vec();
-    let mut now = grid.evaluate(&accel)?;
+    let mut now = start_eval.clone();
     let mut best = (accel.clone(), now.clone());
     let (mut iterations, mut stalls) = (0, 0);
     // With `adaptive_gain`, the gain of the last accepted step, doubled (up to `settings.gain`)
@@ -1027,6 +1027,7 @@ pub fn match_record_scaled(
         scale = (-mean_log).exp();
         start.iter_mut().for_each(|a| *a *= scale);
     }
+    let start_eval = grid.evaluate(&start)?;
     let mut best: Option<Attempt> = None;
     let (mut iterations, mut stalls, mut attempts) = (0, 0, 0);
     for strategy in Strategy::ladder(settings) {
@@ -1036,7 +1037,7 @@ pub fn match_record_scaled(
         {
             break;
         }
-        let a = attempt(&grid, &baseline, &start, settings, &strategy)?;
+        let a = attempt(&grid, &baseline, (&start, &start_eval), settings, &strategy)?;
         attempts += 1;
         iterations += a.iterations;
         stalls += a.stalls;

@@ -426,7 +426,9 @@ impl Lanes {
                     let (u0, v0) = (u[l], v[l]);
                     u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * ag0 + ug1[l] * ag1;
                     v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * ag0 + vg1[l] * ag1;
-                    best[l] = best[l].max(u[l].abs());
+                    let a = u[l].abs();
+                    // `max` without its NaN case (the states are finite): one instruction.
+                    best[l] = if a > best[l] { a } else { best[l] };
                 }
             };
         }
@@ -441,7 +443,7 @@ impl Lanes {
                 let e = self.w2[l] * u[l] * u[l] + v[l] * v[l];
                 let bound = e.sqrt() + grow;
                 let room = self.omega[l] * best[l] - near;
-                may |= !(room > 0.0 && bound * bound <= room * room * MARGIN);
+                may |= !((room > 0.0) & (bound * bound <= room * room * MARGIN));
             }
             let before = best;
             let k1 = (k0 + BLOCK).min(intervals);
