@@ -17,11 +17,13 @@
 //!
 //! Units: accelerations and spectral values in g. Nothing here reads files.
 
-use super::process::{BaselineCorrection, ProcessError};
+use super::process::{BaselineCorrection, PreparedBaseline, ProcessError};
 use crate::limits::{MAX_PERIODS, PERIOD_RANGE_S};
 use crate::sdof::{self, free_displacement};
 pub use crate::spectrum::log_space;
-use crate::spectrum::response::{response_spectrum, validate_record};
+use crate::spectrum::response::{
+    Peak, response_spectrum, response_spectrum_while, validate_record,
+};
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, TargetError, TargetSpectrum};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
@@ -314,7 +316,7 @@ fn wavelet(period_s: f64, damping: f64, peak_s: f64, dt_s: f64, n: usize) -> (us
 /// Response (pseudo-acceleration, same units as the input) of the oscillator with step
 /// coefficients `step`, circular frequency `omega`, at time `at_s`, to the input that is
 /// `samples` from index `first` and zero elsewhere. The scalar reference of
-/// [`wavelet_column`].
+/// [`system_matrix`].
 #[cfg(test)]
 fn response_at(
     step: &sdof::Step,
@@ -356,7 +358,6 @@ fn response_at(
 /// the time, and the step over the rest of that interval (s).
 struct Probe {
     grid: usize,
-    time_s: f64,
     k: usize,
     rest_s: f64,
     partial: sdof::Step,
@@ -368,7 +369,6 @@ impl Probe {
         let rest_s = (c.time_s - k as f64 * grid.dt_s).max(0.0);
         Self {
             grid: c.grid,
-            time_s: c.time_s,
             k,
             rest_s,
             partial: sdof::Step::new(grid.omega[c.grid], grid.zeta, rest_s.max(f64::MIN_POSITIVE)),
@@ -376,97 +376,145 @@ impl Probe {
     }
 }
 
-/// Oscillators stepped together through one wavelet.
+/// Probes whose weights are computed together: two AVX2 registers per quantity.
 const PROBE_LANES: usize = 8;
 
-/// Column `j` of the linearised system: the pseudo-acceleration of every probe's oscillator at
-/// its time in response to the wavelet `samples` starting at sample `first` (zero elsewhere).
-/// Equal to [`response_at`] probe by probe up to round-off (the free vibration after the
-/// wavelet is taken in closed form here): eight oscillators advance together through the
-/// wavelet, each state kept at its probe's sample.
-fn wavelet_column(grid: &Grid, probes: &[Probe], first: usize, samples: &[f64], out: &mut [f64]) {
+/// The matrix of the linearised system, row-major, a row per probe and a column per wave: entry
+/// `(r, j)` is the pseudo-acceleration of probe `r`'s oscillator at its time in response to
+/// wave `j` (first sample and samples, zero elsewhere), for `probes` in time order. Equal to
+/// [`response_at`] entry by entry up to round-off.
+///
+/// The response at a probe is a linear form in the record's samples, `u(t_r) = Σ_s w_s·a_s`:
+/// with the step `x_{s+1} = A·x_s + b₀·a_s + b₁·a_{s+1}` from rest, the adjoint state
+/// `λ_s = Aᵀ·λ_{s+1}` from `λ_k` = the first row of the partial step from the probe's sample `k`
+/// to its time gives `w_s = λ_{s+1}·b₀ + λ_s·b₁` below `k`, and the partial step's own load
+/// terms at `k` and `k + 1`. Eight probes' weights run back together once, and every entry is a
+/// dot product of a wave with them: the cost of one pass per eight probes plus the waves'
+/// lengths, where stepping every oscillator through every wave costs a pass per wave.
+fn system_matrix(
+    grid: &Grid,
+    probes: &[Probe],
+    waves: &[(usize, Vec<f64>)],
+    n: usize,
+    weights: &mut Vec<[f64; PROBE_LANES]>,
+) -> Vec<f64> {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor has AVX2 (checked just above).
-            return unsafe { wavelet_column_avx2(grid, probes, first, samples, out) };
+            return unsafe { system_matrix_avx2(grid, probes, waves, n, weights) };
         }
     }
-    wavelet_column_generic(grid, probes, first, samples, out)
+    system_matrix_generic(grid, probes, waves, n, weights)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn wavelet_column_avx2(
+unsafe fn system_matrix_avx2(
     grid: &Grid,
     probes: &[Probe],
-    first: usize,
-    samples: &[f64],
-    out: &mut [f64],
-) {
-    wavelet_column_generic(grid, probes, first, samples, out)
+    waves: &[(usize, Vec<f64>)],
+    n: usize,
+    weights: &mut Vec<[f64; PROBE_LANES]>,
+) -> Vec<f64> {
+    system_matrix_generic(grid, probes, waves, n, weights)
 }
 
 #[inline(always)]
-fn wavelet_column_generic(
+fn system_matrix_generic(
     grid: &Grid,
     probes: &[Probe],
-    first: usize,
-    samples: &[f64],
-    out: &mut [f64],
-) {
+    waves: &[(usize, Vec<f64>)],
+    n: usize,
+    weights: &mut Vec<[f64; PROBE_LANES]>,
+) -> Vec<f64> {
     const L: usize = PROBE_LANES;
-    let last = first + samples.len() - 1;
-    for (chunk, out) in probes.chunks(L).zip(out.chunks_mut(L)) {
+    let m = waves.len();
+    let mut c = vec![0.0; probes.len() * m];
+    let Some(lo) = waves.iter().map(|w| w.0).min() else {
+        return c;
+    };
+    for (base, chunk) in probes.chunks(L).enumerate().map(|(i, ch)| (i * L, ch)) {
         let lanes = chunk.len();
-        // The sample at which each lane's state is kept: its probe's, or the wavelet's end.
-        let mut cap = [first as f64; L];
-        let mut end = first;
-        for (l, p) in chunk.iter().enumerate() {
-            let c = p.k.clamp(first, last);
-            cap[l] = c as f64;
-            end = end.max(c);
+        // The last sample of the record that any probe of the chunk depends on.
+        let hi = chunk
+            .iter()
+            .map(|p| (p.k + 1).min(n - 1))
+            .max()
+            .unwrap_or(0);
+        if hi < lo {
+            continue;
         }
         let s = |f: fn(&sdof::Step) -> f64| -> [f64; L] {
             std::array::from_fn(|l| chunk.get(l).map_or(0.0, |p| f(&grid.steps[p.grid])))
         };
         let (uu, uv, ug0, ug1) = (s(|s| s.uu), s(|s| s.uv), s(|s| s.ug0), s(|s| s.ug1));
         let (vu, vv, vg0, vg1) = (s(|s| s.vu), s(|s| s.vv), s(|s| s.vg0), s(|s| s.vg1));
-        let (mut u, mut v) = ([0.0f64; L], [0.0f64; L]);
-        let (mut ku, mut kv) = ([0.0f64; L], [0.0f64; L]);
-        for (i, w) in samples[..=end - first].windows(2).enumerate() {
-            let (a0, a1) = (w[0], w[1]);
-            let pos = (first + i + 1) as f64;
-            for l in 0..L {
-                let (u0, v0) = (u[l], v[l]);
-                u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * a0 + ug1[l] * a1;
-                v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * a0 + vg1[l] * a1;
-                let here = pos == cap[l];
-                ku[l] = if here { u[l] } else { ku[l] };
-                kv[l] = if here { v[l] } else { kv[l] };
-            }
-        }
-        for l in 0..lanes {
-            let p = &chunk[l];
-            let omega = grid.omega[p.grid];
-            out[l] = if p.k < first {
-                0.0
-            } else if p.k < last {
-                let a0 = samples[p.k - first];
-                let a1 = a0 + (samples[p.k + 1 - first] - a0) * p.rest_s / grid.dt_s;
-                let u = if p.rest_s > 0.0 {
-                    p.partial.step(ku[l], kv[l], a0, a1).0
-                } else {
-                    ku[l]
-                };
-                omega * omega * u
+        // Each lane's λ at its sample `k` and the partial step's load weights at `k`, `k + 1`.
+        let mut start = [(0.0, 0.0, 0.0, 0.0); L];
+        for (l, p) in chunk.iter().enumerate() {
+            start[l] = if p.rest_s <= 0.0 {
+                (1.0, 0.0, 0.0, 0.0)
+            } else if p.k + 1 < n {
+                let (q, r) = (&p.partial, p.rest_s / grid.dt_s);
+                (q.uu, q.uv, q.ug0 + q.ug1 * (1.0 - r), q.ug1 * r)
             } else {
-                // Free vibration from the wavelet's end.
-                let s = p.time_s - last as f64 * grid.dt_s;
-                omega * omega * free_displacement(omega, grid.zeta, (ku[l], kv[l]), s)
+                // Past the last sample: free vibration (the record is zero after its end).
+                let omega = grid.omega[p.grid];
+                let free = |x| free_displacement(omega, grid.zeta, x, p.rest_s);
+                (free((1.0, 0.0)), free((0.0, 1.0)), 0.0, 0.0)
             };
         }
+        let mut by_k: [usize; L] = std::array::from_fn(|l| l);
+        by_k[..lanes].sort_by_key(|&l| std::cmp::Reverse(chunk[l].k));
+        weights.clear();
+        weights.resize(hi + 1 - lo, [0.0; L]);
+        let (mut lu, mut lv) = ([0.0f64; L], [0.0f64; L]);
+        let mut next = 0;
+        for (s, w) in (lo..=hi).rev().zip(weights.iter_mut().rev()) {
+            let (pu, pv) = (lu, lv);
+            for l in 0..L {
+                lu[l] = uu[l] * pu[l] + vu[l] * pv[l];
+                lv[l] = uv[l] * pu[l] + vv[l] * pv[l];
+            }
+            while next < lanes && chunk[by_k[next]].k == s {
+                let l = by_k[next];
+                (lu[l], lv[l]) = (start[l].0, start[l].1);
+                next += 1;
+            }
+            // The state at sample 0 is rest, whatever the load there.
+            let b1 = if s > 0 { 1.0 } else { 0.0 };
+            for l in 0..L {
+                w[l] = pu[l] * ug0[l] + pv[l] * vg0[l] + b1 * (lu[l] * ug1[l] + lv[l] * vg1[l]);
+            }
+        }
+        for (l, p) in chunk.iter().enumerate() {
+            if (lo..=hi).contains(&p.k) {
+                weights[p.k - lo][l] += start[l].2;
+            }
+            if (lo..=hi).contains(&(p.k + 1)) {
+                weights[p.k + 1 - lo][l] += start[l].3;
+            }
+        }
+        let w2: [f64; L] =
+            std::array::from_fn(|l| chunk.get(l).map_or(0.0, |p| grid.omega[p.grid].powi(2)));
+        for (j, (first, samples)) in waves.iter().enumerate() {
+            let (a, b) = (*first, (first + samples.len() - 1).min(hi));
+            if b < a {
+                continue;
+            }
+            let mut acc = [0.0f64; L];
+            for (w, x) in weights[a - lo..=b - lo].iter().zip(samples) {
+                for l in 0..L {
+                    acc[l] += w[l] * x;
+                }
+            }
+            for l in 0..lanes {
+                c[(base + l) * m + j] = w2[l] * acc[l];
+            }
+        }
     }
+    c
 }
 
 /// Subtracts from `accel` (any units) the linear acceleration `α + β·t` whose removal leaves the
@@ -605,17 +653,49 @@ impl Grid {
     }
 
     fn evaluate(&self, accel: &[f64]) -> Result<Evaluation, SpectrumError> {
-        let psa = signed_psa(accel, self.dt_s, &self.periods_s, self.zeta)?;
-        let ratio = ratios(&psa, &self.target_g);
+        Ok(self
+            .evaluate_below(accel, None)?
+            .expect("an evaluation without a limit is never dropped"))
+    }
+
+    /// [`Grid::evaluate`] when its objective is below `limit` (if any), else `None`: the spectrum is
+    /// taken eight periods at a time and dropped as soon as the objective's partial sum (of
+    /// non-negative terms, in the same order, so never above the whole) reaches `limit`. A
+    /// trial that a line search refuses thus costs only the periods up to where it fails.
+    fn evaluate_below(
+        &self,
+        accel: &[f64],
+        limit: Option<f64>,
+    ) -> Result<Option<Evaluation>, SpectrumError> {
+        let mut sum_sq = 0.0;
+        let target = &self.target_g;
+        let periods = &self.periods_s;
+        let to_psa = |i: usize, p: &Peak| (TAU / periods[i]).powi(2) * p.u_m;
+        let Some(spec) =
+            response_spectrum_while(accel, self.dt_s, periods, self.zeta, |at, group| {
+                for (i, p) in (at..).zip(group) {
+                    sum_sq += (to_psa(i, p).abs() / target[i]).ln().powi(2);
+                }
+                limit.is_none_or(|l| sum_sq < l)
+            })?
+        else {
+            return Ok(None);
+        };
+        let psa: Vec<(f64, f64)> = spec
+            .peaks
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (to_psa(i, p), p.time_s))
+            .collect();
+        let ratio = ratios(&psa, target);
         let (i, worst) = worst_of(&ratio[self.check.0..self.check.1]);
-        let sum_sq = ratio.iter().map(|r| r.ln().powi(2)).sum();
-        Ok(Evaluation {
+        Ok(Some(Evaluation {
             psa,
             ratio,
             worst,
             worst_at: i,
             sum_sq,
-        })
+        }))
     }
 
     /// Secondary response peaks of oscillator `i` in `accel` that the next step must not let
@@ -732,21 +812,18 @@ fn build_step(grid: &Grid, n: usize, cons: &[Constraint], settings: &MatchSettin
         .map(|c| wavelet(grid.periods_s[c.grid], grid.zeta, c.time_s, grid.dt_s, n))
         .collect();
     let m = cons.len();
-    // Probes in time order, so that the eight oscillators stepped together need about the same
-    // stretch of each wavelet, and whole groups before a wavelet's start cost nothing.
+    // Probes in time order, so that the eight whose weights run back together end near the
+    // same sample.
     let mut order: Vec<usize> = (0..m).collect();
     order.sort_by(|&a, &b| cons[a].time_s.total_cmp(&cons[b].time_s));
     let probes: Vec<Probe> = order
         .iter()
         .map(|&r| Probe::new(grid, &cons[r], n))
         .collect();
-    let mut column = vec![0.0; m];
+    let sorted = system_matrix(grid, &probes, &waves, n, &mut Vec::new());
     let mut c = vec![0.0; m * m];
-    for (j, (first, samples)) in waves.iter().enumerate() {
-        wavelet_column(grid, &probes, *first, samples, &mut column);
-        for (&r, &v) in order.iter().zip(&column) {
-            c[r * m + j] = v;
-        }
+    for (&r, row) in order.iter().zip(sorted.chunks(m)) {
+        c[r * m..(r + 1) * m].copy_from_slice(row);
     }
     let misfit: Vec<f64> = cons.iter().map(|c| c.misfit).collect();
     Step {
@@ -755,11 +832,13 @@ fn build_step(grid: &Grid, n: usize, cons: &[Constraint], settings: &MatchSettin
     }
 }
 
-/// `accel + gain·Σ b_j·f_j`, baseline-corrected and brought to rest as the settings ask.
+/// `accel + gain·Σ b_j·f_j`, baseline-corrected (`baseline`, the settings' correction prepared
+/// for the record) and brought to rest as the settings ask.
 fn trial(
     accel: &[f64],
     step: &Step,
     gain: f64,
+    baseline: &PreparedBaseline,
     settings: &MatchSettings,
     dt_s: f64,
 ) -> Result<Vec<f64>, MatchError> {
@@ -769,7 +848,7 @@ fn trial(
             *a += gain * bj * w;
         }
     }
-    let mut trial = settings.baseline.apply(&trial, dt_s)?;
+    let mut trial = baseline.apply(&trial)?;
     if settings.end_at_rest {
         bring_to_rest(&mut trial, dt_s);
     }
@@ -825,19 +904,20 @@ struct Attempt {
     stalls: usize,
 }
 
-/// One attempt from the pre-scaled record `start`: passes of damped Newton steps. When the full
+/// One attempt from the pre-scaled record `start` (its evaluation `start_eval`): passes of damped Newton steps. When the full
 /// step does not lower `Σ (ln spectrum/target)²` over the match grid, the gain is halved (at
 /// most three times); a step that lowers nothing even then is a stall and ends its pass, the
 /// next (denser) pass starting afresh at full gain. The motion kept is the one with the
 /// smallest worst misfit on the check grid seen.
 fn attempt(
     grid: &Grid,
-    start: &[f64],
+    baseline: &PreparedBaseline,
+    (start, start_eval): (&[f64], &Evaluation),
     settings: &MatchSettings,
     strategy: &Strategy,
 ) -> Result<Attempt, MatchError> {
     let mut accel = start.to_vec();
-    let mut now = grid.evaluate(&accel)?;
+    let mut now = start_eval.clone();
     let mut best = (accel.clone(), now.clone());
     let (mut iterations, mut stalls) = (0, 0);
     // With `adaptive_gain`, the gain of the last accepted step, doubled (up to `settings.gain`)
@@ -862,9 +942,8 @@ fn attempt(
             let mut gain = gain_now;
             let mut accepted = false;
             for tried in 0..4 {
-                let trial = trial(&accel, &step, gain, settings, grid.dt_s)?;
-                let eval = grid.evaluate(&trial)?;
-                if eval.sum_sq < now.sum_sq {
+                let trial = trial(&accel, &step, gain, baseline, settings, grid.dt_s)?;
+                if let Some(eval) = grid.evaluate_below(&trial, Some(now.sum_sq))? {
                     if eval.worst < best.1.worst {
                         best = (trial.clone(), eval.clone());
                     }
@@ -935,6 +1014,7 @@ pub fn match_record_scaled(
     let (lo, hi) = settings.check_range_s;
     target.check_covers(lo, hi)?;
     let mut grid = Grid::new(settings, target, dt_s)?;
+    let baseline = settings.baseline.prepare(accel_g.len(), dt_s)?;
     grid.target_g.iter_mut().for_each(|q| *q *= target_factor);
 
     let mut start = accel_g.to_vec();
@@ -947,6 +1027,7 @@ pub fn match_record_scaled(
         scale = (-mean_log).exp();
         start.iter_mut().for_each(|a| *a *= scale);
     }
+    let start_eval = grid.evaluate(&start)?;
     let mut best: Option<Attempt> = None;
     let (mut iterations, mut stalls, mut attempts) = (0, 0, 0);
     for strategy in Strategy::ladder(settings) {
@@ -956,7 +1037,7 @@ pub fn match_record_scaled(
         {
             break;
         }
-        let a = attempt(&grid, &start, settings, &strategy)?;
+        let a = attempt(&grid, &baseline, (&start, &start_eval), settings, &strategy)?;
         attempts += 1;
         iterations += a.iterations;
         stalls += a.stalls;
@@ -1074,17 +1155,17 @@ mod tests {
     }
 
     #[test]
-    fn wavelet_columns_equal_the_scalar_responses() {
-        // Eight oscillators at a time through a wavelet, states kept at each probe and the
-        // free vibration after the wavelet in closed form, equal `response_at` (exact stepping)
-        // to 1e-10 of the largest entry: probes before, inside and after the wavelet, at and
-        // between samples.
+    fn system_matrix_equals_the_scalar_responses() {
+        // The adjoint weights of eight probes at a time, dotted with each wave, equal
+        // `response_at` (stepping each oscillator through the wave) to 1e-10 of the largest
+        // entry: probes before, inside and after the waves, at and between samples and past
+        // the last sample; waves from the record's first sample and cut by its end.
         let settings = MatchSettings::default();
         let target: TargetSpectrum = "is1893:zone=III,soil=I".parse().unwrap();
         let dt = 0.01;
         let n = 4000;
         let grid = Grid::new(&settings, &target, dt).unwrap();
-        let cons: Vec<Constraint> = (0..grid.periods_s.len())
+        let mut cons: Vec<Constraint> = (0..grid.periods_s.len())
             .step_by(7)
             .enumerate()
             .map(|(k, g)| Constraint {
@@ -1093,11 +1174,30 @@ mod tests {
                 misfit: 0.0,
             })
             .collect();
+        for (g, t) in [(3, 0.004), (40, 39.99), (90, 39.995)] {
+            cons.push(Constraint {
+                grid: g,
+                time_s: t,
+                misfit: 0.0,
+            });
+        }
+        cons.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
         let probes: Vec<Probe> = cons.iter().map(|c| Probe::new(&grid, c, n)).collect();
-        for &(t, at) in &[(0.1, 9.0), (1.0, 14.0), (3.0, 20.0)] {
-            let (first, w) = wavelet(t, 0.05, at, dt, n);
-            let mut col = vec![0.0; cons.len()];
-            wavelet_column(&grid, &probes, first, &w, &mut col);
+        assert!(probes.iter().any(|p| p.k == n - 1 && p.rest_s > 0.0));
+        let waves: Vec<(usize, Vec<f64>)> = [
+            (0.1, 9.0),
+            (1.0, 14.0),
+            (3.0, 20.0),
+            (0.5, 0.3),
+            (3.0, 38.0),
+        ]
+        .iter()
+        .map(|&(t, at)| wavelet(t, 0.05, at, dt, n))
+        .collect();
+        assert!(waves.iter().any(|w| w.0 == 0) && waves.iter().any(|w| w.0 + w.1.len() == n));
+        let c = system_matrix(&grid, &probes, &waves, n, &mut Vec::new());
+        let m = waves.len();
+        for (j, (first, w)) in waves.iter().enumerate() {
             let want: Vec<f64> = cons
                 .iter()
                 .map(|c| {
@@ -1106,15 +1206,19 @@ mod tests {
                         grid.omega[c.grid],
                         grid.zeta,
                         dt,
-                        first,
-                        &w,
+                        *first,
+                        w,
                         c.time_s,
                     )
                 })
                 .collect();
             let scale = want.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            for (g, x) in col.iter().zip(&want) {
-                assert!((g - x).abs() < 1e-10 * scale, "T={t}: {g} vs {x}");
+            for (r, x) in want.iter().enumerate() {
+                let g = c[r * m + j];
+                assert!(
+                    (g - x).abs() < 1e-10 * scale,
+                    "wave {j}, probe {r}: {g} vs {x}"
+                );
             }
         }
     }

@@ -364,6 +364,31 @@ impl BaselineCorrection {
         }
     }
 
+    /// This correction prepared for records of `n` samples at step `dt_s`, to be applied to
+    /// many of them ([`PreparedBaseline`]); the same checks as [`BaselineCorrection::apply`]
+    /// that do not need the values.
+    pub fn prepare(&self, n: usize, dt_s: f64) -> Result<PreparedBaseline, ProcessError> {
+        self.check()?;
+        match n {
+            0 => return Err(ProcessError::Empty),
+            1 => return Err(ProcessError::TooShort(1)),
+            _ => {}
+        }
+        if !(dt_s.is_finite() && dt_s > 0.0) {
+            return Err(ProcessError::TimeStep(dt_s));
+        }
+        let poly = match *self {
+            BaselineCorrection::Polynomial { order } => Some(PolynomialFit::new(n, dt_s, order)?),
+            _ => None,
+        };
+        Ok(PreparedBaseline {
+            correction: *self,
+            n,
+            dt_s,
+            poly,
+        })
+    }
+
     /// The corrected acceleration, in the units of `accel` (any: the corrections are linear),
     /// sampled at `dt_s` seconds. Needs at least 2 finite samples.
     pub fn apply(&self, accel: &[f64], dt_s: f64) -> Result<Vec<f64>, ProcessError> {
@@ -400,43 +425,121 @@ fn legendre(x: f64, p: &mut [f64], dp: &mut [f64], d2p: &mut [f64]) {
 }
 
 fn polynomial(accel: &[f64], dt: f64, order: usize) -> Result<Vec<f64>, ProcessError> {
-    let n = accel.len();
-    let m = order + 1;
-    // The sample at t = 0 carries no information (every basis term is 0 there).
-    if n < m + 1 {
-        return Err(ProcessError::TooShortForOrder {
-            order,
-            needed: m + 1,
-            found: n,
-        });
+    Ok(PolynomialFit::new(accel.len(), dt, order)?.correct(accel))
+}
+
+/// The polynomial baseline of [`BaselineCorrection::Polynomial`] for records of one length and
+/// step: the basis at every sample and the least-squares factorisation computed once, so that
+/// [`PolynomialFit::correct`] costs two passes over the record and gives the same bits as
+/// [`BaselineCorrection::apply`].
+struct PolynomialFit {
+    dt: f64,
+    duration: f64,
+    /// `τ` at every sample.
+    tau: Vec<f64>,
+    /// Legendre values and first and second derivatives at `2τ − 1`, sample by sample
+    /// (`order + 1` each).
+    p: Vec<f64>,
+    dp: Vec<f64>,
+    d2p: Vec<f64>,
+    fit: crate::numeric::linalg::LeastSquares,
+    m: usize,
+}
+
+impl PolynomialFit {
+    fn new(n: usize, dt: f64, order: usize) -> Result<Self, ProcessError> {
+        let m = order + 1;
+        // The sample at t = 0 carries no information (every basis term is 0 there).
+        if n < m + 1 {
+            return Err(ProcessError::TooShortForOrder {
+                order,
+                needed: m + 1,
+                found: n,
+            });
+        }
+        let duration = (n - 1) as f64 * dt;
+        let tau: Vec<f64> = (0..n).map(|k| k as f64 / (n - 1) as f64).collect();
+        let (mut p, mut dp, mut d2p) = (vec![0.0; m * n], vec![0.0; m * n], vec![0.0; m * n]);
+        let mut cols = vec![vec![0.0; n]; m];
+        for (k, &t) in tau.iter().enumerate() {
+            let at = k * m..(k + 1) * m;
+            legendre(
+                2.0 * t - 1.0,
+                &mut p[at.clone()],
+                &mut dp[at.clone()],
+                &mut d2p[at.clone()],
+            );
+            for (col, pj) in cols.iter_mut().zip(&p[at]) {
+                col[k] = t * t * pj;
+            }
+        }
+        Ok(Self {
+            dt,
+            duration,
+            tau,
+            p,
+            dp,
+            d2p,
+            fit: crate::numeric::linalg::LeastSquares::new(&cols),
+            m,
+        })
     }
-    let disp = displacement(accel, dt);
-    let duration = (n - 1) as f64 * dt;
-    let tau = |k: usize| k as f64 / (n - 1) as f64;
-    let (mut p, mut dp, mut d2p) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-    let mut cols = vec![vec![0.0; n]; m];
-    for k in 0..n {
-        let t = tau(k);
-        legendre(2.0 * t - 1.0, &mut p, &mut dp, &mut d2p);
-        for (col, pj) in cols.iter_mut().zip(&p) {
-            col[k] = t * t * pj;
+
+    /// `accel` (of the length prepared) less `p''(t)`.
+    fn correct(&self, accel: &[f64]) -> Vec<f64> {
+        let m = self.m;
+        let c = self.fit.solve(&displacement(accel, self.dt));
+        // p(t) = τ²·q(τ): p''(t) = (2q + 4τ·q' + τ²·q'')/T², with d/dτ = 2·d/dx.
+        let t2 = self.duration * self.duration;
+        accel
+            .iter()
+            .zip(&self.tau)
+            .enumerate()
+            .map(|(k, (&a, &t))| {
+                let at = k * m..(k + 1) * m;
+                let (mut q, mut dq, mut d2q) = (0.0, 0.0, 0.0);
+                for (((cj, p), dp), d2p) in c
+                    .iter()
+                    .zip(&self.p[at.clone()])
+                    .zip(&self.dp[at.clone()])
+                    .zip(&self.d2p[at])
+                {
+                    q += cj * p;
+                    dq += 2.0 * cj * dp;
+                    d2q += 4.0 * cj * d2p;
+                }
+                a - (2.0 * q + 4.0 * t * dq + t * t * d2q) / t2
+            })
+            .collect()
+    }
+}
+
+/// A [`BaselineCorrection`] prepared for records of one length and step
+/// ([`BaselineCorrection::prepare`]): what does not depend on the values is computed once. Its
+/// [`PreparedBaseline::apply`] gives the same bits as [`BaselineCorrection::apply`].
+pub struct PreparedBaseline {
+    correction: BaselineCorrection,
+    n: usize,
+    dt_s: f64,
+    poly: Option<PolynomialFit>,
+}
+
+impl PreparedBaseline {
+    /// [`BaselineCorrection::apply`] on `accel`, which must have the length prepared for.
+    pub fn apply(&self, accel: &[f64]) -> Result<Vec<f64>, ProcessError> {
+        assert_eq!(
+            accel.len(),
+            self.n,
+            "record of another length than prepared"
+        );
+        match &self.poly {
+            Some(fit) => {
+                check_series(accel, self.dt_s)?;
+                Ok(fit.correct(accel))
+            }
+            None => self.correction.apply(accel, self.dt_s),
         }
     }
-    let c = crate::numeric::linalg::least_squares(&cols, &disp);
-    // p(t) = τ²·q(τ): p''(t) = (2q + 4τ·q' + τ²·q'')/T², with d/dτ = 2·d/dx.
-    let mut out = Vec::with_capacity(n);
-    for (k, &a) in accel.iter().enumerate() {
-        let t = tau(k);
-        legendre(2.0 * t - 1.0, &mut p, &mut dp, &mut d2p);
-        let (mut q, mut dq, mut d2q) = (0.0, 0.0, 0.0);
-        for (j, cj) in c.iter().enumerate() {
-            q += cj * p[j];
-            dq += 2.0 * cj * dp[j];
-            d2q += 4.0 * cj * d2p[j];
-        }
-        out.push(a - (2.0 * q + 4.0 * t * dq + t * t * d2q) / (duration * duration));
-    }
-    Ok(out)
 }
 
 fn high_pass(
@@ -828,6 +931,49 @@ mod tests {
                 .fold(0.0, |m: f64, (x, y)| m.max((x - y).abs()));
             assert!(diff < 1e-11 * c, "order {order}: {diff}");
         }
+    }
+
+    /// A correction prepared once and applied to several records of its length gives the same
+    /// bits as applying it to each (the prepared basis and factorisation are only read), and
+    /// refuses at preparation what `apply` refuses without the values.
+    #[test]
+    fn prepared_correction_equals_apply_bit_for_bit() {
+        let mut rng = Rng(7);
+        let (n, dt) = (2001, 0.01);
+        let records: Vec<Vec<f64>> = (0..3)
+            .map(|r| {
+                (0..n)
+                    .map(|k| 0.3 * ((0.3 + r as f64) * k as f64 * dt).sin() + 0.05 * rng.unit())
+                    .collect()
+            })
+            .collect();
+        for b in [
+            BaselineCorrection::None,
+            BaselineCorrection::Polynomial { order: 3 },
+            BaselineCorrection::Polynomial { order: 6 },
+            BaselineCorrection::HighPass {
+                corner_hz: 0.1,
+                order: 4,
+            },
+        ] {
+            let prepared = b.prepare(n, dt).unwrap();
+            for rec in &records {
+                let want = b.apply(rec, dt).unwrap();
+                let got = prepared.apply(rec).unwrap();
+                assert!(
+                    got.iter()
+                        .zip(&want)
+                        .all(|(x, y)| x.to_bits() == y.to_bits()),
+                    "{b}"
+                );
+            }
+        }
+        let short = BaselineCorrection::Polynomial { order: 3 }.prepare(4, dt);
+        assert!(matches!(short, Err(ProcessError::TooShortForOrder { .. })));
+        assert!(matches!(
+            BaselineCorrection::None.prepare(10, -1.0),
+            Err(ProcessError::TimeStep(_))
+        ));
     }
 
     /// A forward-backward pass squares the gain: exactly 1/2 at the prewarped corner. A steady sine

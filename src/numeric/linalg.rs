@@ -33,15 +33,43 @@ pub fn cholesky_solve(a: &mut [f64], rhs: &mut [f64], n: usize, min_pivot: f64) 
 /// SVD of `nalgebra`, singular values below `1e-12` of the largest dropped; `cols` holds the
 /// columns of `A`, each of `b`'s length. The one least-squares solver of the project.
 pub fn least_squares(cols: &[Vec<f64>], b: &[f64]) -> Vec<f64> {
-    let m = cols.len();
-    let n = b.len();
-    let a = nalgebra::DMatrix::from_fn(n, m, |i, j| cols[j][i]);
-    let svd = a.svd(true, true);
-    let cutoff = 1e-12 * svd.singular_values.max();
-    let y = nalgebra::DVector::from_column_slice(b);
-    svd.solve(&y, cutoff)
-        .map(|c| c.iter().copied().collect())
-        .unwrap_or_else(|_| vec![0.0; m])
+    LeastSquares::new(cols).solve(b)
+}
+
+/// [`least_squares`] factorised once for many right-hand sides: the SVD of `A` kept, each
+/// [`LeastSquares::solve`] the same arithmetic (and bits) as `least_squares` on that `b`.
+pub struct LeastSquares {
+    svd: nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    cutoff: f64,
+    rows: usize,
+    cols: usize,
+}
+
+impl LeastSquares {
+    /// The factorisation of the matrix whose columns are `cols` (each of the same length).
+    pub fn new(cols: &[Vec<f64>]) -> Self {
+        let m = cols.len();
+        let n = cols.first().map_or(0, Vec::len);
+        let a = nalgebra::DMatrix::from_fn(n, m, |i, j| cols[j][i]);
+        let svd = a.svd(true, true);
+        let cutoff = 1e-12 * svd.singular_values.max();
+        Self {
+            svd,
+            cutoff,
+            rows: n,
+            cols: m,
+        }
+    }
+
+    /// The least-squares solution for `b` (of the columns' length).
+    pub fn solve(&self, b: &[f64]) -> Vec<f64> {
+        assert_eq!(b.len(), self.rows, "right-hand side of the wrong length");
+        let y = nalgebra::DVector::from_column_slice(b);
+        self.svd
+            .solve(&y, self.cutoff)
+            .map(|c| c.iter().copied().collect())
+            .unwrap_or_else(|_| vec![0.0; self.cols])
+    }
 }
 
 pub type Mat4 = [[f64; 4]; 4];

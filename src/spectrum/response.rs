@@ -126,7 +126,7 @@ pub fn response_spectrum(
     for &t in periods_s {
         validate_oscillator(t, damping)?;
     }
-    let reach = reach_per_interval(accel_mps2, dt_s);
+    let reach = Reach::new(accel_mps2, dt_s);
     // Groups of eight periods are independent: in parallel, the result does not depend on the
     // thread count.
     let groups: Vec<Vec<Peak>> = periods_s
@@ -143,6 +143,38 @@ pub fn response_spectrum(
         periods_s: periods_s.to_vec(),
         peaks,
     })
+}
+
+/// [`response_spectrum`] on this thread, eight periods at a time in order, each group's peaks
+/// handed to `keep_going` with the index of its first period; stops with `None` as soon as that
+/// says no. The peaks computed are the same bits as [`response_spectrum`]'s.
+pub fn response_spectrum_while(
+    accel_mps2: &[f64],
+    dt_s: f64,
+    periods_s: &[f64],
+    damping: f64,
+    mut keep_going: impl FnMut(usize, &[Peak]) -> bool,
+) -> Result<Option<ResponseSpectrum>, SpectrumError> {
+    validate_record(accel_mps2, dt_s)?;
+    for &t in periods_s {
+        validate_oscillator(t, damping)?;
+    }
+    let reach = Reach::new(accel_mps2, dt_s);
+    let mut peaks = Vec::with_capacity(periods_s.len());
+    for (i, chunk) in periods_s.chunks(LANES).enumerate() {
+        let mut lanes = [periods_s[0]; LANES];
+        lanes[..chunk.len()].copy_from_slice(chunk);
+        let group = peaks_in_lanes(accel_mps2, &reach, dt_s, &lanes, damping);
+        if !keep_going(i * LANES, &group[..chunk.len()]) {
+            return Ok(None);
+        }
+        peaks.extend_from_slice(&group[..chunk.len()]);
+    }
+    Ok(Some(ResponseSpectrum {
+        damping,
+        periods_s: periods_s.to_vec(),
+        peaks,
+    }))
 }
 
 /// Peak response of one oscillator.
@@ -171,12 +203,34 @@ pub fn sampled_peak(accel_mps2: &[f64], dt_s: f64, period_s: f64, damping: f64) 
 /// independent recurrences to hide the latency of one step.
 const LANES: usize = 8;
 
-/// `h·max(|a_g,k|, |a_g,k+1|)` per interval: how far `√E` can grow across it, m/s.
-fn reach_per_interval(accel: &[f64], h: f64) -> Vec<f64> {
-    accel
-        .windows(2)
-        .map(|w| h * w[0].abs().max(w[1].abs()))
-        .collect()
+/// Intervals per block of the first pass (see [`Lanes::peaks_generic`]).
+const BLOCK: usize = 16;
+
+/// How far `√E` can grow, m/s: over each interval `h·max(|a_g,k|, |a_g,k+1|)`, and per block of
+/// [`BLOCK`] intervals the sum and the largest of those.
+struct Reach {
+    interval: Vec<f64>,
+    block_sum: Vec<f64>,
+    block_max: Vec<f64>,
+}
+
+impl Reach {
+    fn new(accel: &[f64], h: f64) -> Self {
+        let interval: Vec<f64> = accel
+            .windows(2)
+            .map(|w| h * w[0].abs().max(w[1].abs()))
+            .collect();
+        let block_sum = interval.chunks(BLOCK).map(|b| b.iter().sum()).collect();
+        let block_max = interval
+            .chunks(BLOCK)
+            .map(|b| b.iter().fold(0.0f64, |m, &r| m.max(r)))
+            .collect();
+        Self {
+            interval,
+            block_sum,
+            block_max,
+        }
+    }
 }
 
 /// Oscillators of one damping ratio, advanced together.
@@ -207,23 +261,25 @@ struct IntervalLoad {
 /// Relative slack on the bounds against round-off.
 const SLACK: f64 = 1.0 - 1e-10;
 
-/// `(u, v)` of every lane at every sample (m, m/s) and each lane's largest sampled `|u|` with
-/// its first sample.
+/// `(u, v)` of every lane (m, m/s) at the samples of the blocks that may hold the peak (the
+/// other entries are stale), those blocks, and each lane's largest sampled `|u|` with its first
+/// sample.
 struct SampleStates {
     u: Vec<[f64; LANES]>,
     v: Vec<[f64; LANES]>,
+    blocks: Vec<usize>,
     best: [f64; LANES],
     best_k: [usize; LANES],
 }
 
-/// `u` and `v` buffers of [`SampleStates`].
-type StateBuffers = (Vec<[f64; LANES]>, Vec<[f64; LANES]>);
+/// `u`, `v` and block buffers of [`SampleStates`].
+type StateBuffers = (Vec<[f64; LANES]>, Vec<[f64; LANES]>, Vec<usize>);
 
 thread_local! {
     /// The state buffers of the last spectrum computed on this thread, reused: every element
     /// a spectrum reads is written first, so they need no zeroing.
     static STATES: std::cell::Cell<StateBuffers> =
-        const { std::cell::Cell::new((Vec::new(), Vec::new())) };
+        const { std::cell::Cell::new((Vec::new(), Vec::new(), Vec::new())) };
 }
 
 impl Lanes {
@@ -250,20 +306,27 @@ impl Lanes {
         !(room > 0.0 && amp2 <= room * room * SLACK)
     }
 
-    /// The exact peaks, in two passes over the samples. The first runs the recurrence, stores
-    /// the states and takes the largest sampled `|u|` of each lane (a lower bound of the true
-    /// peak, within `1 − cos(π·dt/T)`). The second keeps, with the energy bound of
-    /// [`Lanes::may_raise`] at that sampled peak (branch-free over the lanes), only the intervals
-    /// that can hold a larger `|u|`: the few around the largest excursions. Those face the end
-    /// tests (an interval can hold a larger `|u|` than its ends only if `u̇` vanishes inside,
-    /// which needs a sign change of `u̇` or of the relative acceleration at its ends, unless it
-    /// is longer than a quarter period) and both bounds at the running peak, and the survivors
-    /// are searched exactly. The energy test at the running peak is implied by the one at the
-    /// sampled peak, so the same intervals are searched as without the prefilter.
+    /// The exact peaks, in two passes over the samples. The first runs the recurrence and takes
+    /// the largest sampled `|u|` of each lane (a lower bound of the true peak, within
+    /// `1 − cos(π·dt/T)`); it stores the states only of the blocks of [`BLOCK`] intervals that
+    /// can hold a larger `|u|` than the running sampled peak: `√E` grows by at most the block's
+    /// reach (`Reach::block_sum`) from its value at the block's start, and a block is passed
+    /// over when that bound leaves every lane below the energy test of [`Lanes::may_raise`] at
+    /// the running peak less the block's largest interval reach. The second visits only those
+    /// blocks and keeps, with the energy test at the sampled peak (branch-free over the lanes),
+    /// only the intervals that can hold a larger `|u|`: the few around the largest excursions.
+    /// Those face the end tests (an interval can hold a larger `|u|` than its ends only if `u̇`
+    /// vanishes inside, which needs a sign change of `u̇` or of the relative acceleration at its
+    /// ends, unless it is longer than a quarter period) and both bounds at the running peak, and
+    /// the survivors are searched exactly. Every interval that the block test passes over fails
+    /// the energy test at the sampled peak (the running peak is below it, the bound is above
+    /// `E`, with a margin of `1e-9` against round-off), and that test at the running peak is
+    /// implied by the one at the sampled peak, so the same intervals are searched as without
+    /// either prefilter.
     ///
     /// Compiled twice: for AVX2 (chosen at run time where the processor has it) and for the
     /// baseline. Neither contracts a multiply and an add, so both give the same bits.
-    fn peaks(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
+    fn peaks(&self, accel: &[f64], reach: &Reach) -> [Peak; LANES] {
         #[cfg(target_arch = "x86_64")]
         {
             if std::arch::is_x86_feature_detected!("avx2") {
@@ -276,14 +339,13 @@ impl Lanes {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn peaks_avx2(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
+    unsafe fn peaks_avx2(&self, accel: &[f64], reach: &Reach) -> [Peak; LANES] {
         self.peaks_generic(accel, reach)
     }
 
     #[inline(always)]
-    fn peaks_generic(&self, accel: &[f64], reach: &[f64]) -> [Peak; LANES] {
-        let n = accel.len();
-        let st = self.sample_states(accel);
+    fn peaks_generic(&self, accel: &[f64], reach: &Reach) -> [Peak; LANES] {
+        let st = self.sample_states(accel, reach);
         let mut peaks: [Peak; LANES] = std::array::from_fn(|l| {
             let k = st.best_k[l];
             Peak {
@@ -295,86 +357,133 @@ impl Lanes {
         let omega_peak: [f64; LANES] = std::array::from_fn(|l| self.omega[l] * st.best[l]);
         let two_zw = self.omega.map(|w| 2.0 * self.zeta * w);
         let inv_h = 1.0 / self.h;
-        for k in 0..n - 1 {
-            let (u0, v0) = (&st.u[k], &st.v[k]);
-            let mut any = false;
-            for l in 0..LANES {
-                let e = self.w2[l] * u0[l] * u0[l] + v0[l] * v0[l];
-                let room = omega_peak[l] - reach[k];
-                any |= !(room > 0.0 && e <= room * room * SLACK);
-            }
-            if !any {
-                continue;
-            }
-            let (u1, v1) = (&st.u[k + 1], &st.v[k + 1]);
-            let (ag0, ag1) = (accel[k], accel[k + 1]);
-            let load = IntervalLoad {
-                ag0,
-                ag1,
-                slope: (ag0 - ag1) * inv_h,
-                reach: reach[k],
-            };
-            for l in 0..LANES {
-                let a0 = -ag0 - self.w2[l] * u0[l] - two_zw[l] * v0[l];
-                let a1 = -ag1 - self.w2[l] * u1[l] - two_zw[l] * v1[l];
-                let sign_change =
-                    self.h > self.quarter[l] || v0[l] * v1[l] <= 0.0 || a0 * a1 <= 0.0;
-                if sign_change && self.may_raise(l, peaks[l].sd_m, (u0[l], v0[l]), &load) {
-                    self.search(
-                        l,
-                        k,
-                        (u0[l], v0[l]),
-                        (u1[l], v1[l]),
-                        (ag0, ag1),
-                        &mut peaks[l],
-                    );
+        let intervals = accel.len() - 1;
+        for &b in &st.blocks {
+            for k in b * BLOCK..((b + 1) * BLOCK).min(intervals) {
+                let (u0, v0) = (&st.u[k], &st.v[k]);
+                let mut any = false;
+                for l in 0..LANES {
+                    let e = self.w2[l] * u0[l] * u0[l] + v0[l] * v0[l];
+                    let room = omega_peak[l] - reach.interval[k];
+                    any |= !(room > 0.0 && e <= room * room * SLACK);
+                }
+                if !any {
+                    continue;
+                }
+                let (u1, v1) = (&st.u[k + 1], &st.v[k + 1]);
+                let (ag0, ag1) = (accel[k], accel[k + 1]);
+                let load = IntervalLoad {
+                    ag0,
+                    ag1,
+                    slope: (ag0 - ag1) * inv_h,
+                    reach: reach.interval[k],
+                };
+                for l in 0..LANES {
+                    let a0 = -ag0 - self.w2[l] * u0[l] - two_zw[l] * v0[l];
+                    let a1 = -ag1 - self.w2[l] * u1[l] - two_zw[l] * v1[l];
+                    let sign_change =
+                        self.h > self.quarter[l] || v0[l] * v1[l] <= 0.0 || a0 * a1 <= 0.0;
+                    if sign_change && self.may_raise(l, peaks[l].sd_m, (u0[l], v0[l]), &load) {
+                        self.search(
+                            l,
+                            k,
+                            (u0[l], v0[l]),
+                            (u1[l], v1[l]),
+                            (ag0, ag1),
+                            &mut peaks[l],
+                        );
+                    }
                 }
             }
         }
-        STATES.set((st.u, st.v));
+        STATES.set((st.u, st.v, st.blocks));
         peaks
     }
 
     /// The recurrence over the samples, with the coefficients laid out lane by lane so the
-    /// updates of all lanes run side by side, and the largest sampled `|u|` of each lane (its
-    /// first sample on ties).
+    /// updates of all lanes run side by side, the largest sampled `|u|` of each lane (its first
+    /// sample on ties), and the states of the blocks that may hold a larger `|u|`
+    /// (see [`Lanes::peaks_generic`]).
     #[inline(always)]
-    fn sample_states(&self, accel: &[f64]) -> SampleStates {
+    fn sample_states(&self, accel: &[f64], reach: &Reach) -> SampleStates {
         let c = |f: fn(&Step) -> f64| self.steps.map(|s| f(&s));
         let (uu, uv, ug0, ug1) = (c(|s| s.uu), c(|s| s.uv), c(|s| s.ug0), c(|s| s.ug1));
         let (vu, vv, vg0, vg1) = (c(|s| s.vu), c(|s| s.vv), c(|s| s.vg0), c(|s| s.vg1));
-        let (mut us, mut vs) = STATES.take();
+        let (mut us, mut vs, mut blocks) = STATES.take();
         us.resize(accel.len(), [0.0; LANES]);
         vs.resize(accel.len(), [0.0; LANES]);
-        us[0] = [0.0; LANES];
-        vs[0] = [0.0; LANES];
+        blocks.clear();
         let (mut u, mut v) = ([0.0f64; LANES], [0.0f64; LANES]);
         let mut best = [0.0f64; LANES];
-        let mut best_k = [0.0f64; LANES];
-        for (k, ((w, us), vs)) in accel
-            .windows(2)
-            .zip(&mut us[1..])
-            .zip(&mut vs[1..])
-            .enumerate()
-        {
-            let (ag0, ag1) = (w[0], w[1]);
-            let kf = (k + 1) as f64;
-            for l in 0..LANES {
-                let (u0, v0) = (u[l], v[l]);
-                u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * ag0 + ug1[l] * ag1;
-                v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * ag0 + vg1[l] * ag1;
-                let raised = u[l].abs() > best[l];
-                best[l] = if raised { u[l].abs() } else { best[l] };
-                best_k[l] = if raised { kf } else { best_k[l] };
-            }
-            *us = u;
-            *vs = v;
+        // The last block in which each lane's sampled peak rose.
+        let mut best_block = [usize::MAX; LANES];
+        // One recurrence step of every lane over interval `k`, raising the sampled peaks (a
+        // macro rather than a closure, so that it is compiled into the AVX2 copy).
+        macro_rules! step {
+            ($k:expr) => {
+                let (ag0, ag1) = (accel[$k], accel[$k + 1]);
+                for l in 0..LANES {
+                    let (u0, v0) = (u[l], v[l]);
+                    u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * ag0 + ug1[l] * ag1;
+                    v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * ag0 + vg1[l] * ag1;
+                    let a = u[l].abs();
+                    // `max` without its NaN case (the states are finite): one instruction.
+                    best[l] = if a > best[l] { a } else { best[l] };
+                }
+            };
         }
+        const MARGIN: f64 = SLACK * (1.0 - 1e-9);
+        let intervals = accel.len() - 1;
+        for b in 0..intervals.div_ceil(BLOCK) {
+            let k0 = b * BLOCK;
+            let grow = reach.block_sum[b];
+            let near = reach.block_max[b];
+            let mut may = false;
+            for l in 0..LANES {
+                let e = self.w2[l] * u[l] * u[l] + v[l] * v[l];
+                let bound = e.sqrt() + grow;
+                let room = self.omega[l] * best[l] - near;
+                may |= !((room > 0.0) & (bound * bound <= room * room * MARGIN));
+            }
+            let before = best;
+            let k1 = (k0 + BLOCK).min(intervals);
+            if may {
+                blocks.push(b);
+                us[k0] = u;
+                vs[k0] = v;
+                for k in k0..k1 {
+                    step!(k);
+                    us[k + 1] = u;
+                    vs[k + 1] = v;
+                }
+            } else {
+                for k in k0..k1 {
+                    step!(k);
+                }
+            }
+            for l in 0..LANES {
+                if best[l] > before[l] {
+                    best_block[l] = b;
+                }
+            }
+        }
+        // The first sample of each lane's peak block at its largest |u| (the peak only rises
+        // in a block whose states are kept).
+        let best_k = std::array::from_fn(|l| {
+            if best_block[l] == usize::MAX {
+                return 0;
+            }
+            let k0 = best_block[l] * BLOCK;
+            (k0 + 1..=(k0 + BLOCK).min(intervals))
+                .find(|&k| us[k][l].abs() == best[l])
+                .expect("the peak block holds the peak")
+        });
         SampleStates {
             u: us,
             v: vs,
+            blocks,
             best,
-            best_k: best_k.map(|k| k as usize),
+            best_k,
         }
     }
 
@@ -406,7 +515,7 @@ impl Lanes {
 
 fn peaks_in_lanes(
     accel: &[f64],
-    reach: &[f64],
+    reach: &Reach,
     h: f64,
     periods_s: &[f64; LANES],
     zeta: f64,
