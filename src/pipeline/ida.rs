@@ -345,6 +345,8 @@ fn zone_vars(
         }
     }
     let n = cfg.blocks();
+    // Each limit state's stripes (`[system, case, limit state]`, intensities, runs, exceedances).
+    let mut stripes = Vec::new();
     for s in 0..ns {
         for c in 0..nc {
             for j in 0..ng {
@@ -380,20 +382,27 @@ fn zone_vars(
                         exceed.push(zj);
                     }
                 }
-                let f = fit_lognormal(&x, &trials, &exceed);
-                let at = [s, c, l];
-                v.theta_sa_g[at] = f.theta_sa_g;
-                v.beta[at] = f.beta;
-                v.theta_ci_low_sa_g[at] = f.theta_ci_sa_g.0;
-                v.theta_ci_high_sa_g[at] = f.theta_ci_sa_g.1;
-                v.beta_ci_low[at] = f.beta_ci.0;
-                v.beta_ci_high[at] = f.beta_ci.1;
-                v.fit_status[at] = f.status as u8;
-                if matches!(f.status, FitStatus::Fitted | FitStatus::Degenerate) {
-                    for (j, &sa) in grid.iter().enumerate() {
-                        v.fragility_curve[[s, c, l, j]] = f.probability(sa);
-                    }
-                }
+                stripes.push(([s, c, l], x, trials, exceed));
+            }
+        }
+    }
+    // The fits are independent, each sequential: in parallel, the same bits on any thread count.
+    let fits: Vec<_> = stripes
+        .par_iter()
+        .map(|(_, x, trials, exceed)| fit_lognormal(x, trials, exceed))
+        .collect();
+    for ((at, ..), f) in stripes.iter().zip(fits) {
+        let [s, c, l] = *at;
+        v.theta_sa_g[*at] = f.theta_sa_g;
+        v.beta[*at] = f.beta;
+        v.theta_ci_low_sa_g[*at] = f.theta_ci_sa_g.0;
+        v.theta_ci_high_sa_g[*at] = f.theta_ci_sa_g.1;
+        v.beta_ci_low[*at] = f.beta_ci.0;
+        v.beta_ci_high[*at] = f.beta_ci.1;
+        v.fit_status[*at] = f.status as u8;
+        if matches!(f.status, FitStatus::Fitted | FitStatus::Degenerate) {
+            for (j, &sa) in grid.iter().enumerate() {
+                v.fragility_curve[[s, c, l, j]] = f.probability(sa);
             }
         }
     }
