@@ -328,11 +328,14 @@ def read_at2(path: Path):
 
 def slidestack_history(slidestack: str, record: Path, period_s: float, damping_ratio: float,
                        alpha, mu) -> tuple[list[float], dict]:
-    """Structure displacement at every sample by ``slidestack simulate``, and its JSON."""
+    """Structure displacement at every sample by ``slidestack simulate``, and its JSON. The
+    damping ratio is taken on the bare structure (``--damping-basis structure``), as this
+    model's ``c = 2ζ√(k·m_p)``; slidestack's default basis is the structure with its load."""
     with tempfile.TemporaryDirectory() as d:
         hist = Path(d) / "h.csv"
         r = subprocess.run([slidestack, "simulate", "--record", str(record),
                             "--period", repr(period_s), "--damping", repr(damping_ratio),
+                            "--damping-basis", "structure",
                             "--alpha", ",".join(map(repr, alpha)),
                             "--mu", ",".join(map(repr, mu)), "--json", "--history", str(hist)],
                            capture_output=True, text=True)
