@@ -92,7 +92,7 @@ fn write_sweep_file(path: &Path) {
         mu_static_ratio: 1.0,
         settings: &[],
     };
-    write_sweep(path, &meta, &grid(), &[zone]).unwrap();
+    write_sweep(path, &meta, &grid(), None, &[zone]).unwrap();
 }
 
 #[test]
@@ -113,7 +113,7 @@ fn sweep_h5() {
             "single_rule",
         ],
         write_sweep_file,
-        |p, _| read_zone_sweep(p, "III", 1),
+        |p, _| read_zone_sweep(p, "III", 1, false),
     );
 }
 

@@ -34,7 +34,7 @@ pub mod report;
 pub mod sweep;
 pub mod tnew;
 
-use crate::grid::Grid;
+use crate::grid::{BuildingAxes, Grid};
 use crate::store::{StoreError, atomic};
 use crate::study::config::{ConfigError, StudyConfig};
 use crate::study::physics::{Physics, SystemKind};
@@ -131,6 +131,12 @@ pub enum PipelineError {
     },
     #[error("{}: the `{stage}` stage needs a `grid` section", config.display())]
     NoGrid { config: PathBuf, stage: StageId },
+    #[error(
+        "{}: `building`: the `{stage}` stage cannot yet take a building study (the motions and \
+         sweep stages can; docs/model.md, \"A study over buildings\")",
+        config.display()
+    )]
+    NotForBuilding { config: PathBuf, stage: StageId },
     #[error(transparent)]
     Motions(#[from] motions::MotionsError),
     #[error(transparent)]
@@ -153,6 +159,7 @@ impl PipelineError {
             | PipelineError::BadInput { .. }
             | PipelineError::Setting { .. }
             | PipelineError::NoGrid { .. }
+            | PipelineError::NotForBuilding { .. }
             | PipelineError::Ida(ida::IdaStageError::NoSection { .. }) => true,
             PipelineError::Sweep(e) => e.is_bad_input(),
             PipelineError::Motions(motions::MotionsError::Unmatched(_)) => true,
@@ -236,6 +243,8 @@ pub struct Study {
     /// SHA-256 of the config file's bytes.
     pub config_sha256: String,
     grid: Option<Grid>,
+    /// The building axes of a building study.
+    building: Option<BuildingAxes>,
     fingerprints: Fingerprints,
 }
 
@@ -281,6 +290,7 @@ impl Study {
             }
         };
         let grid = cfg.grid.as_ref().map(|g| g.axes());
+        let building = cfg.building_axes();
         let motions_fp = motions::fingerprint(&cfg);
         let ida = ida::fingerprint(&cfg, &motions_fp);
         let rest = match &cfg.grid {
@@ -299,6 +309,7 @@ impl Study {
             cfg,
             out,
             grid,
+            building,
             fingerprints: Fingerprints {
                 motions: motions_fp,
                 rest,
@@ -319,6 +330,22 @@ impl Study {
     /// The grid, or an error naming the stage that needs it.
     pub fn grid(&self, stage: StageId) -> Result<&Grid, PipelineError> {
         self.grid.as_ref().ok_or_else(|| PipelineError::NoGrid {
+            config: self.config_path.clone(),
+            stage,
+        })
+    }
+
+    /// The building axes of a building study (`None` on one storey).
+    pub fn building(&self) -> Option<&BuildingAxes> {
+        self.building.as_ref()
+    }
+
+    /// Refuses a building study in a stage that cannot yet take one, before any work.
+    pub fn refuse_building(&self, stage: StageId) -> Result<(), PipelineError> {
+        if self.building.is_none() || matches!(stage, StageId::Motions | StageId::Sweep) {
+            return Ok(());
+        }
+        Err(PipelineError::NotForBuilding {
             config: self.config_path.clone(),
             stage,
         })
@@ -498,6 +525,7 @@ pub enum Outcome {
 
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
 pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
+    s.study.refuse_building(stage)?;
     s.study.fingerprint(stage)?;
     for &up in stage.upstream() {
         s.study.require(up)?;

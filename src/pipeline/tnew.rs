@@ -75,7 +75,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let physics = study.physics();
     let mut zones = Vec::new();
     for (z, zc) in study.cfg.zones.iter().enumerate() {
-        let (axes, sw) = read_zone_sweep(&sweep_path, &zc.name, n)?;
+        let (axes, _, sw) = read_zone_sweep(&sweep_path, &zc.name, n, false)?;
         let names: Vec<&String> = motions[z].iter().map(|r| &r.name).collect();
         let differs = if axes != *grid {
             Some("its grid differs from the config's")
