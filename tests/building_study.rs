@@ -7,6 +7,7 @@ mod common;
 
 use slidestack::grid::StackFloor;
 use slidestack::store::sweep::{ZoneSweep, read_zone_sweep};
+use slidestack::store::tnew::read_zone_tnew_in;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -138,8 +139,39 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
          interface [1, 3] ['1', 'roof', 'all']\nTrue\n"
     );
 
+    // T_new per frame: the first mode's, labelled; in one storey the three floors agree.
+    ok(slidestack(&["tnew", cfg_s, "--out", out_s], "2"));
+    let (_, frames, t) = read_zone_tnew_in(&out.join("tnew.h5"), "V", 2, true).unwrap();
+    assert_eq!(frames.as_ref(), Some(&axes));
+    assert_eq!(t.roof_participation[0], 1.0);
+    // Three uniform storeys: the first mode is φ_j = sin(πj/7), Γ_1·φ_1,3 = φ_3·Σφ/Σφ².
+    let phi: Vec<f64> = (1..=3)
+        .map(|j| (std::f64::consts::PI * j as f64 / 7.0).sin())
+        .collect();
+    let want = phi[2] * phi.iter().sum::<f64>() / phi.iter().map(|p| p * p).sum::<f64>();
+    assert!((t.roof_participation[1] - want).abs() < 1e-13, "{want}");
+    let tn = t.vars.t_new.as_slice().unwrap();
+    for f in 1..3 {
+        let same = |v: &[f64]| v[f * per_frame..(f + 1) * per_frame] == v[..per_frame];
+        assert!(same(tn) && same(t.vars.drr_1.as_slice().unwrap()));
+    }
+    let o = ok(Command::new(repo(".venv-test/bin/python"))
+        .args([
+            "-c",
+            "import sys, xarray as xr\n\
+             t = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')\n\
+             print(list(t['T_new'].dims), list(t['roof_participation'].dims))\n",
+            out.join("tnew.h5").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap());
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout),
+        "['storeys', 'stack_floor', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2'] ['storeys']\n"
+    );
+
     // The stages that cannot yet take a building study say so, naming the key, before work.
-    for stage in ["tnew", "fit", "report"] {
+    for stage in ["fit", "report"] {
         let o = slidestack(&[stage, cfg_s, "--out", out_s], "1");
         assert_eq!(o.status.code(), Some(2), "{stage}: {}", stderr(&o));
         let e = stderr(&o);
@@ -148,7 +180,20 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
             "{e}"
         );
     }
-    assert!(!out.join("tnew.h5").exists());
+    assert!(!out.join("fit.h5").exists());
+    let o = slidestack(
+        &[
+            "design", "--study", out_s, "--zone", "V", "--period", "0.5", "--alpha", "0.25,0.5",
+            "--mu", "0.1,0.1",
+        ],
+        "1",
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is a building study's (`building`)"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// `configs/quick.yaml` with `extra` appended to its `grid:` section and `top` added at the top.
@@ -182,16 +227,21 @@ fn one_storey_buildings_are_the_one_storey_study() {
         let (c, o) = (cfg.to_str().unwrap(), out.to_str().unwrap());
         ok(slidestack(&["motions", c, "--out", o], "2"));
         ok(slidestack(&["sweep", c, "--out", o], "2"));
+        ok(slidestack(&["tnew", c, "--out", o], "2"));
     }
     for name in ["III", "V"] {
         let (za, zb) = (zone(&a, name, false), zone(&b, name, true));
         let (va, vb) = (&za.vars, &zb.vars);
-        let same = |x: &ndarray::ArrayD<f64>, y: &ndarray::ArrayD<f64>| {
-            assert_eq!(y.shape()[1..3], [1, 1]);
+        // `y` has the building's two dimensions of length 1 at `at`.
+        let same_at = |at: usize, x: &ndarray::ArrayD<f64>, y: &ndarray::ArrayD<f64>| {
+            let mut squeezed = y.shape().to_vec();
+            assert_eq!(squeezed.drain(at..at + 2).collect::<Vec<_>>(), [1, 1]);
+            assert_eq!(squeezed, x.shape());
             let y: Vec<u64> = y.iter().map(|v| v.to_bits()).collect();
             let x: Vec<u64> = x.iter().map(|v| v.to_bits()).collect();
             assert_eq!(x, y);
         };
+        let same = |x, y| same_at(1, x, y);
         same(&va.u_stack, &vb.u_stack);
         same(&va.u_single, &vb.u_single);
         same(&va.u_rigid, &vb.u_rigid);
@@ -202,6 +252,23 @@ fn one_storey_buildings_are_the_one_storey_study() {
             va.skip_rule.iter().collect::<Vec<_>>(),
             vb.skip_rule.iter().collect::<Vec<_>>()
         );
+        let ta = read_zone_tnew_in(&a.join("tnew.h5"), name, 2, false)
+            .unwrap()
+            .2;
+        let tb = read_zone_tnew_in(&b.join("tnew.h5"), name, 2, true)
+            .unwrap()
+            .2;
+        let (va, vb) = (&ta.vars, &tb.vars);
+        same_at(0, &va.t_new, &vb.t_new);
+        same_at(0, &va.t_rigid, &vb.t_rigid);
+        same_at(0, &va.drr_1, &vb.drr_1);
+        same_at(0, &va.drr_2, &vb.drr_2);
+        same_at(0, &va.flag, &vb.flag);
+        assert_eq!(
+            va.band.iter().collect::<Vec<_>>(),
+            vb.band.iter().collect::<Vec<_>>()
+        );
+        assert!(va.t_new.iter().any(|t| t.is_finite()));
     }
 }
 

@@ -138,6 +138,7 @@ fn tnew_zone(band: u8) -> ZoneTnew {
         },
         period_sd_s: vec![0.1, 0.2, 0.3],
         sd_mean_m: vec![0.0; 3],
+        roof_participation: Vec::new(),
     }
 }
 
@@ -151,7 +152,7 @@ fn write_tnew_with(path: &Path, zone: ZoneTnew, flags: &[(u8, &str)]) {
         mu_static_ratio: 1.0,
         settings: &[],
     };
-    write_tnew(path, &meta, &grid(), &[zone]).unwrap();
+    write_tnew(path, &meta, &grid(), None, &[zone]).unwrap();
 }
 
 #[test]

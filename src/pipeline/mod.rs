@@ -132,8 +132,8 @@ pub enum PipelineError {
     #[error("{}: the `{stage}` stage needs a `grid` section", config.display())]
     NoGrid { config: PathBuf, stage: StageId },
     #[error(
-        "{}: `building`: the `{stage}` stage cannot yet take a building study (the motions and \
-         sweep stages can; docs/model.md, \"A study over buildings\")",
+        "{}: `building`: the `{stage}` stage cannot yet take a building study (the motions, \
+         sweep and tnew stages can; docs/model.md, \"A study over buildings\")",
         config.display()
     )]
     NotForBuilding { config: PathBuf, stage: StageId },
@@ -342,7 +342,9 @@ impl Study {
 
     /// Refuses a building study in a stage that cannot yet take one, before any work.
     pub fn refuse_building(&self, stage: StageId) -> Result<(), PipelineError> {
-        if self.building.is_none() || matches!(stage, StageId::Motions | StageId::Sweep) {
+        if self.building.is_none()
+            || matches!(stage, StageId::Motions | StageId::Sweep | StageId::Tnew)
+        {
             return Ok(());
         }
         Err(PipelineError::NotForBuilding {

@@ -243,7 +243,14 @@ fn write_zone(
         ),
     ];
     for (name, data, units, long) in vars {
-        let ds = write_var(&g, name, data.view(), &chunk, units, long)?;
+        // In a building the structure's peaks are the roof's.
+        let long = match name {
+            "u_stack" | "u_single" | "u_rigid" | "a_stack" if building.is_some() => {
+                format!("{long} (a building: its roof's)")
+            }
+            _ => long.to_string(),
+        };
+        let ds = write_var(&g, name, data.view(), &chunk, units, &long)?;
         attach_all(&ds, &scales)?;
     }
     let mut chunk_i = chunk.clone();

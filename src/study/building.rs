@@ -14,6 +14,8 @@
 //! The building's damping is the grid's (`damping`, `damping_basis`: modal, `ζ` in every mode
 //! of the basis); its period the grid's `period_s`; its storeys elastic.
 
+use crate::case::Case;
+use crate::dynamics::building::model::modes;
 use crate::grid::{BuildingAxes, StackFloor};
 use crate::limits::{MAX_AXIS_VALUES, MAX_STOREYS, excerpt};
 use serde::{Deserialize, Serialize};
@@ -86,6 +88,42 @@ impl Frame {
     /// The floors carrying a stack, 1-based, lowest first.
     pub fn floors(&self) -> Vec<usize> {
         self.stack_floor.floors(self.storeys())
+    }
+
+    /// `Γ_1·φ_1,N` of the bare building: the roof's displacement per unit displacement of the
+    /// first mode's equivalent SDOF (Chopra, *Dynamics of Structures*, the modal expansion of
+    /// the effective earthquake forces: `u_N = Γ_1·φ_1,N·D_1`), `Γ_1 = φ_1ᵀ·M·1 / φ_1ᵀ·M·φ_1`.
+    /// Independent of the mode's scale and sign and of the stiffnesses' scale; 1 on one storey
+    /// (exact: `m·φ²` with `φ = 1/sqrt(m)`, given without round-off).
+    pub fn roof_participation(&self) -> f64 {
+        let n = self.storeys();
+        if n == 1 {
+            return 1.0;
+        }
+        let (_, phi) = modes(&self.floor_masses, &self.storey_stiffnesses);
+        let m_phi_1: f64 = (0..n).map(|j| self.floor_masses[j] * phi[(j, 0)]).sum();
+        let m_phi_phi: f64 = (0..n)
+            .map(|j| self.floor_masses[j] * phi[(j, 0)] * phi[(j, 0)])
+            .sum();
+        m_phi_1 / m_phi_phi * phi[(n - 1, 0)]
+    }
+
+    /// `T_1,rigid`, s: the first-mode period of the building whose bare first-mode period is
+    /// `case.period_s` with the case's whole stack (`α = Σα_i` of each loaded floor's mass)
+    /// rigidly attached to every floor the frame names; on one storey `T_p·sqrt(1+α)`
+    /// ([`Case::t_rigid_s`], the same arithmetic as the one-storey study).
+    pub fn t_rigid_s(&self, case: &Case) -> f64 {
+        if self.storeys() == 1 {
+            return case.t_rigid_s();
+        }
+        let alpha = case.alpha_total();
+        let mut loaded = self.floor_masses.clone();
+        for f in self.floors() {
+            loaded[f - 1] *= 1.0 + alpha;
+        }
+        let bare = modes(&self.floor_masses, &self.storey_stiffnesses).0[0];
+        let rigid = modes(&loaded, &self.storey_stiffnesses).0[0];
+        case.period_s * (bare / rigid).sqrt()
     }
 }
 
@@ -213,5 +251,66 @@ impl BuildingSection {
                 .unwrap_or_else(|| vec![1.0; storeys]),
             stack_floor,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(n: usize, stack_floor: StackFloor) -> Frame {
+        Frame {
+            floor_masses: vec![1.0; n],
+            storey_stiffnesses: vec![1.0; n],
+            stack_floor,
+        }
+    }
+
+    #[test]
+    fn participation_and_rigid_period_against_closed_forms() {
+        // Two equal storeys: the first mode is (1, g), g the golden ratio, so
+        // Γ_1·φ_1,2 = g·(1 + g)/(1 + g²), by hand.
+        let g = (1.0 + 5f64.sqrt()) / 2.0;
+        let two = frame(2, StackFloor::Roof);
+        let want = g * (1.0 + g) / (1.0 + g * g);
+        assert!((two.roof_participation() - want).abs() < 1e-14, "{want}");
+        assert_eq!(frame(1, StackFloor::Roof).roof_participation(), 1.0);
+        // N uniform storeys: φ_j = sin((2r − 1)πj/(2N + 1)) for mode r, so with r = 1
+        // Γ_1·φ_1,N = φ_N·Σφ_j/Σφ_j².
+        for n in [3, 10, 40] {
+            let phi: Vec<f64> = (1..=n)
+                .map(|j| (std::f64::consts::PI * j as f64 / (2 * n + 1) as f64).sin())
+                .collect();
+            let sum: f64 = phi.iter().sum();
+            let want = phi[n - 1] * sum / phi.iter().map(|p| p * p).sum::<f64>();
+            let got = frame(n, StackFloor::Roof).roof_participation();
+            assert!((got - want).abs() < 1e-12, "{n}: {got} vs {want}");
+        }
+
+        // α on floor 1 of two unit storeys (k = 1): m_1 = 1 + α, m_2 = 1 and
+        // m_1·m_2·ω⁴ − k(m_1 + 2m_2)·ω² + k² = 0, the smaller root.
+        let case = Case {
+            period_s: 0.8,
+            alpha: vec![0.3, 0.5],
+            mu: vec![0.2, 0.1],
+        };
+        let w2 = |m1: f64, m2: f64| {
+            let b = m1 + 2.0 * m2;
+            (b - (b * b - 4.0 * m1 * m2).sqrt()) / (2.0 * m1 * m2)
+        };
+        let want = 0.8 * (w2(1.0, 1.0) / w2(1.8, 1.0)).sqrt();
+        let got = frame(2, StackFloor::Floor(1)).t_rigid_s(&case);
+        assert!((got - want).abs() < 1e-13, "{got} vs {want}");
+        let want = 0.8 * (w2(1.0, 1.0) / w2(1.0, 1.8)).sqrt();
+        assert!((two.t_rigid_s(&case) - want).abs() < 1e-13);
+        // Every floor loaded alike scales M: T·sqrt(1+α), in any building.
+        let all = Frame {
+            floor_masses: vec![1.0, 2.0, 0.5, 1.5],
+            storey_stiffnesses: vec![4.0, 3.0, 2.0, 1.0],
+            stack_floor: StackFloor::All,
+        };
+        let got = all.t_rigid_s(&case);
+        assert!((got - case.t_rigid_s()).abs() < 1e-13 * got, "{got}");
+        assert_eq!(frame(1, StackFloor::All).t_rigid_s(&case), case.t_rigid_s());
     }
 }
