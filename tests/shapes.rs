@@ -401,6 +401,7 @@ fn fit_report(coefficients: usize) -> FitReport {
         fingerprint: "f".into(),
         features: slidestack::fit::feature_names(1),
         folds: 5,
+        building: None,
         zones: vec![ZoneFit {
             zone: "III".into(),
             cases: 3,

@@ -132,11 +132,14 @@ pub enum PipelineError {
     #[error("{}: the `{stage}` stage needs a `grid` section", config.display())]
     NoGrid { config: PathBuf, stage: StageId },
     #[error(
-        "{}: `building`: the `{stage}` stage cannot yet take a building study (the motions, \
-         sweep and tnew stages can; docs/model.md, \"A study over buildings\")",
+        "{}: `building`: the `{stage}` stage {why} (docs/model.md, \"A study over buildings\")",
         config.display()
     )]
-    NotForBuilding { config: PathBuf, stage: StageId },
+    NotForBuilding {
+        config: PathBuf,
+        stage: StageId,
+        why: &'static str,
+    },
     #[error(transparent)]
     Motions(#[from] motions::MotionsError),
     #[error(transparent)]
@@ -340,16 +343,29 @@ impl Study {
         self.building.as_ref()
     }
 
-    /// Refuses a building study in a stage that cannot yet take one, before any work.
+    /// Refuses a building study in a stage that cannot yet take it, before any work: the fit
+    /// takes one frame, the report none.
     pub fn refuse_building(&self, stage: StageId) -> Result<(), PipelineError> {
-        if self.building.is_none()
-            || matches!(stage, StageId::Motions | StageId::Sweep | StageId::Tnew)
-        {
+        let Some(b) = &self.building else {
             return Ok(());
-        }
+        };
+        let why = match stage {
+            StageId::Motions | StageId::Sweep | StageId::Tnew => return Ok(()),
+            StageId::Fit if b.frames() == 1 => return Ok(()),
+            StageId::Fit => {
+                "takes a building study of one frame only (one `building.storeys` value, one \
+                 `grid.stack_floor`): the fit over several needs the building's own features, \
+                 not yet done"
+            }
+            StageId::Report | StageId::Ida => {
+                "cannot yet take a building study (motions, sweep, tnew and, for one frame, fit \
+                 can)"
+            }
+        };
         Err(PipelineError::NotForBuilding {
             config: self.config_path.clone(),
             stage,
+            why,
         })
     }
 
