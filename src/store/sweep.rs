@@ -248,6 +248,9 @@ fn write_zone(
             "u_stack" | "u_single" | "u_rigid" | "a_stack" if building.is_some() => {
                 format!("{long} (a building: its roof's)")
             }
+            "friction_energy" if building.is_some() => {
+                format!("{long} (a building: of every stack, per kg of all its floors)")
+            }
             _ => long.to_string(),
         };
         let ds = write_var(&g, name, data.view(), &chunk, units, &long)?;
@@ -261,7 +264,11 @@ fn write_zone(
         v.slip_peak.view(),
         &chunk_i,
         "m",
-        "peak slip of each interface",
+        if building.is_some() {
+            "peak slip of each interface (with a stack on every floor: the largest over them)"
+        } else {
+            "peak slip of each interface"
+        },
     )?;
     attach_all(&ds, &scales)?;
     attach_scale(&ds, &iface, scales.len())?;
