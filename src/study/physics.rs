@@ -3,7 +3,8 @@
 //! systems a case is run as ([`SystemKind`]): the stack, the whole stack as one block, and the
 //! stack rigidly attached. All three share one viscous damper and, on a yielding structure, one
 //! yield force. The one place these systems are built, for the sweep, the T_new stage, the
-//! report and the IDA stage.
+//! report and the IDA stage; in a study over buildings, the same three in a building
+//! ([`Physics::building`], [`Physics::simulate_building`]; one storey is the one-storey case).
 
 use super::building::Frame;
 use crate::case::Case;
