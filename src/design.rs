@@ -16,7 +16,7 @@ use crate::store::StoreError;
 use crate::store::fit::{ZoneFit, read_fit};
 use crate::store::h5::stored_fingerprint;
 use crate::store::motions::read_zone_target;
-use crate::store::tnew::{read_motions_fingerprint, read_zone_tnew, zones_and_blocks};
+use crate::store::tnew::{is_building, read_motions_fingerprint, read_zone_tnew, zones_and_blocks};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -42,6 +42,12 @@ pub enum DesignError {
     /// `motions.h5` is not the one `tnew.h5` was made from (or `tnew.h5` does not say which).
     #[error("{}: {why}", file.display())]
     OtherMotions { file: PathBuf, why: &'static str },
+    #[error(
+        "{}: is a building study's (`building`): `design` cannot yet answer for a building \
+         (docs/model.md, \"A study over buildings\")",
+        file.display()
+    )]
+    Building { file: PathBuf },
     #[error(transparent)]
     Store(#[from] StoreError),
 }
@@ -171,6 +177,9 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         file,
     };
     let tnew_fp = stored_fingerprint(&tnew)?.ok_or_else(|| missing("tnew.h5"))?;
+    if is_building(&tnew)? {
+        return Err(DesignError::Building { file: tnew });
+    }
     let motions_fp = stored_fingerprint(&motions)?.ok_or_else(|| missing("motions.h5"))?;
     match read_motions_fingerprint(&tnew)? {
         Some(fp) if fp == motions_fp => {}

@@ -121,6 +121,86 @@ impl Grid {
     }
 }
 
+/// The floor a building case's stack stands on (`grid.stack_floor`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum StackFloor {
+    /// Floor `j`, `1 … N` (1 the lowest).
+    Floor(usize),
+    /// The top floor `N`, whatever `N` is.
+    Roof,
+    /// Every floor its own stack, each with the case's `α`, `μ` (the warehouse case).
+    All,
+}
+
+impl StackFloor {
+    /// The floors (1-based, lowest first) carrying a stack in a building of `storeys` storeys.
+    pub fn floors(self, storeys: usize) -> Vec<usize> {
+        match self {
+            StackFloor::Floor(f) => vec![f],
+            StackFloor::Roof => vec![storeys],
+            StackFloor::All => (1..=storeys).collect(),
+        }
+    }
+}
+
+/// `3`, `roof`, `all`: as the config writes it and the `stack_floor` coordinate stores it.
+impl std::fmt::Display for StackFloor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StackFloor::Floor(j) => write!(f, "{j}"),
+            StackFloor::Roof => f.write_str("roof"),
+            StackFloor::All => f.write_str("all"),
+        }
+    }
+}
+
+impl std::str::FromStr for StackFloor {
+    type Err = String;
+
+    /// The inverse of `Display`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "roof" => Ok(StackFloor::Roof),
+            "all" => Ok(StackFloor::All),
+            _ => (s.parse().ok())
+                .filter(|&j| j >= 1)
+                .map(StackFloor::Floor)
+                .ok_or_else(|| format!("`{s}` is not a floor, `roof` or `all`")),
+        }
+    }
+}
+
+/// The building axes of a building study, outside the case grid: storey counts `N` and the
+/// floors the stack stands on. Stored arrays put them in front of the case dimensions,
+/// `[storeys, stack_floor, T_p, alpha…, mu…]`, row-major; a *frame* is one pair of them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BuildingAxes {
+    /// Storey counts, increasing.
+    pub storeys: Vec<usize>,
+    pub stack_floor: Vec<StackFloor>,
+}
+
+impl BuildingAxes {
+    /// Names of the two dimensions, as stored.
+    pub const DIMS: [&'static str; 2] = ["storeys", "stack_floor"];
+
+    /// `[storeys, stack_floor]` sizes.
+    pub fn shape(&self) -> [usize; 2] {
+        [self.storeys.len(), self.stack_floor.len()]
+    }
+
+    /// Frames: every `(storeys, stack_floor)` pair.
+    pub fn frames(&self) -> usize {
+        self.storeys.len() * self.stack_floor.len()
+    }
+
+    /// Frame `index` (row-major, the stack floor fastest).
+    pub fn frame(&self, index: usize) -> (usize, StackFloor) {
+        let per = self.stack_floor.len();
+        (self.storeys[index / per], self.stack_floor[index % per])
+    }
+}
+
 impl Grid {
     /// The multilinear interpolation at `point` (`[T_p, α_1 … α_n, μ_1 … μ_n]`, the order of
     /// [`Grid::shape`]) of `values`, one per case in flat order: in each dimension between the

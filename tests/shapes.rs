@@ -92,7 +92,7 @@ fn write_sweep_file(path: &Path) {
         mu_static_ratio: 1.0,
         settings: &[],
     };
-    write_sweep(path, &meta, &grid(), &[zone]).unwrap();
+    write_sweep(path, &meta, &grid(), None, &[zone]).unwrap();
 }
 
 #[test]
@@ -113,7 +113,7 @@ fn sweep_h5() {
             "single_rule",
         ],
         write_sweep_file,
-        |p, _| read_zone_sweep(p, "III", 1),
+        |p, _| read_zone_sweep(p, "III", 1, false),
     );
 }
 
@@ -138,6 +138,7 @@ fn tnew_zone(band: u8) -> ZoneTnew {
         },
         period_sd_s: vec![0.1, 0.2, 0.3],
         sd_mean_m: vec![0.0; 3],
+        roof_participation: Vec::new(),
     }
 }
 
@@ -151,7 +152,7 @@ fn write_tnew_with(path: &Path, zone: ZoneTnew, flags: &[(u8, &str)]) {
         mu_static_ratio: 1.0,
         settings: &[],
     };
-    write_tnew(path, &meta, &grid(), &[zone]).unwrap();
+    write_tnew(path, &meta, &grid(), None, &[zone]).unwrap();
 }
 
 #[test]
@@ -400,6 +401,7 @@ fn fit_report(coefficients: usize) -> FitReport {
         fingerprint: "f".into(),
         features: slidestack::fit::feature_names(1),
         folds: 5,
+        building: None,
         zones: vec![ZoneFit {
             zone: "III".into(),
             cases: 3,

@@ -4,7 +4,8 @@ mod common;
 
 use common::real_records;
 use slidestack::dynamics::Ground;
-use slidestack::grid::Grid;
+use slidestack::grid::{Grid, StackFloor};
+use slidestack::study::building::Frame;
 use slidestack::study::config::{GridConfig, Values};
 use slidestack::study::physics::Physics;
 use slidestack::study::sweep::{UnitOptions, run_unit};
@@ -21,27 +22,46 @@ fn grid(ratio: f64) -> (Grid, Physics) {
         mu_static_ratio: ratio,
         damping: 0.05,
         damping_basis: Default::default(),
+        stack_floor: None,
     };
     (g.axes(), g.physics())
 }
 
 #[test]
 fn skip_rules_equal_brute_force() {
+    skip_rules_hold(None, 2);
+}
+
+/// The same in buildings (docs/model.md, "A study over buildings"): three storeys whose storeys
+/// stiffen downward, the stack on floor 1, on the roof, and on every floor; one record.
+#[test]
+fn skip_rules_equal_brute_force_in_a_building() {
+    for stack_floor in [StackFloor::Floor(1), StackFloor::Roof, StackFloor::All] {
+        let frame = Frame {
+            floor_masses: vec![1.0, 1.0, 0.8],
+            storey_stiffnesses: vec![3.0, 2.0, 1.0],
+            stack_floor,
+        };
+        skip_rules_hold(Some(&frame), 1);
+    }
+}
+
+fn skip_rules_hold(frame: Option<&Frame>, records: usize) {
     // Tolerances: NoSlip compares the rigid SDOF with the stack simulated with every interface
     // stuck (two exact solutions, 1e-9 relative); SingleBlock compares the single block with
     // the stack whose upper interfaces never slip (1e-9, the limit tests' bound is 1e-10).
     let mut counts = [0usize; 3];
     for ratio in [1.0, 1.5] {
         let (g, physics) = grid(ratio);
-        for rec in &real_records()[..2] {
+        for rec in &real_records()[..records] {
             let accel = rec.accel_mps2(1.0);
             let ground = Ground {
                 dt_s: rec.dt_s,
                 accel_mps2: &accel,
             };
             for p in 0..g.periods_s.len() {
-                let fast = run_unit(&g, &physics, &ground, p, UnitOptions { skip: true }).unwrap();
-                let slow = run_unit(&g, &physics, &ground, p, UnitOptions { skip: false }).unwrap();
+                let unit = |skip| run_unit(&g, &physics, frame, &ground, p, UnitOptions { skip });
+                let (fast, slow) = (unit(true).unwrap(), unit(false).unwrap());
                 assert!(slow.skip_rule.iter().all(|&r| r == 0));
                 for c in 0..g.cases_per_unit() {
                     counts[fast.skip_rule[c] as usize] += 1;
@@ -49,7 +69,7 @@ fn skip_rules_equal_brute_force() {
                         let scale = a.abs().max(b.abs()).max(1e-12);
                         assert!(
                             (a - b).abs() <= 1e-9 * scale,
-                            "{} T={} case {c} ({:?}) rule {}: {what} {a} vs {b}",
+                            "{} {frame:?} T={} case {c} ({:?}) rule {}: {what} {a} vs {b}",
                             rec.name,
                             g.periods_s[p],
                             g.stack(c),

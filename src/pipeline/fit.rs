@@ -11,6 +11,11 @@
 //! Forms and folds are fitted in parallel, each fit sequentially: the results do not depend on
 //! the thread count.
 //!
+//! A building study of one frame (one storey count, one `stack_floor`) is fitted as a one-storey
+//! study, `T_p` being its bare first-mode period `T_1` (its `T_new`, the first mode's, over
+//! `T_1`); `fit.yaml` names the frame. A study of several frames needs the building's own
+//! features (issue 23, item 2) and is refused.
+//!
 //! Fingerprint: T_new's, the forms, the number of folds and the box.
 
 use super::{Outcome, PipelineError, Session, StageId};
@@ -285,6 +290,9 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         fingerprint: study.fingerprint(me)?.to_string(),
         features,
         folds: FOLDS,
+        building: (study.building())
+            .and_then(|b| study.cfg.frame(b, 0))
+            .map(|f| f.to_string()),
         zones,
     };
     let (h5, yaml) = (study.path(me.output()), study.path("fit.yaml"));

@@ -34,7 +34,7 @@ pub mod report;
 pub mod sweep;
 pub mod tnew;
 
-use crate::grid::Grid;
+use crate::grid::{BuildingAxes, Grid};
 use crate::store::{StoreError, atomic};
 use crate::study::config::{ConfigError, StudyConfig};
 use crate::study::physics::{Physics, SystemKind};
@@ -131,6 +131,15 @@ pub enum PipelineError {
     },
     #[error("{}: the `{stage}` stage needs a `grid` section", config.display())]
     NoGrid { config: PathBuf, stage: StageId },
+    #[error(
+        "{}: `building`: the `{stage}` stage {why} (docs/model.md, \"A study over buildings\")",
+        config.display()
+    )]
+    NotForBuilding {
+        config: PathBuf,
+        stage: StageId,
+        why: &'static str,
+    },
     #[error(transparent)]
     Motions(#[from] motions::MotionsError),
     #[error(transparent)]
@@ -156,6 +165,7 @@ impl PipelineError {
             | PipelineError::BadInput { .. }
             | PipelineError::Setting { .. }
             | PipelineError::NoGrid { .. }
+            | PipelineError::NotForBuilding { .. }
             | PipelineError::Ida(ida::IdaStageError::NoSection { .. }) => true,
             PipelineError::Sweep(e) => e.is_bad_input(),
             PipelineError::Motions(motions::MotionsError::Unmatched(_)) => true,
@@ -271,6 +281,8 @@ pub struct Study {
     /// SHA-256 of the config file's bytes.
     pub config_sha256: String,
     grid: Option<Grid>,
+    /// The building axes of a building study.
+    building: Option<BuildingAxes>,
     fingerprints: Fingerprints,
 }
 
@@ -325,6 +337,7 @@ impl Study {
             }
         };
         let grid = cfg.grid.as_ref().map(|g| g.axes());
+        let building = cfg.building_axes();
         let motions_fp = motions::fingerprint(&cfg);
         let ida = ida::fingerprint(&cfg, &motions_fp);
         let rest = match &cfg.grid {
@@ -343,6 +356,7 @@ impl Study {
             cfg,
             out,
             grid,
+            building,
             fingerprints: Fingerprints {
                 motions: motions_fp,
                 rest,
@@ -365,6 +379,37 @@ impl Study {
         self.grid.as_ref().ok_or_else(|| PipelineError::NoGrid {
             config: self.config_path.clone(),
             stage,
+        })
+    }
+
+    /// The building axes of a building study (`None` on one storey).
+    pub fn building(&self) -> Option<&BuildingAxes> {
+        self.building.as_ref()
+    }
+
+    /// Refuses a building study in a stage that cannot yet take it, before any work: the fit
+    /// takes one frame, the report none.
+    pub fn refuse_building(&self, stage: StageId) -> Result<(), PipelineError> {
+        let Some(b) = &self.building else {
+            return Ok(());
+        };
+        let why = match stage {
+            StageId::Motions | StageId::Sweep | StageId::Tnew => return Ok(()),
+            StageId::Fit if b.frames() == 1 => return Ok(()),
+            StageId::Fit => {
+                "takes a building study of one frame only (one `building.storeys` value, one \
+                 `grid.stack_floor`): the fit over several needs the building's own features, \
+                 not yet done"
+            }
+            StageId::Report | StageId::Ida => {
+                "cannot yet take a building study (motions, sweep, tnew and, for one frame, fit \
+                 can)"
+            }
+        };
+        Err(PipelineError::NotForBuilding {
+            config: self.config_path.clone(),
+            stage,
+            why,
         })
     }
 
@@ -551,6 +596,7 @@ pub enum Outcome {
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
 pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
     s.check_cancelled(stage)?;
+    s.study.refuse_building(stage)?;
     s.study.fingerprint(stage)?;
     for &up in stage.upstream() {
         s.study.require(up)?;

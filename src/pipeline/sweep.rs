@@ -8,11 +8,15 @@
 //! done). Assembling reads every unit back (checksum and identity checked), writes `sweep.h5`,
 //! reads it back and compares it with what was meant, and only then removes the units.
 //!
-//! Fingerprint: the `zones` and `grid` sections, the solver, and the motions' fingerprint.
+//! In a building study a unit is one zone, one motion, one frame (`storeys`, `stack_floor`) and
+//! one `T_p`.
+//!
+//! Fingerprint: the `zones` and `grid` sections (and `building`, when given), the solver, and
+//! the motions' fingerprint.
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::dynamics::Ground;
-use crate::grid::Grid;
+use crate::grid::{BuildingAxes, Grid};
 use crate::ground_motion::Record;
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
@@ -73,31 +77,44 @@ impl SweepStageError {
 
 /// The fingerprint `sweep.h5` must carry.
 pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> String {
-    let section = serde_json::json!({
+    let mut section = serde_json::json!({
         "zones": cfg.zones, "grid": cfg.grid, "solver": "exact",
     });
+    // Only when given, so that a one-storey study keeps its fingerprint.
+    if let Some(b) = &cfg.building {
+        section["building"] = serde_json::json!(b);
+    }
     hash_parts(&[&section.to_string(), motions_fingerprint])
 }
 
-/// One work unit: zone, motion and period indices.
+/// One work unit: zone, motion, frame (0 on one storey) and period indices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Unit {
     zone: usize,
     motion: usize,
+    frame: usize,
     period: usize,
 }
 
-/// Every unit in the fixed order shards count in.
-fn all_units(grid: &Grid, motions: &[Vec<Record>]) -> Vec<Unit> {
+/// Frames of the study: its building axes' (1 on one storey).
+fn frames(study: &Study) -> usize {
+    study.building().map_or(1, BuildingAxes::frames)
+}
+
+/// Every unit in the fixed order shards count in (the order of the stored axes).
+fn all_units(study: &Study, grid: &Grid, motions: &[Vec<Record>]) -> Vec<Unit> {
     let mut v = Vec::new();
     for (zone, ms) in motions.iter().enumerate() {
         for motion in 0..ms.len() {
-            for period in 0..grid.periods_s.len() {
-                v.push(Unit {
-                    zone,
-                    motion,
-                    period,
-                });
+            for frame in 0..frames(study) {
+                for period in 0..grid.periods_s.len() {
+                    v.push(Unit {
+                        zone,
+                        motion,
+                        frame,
+                        period,
+                    });
+                }
             }
         }
     }
@@ -122,12 +139,18 @@ impl Units<'_> {
             &self.study.path(UNITS_DIR),
             &self.study.cfg.zones[u.zone].name,
             u.motion,
+            self.study.building().map(|_| u.frame),
             u.period,
         )
     }
 
     fn id(&self, u: Unit) -> UnitId {
+        let frame = self.study.building().map(|b| {
+            let (n, floor) = b.frame(u.frame);
+            (u.frame, format!("storeys {n}, stack_floor {floor}"))
+        });
         UnitId {
+            frame,
             fingerprint: self.fingerprint.to_string(),
             zone: self.study.cfg.zones[u.zone].name.clone(),
             motion_index: u.motion,
@@ -199,7 +222,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
         motions: &motions,
         fingerprint: fp,
     };
-    let all = all_units(grid, &motions);
+    let all = all_units(study, grid, &motions);
     if let Some((k, n)) = shard
         && !(1 <= k && k <= n && n <= all.len())
     {
@@ -252,9 +275,11 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
             let rec = &motions[u.zone][u.motion];
             let accel = rec.accel_mps2(1.0);
             let ground = Ground::new(rec.dt_s, &accel);
+            let frame = (study.building()).and_then(|b| study.cfg.frame(b, u.frame));
             let r = run_unit(
                 grid,
                 &physics,
+                frame.as_ref(),
                 &ground,
                 u.period,
                 UnitOptions { skip: true },
@@ -311,7 +336,7 @@ pub fn merge(s: &Session) -> Result<Outcome, PipelineError> {
         motions: &motions,
         fingerprint: study.fingerprint(me)?,
     };
-    let all = all_units(grid, &motions);
+    let all = all_units(study, grid, &motions);
     assemble(s, &units, &all)
 }
 
@@ -346,13 +371,15 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
         .into());
     }
     let n = grid.blocks();
+    let building = study.building();
     let mut zones = Vec::new();
     let mut at = 0;
     for (z, zc) in study.cfg.zones.iter().enumerate() {
-        let count = units.motions[z].len() * grid.periods_s.len();
+        let count = units.motions[z].len() * frames(study) * grid.periods_s.len();
         let cols = &read[at..at + count];
         at += count;
         let mut shape = vec![units.motions[z].len()];
+        shape.extend(building.iter().flat_map(|b| b.shape()));
         shape.extend(grid.shape());
         let mut shape_i = shape.clone();
         shape_i.push(n);
@@ -387,6 +414,11 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
     let fp = study.fingerprint(me)?;
     let motions_fp = study.fingerprint(StageId::Motions)?;
     let physics = study.physics();
+    let building_json = building_attr(study);
+    let mut settings = physics_attrs(&physics).to_vec();
+    if let Some(b) = &building_json {
+        settings.push(("building", Attr::Str(b)));
+    }
     let meta = SweepMeta {
         fingerprint: fp,
         config_sha256: &study.config_sha256,
@@ -394,10 +426,10 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
         skip_rule_codes: SKIP_RULE_CODES,
         skip_rule_flags: &SKIP_RULE_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,
-        settings: &physics_attrs(&physics),
+        settings: &settings,
     };
     let path = study.path(me.output());
-    write_sweep(&path, &meta, grid, &zones)?;
+    write_sweep(&path, &meta, grid, building, &zones)?;
     // Verified on disk before the units go: what reads back is bit for bit what was meant.
     if study.stored(me)?.as_deref() != Some(fp) {
         return Err(SweepStageError::Verify {
@@ -407,7 +439,7 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
         .into());
     }
     for z in &zones {
-        let (_, back) = read_zone_sweep(&path, &z.name, n)?;
+        let (_, _, back) = read_zone_sweep(&path, &z.name, n, building.is_some())?;
         if !same_bits(&back, z) {
             return Err(SweepStageError::Verify {
                 file: path,
@@ -434,6 +466,13 @@ fn array<T>(
         }
         .into()
     })
+}
+
+/// A building study's `building:` section as JSON (the file attribute `building` of `sweep.h5`
+/// and `tnew.h5`).
+pub fn building_attr(study: &Study) -> Option<String> {
+    let b = study.cfg.building.as_ref()?;
+    Some(serde_json::to_string(b).expect("the building section serialises"))
 }
 
 /// The physics settings stored as file attributes of `sweep.h5` and `tnew.h5`.
@@ -482,7 +521,7 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError
             Seeds::Records(r) => r.files.len(),
         };
         return Ok((
-            per_zone * study.cfg.zones.len() * grid.periods_s.len(),
+            per_zone * study.cfg.zones.len() * frames(study) * grid.periods_s.len(),
             0,
             0,
         ));
@@ -494,7 +533,7 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError
         motions: &motions,
         fingerprint: study.fingerprint(StageId::Sweep)?,
     };
-    let all = all_units(grid, &motions);
+    let all = all_units(study, grid, &motions);
     let done = if study.state(StageId::Sweep)? == super::StageState::UpToDate {
         all.len()
     } else {

@@ -3,6 +3,11 @@
 //! rule for several crossings in [`crate::study::tnew`]), whether anything slid, `DRR_1` and
 //! `DRR_2` → `tnew.h5` (layout in [`crate::store::tnew`]).
 //!
+//! In a building study (docs/model.md, "A study over buildings") every frame (`storeys`,
+//! `stack_floor`) is done alike, with the first mode's `T_1,rigid` and the mean peak roof
+//! displacement divided by `Γ_1·φ_1,N` (the first mode's equivalent-SDOF displacement) before
+//! `T_new` is read off the spectrum; one storey is today's arithmetic, bit for bit.
+//!
 //! Fingerprint: the sweep's, and the step of the spectrum's period grid.
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
@@ -11,7 +16,8 @@ use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::read_zone_sweep;
-use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, read_zone_tnew, write_tnew};
+use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, read_zone_tnew_in, write_tnew};
+use crate::study::building::Frame;
 use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
 use ndarray::{ArrayD, Axis};
 use rayon::prelude::*;
@@ -35,7 +41,9 @@ pub fn fingerprint(sweep_fingerprint: &str) -> String {
     hash_parts(&[sweep_fingerprint, &format!("sd_step_s={SD_STEP_S}")])
 }
 
-/// The periods of the mean displacement spectrum: they reach past every `T_rigid` of the grid.
+/// The periods of the mean displacement spectrum: they reach past every `T_rigid` of the grid
+/// (in a building too: a load of at most `α` times each floor's mass lengthens the first mode
+/// by at most `sqrt(1+α)`, Rayleigh's quotient).
 pub fn spectrum_periods_s(grid: &Grid) -> Vec<f64> {
     let alpha_max: f64 = grid
         .alpha
@@ -52,8 +60,9 @@ pub fn spectrum_periods_s(grid: &Grid) -> Vec<f64> {
 pub fn read_zone(study: &Study, zone: &str) -> Result<ZoneTnew, PipelineError> {
     let grid = study.grid(StageId::Tnew)?;
     let path = study.path(StageId::Tnew.output());
-    let (axes, t) = read_zone_tnew(&path, zone, grid.blocks())?;
-    let why = if axes != *grid {
+    let building = study.building();
+    let (axes, frames, t) = read_zone_tnew_in(&path, zone, grid.blocks(), building.is_some())?;
+    let why = if axes != *grid || frames.as_ref() != building {
         "its grid differs from the config's"
     } else if t.period_sd_s != spectrum_periods_s(grid) {
         "its spectrum's periods differ from the config's grid"
@@ -73,11 +82,28 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let period_sd_s = spectrum_periods_s(grid);
     let n = grid.blocks();
     let physics = study.physics();
+    let building = study.building();
+    let frames: Vec<Option<Frame>> = match building {
+        None => vec![None],
+        Some(b) => (0..b.frames()).map(|f| study.cfg.frame(b, f)).collect(),
+    };
+    // Γ_1·φ_1,N per frame, and per storey count (stored).
+    let participation: Vec<f64> = (frames.iter())
+        .map(|f| f.as_ref().map_or(1.0, Frame::roof_participation))
+        .collect();
+    let per_storeys: Vec<f64> = match building {
+        None => Vec::new(),
+        Some(b) => (0..b.storeys.len())
+            .map(|s| participation[s * b.stack_floor.len()])
+            .collect(),
+    };
+    let mut shape: Vec<usize> = building.iter().flat_map(|b| b.shape()).collect();
+    shape.extend(grid.shape());
     let mut zones = Vec::new();
     for (z, zc) in study.cfg.zones.iter().enumerate() {
-        let (axes, sw) = read_zone_sweep(&sweep_path, &zc.name, n)?;
+        let (axes, stored, sw) = read_zone_sweep(&sweep_path, &zc.name, n, building.is_some())?;
         let names: Vec<&String> = motions[z].iter().map(|r| &r.name).collect();
-        let differs = if axes != *grid {
+        let differs = if axes != *grid || stored.as_ref() != building {
             Some("its grid differs from the config's")
         } else if sw.motions.iter().collect::<Vec<_>>() != names {
             Some("its motions are not those of motions.h5")
@@ -108,9 +134,10 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let mean = |v: &ArrayD<f64>| v.sum_axis(Axis(0)) / m as f64;
         let v = &sw.vars;
         let (u_stack, u_single, u_rigid) = (mean(&v.u_stack), mean(&v.u_single), mean(&v.u_rigid));
-        // A case slides when any interface slips under any motion: slip_peak [motion, case…,
-        // interface] folded over its first and last axes.
-        let cases = grid.cases();
+        // A case slides when any interface slips under any motion: slip_peak [motion, (frame,)
+        // case…, interface] folded over its first and last axes.
+        let per_frame = grid.cases();
+        let cases = frames.len() * per_frame;
         let slip = v
             .slip_peak
             .view()
@@ -124,16 +151,19 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let mut flag = Vec::with_capacity(cases);
         let mut band = Vec::with_capacity(cases);
         for (c, (&us, &slid)) in u_stack.iter().zip(&slides).enumerate() {
-            let case = grid.case(c);
-            let tr = case.t_rigid_s();
-            let (tn, f) = tnew::t_new(&period_sd_s, &sd_mean_m, us, tr, slid);
+            let case = grid.case(c % per_frame);
+            let (tr, u) = match &frames[c / per_frame] {
+                None => (case.t_rigid_s(), us),
+                Some(frame) => (frame.t_rigid_s(&case), us / participation[c / per_frame]),
+            };
+            let (tn, f) = tnew::t_new(&period_sd_s, &sd_mean_m, u, tr, slid);
             t_rigid.push(tr);
             t_new.push(tn);
             flag.push(f64::from(f as u8));
             band.push(Band::of(case.period_s, tr, tn, f) as u8);
         }
         let shaped = |v: Vec<f64>| {
-            ArrayD::from_shape_vec(grid.shape(), v).expect("one value per case of the grid")
+            ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
         };
         let counts = BandCounts::new(&band, &t_new, &t_rigid);
         s.reporter.info(
@@ -150,7 +180,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             t_new: shaped(t_new),
             slides: shaped(slides.iter().map(|&b| f64::from(u8::from(b))).collect()),
             flag: shaped(flag),
-            band: ArrayD::from_shape_vec(grid.shape(), band).expect("one code per case"),
+            band: ArrayD::from_shape_vec(shape.clone(), band).expect("one code per case"),
         };
         zones.push(ZoneTnew {
             name: zc.name.clone(),
@@ -158,7 +188,13 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             vars,
             period_sd_s: period_sd_s.clone(),
             sd_mean_m,
+            roof_participation: per_storeys.clone(),
         });
+    }
+    let building_json = super::sweep::building_attr(study);
+    let mut settings = super::sweep::physics_attrs(&physics).to_vec();
+    if let Some(b) = &building_json {
+        settings.push(("building", crate::store::h5::Attr::Str(b)));
     }
     let meta = TnewMeta {
         fingerprint: study.fingerprint(me)?,
@@ -167,9 +203,9 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         flag_codes: TNEW_FLAG_CODES,
         band_flags: &BAND_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,
-        settings: &super::sweep::physics_attrs(&physics),
+        settings: &settings,
     };
     let path = study.path(me.output());
-    write_tnew(&path, &meta, grid, &zones)?;
+    write_tnew(&path, &meta, grid, building, &zones)?;
     Ok(Outcome::Wrote(vec![path]))
 }

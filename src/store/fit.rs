@@ -103,6 +103,10 @@ pub struct FitReport {
     /// Folds of the cross-validation.
     #[serde(default)]
     pub folds: usize,
+    /// A building study's one frame (`3 storeys, stack on the roof`): `T_p` is then the bare
+    /// building's first-mode period `T_1` and `T_new` the first mode's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub building: Option<String>,
     pub zones: Vec<ZoneFit>,
 }
 
@@ -130,6 +134,9 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
         &r.fingerprint,
         |f| {
             attr_str(f, "features", &r.features.join(", "))?;
+            if let Some(b) = &r.building {
+                attr_str(f, "building", b)?;
+            }
             for z in &r.zones {
                 let g = f.create_group(&format!("zone_{}", z.zone))?;
                 attr_str(&g, "recommended_form", z.recommended.name())?;

@@ -9,6 +9,11 @@
 //!     skip_rule, single_rule                       [motion, T_p, alpha_1 … alpha_n, mu_1 … mu_n]
 //!     slip_peak (m)                                [… , interface]
 //! ```
+//! A building study (docs/model.md, "A study over buildings") has two more coordinates,
+//! `storeys` (numbers) and `stack_floor` (strings: a floor number, `roof`, `all`), as dimensions
+//! after `motion`: `[motion, storeys, stack_floor, T_p, …]`; the structure's peaks are then the
+//! roof's.
+//!
 //! Variables are chunked by work unit (one motion, one `T_p`), deflate+shuffle compressed,
 //! Fletcher32-checksummed, with NaN (255 for the codes) as fill value. Objects are written in a
 //! fixed order with their times not tracked, so the same inputs give the same bytes.
@@ -18,7 +23,7 @@ use super::h5::{
     Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, set_scale, write_attrs,
     write_flags, write_stage_file, write_strings, write_var,
 };
-use crate::grid::Grid;
+use crate::grid::{BuildingAxes, Grid, StackFloor};
 use ndarray::ArrayD;
 use std::path::Path;
 
@@ -104,11 +109,54 @@ pub fn read_case_coordinates(g: &GroupReader, blocks: usize) -> Result<Grid, Sto
     })
 }
 
-/// Writes `sweep.h5` at `path` (checked and atomic, [`write_stage_file`]).
+/// The coordinates `storeys` and `stack_floor` of a building study in group `g`, as dimension
+/// scales in that order (shared by `sweep.h5` and `tnew.h5`).
+pub fn building_coordinates(
+    g: &hdf5::Group,
+    axes: &BuildingAxes,
+) -> hdf5::Result<Vec<hdf5::Dataset>> {
+    let storeys: Vec<f64> = axes.storeys.iter().map(|&n| n as f64).collect();
+    let s = coordinate(g, "storeys", &storeys, "1", "storeys N of the building")?;
+    let floors: Vec<String> = axes.stack_floor.iter().map(|f| f.to_string()).collect();
+    let f = write_strings(
+        g,
+        "stack_floor",
+        &floors,
+        "floor carrying the stack (1 the lowest; roof: floor N; all: a stack on every floor)",
+    )?;
+    set_scale(&f, "stack_floor")?;
+    Ok(vec![s, f])
+}
+
+/// The building axes stored in a group by [`building_coordinates`].
+pub fn read_building_coordinates(g: &GroupReader) -> Result<BuildingAxes, StoreError> {
+    let bad = |why: String| StoreError::corrupt(g.file(), why);
+    let storeys = (g.vector("storeys")?.into_iter())
+        .map(|n| {
+            (n >= 1.0 && n.fract() == 0.0 && n <= u32::MAX as f64)
+                .then_some(n as usize)
+                .ok_or_else(|| bad(format!("storeys: {n} is not a storey count")))
+        })
+        .collect::<Result<_, _>>()?;
+    let stack_floor = (g.strings("stack_floor")?.iter())
+        .map(|s| {
+            s.parse::<StackFloor>()
+                .map_err(|why| bad(format!("stack_floor: {why}")))
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(BuildingAxes {
+        storeys,
+        stack_floor,
+    })
+}
+
+/// Writes `sweep.h5` at `path` (checked and atomic, [`write_stage_file`]); `building` the
+/// building axes of a building study.
 pub fn write_sweep(
     path: &Path,
     meta: &SweepMeta,
     grid: &Grid,
+    building: Option<&BuildingAxes>,
     zones: &[ZoneSweep],
 ) -> Result<(), StoreError> {
     write_stage_file(
@@ -121,14 +169,20 @@ pub fn write_sweep(
             attr_str(f, "skip_rule_codes", meta.skip_rule_codes)?;
             write_attrs(f, meta.settings)?;
             for z in zones {
-                write_zone(f, grid, z, meta)?;
+                write_zone(f, grid, building, z, meta)?;
             }
             Ok(())
         },
     )
 }
 
-fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneSweep, meta: &SweepMeta) -> hdf5::Result<()> {
+fn write_zone(
+    f: &hdf5::File,
+    grid: &Grid,
+    building: Option<&BuildingAxes>,
+    z: &ZoneSweep,
+    meta: &SweepMeta,
+) -> hdf5::Result<()> {
     let g = f.create_group(&format!("zone_{}", z.name))?;
     attr_str(&g, "target", &z.target)?;
     let n = grid.blocks();
@@ -140,6 +194,9 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneSweep, meta: &SweepMeta) -> h
     )?;
     set_scale(&m, "motion")?;
     let mut scales = vec![m];
+    if let Some(b) = building {
+        scales.extend(building_coordinates(&g, b)?);
+    }
     scales.extend(case_coordinates(&g, grid, meta.mu_static_ratio)?);
     let iface: Vec<f64> = (1..=n).map(|i| i as f64).collect();
     let iface = coordinate(
@@ -149,8 +206,8 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneSweep, meta: &SweepMeta) -> h
         "1",
         "interface (1 = structure–block 1)",
     )?;
-    // One chunk per work unit: one motion, one T_p.
-    let mut chunk = vec![1, 1];
+    // One chunk per work unit: one motion (one frame), one T_p.
+    let mut chunk = vec![1; if building.is_some() { 4 } else { 2 }];
     chunk.extend(grid.case_shape());
     let v = &z.vars;
     let vars: [(&str, &ArrayD<f64>, &str, &str); 5] = [
@@ -186,7 +243,17 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneSweep, meta: &SweepMeta) -> h
         ),
     ];
     for (name, data, units, long) in vars {
-        let ds = write_var(&g, name, data.view(), &chunk, units, long)?;
+        // In a building the structure's peaks are the roof's.
+        let long = match name {
+            "u_stack" | "u_single" | "u_rigid" | "a_stack" if building.is_some() => {
+                format!("{long} (a building: its roof's)")
+            }
+            "friction_energy" if building.is_some() => {
+                format!("{long} (a building: of every stack, per kg of all its floors)")
+            }
+            _ => long.to_string(),
+        };
+        let ds = write_var(&g, name, data.view(), &chunk, units, &long)?;
         attach_all(&ds, &scales)?;
     }
     let mut chunk_i = chunk.clone();
@@ -197,7 +264,11 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneSweep, meta: &SweepMeta) -> h
         v.slip_peak.view(),
         &chunk_i,
         "m",
-        "peak slip of each interface",
+        if building.is_some() {
+            "peak slip of each interface (with a stack on every floor: the largest over them)"
+        } else {
+            "peak slip of each interface"
+        },
     )?;
     attach_all(&ds, &scales)?;
     attach_scale(&ds, &iface, scales.len())?;
@@ -222,17 +293,22 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneSweep, meta: &SweepMeta) -> h
     Ok(())
 }
 
-/// Zone `zone` of `sweep.h5` (`blocks` blocks) and the grid axes stored with it; every variable
-/// has the shape its coordinates give.
+/// Zone `zone` of `sweep.h5` (`blocks` blocks; `building`: of a building study) and the axes
+/// stored with it; every variable has the shape its coordinates give.
 pub fn read_zone_sweep(
     path: &Path,
     zone: &str,
     blocks: usize,
-) -> Result<(Grid, ZoneSweep), StoreError> {
+    building: bool,
+) -> Result<(Grid, Option<BuildingAxes>, ZoneSweep), StoreError> {
     let g = GroupReader::open(path, &format!("zone_{zone}"))?;
     let grid = read_case_coordinates(&g, blocks)?;
+    let axes = building
+        .then(|| read_building_coordinates(&g))
+        .transpose()?;
     let motions = g.strings("motion")?;
     let mut shape = vec![motions.len()];
+    shape.extend(axes.iter().flat_map(BuildingAxes::shape));
     shape.extend(grid.shape());
     let mut per_interface = shape.clone();
     per_interface.push(blocks);
@@ -252,5 +328,5 @@ pub fn read_zone_sweep(
         motions,
         vars,
     };
-    Ok((grid, zone))
+    Ok((grid, axes, zone))
 }

@@ -9,14 +9,19 @@
 //!     slides (0/1), T_new_flag, T_new_band (CF flags)     [T_p, alpha_1 … alpha_n, mu_1 … mu_n]
 //!     period_sd (s), sd_mean (m): the zone's mean 5 %-damped displacement spectrum
 //! ```
+//! A building study's variables have the dimensions `storeys` and `stack_floor` in front
+//! (coordinates as in `sweep.h5`), and `roof_participation` `[storeys]` is `Γ_1·φ_1,N`, by which
+//! the mean peak roof displacement is divided before `T_new` is read off the spectrum.
 
 use super::h5::{
     Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, group, open, write_attrs,
     write_flags, write_small, write_stage_file, write_var,
 };
-use super::sweep::{case_coordinates, read_case_coordinates};
+use super::sweep::{
+    building_coordinates, case_coordinates, read_building_coordinates, read_case_coordinates,
+};
 use super::{H5Context, StoreError};
-use crate::grid::Grid;
+use crate::grid::{BuildingAxes, Grid};
 use ndarray::ArrayD;
 use std::path::Path;
 
@@ -44,6 +49,8 @@ pub struct ZoneTnew {
     /// The zone's mean 5 %-damped displacement spectrum: periods, s, and values, m.
     pub period_sd_s: Vec<f64>,
     pub sd_mean_m: Vec<f64>,
+    /// A building study's `Γ_1·φ_1,N` per storey count (empty on one storey).
+    pub roof_participation: Vec<f64>,
 }
 
 /// Provenance written on `tnew.h5`.
@@ -63,11 +70,12 @@ pub struct TnewMeta<'a> {
     pub settings: &'a [(&'a str, Attr<'a>)],
 }
 
-/// Writes `tnew.h5` (checked and atomic).
+/// Writes `tnew.h5` (checked and atomic); `building` the building axes of a building study.
 pub fn write_tnew(
     path: &Path,
     meta: &TnewMeta,
     grid: &Grid,
+    building: Option<&BuildingAxes>,
     zones: &[ZoneTnew],
 ) -> Result<(), StoreError> {
     write_stage_file(
@@ -80,18 +88,37 @@ pub fn write_tnew(
             attr_str(f, "T_new_flag_codes", meta.flag_codes)?;
             write_attrs(f, meta.settings)?;
             for z in zones {
-                write_zone(f, grid, z, meta)?;
+                write_zone(f, grid, building, z, meta)?;
             }
             Ok(())
         },
     )
 }
 
-fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, meta: &TnewMeta) -> hdf5::Result<()> {
+fn write_zone(
+    f: &hdf5::File,
+    grid: &Grid,
+    building: Option<&BuildingAxes>,
+    z: &ZoneTnew,
+    meta: &TnewMeta,
+) -> hdf5::Result<()> {
     let g = f.create_group(&format!("zone_{}", z.name))?;
     attr_str(&g, "target", &z.target)?;
-    let scales = case_coordinates(&g, grid, meta.mu_static_ratio)?;
-    let mut chunk = vec![1];
+    let mut scales = Vec::new();
+    if let Some(b) = building {
+        scales.extend(building_coordinates(&g, b)?);
+        let ds = write_small(
+            &g,
+            "roof_participation",
+            ndarray::ArrayView1::from(&z.roof_participation).into_dyn(),
+            "1",
+            "Γ_1·φ_1,N of the bare building: roof displacement per first-mode equivalent-SDOF \
+             displacement",
+        )?;
+        attach_scale(&ds, &scales[0], 0)?;
+    }
+    scales.extend(case_coordinates(&g, grid, meta.mu_static_ratio)?);
+    let mut chunk = vec![1; if building.is_some() { 3 } else { 1 }];
     chunk.extend(grid.case_shape());
     let v = &z.vars;
     let vars: [(&str, &ArrayD<f64>, &str, &str); 9] = [
@@ -117,13 +144,22 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, meta: &TnewMeta) -> hdf
             "T_rigid",
             &v.t_rigid,
             "s",
-            "period with the stack rigidly attached, T_p·sqrt(1+α)",
+            if building.is_some() {
+                "first-mode period with the stack rigidly attached"
+            } else {
+                "period with the stack rigidly attached, T_p·sqrt(1+α)"
+            },
         ),
         (
             "T_new",
             &v.t_new,
             "s",
-            "period whose mean 5 %-damped spectral displacement equals u_stack_mean (Section 7.1)",
+            if building.is_some() {
+                "period whose mean 5 %-damped spectral displacement equals u_stack_mean / \
+                 roof_participation (the first mode's equivalent SDOF)"
+            } else {
+                "period whose mean 5 %-damped spectral displacement equals u_stack_mean (Section 7.1)"
+            },
         ),
         (
             "DRR_1",
@@ -151,7 +187,14 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, meta: &TnewMeta) -> hdf
         ),
     ];
     for (name, data, units, long) in vars {
-        let ds = write_var(&g, name, data.view(), &chunk, units, long)?;
+        // In a building the structure's peaks are the roof's.
+        let long = match name {
+            "u_stack_mean" | "u_single_mean" | "u_rigid_mean" if building.is_some() => {
+                format!("{long} (a building: its roof's)")
+            }
+            _ => long.to_string(),
+        };
+        let ds = write_var(&g, name, data.view(), &chunk, units, &long)?;
         attach_all(&ds, &scales)?;
     }
     let ds = write_flags(
@@ -181,16 +224,38 @@ fn write_zone(f: &hdf5::File, grid: &Grid, z: &ZoneTnew, meta: &TnewMeta) -> hdf
     Ok(())
 }
 
-/// Zone `zone` of `tnew.h5` and the grid axes stored with it; every variable has the shape its
-/// coordinates give, and every `T_new_band` code is one of its `flag_values`.
+/// Zone `zone` of a one-storey study's `tnew.h5` ([`read_zone_tnew_in`]).
 pub fn read_zone_tnew(
     path: &Path,
     zone: &str,
     blocks: usize,
 ) -> Result<(Grid, ZoneTnew), StoreError> {
+    read_zone_tnew_in(path, zone, blocks, false).map(|(grid, _, z)| (grid, z))
+}
+
+/// Zone `zone` of `tnew.h5` (`building`: of a building study) and the axes stored with it;
+/// every variable has the shape its coordinates give, and every `T_new_band` code is one of
+/// its `flag_values`.
+pub fn read_zone_tnew_in(
+    path: &Path,
+    zone: &str,
+    blocks: usize,
+    building: bool,
+) -> Result<(Grid, Option<BuildingAxes>, ZoneTnew), StoreError> {
     let g = GroupReader::open(path, &format!("zone_{zone}"))?;
     let grid = read_case_coordinates(&g, blocks)?;
-    let shape = grid.shape();
+    let axes = building
+        .then(|| read_building_coordinates(&g))
+        .transpose()?;
+    let mut shape: Vec<usize> = axes.iter().flat_map(|b| b.shape()).collect();
+    shape.extend(grid.shape());
+    let roof_participation = match &axes {
+        Some(b) => (g.array::<f64>("roof_participation", &[b.storeys.len()])?)
+            .iter()
+            .copied()
+            .collect(),
+        None => Vec::new(),
+    };
     let vars = TnewVars {
         u_stack_mean: g.array("u_stack_mean", &shape)?,
         u_single_mean: g.array("u_single_mean", &shape)?,
@@ -221,8 +286,17 @@ pub fn read_zone_tnew(
         vars,
         period_sd_s,
         sd_mean_m: sd_mean_m.iter().copied().collect(),
+        roof_participation,
     };
-    Ok((grid, z))
+    Ok((grid, axes, z))
+}
+
+/// Whether `tnew.h5` is a building study's (its first zone has a `storeys` coordinate).
+pub fn is_building(path: &Path) -> Result<bool, StoreError> {
+    let (zones, _) = zones_and_blocks(path)?;
+    let f = open(path)?;
+    let g = group(&f, path, &format!("zone_{}", zones[0]))?;
+    Ok(g.link_exists("storeys"))
 }
 
 /// The fingerprint of the `motions.h5` that `tnew.h5` was made from; `None` in a file made

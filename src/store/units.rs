@@ -31,6 +31,9 @@ pub struct UnitId {
     pub motion: String,
     pub period_index: usize,
     pub period_s: f64,
+    /// A building study's frame: its index and `storeys`/`stack_floor` (absent on one storey).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<(usize, String)>,
 }
 
 /// A unit's values, as columns.
@@ -50,9 +53,19 @@ pub enum Stored {
     Valid(Columns),
 }
 
-/// File name of unit (zone, motion, period) inside the units directory.
-pub fn unit_path(dir: &Path, zone: &str, motion: usize, period: usize) -> PathBuf {
-    dir.join(format!("{zone}_{motion:03}_{period:03}.unit"))
+/// File name of unit (zone, motion, frame of a building study, period) inside the units
+/// directory.
+pub fn unit_path(
+    dir: &Path,
+    zone: &str,
+    motion: usize,
+    frame: Option<usize>,
+    period: usize,
+) -> PathBuf {
+    match frame {
+        None => dir.join(format!("{zone}_{motion:03}_{period:03}.unit")),
+        Some(f) => dir.join(format!("{zone}_{motion:03}_f{f:03}_{period:03}.unit")),
+    }
 }
 
 /// Writes a unit atomically.
@@ -113,15 +126,20 @@ pub fn read_unit(path: &Path, want: &UnitId) -> Result<Stored, StoreError> {
         return Ok(Stored::Stale);
     }
     if id != *want {
+        let frame = |u: &UnitId| {
+            (u.frame.as_ref()).map_or(String::new(), |(_, f)| format!(", frame `{f}`"))
+        };
         return Err(bad(&format!(
-            "holds unit (zone {}, motion {} `{}`, T_p {} s) where unit (zone {}, motion {} `{}`, T_p {} s) belongs",
+            "holds unit (zone {}, motion {} `{}`{}, T_p {} s) where unit (zone {}, motion {} `{}`{}, T_p {} s) belongs",
             id.zone,
             id.motion_index + 1,
             id.motion,
+            frame(&id),
             id.period_s,
             want.zone,
             want.motion_index + 1,
             want.motion,
+            frame(want),
             want.period_s
         )));
     }
@@ -160,6 +178,7 @@ mod tests {
             motion: format!("m{motion}"),
             period_index: 4,
             period_s: 0.5,
+            frame: None,
         }
     }
 

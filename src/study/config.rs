@@ -16,10 +16,12 @@
 //!   allow_unmatched: false         # true: keep motions outside the band, flagged
 //! ```
 
+use super::building::{BuildingSection, FloorKey, Frame, OneOrList};
 use super::ida::IdaConfig;
 use super::physics::{DampingBasis, Physics};
-use crate::grid::Grid;
+use crate::dynamics::building::Building;
 use crate::grid::linear_range;
+use crate::grid::{BuildingAxes, Grid};
 use crate::ground_motion::matching::{MatchError, MatchSettings};
 use crate::ground_motion::stochastic::{StochasticError, StochasticModel};
 use crate::ground_motion::{ReadOptions, Units};
@@ -47,6 +49,10 @@ pub struct StudyConfig {
     /// Incremental dynamic analysis of a yielding structure; required by `ida`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ida: Option<IdaConfig>,
+    /// A study over buildings: the structure is a shear building (docs/model.md, "A study over
+    /// buildings").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub building: Option<BuildingSection>,
     /// The config file and the files it names, as [`StudyConfig::load`] read them.
     #[serde(skip)]
     pub loaded: Loaded,
@@ -150,6 +156,10 @@ pub struct GridConfig {
     /// attached, one damper for every system; `structure`: of the bare structure.
     #[serde(default)]
     pub damping_basis: DampingBasis,
+    /// With a `building:` section: the floor the stack stands on, `roof` (the default), `all`
+    /// (a stack on every floor), or a list of them (the `stack_floor` axis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stack_floor: Option<OneOrList<FloorKey>>,
 }
 
 impl GridConfig {
@@ -401,6 +411,7 @@ impl StudyConfig {
                 format!("{m} must be in (0, matching.upper]"),
             );
         }
+        let frames = self.validate_building()?;
         if let Some(g) = &self.grid {
             validate_grid(g)?;
             let per_zone = match (&self.motions.seeds.stochastic, &self.motions.seeds.records) {
@@ -409,7 +420,8 @@ impl StudyConfig {
                 (None, None) => 0,
             };
             // Counted in floating point: a product of axis lengths can overflow any integer.
-            let cases: f64 = g.axes().shape().iter().map(|&n| n as f64).product();
+            let cases: f64 = g.axes().shape().iter().map(|&n| n as f64).product::<f64>()
+                * frames.as_ref().map_or(1, BuildingAxes::frames) as f64;
             let results = cases * per_zone as f64 * self.zones.len() as f64;
             if results > MAX_CASE_RESULTS as f64 {
                 return err(
@@ -491,6 +503,49 @@ impl StudyConfig {
             }
         }
         Ok(())
+    }
+
+    /// The `building:` section against the grid; the building axes of a building study.
+    fn validate_building(&self) -> Result<Option<BuildingAxes>, (String, String)> {
+        let stack_floor = self.grid.as_ref().and_then(|g| g.stack_floor.as_ref());
+        let Some(b) = &self.building else {
+            if stack_floor.is_some() {
+                let why = "needs a `building` section (a one-storey study has one floor)";
+                return Err(("grid.stack_floor".into(), why.into()));
+            }
+            return Ok(None);
+        };
+        if self.ida.is_some() {
+            let why = "the IDA of a building is not yet supported in a study: remove `ida` \
+                       (or `building`)";
+            return Err(("ida".into(), why.into()));
+        }
+        let axes = b.axes(stack_floor)?;
+        if let Some(g) = &self.grid {
+            let periods = g.period_s.values();
+            let physics = g.physics();
+            for &n in &axes.storeys {
+                for p in [periods.first(), periods.last()].into_iter().flatten() {
+                    let frame = b.frame(n, crate::grid::StackFloor::Roof);
+                    Building::new(&physics.bare_building(*p, &frame))
+                        .map_err(|e| ("building".to_string(), e.to_string()))?;
+                }
+            }
+        }
+        Ok(Some(axes))
+    }
+
+    /// The building axes of a building study (`None` without a `building:` section).
+    pub fn building_axes(&self) -> Option<BuildingAxes> {
+        let b = self.building.as_ref()?;
+        b.axes(self.grid.as_ref().and_then(|g| g.stack_floor.as_ref()))
+            .ok()
+    }
+
+    /// Frame `index` of the building axes (see [`BuildingAxes::frame`]).
+    pub fn frame(&self, axes: &BuildingAxes, index: usize) -> Option<Frame> {
+        let (n, floor) = axes.frame(index);
+        Some(self.building.as_ref()?.frame(n, floor))
     }
 
     /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`; the defaults without a

@@ -1,6 +1,7 @@
 //! The parametric study's numerics and configuration (the stages that drive them are in
 //! [`crate::pipeline`]).
 //!
+//! * [`building`]: a study over buildings: the `building:` section, `grid.stack_floor`, a frame.
 //! * [`cases`]: the paper's named cases (Section 7.1, Table 2, Section 9).
 //! * [`config`]: the study file (YAML), validated before any work.
 //! * [`ida`]: the `ida:` section, a case's systems on a yielding structure, one traced unit.
@@ -9,6 +10,7 @@
 //! * [`sweep`]: the skip rules, one work unit.
 //! * [`tnew`]: `T_new` from the mean displacement spectrum; the fit's samples.
 
+pub mod building;
 pub mod cases;
 pub mod config;
 pub mod ida;

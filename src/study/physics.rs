@@ -3,9 +3,14 @@
 //! systems a case is run as ([`SystemKind`]): the stack, the whole stack as one block, and the
 //! stack rigidly attached. All three share one viscous damper and, on a yielding structure, one
 //! yield force. The one place these systems are built, for the sweep, the T_new stage, the
-//! report and the IDA stage.
+//! report and the IDA stage; in a study over buildings, the same three in a building
+//! ([`Physics::building`], [`Physics::simulate_building`]; one storey is the one-storey case).
 
+use super::building::Frame;
 use crate::case::Case;
+use crate::dynamics::building::{
+    Building, BuildingError, BuildingResponse, BuildingSpec, StackSpec, simulate_building,
+};
 use crate::dynamics::{
     ExactOptions, Ground, ModelError, Response, SimError, System, SystemSpec, Yielding,
     simulate_exact,
@@ -66,6 +71,19 @@ pub enum CaseError {
         case: Case,
         kind: SystemKind,
         source: SimError,
+    },
+    #[error("case {case}, {} system: {source}", kind.name())]
+    BuildingModel {
+        case: Case,
+        kind: SystemKind,
+        source: Box<BuildingError>,
+    },
+    /// A system of a case in a building: the building (`3 storeys, stack on the roof`) and the
+    /// error.
+    #[error("{frame}: {source}")]
+    InBuilding {
+        frame: String,
+        source: Box<CaseError>,
     },
 }
 
@@ -178,6 +196,94 @@ impl Physics {
             case: case.clone(),
             kind,
             source,
+        })
+    }
+
+    /// The bare building of `frame` with first-mode period `period_s`: the study's damping
+    /// ratio in every mode of its basis, elastic storeys, no stacks.
+    pub fn bare_building(&self, period_s: f64, frame: &Frame) -> BuildingSpec {
+        BuildingSpec {
+            period_s,
+            floor_masses: frame.floor_masses.clone(),
+            storey_stiffnesses: frame.storey_stiffnesses.clone(),
+            damping_ratio: self.damping,
+            damping_basis: self.basis,
+            yielding: None,
+            stacks: Vec::new(),
+        }
+    }
+
+    /// System `kind` of `case` in the building `frame` (docs/model.md, "A study over
+    /// buildings"): `T_p` is the bare building's first-mode period, the case's stack stands on
+    /// each of the frame's floors (`α_i` over that floor's mass). The single block is each stack
+    /// as one block on its interface 1; the rigid system is that single block rigidly attached
+    /// to its floor ([`Building::with_stacks_attached`]: the same stiffnesses and damping
+    /// matrix), so that it is made of `α` alone, as on one storey. The damping matrix is the
+    /// basis's, the same for all three: on a rigid basis every loaded floor carries the same
+    /// `α` in all of them.
+    pub fn building(
+        &self,
+        kind: SystemKind,
+        case: &Case,
+        frame: &Frame,
+    ) -> Result<Building, BuildingError> {
+        let total = [case.alpha_total()];
+        let (alpha, mu) = match kind {
+            SystemKind::SingleBlock | SystemKind::Rigid => (&total[..], &case.mu[..1]),
+            SystemKind::Stack => (&case.alpha[..], &case.mu[..]),
+        };
+        let mut spec = self.bare_building(case.period_s, frame);
+        spec.stacks = frame
+            .floors()
+            .into_iter()
+            .map(|floor| StackSpec {
+                floor,
+                alpha: alpha.to_vec(),
+                mu: mu.to_vec(),
+                mu_static: Some(mu.iter().map(|m| m * self.mu_static_ratio).collect()),
+            })
+            .collect();
+        let b = Building::new(&spec)?;
+        Ok(match kind {
+            SystemKind::Rigid => b.with_stacks_attached(),
+            SystemKind::Stack | SystemKind::SingleBlock => b,
+        })
+    }
+
+    /// System `kind` of `case` in the building `frame` on the elastic storeys under `ground`,
+    /// by the exact integrator. A building of one storey (one stack) is the one-storey case:
+    /// it runs as [`Physics::simulate`] runs it, bit for bit and as fast (the building's
+    /// integrator agrees with it to round-off, `tests/building.rs`).
+    pub fn simulate_building(
+        &self,
+        kind: SystemKind,
+        case: &Case,
+        frame: &Frame,
+        ground: &Ground,
+        opts: &ExactOptions,
+    ) -> Result<BuildingResponse, CaseError> {
+        if frame.storeys() == 1 {
+            return self
+                .simulate(kind, case, ground, opts)
+                .map(BuildingResponse::from_one_storey);
+        }
+        let in_building = |e| CaseError::InBuilding {
+            frame: frame.to_string(),
+            source: Box::new(e),
+        };
+        let b = self.building(kind, case, frame).map_err(|source| {
+            in_building(CaseError::BuildingModel {
+                case: case.clone(),
+                kind,
+                source: Box::new(source),
+            })
+        })?;
+        simulate_building(&b, ground, opts).map_err(|source| {
+            in_building(CaseError::Simulation {
+                case: case.clone(),
+                kind,
+                source,
+            })
         })
     }
 }

@@ -14,9 +14,15 @@
 //! * when the coefficients never decrease upward and static equals kinetic, no upper interface
 //!   can slip before the one below it, so the stack acts as one block ([`SkipRule::SingleBlock`],
 //!   docs/model.md "Stated special cases").
+//!
+//! In a building ([`Frame`]) each rule holds as stated, the rigid system's acceleration being
+//! that of every floor carrying a stack (docs/model.md, "A study over buildings", gives the
+//! reasoning); the structure's peaks are then the roof's.
 
+use super::building::Frame;
 use super::physics::{CaseError, Physics, SystemKind};
 use crate::case::Case;
+use crate::dynamics::building::BuildingResponse;
 use crate::dynamics::{ExactOptions, G, Ground, Response};
 use crate::grid::Grid;
 use std::collections::HashMap;
@@ -45,14 +51,66 @@ pub const SKIP_RULE_FLAGS: [(u8, &str); 3] = [
     (SkipRule::SingleBlock as u8, "single_block"),
 ];
 
+/// What the sweep keeps of one system's run.
+#[derive(Debug, Clone, PartialEq)]
+struct Peaks {
+    /// Peak displacement of the structure (a building's roof) relative to the ground, m.
+    u_m: f64,
+    /// Peak absolute acceleration of the structure (a building's roof), m/s².
+    a_mps2: f64,
+    /// The largest peak absolute acceleration of the floors carrying a stack, m/s² (the
+    /// structure's on one storey): what the no-slip rules compare with `μ_s·g`.
+    a_hold_mps2: f64,
+    /// Peak slip per interface of the case's stack, m; with a stack on several floors, the
+    /// largest over them.
+    slip_m: Vec<f64>,
+    /// Energy dissipated by friction, J per kg of the bare structure's mass.
+    friction: f64,
+}
+
+impl Peaks {
+    fn of_structure(r: Response) -> Self {
+        Self {
+            u_m: r.peak_displacement_m,
+            a_mps2: r.peak_abs_accel_mps2[0],
+            a_hold_mps2: r.peak_abs_accel_mps2[0],
+            slip_m: r.peak_slip_m,
+            friction: r.energy.friction,
+        }
+    }
+
+    /// `blocks` blocks per stack, on `floors` (1-based).
+    fn of_building(r: BuildingResponse, floors: &[usize], blocks: usize) -> Self {
+        let roof = r.floor_peak_displacement_m.len() - 1;
+        let a_hold_mps2 = floors
+            .iter()
+            .map(|&f| r.floor_peak_abs_accel_mps2[f - 1])
+            .fold(0.0, f64::max);
+        let slip_m = (0..blocks)
+            .map(|i| {
+                (r.peak_slip_m.iter().skip(i).step_by(blocks.max(1)))
+                    .copied()
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        Self {
+            u_m: r.floor_peak_displacement_m[roof],
+            a_mps2: r.floor_peak_abs_accel_mps2[roof],
+            a_hold_mps2,
+            slip_m,
+            friction: r.energy.friction,
+        }
+    }
+}
+
 /// Results of one work unit, one entry per case (order of [`Grid::case`]).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct UnitResult {
-    /// Peak structure displacement, m: stack, single block, rigid.
+    /// Peak structure displacement (a building's roof), m: stack, single block, rigid.
     pub u_stack: Vec<f64>,
     pub u_single: Vec<f64>,
     pub u_rigid: Vec<f64>,
-    /// Peak absolute structure acceleration with the stack, g.
+    /// Peak absolute structure (a building's roof) acceleration with the stack, g.
     pub a_stack: Vec<f64>,
     /// Peak slip per interface, m, `[case][interface]` row-major.
     pub slip_peak: Vec<f64>,
@@ -72,10 +130,12 @@ pub struct UnitOptions {
     pub skip: bool,
 }
 
-/// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`.
+/// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`, on
+/// one storey (`frame` `None`) or in the building `frame`.
 pub fn run_unit(
     grid: &Grid,
     physics: &Physics,
+    frame: Option<&Frame>,
     ground: &Ground,
     period_index: usize,
     opts: UnitOptions,
@@ -89,10 +149,22 @@ pub fn run_unit(
         energy_balance: false,
         ..ExactOptions::default()
     };
-    let simulate = |kind, case: &Case| physics.simulate(kind, case, ground, &exact);
+    let floors = frame.map(Frame::floors);
+    let simulate = |kind, case: &Case| match (frame, &floors) {
+        (Some(f), Some(floors)) => {
+            let blocks = match kind {
+                SystemKind::Stack => n,
+                SystemKind::SingleBlock => 1,
+                SystemKind::Rigid => 0,
+            };
+            (physics.simulate_building(kind, case, f, ground, &exact))
+                .map(|r| Peaks::of_building(r, floors, blocks))
+        }
+        _ => (physics.simulate(kind, case, ground, &exact)).map(Peaks::of_structure),
+    };
     // Keyed by the bits of α (and the index of μ_1): the same floating-point sum, the same system.
-    let mut rigid: HashMap<u64, Response> = HashMap::new();
-    let mut single: HashMap<(u64, u64), Response> = HashMap::new();
+    let mut rigid: HashMap<u64, Peaks> = HashMap::new();
+    let mut single: HashMap<(u64, u64), Peaks> = HashMap::new();
     for c in 0..cases {
         let (alpha, mu) = grid.stack(c);
         let case = Case {
@@ -108,10 +180,9 @@ pub fn run_unit(
             out.simulations += 1;
         }
         let r = &rigid[&key];
-        let a_rigid = r.peak_abs_accel_mps2[0];
-        // Holding needs |a| ≤ μ_s·g at every instant; the margin keeps clear of the
-        // integrator's own switch tolerance.
-        let holds = |mu_s: f64| a_rigid < mu_s * G * (1.0 - 1e-9);
+        // Holding needs |a| ≤ μ_s·g at every instant on every floor carrying a stack; the
+        // margin keeps clear of the integrator's own switch tolerance.
+        let holds = |mu_s: f64| r.a_hold_mps2 < mu_s * G * (1.0 - 1e-9);
 
         let skey = (key, mu[0].to_bits());
         let single_holds = opts.skip && holds(mu_s[0]);
@@ -120,9 +191,9 @@ pub fn run_unit(
             out.simulations += 1;
         }
         let u_single = if single_holds {
-            r.peak_displacement_m
+            r.u_m
         } else {
-            single[&skey].peak_displacement_m
+            single[&skey].u_m
         };
 
         let min_mu_s = mu_s.iter().copied().fold(f64::INFINITY, f64::min);
@@ -138,32 +209,31 @@ pub fn run_unit(
                 Some(simulate(SystemKind::Stack, &case)?),
             )
         };
-        out.u_rigid.push(r.peak_displacement_m);
+        out.u_rigid.push(r.u_m);
         out.u_single.push(u_single);
         out.single_rule.push(u8::from(single_holds));
         out.skip_rule.push(rule as u8);
         match (rule, &resp) {
             (_, Some(s)) => {
-                out.u_stack.push(s.peak_displacement_m);
-                out.a_stack.push(s.peak_abs_accel_mps2[0] / G);
-                out.slip_peak.extend_from_slice(&s.peak_slip_m);
-                out.friction_energy.push(s.energy.friction);
+                out.u_stack.push(s.u_m);
+                out.a_stack.push(s.a_mps2 / G);
+                out.slip_peak.extend_from_slice(&s.slip_m);
+                out.friction_energy.push(s.friction);
             }
             (SkipRule::NoSlip, None) => {
-                out.u_stack.push(r.peak_displacement_m);
-                out.a_stack.push(a_rigid / G);
+                out.u_stack.push(r.u_m);
+                out.a_stack.push(r.a_mps2 / G);
                 out.slip_peak.extend(std::iter::repeat_n(0.0, n));
                 out.friction_energy.push(0.0);
             }
             (_, None) => {
                 let s = if single_holds { r } else { &single[&skey] };
-                out.u_stack.push(s.peak_displacement_m);
-                out.a_stack.push(s.peak_abs_accel_mps2[0] / G);
-                out.slip_peak
-                    .push(s.peak_slip_m.first().copied().unwrap_or(0.0));
+                out.u_stack.push(s.u_m);
+                out.a_stack.push(s.a_mps2 / G);
+                out.slip_peak.push(s.slip_m.first().copied().unwrap_or(0.0));
                 out.slip_peak.extend(std::iter::repeat_n(0.0, n - 1));
                 out.friction_energy
-                    .push(if single_holds { 0.0 } else { s.energy.friction });
+                    .push(if single_holds { 0.0 } else { s.friction });
             }
         }
     }

@@ -1,0 +1,316 @@
+//! A study over buildings (docs/model.md, "A study over buildings"): the config's `building:`
+//! section and `grid.stack_floor`, checked, and the [`Frame`] a case of such a study stands in.
+//!
+//! ```yaml
+//! building:
+//!   storeys: [1, 3, 6]             # one value or a list (a grid axis, `storeys`)
+//!   floor_masses: [1, 1, 1]        # relative, floor 1 first (only with one `storeys` value)
+//!   storey_stiffnesses: [3, 2, 1]  # relative, storey 1 first (idem) [default: all 1]
+//! grid:
+//!   period_s: [0.3, 0.6]           # the bare building's first-mode period
+//!   stack_floor: [1, roof, all]    # a floor number, `roof`, `all`, or a list (an axis)
+//! ```
+//!
+//! The building's damping is the grid's (`damping`, `damping_basis`: modal, `ζ` in every mode
+//! of the basis); its period the grid's `period_s`; its storeys elastic.
+
+use crate::case::Case;
+use crate::dynamics::building::model::modes;
+use crate::grid::{BuildingAxes, StackFloor};
+use crate::limits::{MAX_AXIS_VALUES, MAX_STOREYS, excerpt};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// One value or a list of them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum OneOrList<T> {
+    One(T),
+    List(Vec<T>),
+}
+
+impl<T: Clone> OneOrList<T> {
+    pub fn to_vec(&self) -> Vec<T> {
+        match self {
+            OneOrList::One(v) => vec![v.clone()],
+            OneOrList::List(v) => v.clone(),
+        }
+    }
+}
+
+/// A floor as the config writes it: a number, `roof` or `all`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum FloorKey {
+    Index(usize),
+    Name(String),
+}
+
+/// The `building:` section of a study: the case file's building keys, `storeys` possibly a
+/// list. The keys a study sets elsewhere (`period`) or does not yet run (`structure` other than
+/// `elastic`, the yield keys) are read so that they can be refused by name.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BuildingSection {
+    /// Storey counts `N`: one, or a list (the `storeys` axis).
+    pub storeys: OneOrList<usize>,
+    /// Relative floor masses, floor 1 first [default: all 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floor_masses: Option<Vec<f64>>,
+    /// Relative storey stiffnesses, storey 1 first [default: all 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub storey_stiffnesses: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub structure: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yield_strength_ratios: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub post_yield_ratio: Option<f64>,
+}
+
+/// The building a case of a building study stands in: the bare building's relative floor
+/// masses and storey stiffnesses (its first-mode period is the case's `T_p`) and the floors
+/// carrying the case's stack.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    pub floor_masses: Vec<f64>,
+    pub storey_stiffnesses: Vec<f64>,
+    pub stack_floor: StackFloor,
+}
+
+impl Frame {
+    pub fn storeys(&self) -> usize {
+        self.floor_masses.len()
+    }
+
+    /// The floors carrying a stack, 1-based, lowest first.
+    pub fn floors(&self) -> Vec<usize> {
+        self.stack_floor.floors(self.storeys())
+    }
+
+    /// `Γ_1·φ_1,N` of the bare building: the roof's displacement per unit displacement of the
+    /// first mode's equivalent SDOF (Chopra, *Dynamics of Structures*, the modal expansion of
+    /// the effective earthquake forces: `u_N = Γ_1·φ_1,N·D_1`), `Γ_1 = φ_1ᵀ·M·1 / φ_1ᵀ·M·φ_1`.
+    /// Independent of the mode's scale and sign and of the stiffnesses' scale; 1 on one storey
+    /// (exact: `m·φ²` with `φ = 1/sqrt(m)`, given without round-off).
+    pub fn roof_participation(&self) -> f64 {
+        let n = self.storeys();
+        if n == 1 {
+            return 1.0;
+        }
+        let (_, phi) = modes(&self.floor_masses, &self.storey_stiffnesses);
+        let m_phi_1: f64 = (0..n).map(|j| self.floor_masses[j] * phi[(j, 0)]).sum();
+        let m_phi_phi: f64 = (0..n)
+            .map(|j| self.floor_masses[j] * phi[(j, 0)] * phi[(j, 0)])
+            .sum();
+        m_phi_1 / m_phi_phi * phi[(n - 1, 0)]
+    }
+
+    /// `T_1,rigid`, s: the first-mode period of the building whose bare first-mode period is
+    /// `case.period_s` with the case's whole stack (`α = Σα_i` of each loaded floor's mass)
+    /// rigidly attached to every floor the frame names; on one storey `T_p·sqrt(1+α)`
+    /// ([`Case::t_rigid_s`], the same arithmetic as the one-storey study).
+    pub fn t_rigid_s(&self, case: &Case) -> f64 {
+        if self.storeys() == 1 {
+            return case.t_rigid_s();
+        }
+        let alpha = case.alpha_total();
+        let mut loaded = self.floor_masses.clone();
+        for f in self.floors() {
+            loaded[f - 1] *= 1.0 + alpha;
+        }
+        let bare = modes(&self.floor_masses, &self.storey_stiffnesses).0[0];
+        let rigid = modes(&loaded, &self.storey_stiffnesses).0[0];
+        case.period_s * (bare / rigid).sqrt()
+    }
+}
+
+/// `3 storeys, stack on floor 2` (or `on the roof`, `on every floor`).
+impl fmt::Display for Frame {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let n = self.storeys();
+        let s = if n == 1 { "" } else { "s" };
+        match self.stack_floor {
+            StackFloor::Floor(j) => write!(f, "{n} storey{s}, stack on floor {j}"),
+            StackFloor::Roof => write!(f, "{n} storey{s}, stack on the roof"),
+            StackFloor::All => write!(f, "{n} storey{s}, a stack on every floor"),
+        }
+    }
+}
+
+impl BuildingSection {
+    /// Checks the section and `grid.stack_floor` against it (`None`: the roof) and gives the
+    /// building axes; `Err((key, why))`. The relative masses and stiffnesses are checked by
+    /// [`Self::frame`]'s building when the physics builds it, and here by building each.
+    pub fn axes(
+        &self,
+        stack_floor: Option<&OneOrList<FloorKey>>,
+    ) -> Result<BuildingAxes, (String, String)> {
+        let err = |k: &str, w: String| Err((k.to_string(), w));
+        if self.period.is_some() {
+            return err(
+                "building.period",
+                "a study's periods are `grid.period_s` (the bare building's first-mode period); \
+                 remove `building.period`"
+                    .into(),
+            );
+        }
+        let yielding = self.yield_strength_ratios.is_some() || self.post_yield_ratio.is_some();
+        if yielding || self.structure.as_ref().is_some_and(|s| s != "elastic") {
+            return err(
+                "building.structure",
+                "a building study's sweep is elastic; yielding storeys (structure, \
+                 yield_strength_ratios, post_yield_ratio) are not yet supported in a study"
+                    .into(),
+            );
+        }
+        let storeys = self.storeys.to_vec();
+        if storeys.is_empty() || storeys.len() > MAX_AXIS_VALUES {
+            return err(
+                "building.storeys",
+                format!("needs 1 to {MAX_AXIS_VALUES} values"),
+            );
+        }
+        if let Some(n) = storeys.iter().find(|n| !(1..=MAX_STOREYS).contains(*n)) {
+            return err(
+                "building.storeys",
+                format!("{n}: a building has 1 … {MAX_STOREYS} storeys"),
+            );
+        }
+        if storeys.windows(2).any(|w| w[1] <= w[0]) {
+            return err(
+                "building.storeys",
+                "values must be strictly increasing".into(),
+            );
+        }
+        for (key, v) in [
+            ("building.floor_masses", &self.floor_masses),
+            ("building.storey_stiffnesses", &self.storey_stiffnesses),
+        ] {
+            if let Some(v) = v
+                && (storeys.len() != 1 || v.len() != storeys[0])
+            {
+                return err(
+                    key,
+                    format!(
+                        "lists {} values; it needs one per storey, and so one `building.storeys` \
+                         value (omit it for uniform storeys)",
+                        v.len()
+                    ),
+                );
+            }
+        }
+        let lowest = storeys[0];
+        let keys = stack_floor.map_or(vec![FloorKey::Name("roof".into())], OneOrList::to_vec);
+        if keys.is_empty() {
+            return err("grid.stack_floor", "needs at least one value".into());
+        }
+        let mut floors = Vec::with_capacity(keys.len());
+        for k in keys {
+            let f = match k {
+                FloorKey::Index(j) if (1..=lowest).contains(&j) => StackFloor::Floor(j),
+                FloorKey::Index(j) => {
+                    return err(
+                        "grid.stack_floor",
+                        format!(
+                            "floor {j} is not a floor of every building: floors are 1 … {lowest} \
+                             in the lowest (`building.storeys`); use `roof` for the top floor"
+                        ),
+                    );
+                }
+                FloorKey::Name(s) if s == "roof" => StackFloor::Roof,
+                FloorKey::Name(s) if s == "all" => StackFloor::All,
+                FloorKey::Name(s) => {
+                    return err(
+                        "grid.stack_floor",
+                        format!(
+                            "`{}`: a floor number, `roof` or `all` (or a list of them)",
+                            excerpt(&s)
+                        ),
+                    );
+                }
+            };
+            if floors.contains(&f) {
+                return err("grid.stack_floor", format!("`{f}` is listed twice"));
+            }
+            floors.push(f);
+        }
+        Ok(BuildingAxes {
+            storeys,
+            stack_floor: floors,
+        })
+    }
+
+    /// The frame of `storeys` storeys with the stack on `stack_floor`.
+    pub fn frame(&self, storeys: usize, stack_floor: StackFloor) -> Frame {
+        Frame {
+            floor_masses: (self.floor_masses.clone()).unwrap_or_else(|| vec![1.0; storeys]),
+            storey_stiffnesses: (self.storey_stiffnesses.clone())
+                .unwrap_or_else(|| vec![1.0; storeys]),
+            stack_floor,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(n: usize, stack_floor: StackFloor) -> Frame {
+        Frame {
+            floor_masses: vec![1.0; n],
+            storey_stiffnesses: vec![1.0; n],
+            stack_floor,
+        }
+    }
+
+    #[test]
+    fn participation_and_rigid_period_against_closed_forms() {
+        // Two equal storeys: the first mode is (1, g), g the golden ratio, so
+        // Γ_1·φ_1,2 = g·(1 + g)/(1 + g²), by hand.
+        let g = (1.0 + 5f64.sqrt()) / 2.0;
+        let two = frame(2, StackFloor::Roof);
+        let want = g * (1.0 + g) / (1.0 + g * g);
+        assert!((two.roof_participation() - want).abs() < 1e-14, "{want}");
+        assert_eq!(frame(1, StackFloor::Roof).roof_participation(), 1.0);
+        // N uniform storeys: φ_j = sin((2r − 1)πj/(2N + 1)) for mode r, so with r = 1
+        // Γ_1·φ_1,N = φ_N·Σφ_j/Σφ_j².
+        for n in [3, 10, 40] {
+            let phi: Vec<f64> = (1..=n)
+                .map(|j| (std::f64::consts::PI * j as f64 / (2 * n + 1) as f64).sin())
+                .collect();
+            let sum: f64 = phi.iter().sum();
+            let want = phi[n - 1] * sum / phi.iter().map(|p| p * p).sum::<f64>();
+            let got = frame(n, StackFloor::Roof).roof_participation();
+            assert!((got - want).abs() < 1e-12, "{n}: {got} vs {want}");
+        }
+
+        // α on floor 1 of two unit storeys (k = 1): m_1 = 1 + α, m_2 = 1 and
+        // m_1·m_2·ω⁴ − k(m_1 + 2m_2)·ω² + k² = 0, the smaller root.
+        let case = Case {
+            period_s: 0.8,
+            alpha: vec![0.3, 0.5],
+            mu: vec![0.2, 0.1],
+        };
+        let w2 = |m1: f64, m2: f64| {
+            let b = m1 + 2.0 * m2;
+            (b - (b * b - 4.0 * m1 * m2).sqrt()) / (2.0 * m1 * m2)
+        };
+        let want = 0.8 * (w2(1.0, 1.0) / w2(1.8, 1.0)).sqrt();
+        let got = frame(2, StackFloor::Floor(1)).t_rigid_s(&case);
+        assert!((got - want).abs() < 1e-13, "{got} vs {want}");
+        let want = 0.8 * (w2(1.0, 1.0) / w2(1.0, 1.8)).sqrt();
+        assert!((two.t_rigid_s(&case) - want).abs() < 1e-13);
+        // Every floor loaded alike scales M: T·sqrt(1+α), in any building.
+        let all = Frame {
+            floor_masses: vec![1.0, 2.0, 0.5, 1.5],
+            storey_stiffnesses: vec![4.0, 3.0, 2.0, 1.0],
+            stack_floor: StackFloor::All,
+        };
+        let got = all.t_rigid_s(&case);
+        assert!((got - case.t_rigid_s()).abs() < 1e-13 * got, "{got}");
+        assert_eq!(frame(1, StackFloor::All).t_rigid_s(&case), case.t_rigid_s());
+    }
+}
