@@ -184,28 +184,42 @@ fn trust_region(
     Ok((p, sse, iterations, converged))
 }
 
-/// Nelder–Mead from `p0` in the scaled parameters, simplex steps of 0.1 (about 0.1 s of
-/// prediction each): the best point and whether it stopped on its tolerance.
-fn nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), FitError> {
-    let scaled = Scaled::new(problem, problem.column_scales(p0));
-    let q0 = scaled.to_q(p0);
-    let mut simplex = vec![q0.clone()];
+/// The state argmin's Nelder–Mead keeps.
+type NmState = IterState<Vec<f64>, (), (), (), (), f64>;
+
+/// argmin's Nelder–Mead on `problem` (a scaled problem) from `q0`, simplex steps of 0.1 in
+/// every scaled parameter, stopped when the simplex's costs agree to 1e-12 of the starting
+/// cost (a relative bound) or after [`MAX_NELDER_MEAD_ITERATIONS`].
+fn run_nelder_mead<P>(
+    problem: P,
+    q0: &[f64],
+) -> Result<OptimizationResult<P, NelderMead<Vec<f64>, f64>, NmState>, FitError>
+where
+    P: CostFunction<Param = Vec<f64>, Output = f64>,
+{
+    let mut simplex = vec![q0.to_vec()];
     for i in 0..q0.len() {
-        let mut v = q0.clone();
+        let mut v = q0.to_vec();
         v[i] += 0.1;
         simplex.push(v);
     }
-    let start_cost = scaled.cost(&q0).map_err(solver_error)?;
-    // Stop when the simplex's costs agree to 1e-12 of the starting cost (a relative bound).
+    let start_cost = problem.cost(&q0.to_vec()).map_err(solver_error)?;
     let solver = NelderMead::new(simplex)
         .with_sd_tolerance(1e-12 * start_cost.max(f64::MIN_POSITIVE))
         .map_err(solver_error)?;
-    let result = Executor::new(scaled, solver)
+    Executor::new(problem, solver)
         .configure(|s| s.max_iters(MAX_NELDER_MEAD_ITERATIONS))
         .timer(false)
         .run()
-        .map_err(solver_error)?;
-    outcome(result, "Nelder–Mead")
+        .map_err(solver_error)
+}
+
+/// Nelder–Mead from `p0` in the scaled parameters (a step of 0.1 is about 0.1 s of
+/// prediction): the best point and whether it stopped on its tolerance.
+fn nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), FitError> {
+    let scaled = Scaled::new(problem, problem.column_scales(p0));
+    let q0 = scaled.to_q(p0);
+    outcome(run_nelder_mead(scaled, &q0)?, "Nelder–Mead")
 }
 
 /// The paper form's fallback: Nelder–Mead over its `k` exponent weights `c` only, the linear
@@ -224,21 +238,7 @@ fn projected_nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64
         .zip(&projected.d)
         .map(|(c, d)| c * d)
         .collect();
-    let mut simplex = vec![q0.clone()];
-    for i in 0..k {
-        let mut v = q0.clone();
-        v[i] += 0.1;
-        simplex.push(v);
-    }
-    let start_cost = projected.cost(&q0).map_err(solver_error)?;
-    let solver = NelderMead::new(simplex)
-        .with_sd_tolerance(1e-12 * start_cost.max(f64::MIN_POSITIVE))
-        .map_err(solver_error)?;
-    let result = Executor::new(projected, solver)
-        .configure(|s| s.max_iters(MAX_NELDER_MEAD_ITERATIONS))
-        .timer(false)
-        .run()
-        .map_err(solver_error)?;
+    let result = run_nelder_mead(projected, &q0)?;
     let converged = matches!(
         result.state.get_termination_reason(),
         Some(TerminationReason::SolverConverged)
