@@ -184,16 +184,14 @@ fn trust_region(
     Ok((p, sse, iterations, converged))
 }
 
-/// The state argmin's Nelder–Mead keeps.
-type NmState = IterState<Vec<f64>, (), (), (), (), f64>;
+/// A finished run of argmin's Nelder–Mead on the problem `P`.
+type NmRun<P> =
+    OptimizationResult<P, NelderMead<Vec<f64>, f64>, IterState<Vec<f64>, (), (), (), (), f64>>;
 
 /// argmin's Nelder–Mead on `problem` (a scaled problem) from `q0`, simplex steps of 0.1 in
 /// every scaled parameter, stopped when the simplex's costs agree to 1e-12 of the starting
 /// cost (a relative bound) or after [`MAX_NELDER_MEAD_ITERATIONS`].
-fn run_nelder_mead<P>(
-    problem: P,
-    q0: &[f64],
-) -> Result<OptimizationResult<P, NelderMead<Vec<f64>, f64>, NmState>, FitError>
+fn run_nelder_mead<P>(problem: P, q0: &[f64]) -> Result<NmRun<P>, FitError>
 where
     P: CostFunction<Param = Vec<f64>, Output = f64>,
 {
