@@ -179,7 +179,7 @@ fn trust_region(
         .timer(false)
         .run()
         .map_err(solver_error)?;
-    let (p, iterations, converged) = outcome(result, "trust region")?;
+    let (p, iterations, converged) = outcome(result, "trust region", Scaled::to_p)?;
     let sse = problem.sse(&p);
     Ok((p, sse, iterations, converged))
 }
@@ -217,7 +217,7 @@ where
 fn nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), FitError> {
     let scaled = Scaled::new(problem, problem.column_scales(p0));
     let q0 = scaled.to_q(p0);
-    outcome(run_nelder_mead(scaled, &q0)?, "Nelder–Mead")
+    outcome(run_nelder_mead(scaled, &q0)?, "Nelder–Mead", Scaled::to_p)
 }
 
 /// The paper form's fallback: Nelder–Mead over its `k` exponent weights `c` only, the linear
@@ -236,36 +236,26 @@ fn projected_nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64
         .zip(&projected.d)
         .map(|(c, d)| c * d)
         .collect();
-    let result = run_nelder_mead(projected, &q0)?;
-    let converged = matches!(
-        result.state.get_termination_reason(),
-        Some(TerminationReason::SolverConverged)
-    );
-    let iterations = result.state.get_iter();
-    let q = result
-        .state
-        .get_best_param()
-        .ok_or_else(|| FitError::Solver("Nelder–Mead (projected): no best parameters".into()))?;
-    let c = result
-        .problem
-        .problem
-        .as_ref()
-        .map(|s| s.to_c(q))
-        .ok_or_else(|| FitError::Solver("Nelder–Mead (projected): problem not returned".into()))?;
+    let (c, iterations, converged) = outcome(
+        run_nelder_mead(projected, &q0)?,
+        "Nelder–Mead (projected)",
+        Projected::to_c,
+    )?;
     let mut start = p0.to_vec();
     start[k..2 * k].copy_from_slice(&c);
     Ok((problem.complete_start(&start), iterations, converged))
 }
 
-/// A run of an argmin solver `S` on the scaled problem, as the executor returns it.
-type Finished<'a, S, G, J, H, R> =
-    OptimizationResult<Scaled<'a>, S, IterState<Vec<f64>, G, J, H, R, f64>>;
+/// A run of an argmin solver `S` on the problem `P`, as the executor returns it.
+type Finished<P, S, G, J, H, R> = OptimizationResult<P, S, IterState<Vec<f64>, G, J, H, R, f64>>;
 
-/// A finished run's best point in natural parameters, its iterations and whether the solver
-/// converged (rather than stopped at its limit or stalled).
-fn outcome<S, G, J, H, R>(
-    result: Finished<S, G, J, H, R>,
+/// A finished run's best point mapped by `unscale` (from the solver's parameters to the ones
+/// the caller wants), its iterations and whether the solver converged (rather than stopped at
+/// its limit or stalled).
+fn outcome<P, S, G, J, H, R>(
+    result: Finished<P, S, G, J, H, R>,
     method: &str,
+    unscale: impl Fn(&P, &[f64]) -> Vec<f64>,
 ) -> Result<(Vec<f64>, u64, bool), FitError> {
     let converged = matches!(
         result.state.get_termination_reason(),
@@ -280,7 +270,7 @@ fn outcome<S, G, J, H, R>(
         .problem
         .problem
         .as_ref()
-        .map(|s| s.to_p(q))
+        .map(|s| unscale(s, q))
         .ok_or_else(|| FitError::Solver(format!("{method}: problem not returned")))?;
     Ok((p, iterations, converged))
 }
