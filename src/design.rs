@@ -8,15 +8,25 @@
 //! and at `T_new`, from the target spectrum stored in `motions.h5` (never from a table file,
 //! which may have changed since). Reads only verified files of the study directory, and only a
 //! `motions.h5` that `tnew.h5` was made from.
+//!
+//! In a building study the question names a frame, a storey count and the floor carrying the
+//! stack (`floor N` is the roof): `T_p` is then the bare building's first-mode period `T_1`,
+//! `T_rigid` the first-mode period with the stack rigidly attached to its floor(s)
+//! ([`crate::study::building::Frame::t_rigid_s`], from the frame `fit.yaml` stores), the grid's
+//! `T_new` the frame's own, the fit evaluated with the building's features. Between storey
+//! counts or floors nothing is interpolated: a frame the study does not hold is refused.
 
-use crate::fit::{Fitted, PaperEquation, Sample, features};
-use crate::grid::{Grid, OutsideGrid};
+use crate::case::Case;
+use crate::fit::{BuildingFeatures, Fitted, PaperEquation, Sample, features};
+use crate::grid::{BuildingAxes, Grid, OutsideGrid, StackFloor};
 use crate::spectrum::target::TargetSpectrum;
 use crate::store::StoreError;
-use crate::store::fit::{ZoneFit, read_fit};
+use crate::store::fit::{FitReport, FrameSpec, ZoneFit, read_fit};
 use crate::store::h5::stored_fingerprint;
 use crate::store::motions::read_zone_target;
-use crate::store::tnew::{is_building, read_motions_fingerprint, read_zone_tnew, zones_and_blocks};
+use crate::store::tnew::{
+    is_building, read_motions_fingerprint, read_zone_tnew_in, zones_and_blocks,
+};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -43,11 +53,21 @@ pub enum DesignError {
     #[error("{}: {why}", file.display())]
     OtherMotions { file: PathBuf, why: &'static str },
     #[error(
-        "{}: is a building study's (`building`): `design` cannot yet answer for a building \
-         (docs/model.md, \"A study over buildings\")",
+        "{}: is a building study's (`building`): say which building, its storey count and the \
+         floor carrying the stack (`storeys`, `floor`)",
         file.display()
     )]
     Building { file: PathBuf },
+    #[error("{}: is a one-storey study's: `storeys` and `floor` are for a building study", file.display())]
+    NotBuilding { file: PathBuf },
+    #[error(
+        "the study has no building of {storeys} storeys with the stack on floor `{floor}`; it has {known}"
+    )]
+    UnknownFrame {
+        storeys: usize,
+        floor: String,
+        known: String,
+    },
     #[error(transparent)]
     Store(#[from] StoreError),
 }
@@ -74,6 +94,9 @@ pub struct Query {
     pub mu: Vec<f64>,
     /// Outside the grid, answer from the fit instead of refusing.
     pub extrapolate: bool,
+    /// A building study's: the storey count and the floor carrying the stack (`period_s` is
+    /// then the bare building's first-mode period `T_1`).
+    pub building: Option<(usize, StackFloor)>,
 }
 
 /// The answer (`slidestack design --json` prints it).
@@ -81,6 +104,10 @@ pub struct Query {
 pub struct Answer {
     pub zone: String,
     pub target: String,
+    /// A building study's frame (`3 storeys, stack on the roof`); `period_s` is its `T_1`,
+    /// `t_rigid_s` its `T_1,rigid` and every `T_new` the first mode's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub building: Option<String>,
     pub period_s: f64,
     pub alpha: Vec<f64>,
     pub mu: Vec<f64>,
@@ -119,6 +146,10 @@ pub struct ZoneDesign {
     pub fit: Option<Fitted>,
     /// The paper's Eq. 16 or 17, for zones III and V with two blocks.
     pub paper: Option<PaperEquation>,
+    /// A building study's frame, and the building features of its fit (`None`: the
+    /// one-storey features, a study of one frame).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub building: Option<(FrameSpec, Option<BuildingFeatures>)>,
 }
 
 impl ZoneDesign {
@@ -141,6 +172,7 @@ impl ZoneDesign {
             grid,
             t_new_s,
             paper,
+            building: None,
         }
     }
 }
@@ -177,8 +209,11 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         file,
     };
     let tnew_fp = stored_fingerprint(&tnew)?.ok_or_else(|| missing("tnew.h5"))?;
-    if is_building(&tnew)? {
-        return Err(DesignError::Building { file: tnew });
+    let building = is_building(&tnew)?;
+    match (building, q.building) {
+        (true, None) => return Err(DesignError::Building { file: tnew }),
+        (false, Some(_)) => return Err(DesignError::NotBuilding { file: tnew }),
+        _ => {}
     }
     let motions_fp = stored_fingerprint(&motions)?.ok_or_else(|| missing("motions.h5"))?;
     match read_motions_fingerprint(&tnew)? {
@@ -210,17 +245,65 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         });
     }
     check_counts(q, blocks)?;
-    let (grid, t) = read_zone_tnew(&tnew, &q.zone, blocks)?;
+    let (grid, axes, t) = read_zone_tnew_in(&tnew, &q.zone, blocks, building)?;
     let target = read_zone_target(&motions, &q.zone)?;
     let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
-    let data = ZoneDesign::new(
-        &q.zone,
-        target,
-        grid,
-        t.vars.t_new.iter().copied().collect(),
-        zone_fit,
-    );
+    let t_new: Vec<f64> = t.vars.t_new.iter().copied().collect();
+    let (t_new, frame) = match (q.building, axes) {
+        (Some((storeys, floor)), Some(axes)) => {
+            let f = frame_index(&fit, &axes, storeys, floor, &fit_yaml)?;
+            let per = grid.cases();
+            let features = BuildingFeatures::of_names(&fit.features, blocks);
+            let frame = (fit.frames[f].clone(), features);
+            (t_new[f * per..(f + 1) * per].to_vec(), Some(frame))
+        }
+        _ => (t_new, None),
+    };
+    let mut data = ZoneDesign::new(&q.zone, target, grid, t_new, zone_fit);
+    data.building = frame;
     answer(&data, q)
+}
+
+/// The index of the frame of `storeys` storeys with the stack on `floor` among the study's
+/// (`fit.yaml`'s, `tnew.h5`'s order): the one whose stacks stand on the same floors (floor `N`
+/// is the roof).
+fn frame_index(
+    fit: &FitReport,
+    axes: &BuildingAxes,
+    storeys: usize,
+    floor: StackFloor,
+    fit_yaml: &Path,
+) -> Result<usize, DesignError> {
+    let stored: Vec<(usize, StackFloor)> = (0..axes.frames()).map(|f| axes.frame(f)).collect();
+    let agrees = fit.frames.len() == stored.len()
+        && (fit.frames.iter().zip(&stored))
+            .all(|(a, b)| a.storeys == b.0 && a.stack_floor == b.1.to_string());
+    if !agrees {
+        return Err(DesignError::Mismatch {
+            file: fit_yaml.to_path_buf(),
+        });
+    }
+    let wanted = floor.floors(storeys);
+    if let StackFloor::Floor(j) = floor
+        && !(1..=storeys).contains(&j)
+    {
+        return Err(DesignError::UnknownFrame {
+            storeys,
+            floor: floor.to_string(),
+            known: format!("floors 1 … {storeys} in a building of {storeys} storeys"),
+        });
+    }
+    (stored.iter())
+        .position(|&(n, f)| n == storeys && f.floors(n) == wanted)
+        .ok_or_else(|| DesignError::UnknownFrame {
+            storeys,
+            floor: floor.to_string(),
+            known: (fit.frames.iter())
+                .filter_map(FrameSpec::frame)
+                .map(|f| format!("`{f}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
 }
 
 /// One value per block in `alpha` and `mu`.
@@ -237,9 +320,25 @@ fn check_counts(q: &Query, blocks: usize) -> Result<(), DesignError> {
 pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
     check_values(q)?;
     check_counts(q, z.grid.blocks())?;
-    let alpha_total: f64 = q.alpha.iter().sum();
-    let t_rigid_s = q.period_s * (1.0 + alpha_total).sqrt();
+    let case = Case {
+        period_s: q.period_s,
+        alpha: q.alpha.clone(),
+        mu: q.mu.clone(),
+    };
+    let frame =
+        (z.building.as_ref()).and_then(|(spec, features)| Some((spec.frame()?, spec, *features)));
+    let t_rigid_s = frame
+        .as_ref()
+        .map_or_else(|| case.t_rigid_s(), |(f, _, _)| f.t_rigid_s(&case));
     let mut notes = Vec::new();
+    if frame.is_some() {
+        notes.push(
+            "a building: T_p is its bare first-mode period T_1, T_rigid its first-mode period \
+             with the stacks rigidly attached, T_new the first mode's; the paper's equation is \
+             the one-storey one, read at T_1"
+                .into(),
+        );
+    }
 
     let mut point = vec![q.period_s];
     point.extend(&q.alpha);
@@ -262,9 +361,19 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
     };
 
     let x = features(q.period_s, &q.alpha, &q.mu);
+    let fit_x = match &frame {
+        Some((f, spec, Some(bf))) => bf.features(
+            q.period_s,
+            &q.alpha,
+            &q.mu,
+            spec.storeys,
+            f.stack_height_ratio(),
+        ),
+        _ => x.clone(),
+    };
     let t_new_fit_s = z.fit.as_ref().map(|f| {
         f.predict(&Sample {
-            x: x.clone(),
+            x: fit_x,
             t_rigid_s,
             t_new_s: f64::NAN,
         })
@@ -275,6 +384,7 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
     Ok(Answer {
         zone: q.zone.clone(),
         target: target.to_string(),
+        building: frame.map(|(f, _, _)| f.to_string()),
         period_s: q.period_s,
         alpha: q.alpha.clone(),
         mu: q.mu.clone(),

@@ -170,32 +170,135 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
         "['storeys', 'stack_floor', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2'] ['storeys']\n"
     );
 
-    // The stages that cannot yet take this building study say so, naming the key, before work.
-    for (stage, why) in [
-        (
-            "fit",
-            "`building`: the `fit` stage takes a building study of one frame only",
-        ),
-        (
-            "report",
-            "`building`: the `report` stage cannot yet take a building study",
-        ),
-    ] {
-        let o = slidestack(&[stage, cfg_s, "--out", out_s], "1");
-        assert_eq!(o.status.code(), Some(2), "{stage}: {}", stderr(&o));
-        assert!(stderr(&o).contains(why), "{}", stderr(&o));
-    }
-    assert!(!out.join("fit.h5").exists());
-    let o = slidestack(
-        &[
-            "design", "--study", out_s, "--zone", "V", "--period", "0.5", "--alpha", "0.25,0.5",
-            "--mu", "0.1,0.1",
-        ],
-        "1",
-    );
+    // The report cannot yet take this building study and says so, naming the key, before work.
+    let o = slidestack(&["report", cfg_s, "--out", out_s], "1");
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("is a building study's (`building`)"),
+        stderr(&o).contains("`building`: the `report` stage cannot yet take a building study"),
+        "{}",
+        stderr(&o)
+    );
+    several_frames_are_fitted_and_designed_for(&out);
+}
+
+/// The fit over the six frames of `configs/mdof-quick.yaml` (finished through `tnew` in `out`)
+/// with the building's features, and `design` in each frame.
+fn several_frames_are_fitted_and_designed_for(out: &Path) {
+    let cfg = repo("configs/mdof-quick.yaml");
+    let (cfg_s, out_s) = (cfg.to_str().unwrap(), out.to_str().unwrap());
+    let design = |extra: &[&str]| {
+        let mut args = vec![
+            "design", "--study", out_s, "--zone", "V", "--alpha", "0.25,0.5", "--mu", "0.1,0.05",
+        ];
+        args.extend(extra);
+        slidestack(&args, "1")
+    };
+    // Before the fit, design says what is missing.
+    let o = design(&["--period", "0.6", "--storeys", "3", "--floor", "roof"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no fit.yaml"), "{}", stderr(&o));
+
+    ok(slidestack(&["fit", cfg_s, "--out", out_s], "2"));
+    let text = std::fs::read_to_string(out.join("fit.yaml")).unwrap();
+    let fit: serde_yaml::Value = serde_yaml::from_str(&text).unwrap();
+    let names: Vec<&str> = (fit["features"].as_sequence().unwrap().iter())
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        ["T_1", "mu_1", "mu_2", "alpha_1", "alpha_2", "N", "z_stack"]
+    );
+    let frames = fit["frames"].as_sequence().unwrap();
+    assert_eq!(frames.len(), 6);
+    let zone_v = (fit["zones"].as_sequence().unwrap().iter())
+        .find(|z| z["zone"].as_str() == Some("V"))
+        .unwrap();
+    // The fit counts each building once: floor 1, the roof and every floor of one storey are
+    // one building (3 periods × 8 stacks × 4 distinct frames).
+    assert_eq!(zone_v["cases"].as_u64(), Some(96));
+    let per_frame = zone_v["frames"].as_sequence().unwrap();
+    assert_eq!(per_frame.len(), 6);
+    // The one-storey equation on the one-storey frame is its own fit: the same R².
+    let one = &zone_v["one_storey"]["all_cases"]["r2"];
+    assert!(
+        (per_frame[0]["one_storey"]["r2"].as_f64().unwrap() - one.as_f64().unwrap()).abs() < 1e-12
+    );
+
+    // design at every grid point of each frame: the grid's T_new is the stored one, its
+    // T_rigid the stored T_1,rigid, and the fitted T_new gives back the frame's R² in fit.yaml
+    // (the design's features and the fit's agree).
+    let (grid, axes, t) = read_zone_tnew_in(&out.join("tnew.h5"), "V", 2, true).unwrap();
+    let axes = axes.unwrap();
+    let per = grid.cases();
+    let t_new = t.vars.t_new.as_slice().unwrap();
+    let t_rigid = t.vars.t_rigid.as_slice().unwrap();
+    for f in 0..axes.frames() {
+        let (n, floor) = axes.frame(f);
+        let (mut observed, mut fitted) = (Vec::new(), Vec::new());
+        for c in 0..per {
+            let case = grid.case(c);
+            let join = |v: &[f64]| {
+                v.iter()
+                    .map(|x| x.to_string())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            };
+            let (p, a, m) = (case.period_s.to_string(), join(&case.alpha), join(&case.mu));
+            let (n_s, floor_s) = (n.to_string(), floor.to_string());
+            let o = ok(slidestack(
+                &[
+                    "design",
+                    "--study",
+                    out_s,
+                    "--zone",
+                    "V",
+                    "--period",
+                    &p,
+                    "--alpha",
+                    &a,
+                    "--mu",
+                    &m,
+                    "--storeys",
+                    &n_s,
+                    "--floor",
+                    &floor_s,
+                    "--json",
+                ],
+                "1",
+            ));
+            let a: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            let want = t_new[f * per + c];
+            match a["t_new_grid_s"].as_f64() {
+                Some(got) => assert_eq!(got, want, "frame {f} case {c}"),
+                None => assert!(!want.is_finite()),
+            }
+            let tr = a["t_rigid_s"].as_f64().unwrap();
+            assert!(
+                (tr - t_rigid[f * per + c]).abs() < 1e-12 * tr,
+                "frame {f} case {c}"
+            );
+            if want.is_finite() {
+                observed.push(want);
+                fitted.push(a["t_new_fit_s"].as_f64().unwrap());
+            }
+        }
+        let r2 = slidestack::fit::metrics(&observed, &fitted).r2;
+        let stored = per_frame[f]["building"]["r2"].as_f64().unwrap();
+        assert!((r2 - stored).abs() < 1e-12, "frame {f}: {r2} vs {stored}");
+    }
+
+    // A frame the study does not hold, and a building study asked without one, are refused.
+    let o = design(&["--period", "0.6", "--storeys", "3", "--floor", "2"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no building of 3 storeys with the stack on floor `2`; it has"),
+        "{}",
+        stderr(&o)
+    );
+    let o = design(&["--period", "0.6"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is a building study's (`building`): say which building"),
         "{}",
         stderr(&o)
     );
@@ -243,6 +346,9 @@ fn one_storey_buildings_are_the_one_storey_study() {
         map.remove("fingerprint").unwrap();
         if let Some(b) = map.remove("building") {
             assert_eq!(b.as_str(), Some("1 storey, stack on the roof"));
+        }
+        if let Some(f) = map.remove("frames") {
+            assert_eq!(f[0]["storeys"].as_u64(), Some(1));
         }
         v
     };

@@ -423,7 +423,10 @@ fn fit_report(coefficients: usize) -> FitReport {
             published: None,
             recommendation: String::new(),
             not_fitted: Vec::new(),
+            frames: Vec::new(),
+            one_storey: None,
         }],
+        frames: Vec::new(),
     }
 }
 

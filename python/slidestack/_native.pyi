@@ -72,9 +72,12 @@ def design(
     alpha: _Floats,
     mu: _Floats,
     extrapolate: bool = False,
+    storeys: Optional[int] = None,
+    floor: Union[int, str, None] = None,
 ) -> Dict[str, Any]:
     """T_new of one structure from a finished study: the dict ``slidestack design --json``
-    prints."""
+    prints. In a building study, ``storeys`` and ``floor`` (a number, ``"roof"`` or ``"all"``)
+    name the building, and ``period`` is its bare first-mode period T_1."""
 
 def run(
     config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True

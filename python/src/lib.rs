@@ -22,6 +22,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 use slidestack::design::{Query, design as design_query};
 use slidestack::dynamics::History;
+use slidestack::grid::StackFloor;
 use slidestack::ground_motion::matching::{MatchSettings, match_record};
 use slidestack::ground_motion::{ReadOptions, Record, Units, read_record_with};
 use slidestack::simulation::building::history_layout;
@@ -341,7 +342,8 @@ fn match_<'py>(
 
 /// `T_new` of one structure from a finished study: the dict `slidestack design --json` prints.
 #[pyfunction]
-#[pyo3(signature = (study, zone, period, alpha, mu, extrapolate=false))]
+#[pyo3(signature = (study, zone, period, alpha, mu, extrapolate=false, storeys=None, floor=None))]
+#[allow(clippy::too_many_arguments)]
 fn design<'py>(
     py: Python<'py>,
     study: PathBuf,
@@ -350,13 +352,34 @@ fn design<'py>(
     alpha: &Bound<'py, PyAny>,
     mu: &Bound<'py, PyAny>,
     extrapolate: bool,
+    storeys: Option<usize>,
+    floor: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let floor = match floor {
+        None => None,
+        Some(f) => {
+            let text = f.str()?.to_string();
+            Some(text.parse::<StackFloor>().map_err(|_| {
+                PyValueError::new_err(format!("floor `{text}`: a floor number, `roof` or `all`"))
+            })?)
+        }
+    };
+    let building = match (storeys, floor) {
+        (Some(n), Some(f)) => Some((n, f)),
+        (None, None) => None,
+        _ => {
+            return Err(PyValueError::new_err(
+                "a building study's design needs both `storeys` and `floor`",
+            ));
+        }
+    };
     let q = Query {
         zone,
         period_s: period,
         alpha: convert::float_vec(alpha, "alpha")?,
         mu: convert::float_vec(mu, "mu")?,
         extrapolate,
+        building,
     };
     let a = py
         .detach(|| design_query(&study, &q))

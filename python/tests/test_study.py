@@ -253,3 +253,23 @@ def test_shards_and_merge_make_the_same_sweep(quick, tmp_path):
     assert (out / "sweep.h5").read_bytes() == (py_out / "sweep.h5").read_bytes()
     with pytest.raises(ValueError, match="needs 1 ≤ k ≤ n"):
         slidestack.sweep(QUICK, out=out, shard=(3, 2))
+
+
+def test_design_in_a_building_study_is_the_clis(tmp_path, cli):
+    """configs/mdof-quick.yaml through its fit by the CLI; the module's design of one frame is
+    the CLI's, and asking a building study without a frame raises ValueError naming the keys."""
+    cfg, out = ROOT / "configs/mdof-quick.yaml", tmp_path / "mdof"
+    for stage in ("motions", "sweep", "tnew", "fit"):
+        run_cli(cli, stage, str(cfg), "--out", str(out))
+    import json
+
+    args = ["design", "--study", str(out), "--zone", "V", "--period", "0.6"]
+    args += ["--alpha", "0.25,0.5", "--mu", "0.1,0.05", "--storeys", "3", "--floor", "roof"]
+    want = json.loads(run_cli(cli, *args, "--json").stdout)
+    got = slidestack.design(out, "V", 0.6, [0.25, 0.5], [0.1, 0.05], storeys=3, floor="roof")
+    assert got == want and want["building"] == "3 storeys, stack on the roof"
+    assert slidestack.design(out, "V", 0.6, [0.25, 0.5], [0.1, 0.05], storeys=3, floor=3) == want
+    with pytest.raises(ValueError, match="say which building, its storey count and the floor"):
+        slidestack.design(out, "V", 0.6, [0.25, 0.5], [0.1, 0.05])
+    with pytest.raises(ValueError, match="needs both `storeys` and `floor`"):
+        slidestack.design(out, "V", 0.6, [0.25, 0.5], [0.1, 0.05], storeys=3)

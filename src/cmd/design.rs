@@ -1,9 +1,10 @@
 //! `slidestack design --study OUT_DIR --zone III --period 0.7 --alpha 1,1 --mu 0.3,0.1 [--json]`:
 //! `T_new` and the design spectral accelerations of one structure from a finished study
-//! ([`slidestack::design`]).
+//! ([`slidestack::design`]); in a building study also `--storeys 3 --floor roof`.
 
 use anyhow::Result;
 use slidestack::design::{Answer, Query, design};
+use slidestack::grid::StackFloor;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -27,6 +28,13 @@ pub struct Args {
     /// Outside the study's grid, answer from the fitted form instead of refusing.
     #[arg(long)]
     extrapolate: bool,
+    /// A building study's storey count N (with --floor; --period is then its bare first-mode
+    /// period T_1).
+    #[arg(long, requires = "floor")]
+    storeys: Option<usize>,
+    /// A building study's floor carrying the stack: a number (1 the lowest), roof or all.
+    #[arg(long, requires = "storeys")]
+    floor: Option<StackFloor>,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
@@ -39,6 +47,7 @@ pub fn run(args: Args) -> Result<()> {
         alpha: args.alpha,
         mu: args.mu,
         extrapolate: args.extrapolate,
+        building: args.storeys.zip(args.floor),
     };
     let a = design(&args.study, &q)?;
     if args.json {
@@ -56,6 +65,9 @@ fn print_table(a: &Answer) {
         "zone {} ({}): T_p {} s, α {:?}, μ {:?}",
         a.zone, a.target, a.period_s, a.alpha, a.mu
     );
+    if let Some(b) = &a.building {
+        println!("building: {b} (T_p is its bare first-mode period T_1)");
+    }
     println!("{:<34}{:>10}{:>12}", "", "period", "Sa");
     println!(
         "{:<34}{:>10}{:>12}",

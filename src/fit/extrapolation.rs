@@ -23,11 +23,14 @@ pub const LOWER_T_P: f64 = 0.5;
 /// … and `T_new ≤ UPPER·T_rigid`.
 pub const UPPER_T_RIGID: f64 = 1.5;
 
-/// A box in feature space, `(T_p, μ_1 … μ_n, α_1 … α_n)`.
+/// A box in feature space, `(T_p, μ_1 … μ_n, α_1 … α_n)` and, for a building study,
+/// `building` features after them ([`crate::fit::BuildingFeatures`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DesignBox {
     pub lower: Vec<f64>,
     pub upper: Vec<f64>,
+    /// Features after the stack's (a building's `N`, `z_stack`).
+    pub building: usize,
 }
 
 impl DesignBox {
@@ -37,6 +40,7 @@ impl DesignBox {
         Self {
             lower: ranges.iter().map(|r| (1.0 - margin) * r.0).collect(),
             upper: ranges.iter().map(|r| (1.0 + margin) * r.1).collect(),
+            building: 0,
         }
     }
 
@@ -130,9 +134,14 @@ pub struct BoxCheck {
 }
 
 /// Checks `fitted` on `bx` with `quasi` quasi-random points besides the corners.
+///
+/// For a building, `T_rigid` at a point is taken as `T_1·√(1 + Σα)`: the first-mode period
+/// with every floor's mass scaled by `1 + Σα`, an upper bound of the period with the stack on
+/// any of its floors (Rayleigh's quotient: that mass matrix exceeds the loaded one), and the
+/// band's upper limit with it.
 pub fn check_box(fitted: &Fitted, bx: &DesignBox, quasi: usize, margin: f64) -> BoxCheck {
     let k = bx.lower.len();
-    let blocks = k.saturating_sub(1) / 2;
+    let blocks = k.saturating_sub(1 + bx.building) / 2;
     let mut c = BoxCheck {
         margin,
         min_t_new_over_t_p: f64::INFINITY,
@@ -142,7 +151,7 @@ pub fn check_box(fitted: &Fitted, bx: &DesignBox, quasi: usize, margin: f64) -> 
     for x in bx.points(quasi) {
         c.points += 1;
         let t_p = x[0];
-        let alpha: f64 = x[1 + blocks..].iter().sum();
+        let alpha: f64 = x[1 + blocks..1 + 2 * blocks].iter().sum();
         let t_rigid = t_p * (1.0 + alpha).sqrt();
         let s = Sample {
             x,

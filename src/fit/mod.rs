@@ -55,6 +55,71 @@ pub fn features(period_s: f64, alpha: &[f64], mu: &[f64]) -> Vec<f64> {
     x
 }
 
+/// The feature of a building study of several frames giving its storey count `N`.
+pub const STOREYS_FEATURE: &str = "N";
+/// The feature giving the relative height `z = h/H` of the floor carrying the stack
+/// ([`crate::study::building::Frame::stack_height_ratio`]).
+pub const HEIGHT_FEATURE: &str = "z_stack";
+
+/// The features of a building study of several frames (docs/fit.md, "A study over buildings"):
+/// the stack's, `T_p` being the bare building's first-mode period `T_1`, then `N` when the
+/// study has several storey counts and `z_stack` when the stack's relative height varies
+/// over the frames. A feature that is one value for every case is left out: it would only
+/// repeat the intercept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct BuildingFeatures {
+    pub blocks: usize,
+    pub storeys: bool,
+    pub height: bool,
+}
+
+impl BuildingFeatures {
+    /// The names, in [`Self::features`] order; the first is `T_1`.
+    pub fn names(self) -> Vec<String> {
+        let mut names = feature_names(self.blocks);
+        names[0] = "T_1".into();
+        if self.storeys {
+            names.push(STOREYS_FEATURE.into());
+        }
+        if self.height {
+            names.push(HEIGHT_FEATURE.into());
+        }
+        names
+    }
+
+    /// The features named `names` for stacks of `blocks` blocks, if they are a building
+    /// study's.
+    pub fn of_names(names: &[String], blocks: usize) -> Option<Self> {
+        [(false, false), (true, false), (false, true), (true, true)]
+            .into_iter()
+            .map(|(storeys, height)| Self {
+                blocks,
+                storeys,
+                height,
+            })
+            .find(|f| f.names() == names)
+    }
+
+    /// `(T_1, μ_1 … μ_n, α_1 … α_n[, N][, z_stack])`, `T_1` in s.
+    pub fn features(
+        self,
+        period_s: f64,
+        alpha: &[f64],
+        mu: &[f64],
+        storeys: usize,
+        z_stack: f64,
+    ) -> Vec<f64> {
+        let mut x = features(period_s, alpha, mu);
+        if self.storeys {
+            x.push(storeys as f64);
+        }
+        if self.height {
+            x.push(z_stack);
+        }
+        x
+    }
+}
+
 /// One case: features, its two physical limits and the computed `T_new`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sample {

@@ -13,21 +13,27 @@
 //!
 //! A building study of one frame (one storey count, one `stack_floor`) is fitted as a one-storey
 //! study, `T_p` being its bare first-mode period `T_1` (its `T_new`, the first mode's, over
-//! `T_1`); `fit.yaml` names the frame. A study of several frames needs the building's own
-//! features (issue 23, item 2) and is refused.
+//! `T_1`); `fit.yaml` names the frame. A study of several frames is fitted over its distinct
+//! frames (floor 1, the roof and every floor of one storey are one building) with the building's
+//! features (`N`, `z_stack`: [`BuildingFeatures`]), each case's `T_rigid`
+//! its frame's `T_1,rigid`; then per frame the recommended form's metrics beside those of the
+//! one-storey equation (every form fitted to the study's one-storey frame, if it has one, the
+//! best recommended as for a one-storey study) and the paper's: where the one-storey equations
+//! hold and where the higher modes make them fail (docs/fit.md, "A study over buildings").
 //!
 //! Fingerprint: T_new's, the forms, the number of folds and the box.
 
 use super::{Outcome, PipelineError, Session, StageId};
 use crate::fit::extrapolation::{BOX_MARGIN, BOX_POINTS};
 use crate::fit::{
-    DesignBox, FitError, Form, Sample, check_box, cross_validate, feature_names, fit, metrics,
-    paper_equation, uncertainty,
+    BuildingFeatures, DesignBox, FitError, Fitted, Form, Metrics, Sample, check_box,
+    cross_validate, feature_names, fit, metrics, paper_equation, uncertainty,
 };
 use crate::grid::Grid;
 use crate::store::fingerprint::fingerprint as hash_parts;
-use crate::store::fit::{FitReport, FormFit, NotFitted, ZoneFit, write_fit};
-use crate::study::tnew::samples;
+use crate::store::fit::{FitReport, FormFit, FrameFit, FrameSpec, NotFitted, ZoneFit, write_fit};
+use crate::study::building::Frame;
+use crate::study::tnew::{building_samples, samples};
 use rayon::prelude::*;
 use thiserror::Error;
 
@@ -137,18 +143,49 @@ fn recommend(forms: &[FormFit]) -> (Form, String) {
     }
 }
 
-/// The box of the box check: [`BOX_MARGIN`] beyond the grid's range of every feature.
-fn design_box(grid: &Grid) -> DesignBox {
-    let range = |v: &[f64]| {
-        v.iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                (lo.min(*x), hi.max(*x))
-            })
+/// The box of the box check: [`BOX_MARGIN`] beyond the grid's range of every feature; for a
+/// building study of several frames also beyond its range of `N` and `z_stack`, but no lower
+/// than one storey and no higher than the roof.
+fn design_box(grid: &Grid, building: Option<(BuildingFeatures, &[Frame])>) -> DesignBox {
+    let range = |v: &mut dyn Iterator<Item = f64>| {
+        v.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        })
     };
-    let mut ranges = vec![range(&grid.periods_s)];
-    ranges.extend(grid.mu.iter().map(|v| range(v)));
-    ranges.extend(grid.alpha.iter().map(|v| range(v)));
-    DesignBox::beyond(&ranges, BOX_MARGIN)
+    let mut ranges = vec![range(&mut grid.periods_s.iter().copied())];
+    ranges.extend(grid.mu.iter().map(|v| range(&mut v.iter().copied())));
+    ranges.extend(grid.alpha.iter().map(|v| range(&mut v.iter().copied())));
+    let k = ranges.len();
+    let Some((features, frames)) = building else {
+        return DesignBox::beyond(&ranges, BOX_MARGIN);
+    };
+    if features.storeys {
+        ranges.push(range(&mut frames.iter().map(|f| f.storeys() as f64)));
+    }
+    if features.height {
+        ranges.push(range(&mut frames.iter().map(Frame::stack_height_ratio)));
+    }
+    let mut bx = DesignBox::beyond(&ranges, BOX_MARGIN);
+    bx.building = ranges.len() - k;
+    let mut j = k;
+    if features.storeys {
+        bx.lower[j] = bx.lower[j].max(1.0);
+        j += 1;
+    }
+    if features.height {
+        bx.upper[j] = bx.upper[j].min(1.0);
+    }
+    bx
+}
+
+/// Which building features vary over `frames` (`None`: not a study of several frames).
+fn building_features(blocks: usize, frames: &[Frame]) -> Option<BuildingFeatures> {
+    let varies = |v: Vec<f64>| v.iter().any(|x| *x != v[0]);
+    (frames.len() > 1).then(|| BuildingFeatures {
+        blocks,
+        storeys: varies(frames.iter().map(|f| f.storeys() as f64).collect()),
+        height: varies(frames.iter().map(Frame::stack_height_ratio).collect()),
+    })
 }
 
 /// One line on a fitted form: its metrics, cross-validated ones, solver and box check.
@@ -192,6 +229,107 @@ fn describe(f: &FormFit) -> String {
     )
 }
 
+/// One zone's samples: the cases fitted, every case with a `T_new` (for a building study of
+/// several frames, of its distinct frames, with the building's features); a building study's
+/// every case with its frame's index; and its one-storey frame's cases with the one-storey
+/// features.
+struct ZoneData {
+    zone: String,
+    data: Vec<Sample>,
+    every: Vec<(usize, Sample)>,
+    one_storey: Vec<Sample>,
+}
+
+/// The first `1 + 2n` features of a building sample: the one-storey equation's (`T_p = T_1`).
+fn stack_sample(s: &Sample, blocks: usize) -> Sample {
+    Sample {
+        x: s.x[..1 + 2 * blocks].to_vec(),
+        ..s.clone()
+    }
+}
+
+/// A stored form as a function.
+fn fitted(f: &FormFit) -> Fitted {
+    Fitted {
+        form: f.form,
+        params: f.coefficients.iter().map(|c| c.1).collect(),
+    }
+}
+
+/// The recommended building equation, the one-storey equation and the paper's on each frame's
+/// cases.
+fn frame_fits(
+    z: &ZoneData,
+    frames: &[Frame],
+    blocks: usize,
+    building: &FormFit,
+    one_storey: Option<&FormFit>,
+) -> Vec<FrameFit> {
+    let (building, one_storey) = (fitted(building), one_storey.map(fitted));
+    (frames.iter().enumerate())
+        .map(|(f, frame)| {
+            let cases: Vec<&Sample> = (z.every.iter())
+                .filter(|(g, _)| *g == f)
+                .map(|(_, s)| s)
+                .collect();
+            let observed: Vec<f64> = cases.iter().map(|s| s.t_new_s).collect();
+            let of = |p: &dyn Fn(&Sample) -> Option<f64>| -> Option<Metrics> {
+                let predicted: Option<Vec<f64>> = cases.iter().map(|s| p(s)).collect();
+                predicted.map(|p| metrics(&observed, &p))
+            };
+            FrameFit {
+                frame: frame.to_string(),
+                cases: cases.len(),
+                building: of(&|s| Some(building.predict(s))).expect("every case predicted"),
+                one_storey: (one_storey.as_ref())
+                    .and_then(|o| of(&|s| Some(o.predict(&stack_sample(s, blocks))))),
+                published: of(&|s| paper_equation(&z.zone, &s.x[..1 + 2 * blocks])),
+            }
+        })
+        .collect()
+}
+
+/// A zone's forms from the stage's jobs, in [`Form::ALL`] order: the fitted ones (each
+/// described through `reporter`) and the ones that do not apply.
+fn collect_forms(
+    s: &Session,
+    zone: &str,
+    what: &str,
+    results: &mut impl Iterator<Item = Result<Result<FormFit, NotFitted>, FitStageError>>,
+) -> Result<(Vec<FormFit>, Vec<NotFitted>), PipelineError> {
+    let me = StageId::Fit;
+    let mut forms = Vec::new();
+    let mut not_fitted = Vec::new();
+    for _ in Form::ALL {
+        match results.next().expect("one result per job")? {
+            Ok(f) => forms.push(f),
+            Err(nf) => not_fitted.push(nf),
+        }
+    }
+    for f in &forms {
+        s.reporter
+            .info(me, &format!("zone {zone}{what}: {}", describe(f)));
+    }
+    for nf in &not_fitted {
+        s.reporter.warn(
+            me,
+            &format!("zone {zone}{what}: {} form: {}", nf.form.name(), nf.reason),
+        );
+    }
+    if forms.is_empty() {
+        return Err(FitStageError::NoForm {
+            zone: zone.to_string(),
+            reasons: not_fitted
+                .iter()
+                .map(|n| n.reason.as_str())
+                .collect::<Vec<_>>()
+                .join("; "),
+        }
+        .into());
+    }
+    Ok((forms, not_fitted))
+}
+
 /// Builds `fit.h5` and `fit.yaml`.
 pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let start = std::time::Instant::now();
@@ -199,23 +337,87 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let me = StageId::Fit;
     let grid = study.grid(me)?;
     let n = grid.blocks();
-    let features = feature_names(n);
-    let bx = design_box(grid);
+    let frames: Vec<Frame> = (study.building())
+        .map(|b| {
+            (0..b.frames())
+                .filter_map(|f| study.cfg.frame(b, f))
+                .collect()
+        })
+        .unwrap_or_default();
+    let building = building_features(n, &frames);
+    let features = building.map_or_else(|| feature_names(n), BuildingFeatures::names);
+    let one_storey_features = feature_names(n);
+    let bx = design_box(grid, building.map(|f| (f, frames.as_slice())));
+    let one_storey_bx = design_box(grid, None);
+    // A building study's one-storey frame, where the one-storey equation is fitted (its
+    // stack floors are all the same building).
+    let one_storey_frame = building.and(frames.iter().position(|f| f.storeys() == 1));
+    // A frame that is an earlier one's building (on one storey floor 1, the roof and every
+    // floor are one; on N, floor N is the roof) would count its cases twice in the fit.
+    let repeats: Vec<bool> = (0..frames.len())
+        .map(|f| {
+            let same =
+                |g: &Frame| g.storeys() == frames[f].storeys() && g.floors() == frames[f].floors();
+            frames[..f].iter().any(same)
+        })
+        .collect();
     let mut zone_data = Vec::new();
     for zc in &study.cfg.zones {
         let t = super::tnew::read_zone(study, &zc.name)?;
         let t_rigid: Vec<f64> = t.vars.t_rigid.iter().copied().collect();
         let t_new: Vec<f64> = t.vars.t_new.iter().copied().collect();
-        zone_data.push((zc.name.clone(), samples(grid, &t_rigid, &t_new)));
+        let z = match building {
+            None => ZoneData {
+                zone: zc.name.clone(),
+                data: samples(grid, &t_rigid, &t_new),
+                every: Vec::new(),
+                one_storey: Vec::new(),
+            },
+            Some(f) => {
+                let every = building_samples(grid, &frames, f, &t_rigid, &t_new);
+                let data = (every.iter())
+                    .filter(|(f, _)| !repeats[*f])
+                    .map(|(_, s)| s.clone())
+                    .collect();
+                let per = grid.cases();
+                let one_storey = one_storey_frame.map_or_else(Vec::new, |o| {
+                    let cases = o * per..(o + 1) * per;
+                    samples(grid, &t_rigid[cases.clone()], &t_new[cases])
+                });
+                ZoneData {
+                    zone: zc.name.clone(),
+                    data,
+                    every,
+                    one_storey,
+                }
+            }
+        };
+        zone_data.push(z);
     }
-    let jobs: Vec<(usize, Form)> = (0..zone_data.len())
-        .flat_map(|z| Form::ALL.map(|f| (z, f)))
+    // Per zone every form on its data, then (a building study with a one-storey frame) every
+    // form on the one-storey frame's cases.
+    let jobs: Vec<(usize, Form, bool)> = (0..zone_data.len())
+        .flat_map(|z| {
+            let one = !zone_data[z].one_storey.is_empty();
+            (Form::ALL.map(|f| (z, f, false)).into_iter()).chain(
+                Form::ALL
+                    .map(|f| (z, f, true))
+                    .into_iter()
+                    .filter(move |_| one),
+            )
+        })
         .collect();
     let results: Vec<_> = jobs
         .par_iter()
-        .map(|&(z, form)| {
-            assess(form, &zone_data[z].1, &features, &bx).map_err(|source| FitStageError::Fit {
-                zone: zone_data[z].0.clone(),
+        .map(|&(z, form, one)| {
+            let d = &zone_data[z];
+            let run = if one {
+                assess(form, &d.one_storey, &one_storey_features, &one_storey_bx)
+            } else {
+                assess(form, &d.data, &features, &bx)
+            };
+            run.map_err(|source| FitStageError::Fit {
+                zone: d.zone.clone(),
                 form: form.name(),
                 source,
             })
@@ -223,38 +425,20 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         .collect();
     let mut results = results.into_iter();
     let mut zones = Vec::new();
-    for (zone, data) in &zone_data {
-        let mut forms = Vec::new();
-        let mut not_fitted = Vec::new();
-        for _ in Form::ALL {
-            match results.next().expect("one result per job")? {
-                Ok(f) => forms.push(f),
-                Err(nf) => not_fitted.push(nf),
-            }
-        }
-        for f in &forms {
-            s.reporter
-                .info(me, &format!("zone {zone}: {}", describe(f)));
-        }
-        for nf in &not_fitted {
-            s.reporter.warn(
-                me,
-                &format!("zone {zone}: {} form: {}", nf.form.name(), nf.reason),
-            );
-        }
-        if forms.is_empty() {
-            return Err(FitStageError::NoForm {
-                zone: zone.clone(),
-                reasons: not_fitted
-                    .iter()
-                    .map(|n| n.reason.as_str())
-                    .collect::<Vec<_>>()
-                    .join("; "),
-            }
-            .into());
-        }
+    for z in &zone_data {
+        let (zone, data) = (&z.zone, &z.data);
+        let (forms, not_fitted) = collect_forms(s, zone, "", &mut results)?;
+        let one_storey = if z.one_storey.is_empty() {
+            None
+        } else {
+            let (forms, _) = collect_forms(s, zone, ", one storey", &mut results)?;
+            let (best, _) = recommend(&forms);
+            forms.into_iter().find(|f| f.form == best)
+        };
         let observed: Vec<f64> = data.iter().map(|s| s.t_new_s).collect();
-        let published: Option<Vec<f64>> = data.iter().map(|s| paper_equation(zone, &s.x)).collect();
+        let published: Option<Vec<f64>> = (data.iter())
+            .map(|s| paper_equation(zone, &s.x[..1 + 2 * n]))
+            .collect();
         let published = published.map(|p| metrics(&observed, &p));
         if let Some(m) = &published {
             s.reporter.info(
@@ -275,6 +459,25 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 recommended.name()
             ),
         );
+        let best = forms.iter().find(|f| f.form == recommended);
+        let frame_fits = match (building, best) {
+            (Some(_), Some(best)) => frame_fits(z, &frames, n, best, one_storey.as_ref()),
+            _ => Vec::new(),
+        };
+        for f in &frame_fits {
+            let r2 = |m: &Option<Metrics>| m.map_or("–".to_string(), |m| format!("{:.4}", m.r2));
+            s.reporter.info(
+                me,
+                &format!(
+                    "zone {zone}, {}: {} cases, R² {:.4} (one-storey equation {}, published {})",
+                    f.frame,
+                    f.cases,
+                    f.building.r2,
+                    r2(&f.one_storey),
+                    r2(&f.published)
+                ),
+            );
+        }
         zones.push(ZoneFit {
             zone: zone.clone(),
             cases: data.len(),
@@ -283,6 +486,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             published,
             recommendation,
             not_fitted,
+            frames: frame_fits,
+            one_storey,
         });
     }
     let report = FitReport {
@@ -290,9 +495,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         fingerprint: study.fingerprint(me)?.to_string(),
         features,
         folds: FOLDS,
-        building: (study.building())
-            .and_then(|b| study.cfg.frame(b, 0))
-            .map(|f| f.to_string()),
+        building: (frames.len() == 1).then(|| frames[0].to_string()),
+        frames: frames.iter().map(FrameSpec::of).collect(),
         zones,
     };
     let (h5, yaml) = (study.path(me.output()), study.path("fit.yaml"));

@@ -387,23 +387,15 @@ impl Study {
         self.building.as_ref()
     }
 
-    /// Refuses a building study in a stage that cannot yet take it, before any work: the fit
-    /// takes one frame, the report none.
+    /// Refuses a building study in a stage that cannot yet take it, before any work.
     pub fn refuse_building(&self, stage: StageId) -> Result<(), PipelineError> {
-        let Some(b) = &self.building else {
+        if self.building.is_none() {
             return Ok(());
-        };
+        }
         let why = match stage {
-            StageId::Motions | StageId::Sweep | StageId::Tnew => return Ok(()),
-            StageId::Fit if b.frames() == 1 => return Ok(()),
-            StageId::Fit => {
-                "takes a building study of one frame only (one `building.storeys` value, one \
-                 `grid.stack_floor`): the fit over several needs the building's own features, \
-                 not yet done"
-            }
+            StageId::Motions | StageId::Sweep | StageId::Tnew | StageId::Fit => return Ok(()),
             StageId::Report | StageId::Ida => {
-                "cannot yet take a building study (motions, sweep, tnew and, for one frame, fit \
-                 can)"
+                "cannot yet take a building study (motions, sweep, tnew and fit can)"
             }
         };
         Err(PipelineError::NotForBuilding {

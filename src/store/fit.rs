@@ -17,11 +17,19 @@
 //!          /zone_<name>/<form>/coefficients   attrs: names
 //!          /zone_<name>/<form>/standard_errors attrs: names
 //!          /zone_<name>/published             attrs: r2, r, rmse_s, mse_s2, mae_s, n
+//!          /zone_<name>/frame_<i>             (a building study of several frames, frame i of
+//!                                             fit.yaml's `frames`) attrs: frame, the
+//!                                             recommended form's metrics on its cases (r2, …),
+//!                                             one_storey_r2, …, published_r2, …
 //! ```
 
 use super::h5::{attr_f64, attr_str, write_1d, write_stage_file};
 use super::{StoreError, checksum};
-use crate::fit::{BoxCheck, Form, Method, Metrics, SolverReport, feature_names};
+use crate::fit::{
+    BoxCheck, BuildingFeatures, Form, HEIGHT_FEATURE, Method, Metrics, STOREYS_FEATURE,
+    SolverReport, feature_names,
+};
+use crate::study::building::Frame;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -69,6 +77,60 @@ pub struct NotFitted {
     pub reason: String,
 }
 
+/// How the design equations do on one frame of a building study of several frames: where the
+/// one-storey equations still hold and where they fail.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrameFit {
+    /// `3 storeys, stack on the roof`.
+    pub frame: String,
+    /// Cases of the frame with a `T_new`.
+    pub cases: usize,
+    /// The zone's recommended form, fitted with the building's features, on this frame's cases.
+    pub building: Metrics,
+    /// The recommended one-storey equation (fitted to the study's one-storey frame with the
+    /// one-storey features, `T_p = T_1`) on this frame's cases; `None` without a one-storey
+    /// frame.
+    pub one_storey: Option<Metrics>,
+    /// The paper's published equation (`T_p = T_1`) on this frame's cases, when it applies.
+    pub published: Option<Metrics>,
+}
+
+/// A frame of a building study, all `design` needs to evaluate the fitted forms there: its
+/// `T_1,rigid` and features.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrameSpec {
+    pub storeys: usize,
+    /// `3`, `roof` or `all`.
+    pub stack_floor: String,
+    /// Relative floor masses, floor 1 first.
+    pub floor_masses: Vec<f64>,
+    /// Relative storey stiffnesses, storey 1 first.
+    pub storey_stiffnesses: Vec<f64>,
+    /// The stack's relative height `z_stack`.
+    pub z_stack: f64,
+}
+
+impl FrameSpec {
+    /// The frame, back (`None` if `stack_floor` is not one).
+    pub fn frame(&self) -> Option<Frame> {
+        Some(Frame {
+            floor_masses: self.floor_masses.clone(),
+            storey_stiffnesses: self.storey_stiffnesses.clone(),
+            stack_floor: self.stack_floor.parse().ok()?,
+        })
+    }
+
+    pub fn of(f: &Frame) -> Self {
+        Self {
+            storeys: f.storeys(),
+            stack_floor: f.stack_floor.to_string(),
+            floor_masses: f.floor_masses.clone(),
+            storey_stiffnesses: f.storey_stiffnesses.clone(),
+            z_stack: f.stack_height_ratio(),
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ZoneFit {
     pub zone: String,
@@ -85,6 +147,14 @@ pub struct ZoneFit {
     /// Forms that could not be fitted to this zone's data.
     #[serde(default)]
     pub not_fitted: Vec<NotFitted>,
+    /// A building study of several frames: the recommended equation frame by frame, beside the
+    /// one-storey ones.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub frames: Vec<FrameFit>,
+    /// The recommended one-storey equation of `frames` (its form and coefficients), fitted to
+    /// the study's one-storey frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub one_storey: Option<FormFit>,
 }
 
 impl ZoneFit {
@@ -107,6 +177,10 @@ pub struct FitReport {
     /// building's first-mode period `T_1` and `T_new` the first mode's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub building: Option<String>,
+    /// A building study's frames, in `tnew.h5`'s order (`T_p` is then `T_1`; with several
+    /// frames the features end with the building's: [`crate::fit::BuildingFeatures`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub frames: Vec<FrameSpec>,
     pub zones: Vec<ZoneFit>,
 }
 
@@ -193,6 +267,17 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
                     let sub = g.create_group("published")?;
                     write_metrics(&sub, "", m)?;
                 }
+                for (i, fr) in z.frames.iter().enumerate() {
+                    let sub = g.create_group(&format!("frame_{i}"))?;
+                    attr_str(&sub, "frame", &fr.frame)?;
+                    write_metrics(&sub, "", &fr.building)?;
+                    if let Some(m) = &fr.one_storey {
+                        write_metrics(&sub, "one_storey_", m)?;
+                    }
+                    if let Some(m) = &fr.published {
+                        write_metrics(&sub, "published_", m)?;
+                    }
+                }
             }
             Ok(())
         },
@@ -205,7 +290,8 @@ impl FitReport {
     /// Refuses a report (read from `yaml`) whose features are not those of a stack of `blocks`
     /// blocks, the stack its forms are evaluated on.
     pub fn check_blocks(&self, yaml: &Path, blocks: usize) -> Result<(), StoreError> {
-        if self.features == feature_names(blocks) {
+        let building = BuildingFeatures::of_names(&self.features, blocks);
+        if self.features == feature_names(blocks) || !self.frames.is_empty() && building.is_some() {
             return Ok(());
         }
         Err(StoreError::corrupt(
@@ -228,8 +314,12 @@ pub fn read_fit(yaml: &Path) -> Result<Option<FitReport>, StoreError> {
     let report: FitReport = serde_yaml::from_str(&text)
         .map_err(|e| StoreError::corrupt(yaml, format!("is not a slidestack fit report: {e}")))?;
     let k = report.features.len();
+    let building = (report.features.iter())
+        .filter(|f| [STOREYS_FEATURE, HEIGHT_FEATURE].contains(&f.as_str()))
+        .count();
     for z in &report.zones {
-        for f in &z.forms {
+        let forms = z.forms.iter().map(|f| (f, k));
+        for (f, k) in forms.chain(z.one_storey.iter().map(|f| (f, k - building))) {
             let want = [f.form.parameter_count(k)];
             for (what, found) in [
                 ("coefficients", f.coefficients.len()),

@@ -90,6 +90,22 @@ impl Frame {
         self.stack_floor.floors(self.storeys())
     }
 
+    /// The relative height `z = h/H` of the stack's floor, `h` its height above the ground and
+    /// `H` the roof's, storeys of equal height; with a stack on every floor, their mean
+    /// weighted by the stacks' masses (each stack's mass is `α` times its floor's): the height
+    /// of the stacks' centre of mass over `H`. 1 on one storey.
+    pub fn stack_height_ratio(&self) -> f64 {
+        let n = self.storeys() as f64;
+        let floors = self.floors();
+        let weight = |f: usize| self.floor_masses[f - 1];
+        let total: f64 = floors.iter().map(|&f| weight(f)).sum();
+        floors
+            .iter()
+            .map(|&f| weight(f) * f as f64 / n)
+            .sum::<f64>()
+            / total
+    }
+
     /// `Γ_1·φ_1,N` of the bare building: the roof's displacement per unit displacement of the
     /// first mode's equivalent SDOF (Chopra, *Dynamics of Structures*, the modal expansion of
     /// the effective earthquake forces: `u_N = Γ_1·φ_1,N·D_1`), `Γ_1 = φ_1ᵀ·M·1 / φ_1ᵀ·M·φ_1`.
@@ -312,5 +328,20 @@ mod tests {
         let got = all.t_rigid_s(&case);
         assert!((got - case.t_rigid_s()).abs() < 1e-13 * got, "{got}");
         assert_eq!(frame(1, StackFloor::All).t_rigid_s(&case), case.t_rigid_s());
+    }
+
+    #[test]
+    fn stack_height_ratio_by_hand() {
+        assert_eq!(frame(1, StackFloor::All).stack_height_ratio(), 1.0);
+        assert_eq!(frame(4, StackFloor::Roof).stack_height_ratio(), 1.0);
+        assert_eq!(frame(4, StackFloor::Floor(1)).stack_height_ratio(), 0.25);
+        // Uniform masses: the mean of 1/3, 2/3, 1; masses 3, 1, 1: (3/3 + 2/3 + 1)/5.
+        assert!((frame(3, StackFloor::All).stack_height_ratio() - 2.0 / 3.0).abs() < 1e-15);
+        let heavy = Frame {
+            floor_masses: vec![3.0, 1.0, 1.0],
+            storey_stiffnesses: vec![1.0; 3],
+            stack_floor: StackFloor::All,
+        };
+        assert!((heavy.stack_height_ratio() - (1.0 + 2.0 / 3.0 + 1.0) / 5.0).abs() < 1e-15);
     }
 }

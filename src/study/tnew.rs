@@ -12,8 +12,9 @@
 //! attached mass, and the crossing near `T_rigid` is the one that continues the `μ → ∞` limit.
 //! The flag says which case applied.
 
-use crate::fit::{Sample, features};
+use crate::fit::{BuildingFeatures, Sample, features};
 use crate::grid::Grid;
+use crate::study::building::Frame;
 
 /// The fit's samples: every case of `grid` (flat over `[T_p][case]`) with a finite `T_new`,
 /// features `(T_p, μ_1 … μ_n, α_1 … α_n)`.
@@ -27,6 +28,39 @@ pub fn samples(grid: &Grid, t_rigid_s: &[f64], t_new_s: &[f64]) -> Vec<Sample> {
                 t_rigid_s: t_rigid_s[c],
                 t_new_s: t_new_s[c],
             }
+        })
+        .collect()
+}
+
+/// The fit's samples of a building study of several frames: every case of every frame (flat
+/// over `[frame][T_1][case]`, as `tnew.h5` stores them) with a finite `T_new`, with its frame's
+/// index and the features `features` names.
+pub fn building_samples(
+    grid: &Grid,
+    frames: &[Frame],
+    features: BuildingFeatures,
+    t_rigid_s: &[f64],
+    t_new_s: &[f64],
+) -> Vec<(usize, Sample)> {
+    let per_frame = grid.cases();
+    (0..t_new_s.len())
+        .filter(|&c| t_new_s[c].is_finite())
+        .map(|c| {
+            let (f, case) = (c / per_frame, grid.case(c % per_frame));
+            let frame = &frames[f];
+            let x = features.features(
+                case.period_s,
+                &case.alpha,
+                &case.mu,
+                frame.storeys(),
+                frame.stack_height_ratio(),
+            );
+            let sample = Sample {
+                x,
+                t_rigid_s: t_rigid_s[c],
+                t_new_s: t_new_s[c],
+            };
+            (f, sample)
         })
         .collect()
 }
