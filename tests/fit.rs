@@ -49,6 +49,8 @@ fn truths() -> Vec<(Form, Vec<f64>)> {
                 1.5, 2.0, 0.3, 0.5, 0.4, 0.3, 2.0, -1.0, 0.5, -1.5, 0.3, 0.2, -0.5, -1.0,
             ],
         ),
+        // A fraction (a building's λ) falling with T_p and rising with μ: 0.03 … 0.99.
+        (Form::Fraction, vec![-1.2, 0.8, 0.3, 0.2, -0.1, 0.4, 1.0]),
     ]
 }
 

@@ -21,6 +21,12 @@
 //!   elongation ratio `T_new/T_p` (least squares weighted by `1/T_p`, [`Form::weight`]), so a
 //!   short-period structure counts as much as a long-period one.
 //!
+//! * [`Form::Fraction`]: not a form of `T_new` but of a fraction in `[0, 1]`, a building's
+//!   effective live-load fraction `λ` (docs/model.md, "A study over buildings"):
+//!   `λ = σ(w·z + w₀)`, `z = (ln x, (ln T_p)²)` as for the damped form; in `[0, 1]` by
+//!   construction. Its "`T_new`" in a [`Sample`] is the fraction, and `T_p`, `T_rigid` are not
+//!   used. Not in [`Form::ALL`].
+//!
 //! `docs/fit.md` tells why this form, these features and this objective, with the numbers
 //! measured on the paper grid.
 
@@ -34,6 +40,7 @@ pub enum Form {
     Paper,
     Bounded,
     Damped,
+    Fraction,
 }
 
 /// Largest fraction of `T_p` the friction-damping term of [`Form::Damped`] can take away.
@@ -63,6 +70,7 @@ impl Form {
             Form::Paper => "paper",
             Form::Bounded => "bounded",
             Form::Damped => "damped",
+            Form::Fraction => "fraction",
         }
     }
 
@@ -75,13 +83,14 @@ impl Form {
                 "T_new = T_p·(1 − σ(v·z + v_0)/2) + (T_rigid − T_p)·σ(w·z + w_0), \
                  z = (ln x, (ln T_p)²)"
             }
+            Form::Fraction => "λ = σ(w·z + w_0), z = (ln x, (ln T_p)²)",
         }
     }
 
     /// Whether every input gives a `T_new` inside `[½·T_p, T_rigid]` (for `T_rigid ≥ T_p`),
     /// whatever the finite parameters.
     pub fn bounded_by_construction(self) -> bool {
-        matches!(self, Form::Bounded | Form::Damped)
+        matches!(self, Form::Bounded | Form::Damped | Form::Fraction)
     }
 
     /// What the least squares minimise, for people.
@@ -89,6 +98,7 @@ impl Form {
         match self {
             Form::Paper | Form::Bounded => "sum of squared errors of T_new (s²)",
             Form::Damped => "sum of squared errors of T_new/T_p (weights 1/T_p)",
+            Form::Fraction => "sum of squared errors of λ",
         }
     }
 
@@ -96,7 +106,7 @@ impl Form {
     /// [`Form::Damped`] (errors of `T_new/T_p`).
     pub fn weight(self, t_p_s: f64) -> f64 {
         match self {
-            Form::Paper | Form::Bounded => 1.0,
+            Form::Paper | Form::Bounded | Form::Fraction => 1.0,
             Form::Damped => 1.0 / t_p_s,
         }
     }
@@ -107,6 +117,7 @@ impl Form {
             Form::Paper => 2 * k + 2,
             Form::Bounded => k + 1,
             Form::Damped => 2 * k + 4,
+            Form::Fraction => k + 2,
         }
     }
 
@@ -147,6 +158,12 @@ impl Form {
                 v.extend([format!("v_{square}"), "v_0".into()]);
                 v
             }
+            Form::Fraction => {
+                let square = format!("ln_{}_sq", features.first().map_or("T_p", |f| f));
+                let mut v = each("w", true);
+                v.extend([format!("w_{square}"), "w_0".into()]);
+                v
+            }
         }
     }
 
@@ -155,7 +172,7 @@ impl Form {
     pub fn regressors(self, x: &[f64]) -> Vec<f64> {
         match self {
             Form::Paper | Form::Bounded => x.to_vec(),
-            Form::Damped => {
+            Form::Damped | Form::Fraction => {
                 let mut z: Vec<f64> = x.iter().map(|v| v.ln()).collect();
                 z.push(z[0] * z[0]);
                 z
@@ -217,6 +234,16 @@ impl Form {
                 }
                 t_p_s * (1.0 - DAMPING_DEPTH * s2) + span * s1
             }
+            Form::Fraction => {
+                let (s, ds) = logistic(dot(&p[..k], z) + p[k]);
+                if let Some(g) = grad {
+                    for j in 0..k {
+                        g[j] = ds * z[j];
+                    }
+                    g[k] = ds;
+                }
+                s
+            }
         }
     }
 
@@ -261,6 +288,15 @@ impl Form {
                 p
             })
             .collect(),
+            // Flat at λ = σ(w_0): 0.88, 0.5, 0.12.
+            Form::Fraction => [2.0, 0.0, -2.0]
+                .iter()
+                .map(|&w0| {
+                    let mut p = vec![0.0; k + 2];
+                    p[k + 1] = w0;
+                    p
+                })
+                .collect(),
         }
     }
 }
@@ -288,7 +324,7 @@ mod tests {
     #[test]
     fn names_match_counts() {
         let f: Vec<String> = ["T_p", "mu_1", "alpha_1"].map(String::from).to_vec();
-        for form in Form::ALL {
+        for form in Form::ALL.into_iter().chain([Form::Fraction]) {
             assert_eq!(form.parameter_names(&f).len(), form.parameter_count(3));
             for s in form.starts(3) {
                 assert_eq!(s.len(), form.parameter_count(3));
