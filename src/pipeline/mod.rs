@@ -394,16 +394,16 @@ impl Study {
             return Ok(());
         };
         let why = match stage {
-            StageId::Motions | StageId::Sweep | StageId::Tnew => return Ok(()),
+            StageId::Motions | StageId::Sweep | StageId::Tnew | StageId::Ida => return Ok(()),
             StageId::Fit if b.frames() == 1 => return Ok(()),
             StageId::Fit => {
                 "takes a building study of one frame only (one `building.storeys` value, one \
                  `grid.stack_floor`): the fit over several needs the building's own features, \
                  not yet done"
             }
-            StageId::Report | StageId::Ida => {
-                "cannot yet take a building study (motions, sweep, tnew and, for one frame, fit \
-                 can)"
+            StageId::Report => {
+                "cannot yet take a building study (motions, sweep, tnew, ida and, for one frame, \
+                 fit can)"
             }
         };
         Err(PipelineError::NotForBuilding {
