@@ -92,6 +92,23 @@ fn the_building_ida_runs_is_deterministic_resumes_and_is_labelled() {
         "{d:?}"
     );
 
+    // The report's IDA figure, per frame (`--figure` draws what the report's IDA section does).
+    let fig = dir.path().join("ida.svg");
+    let o = ok(slidestack(
+        &["ida", s(&cfg), "--out", s(&out), "--figure", s(&fig)],
+        "1",
+    ));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("is up to date"));
+    let svg = std::fs::read_to_string(&fig).unwrap();
+    roxmltree::Document::parse(&svg).unwrap();
+    for needle in [
+        "peak interstorey drift ratio",
+        "3 storeys, stack on floor 1",
+        "3 storeys, stack on the roof",
+    ] {
+        assert!(svg.contains(needle), "{needle}");
+    }
+
     // One thread: the same bytes.
     let one = dir.path().join("one");
     common::copy_motions(&m, &one);
