@@ -406,7 +406,11 @@ fn write_cases(
         &v.c_y,
         &[&d.case],
         "1",
-        "yield strength ratio F_y/(m_p g) of the structure",
+        if d.building.is_some() {
+            "base-shear coefficient V_B/(g sum_j m_j) of the bare building (the strength of storey 1)"
+        } else {
+            "yield strength ratio F_y/(m_p g) of the structure"
+        },
     )?;
     if let (Some(c), Some([n, _, storey])) = (&v.storey_c_y, &d.building) {
         put(

@@ -76,4 +76,34 @@ mod tests {
         }
         assert_eq!(storey_strength_ratios(0.37, &[3.0], &[2.5]), vec![0.37]);
     }
+
+    /// Through the building model, which takes `F_y,i = C_y,i·g·Σ_{j≥i} m_j`: each storey's
+    /// yield force is its design shear `V_i = Σ_{j≥i} Q_j`, the floor forces summed by hand
+    /// (1e-12 relative: a handful of roundings each).
+    #[test]
+    fn the_model_s_storey_yield_forces_are_the_design_shears() {
+        use crate::dynamics::G;
+        use crate::dynamics::building::{Building, BuildingSpec, StoreyYielding};
+        let (m, h) = ([2.0, 1.5, 1.0], [4.0, 3.0, 3.0]);
+        let spec = BuildingSpec {
+            floor_masses: m.to_vec(),
+            storey_stiffnesses: vec![3.0, 2.0, 1.0],
+            yielding: Some(StoreyYielding {
+                strength_ratios: storey_strength_ratios(0.1, &m, &h),
+                post_yield_ratio: 0.05,
+            }),
+            ..BuildingSpec::uniform(3, 0.8)
+        };
+        let b = Building::new(&spec).unwrap();
+        let v_b = 0.1 * G * 4.5;
+        let q = [32.0, 73.5, 100.0].map(|mh| v_b * mh / 205.5);
+        let want = [q[0] + q[1] + q[2], q[1] + q[2], q[2]];
+        for (s, w) in b.springs().unwrap().iter().zip(want) {
+            assert!(
+                (s.yield_force_n - w).abs() <= 1e-12 * w,
+                "{} vs {w}",
+                s.yield_force_n
+            );
+        }
+    }
 }
