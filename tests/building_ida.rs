@@ -372,3 +372,44 @@ fn keys_that_do_not_fit_are_refused_by_name_before_any_work() {
         assert!(!out.exists(), "{to}: work started");
     }
 }
+
+#[test]
+fn design_strengths_come_from_the_zone_s_spectrum_at_t_1() {
+    // `design: {importance: 1, response_reduction: 3}` at T_1 = 1 s on rock: IS 1893
+    // (Part 1):2016 gives Sa/g = 1/T = 1 (Clause 6.4.2, soil type I, 0.4 s < T < 4 s), so
+    // C_y = (Z/2)·(I/R)·1 = 0.16/6 in Zone III and 0.36/6 in Zone V, by hand; storey 1 carries
+    // it all and the storeys above are stronger for their mass.
+    let dir = tempfile::tempdir().unwrap();
+    let m = motions(dir.path());
+    let text = std::fs::read_to_string(repo("configs/mdof-ida-quick.yaml")).unwrap();
+    let from = "c_y: 0.3                     # base shear / bare weight, V_B/(g Σm)";
+    assert!(text.contains(from));
+    let cfg = dir.path().join("design.yaml");
+    std::fs::write(
+        &cfg,
+        text.replace(from, "design: { importance: 1.0, response_reduction: 3.0 }"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    common::copy_motions(&m, &out);
+    ok(slidestack(&["ida", s(&cfg), "--out", s(&out)], "2"));
+    for (name, z) in [("III", 0.16), ("V", 0.36)] {
+        let (_, zone) = zone(&out, name);
+        let want = z / 2.0 / 3.0;
+        let c_y = zone.vars.c_y[[0]];
+        assert!(
+            (c_y - want).abs() <= 1e-12 * want,
+            "{name}: {c_y} vs {want}"
+        );
+        let storeys = zone.vars.storey_c_y.unwrap();
+        assert_eq!(storeys[[0, 0, 0]], c_y);
+        assert!(storeys[[0, 0, 1]] > c_y && storeys[[0, 0, 2]] > storeys[[0, 0, 1]]);
+        // Every trace ran: the first run of every record and system has a drift.
+        let first = zone
+            .vars
+            .run_demand
+            .slice(ndarray::s![.., .., .., 0, 0])
+            .to_owned();
+        assert!(first.iter().all(|d| *d > 0.0), "{first:?}");
+    }
+}
