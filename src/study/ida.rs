@@ -17,13 +17,12 @@
 //! drift ratio of `collapse_drift_ratio`. A building of one storey runs as the one-storey model.
 
 use super::building::Frame;
+use super::physics::{Physics, SystemKind};
 use super::storey_strength::storey_strength_ratios;
+use crate::case::Case;
 use crate::dynamics::building::{
     Building, BuildingError, BuildingResponse, StoreyYielding, simulate_building,
 };
-
-use super::physics::{Physics, SystemKind};
-use crate::case::Case;
 use crate::dynamics::{
     ExactOptions, G, Ground, ModelError, SimError, System, Yielding, simulate_exact,
 };
@@ -687,4 +686,65 @@ pub fn padded(accel_mps2: &[f64], dt_s: f64, pad_s: f64) -> Vec<f64> {
     v.extend_from_slice(accel_mps2);
     v.resize(accel_mps2.len() + extra, 0.0);
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_layout_s_indices_name_their_demands() {
+        for building in [false, true] {
+            let l = DemandLayout {
+                building,
+                blocks: 3,
+            };
+            let names = l.names();
+            assert_eq!(names.len(), if building { 4 } else { 2 } + 2 * 3);
+            assert_eq!(names[l.ductility()], "ductility");
+            assert_eq!(names[l.first_slip()], "peak_slip_1_m");
+            assert_eq!(names[l.first_slip() + 3], "residual_slip_1_m");
+            let primary = if building {
+                "peak_drift_ratio"
+            } else {
+                "ductility"
+            };
+            assert_eq!(names[DemandLayout::PRIMARY], primary);
+        }
+    }
+
+    /// A building's demands from a response set by hand: two storeys of 3 m and 4 m, two stacks
+    /// of two blocks (a stack on each floor).
+    #[test]
+    fn a_building_s_demands_are_its_largest_ratios_and_slips() {
+        let cfg: IdaConfig = serde_yaml::from_str(
+            "structure: { c_y: 0.3, post_yield_ratio: 0.05 }\n\
+             cases: [{ period_s: 1.0, alpha: [0.5, 0.5], mu: [0.2, 0.1] }]\n\
+             tracing: { first_sa_g: 0.1, step_increment_sa_g: 0.1, bracket_runs: 1, \
+             fill_runs: 1, cap_sa_g: 1.0 }\n\
+             grid_points: 10\n\
+             collapse_drift_ratio: 0.02\n\
+             slip_limit_m: 0.3\n\
+             limit_states: [{ name: LS, drift_ratio: 0.01 }]\n",
+        )
+        .unwrap();
+        let mut r = BuildingResponse::zeroed(2, 4);
+        r.storey_peak_drift_m = vec![0.066, 0.04]; // 0.022 and 0.01 of the heights
+        r.storey_residual_drift_m = vec![-0.003, 0.008]; // 0.001 and 0.002
+        r.floor_peak_abs_accel_mps2 = vec![G, 2.5 * G];
+        r.storey_ductility = Some(vec![3.0, 1.5]);
+        r.peak_slip_m = vec![0.1, -0.05, 0.2, 0.01];
+        r.residual_slip_m = vec![-0.04, 0.0, 0.02, -0.03];
+        let (d, collapsed) = run_demand(&cfg, &r, Some(&[3.0, 4.0]));
+        let want = [0.022, 0.002, 2.5, 3.0, 0.2, 0.05, 0.04, 0.03];
+        for (got, want) in d.values.iter().zip(want) {
+            assert!((got - want).abs() <= 1e-15, "{:?}", d.values);
+        }
+        assert_eq!(d.values.len(), want.len());
+        assert!(collapsed && !d.slip_exceeded);
+        r.storey_peak_drift_m[0] = 0.059; // 0.0197: below the cap 0.02
+        r.peak_slip_m[3] = -0.3;
+        let (d, collapsed) = run_demand(&cfg, &r, Some(&[3.0, 4.0]));
+        assert!(!collapsed && d.slip_exceeded);
+    }
 }
