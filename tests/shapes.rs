@@ -314,10 +314,12 @@ fn write_ida_file(path: &Path) {
         limit_states: vec!["DL".into()],
         limit_state_definitions: vec!["ductility >= 2".into()],
         fractiles: vec![0.16, 0.5, 0.84],
+        building: None,
     };
     let fit = [s, c, l];
     let vars = IdaVars {
         c_y: zeros(&[c]),
+        storey_c_y: None,
         record_sa_g: zeros(&[r, c]),
         run_sa_g: zeros(&[s, r, c, n]),
         run_demand: zeros(&[s, r, c, n, d]),

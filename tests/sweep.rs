@@ -40,6 +40,7 @@ fn skip_rules_equal_brute_force_in_a_building() {
         let frame = Frame {
             floor_masses: vec![1.0, 1.0, 0.8],
             storey_stiffnesses: vec![3.0, 2.0, 1.0],
+            storey_heights_m: vec![3.0; 3],
             stack_floor,
         };
         skip_rules_hold(Some(&frame), 1);

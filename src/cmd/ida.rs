@@ -35,8 +35,12 @@ pub fn run(args: Args) -> Result<()> {
         "zone", "case", "system", "limit", "θ (g)", "95 % CI θ", "β", "95 % CI β"
     );
     for r in &rows {
+        let frame = r
+            .frame
+            .as_ref()
+            .map_or(String::new(), |f| format!("  ({f})"));
         println!(
-            "{:<5} {:>4} {:<6} {:<10} {:>8.3} {:>8.3}–{:<8.3} {:>6.3} {:>7.3}–{:<7.3}  {}",
+            "{:<5} {:>4} {:<6} {:<10} {:>8.3} {:>8.3}–{:<8.3} {:>6.3} {:>7.3}–{:<7.3}  {}{frame}",
             r.zone,
             r.case,
             r.system,
@@ -50,12 +54,16 @@ pub fn run(args: Args) -> Result<()> {
             r.status
         );
     }
+    let medians = ida::median_ductility(&session.study)?;
     println!(
-        "median ductility at multiples of the zone's target Sa(T_p) (the matched motions' level):"
+        "median {} at multiples of the zone's target Sa(T_p) (the matched motions' level):",
+        medians.first().map_or("ductility", |m| m.demand.as_str())
     );
-    for m in ida::median_ductility(&session.study)? {
+    for m in medians {
+        let frame = m.frame.as_ref().map_or(String::new(), |f| format!(", {f}"));
+        let p = if m.frame.is_some() { 4 } else { 3 };
         println!(
-            "{:<5} case {:>3} (T_p {} s, α {:?}, μ {:?}) at {:.2} × {:.3} g: stack {:.3}, rigid {:.3} ({:+.1} %); largest slip {:.4} m",
+            "{:<5} case {:>3}{frame} (T_p {} s, α {:?}, μ {:?}) at {:.2} × {:.3} g: stack {:.p$}, rigid {:.p$} ({:+.1} %); largest slip {:.4} m",
             m.zone,
             m.case,
             m.period_s,

@@ -8,10 +8,15 @@
 //! (removed by the next session) and the rerun computes everything again (the quick config takes
 //! seconds).
 //!
+//! In a building study a unit is one zone, one motion, one case and one frame (`storeys`,
+//! `stack_floor`; docs/model.md, "Incremental dynamic analysis", "In a building").
+//!
 //! Fingerprint: the `zones` section, the physics of the grid, the `ida` section and the
-//! motions' fingerprint.
+//! motions' fingerprint; in a building study also the `building` section and
+//! `grid.stack_floor`.
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
+use crate::grid::BuildingAxes;
 use crate::ida::curve::{fractile, on_grid};
 use crate::ida::fragility::{FIT_STATUS_FLAGS, FitStatus, fit_lognormal};
 use crate::ida::trace::Trace;
@@ -21,9 +26,11 @@ use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
 use crate::store::motions::read_zone_target;
+use crate::study::building::Frame;
 use crate::study::config::StudyConfig;
-use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
+use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
 use crate::study::physics::Physics;
+use crate::study::storey_strength::storey_strength_ratios;
 use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -36,11 +43,13 @@ pub const FRACTILES: [f64; 3] = [0.16, 0.5, 0.84];
 pub enum IdaStageError {
     #[error("{}: the `ida` stage needs an `ida` section", config.display())]
     NoSection { config: PathBuf },
-    #[error("zone {zone}, motion {motion}, case {case} ({system}): {why}")]
+    #[error("zone {zone}, motion {motion}, case {case}{frame} ({system}): {why}")]
     Simulation {
         zone: String,
         motion: String,
         case: usize,
+        /// `, 3 storeys, stack on the roof` in a building study, else empty.
+        frame: String,
         system: &'static str,
         why: String,
     },
@@ -50,10 +59,15 @@ pub enum IdaStageError {
 pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<String> {
     let ida = cfg.ida.as_ref()?;
     let p = cfg.physics();
-    let section = serde_json::json!({
+    let mut section = serde_json::json!({
         "zones": cfg.zones, "ida": ida, "solver": "exact",
         "physics": { "damping": p.damping, "basis": p.basis, "mu_static_ratio": p.mu_static_ratio },
     });
+    if let Some(b) = &cfg.building {
+        section["building"] = serde_json::json!(b);
+        let floors = cfg.grid.as_ref().and_then(|g| g.stack_floor.as_ref());
+        section["stack_floor"] = serde_json::json!(floors);
+    }
     Some(hash_parts(&[&section.to_string(), motions_fingerprint]))
 }
 
@@ -79,6 +93,14 @@ fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
         })
 }
 
+/// The frames of the study, in [`BuildingAxes::frame`] order (`[None]` on one storey).
+fn frames_of(study: &Study) -> Vec<Option<Frame>> {
+    match study.building() {
+        None => vec![None],
+        Some(b) => (0..b.frames()).map(|i| study.cfg.frame(b, i)).collect(),
+    }
+}
+
 /// Builds `ida.h5`.
 pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let study = &s.study;
@@ -88,21 +110,30 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let motions = super::sweep::load_motions(study)?;
     let physics = study.physics();
     let targets = stored_targets(study)?;
-    let units: Vec<(usize, usize, usize)> = motions
+    let frames = frames_of(study);
+    let nf = frames.len();
+    let units: Vec<(usize, usize, usize, usize)> = motions
         .iter()
         .enumerate()
         .flat_map(|(z, ms)| {
-            (0..ms.len()).flat_map(move |m| (0..cfg.cases.len()).map(move |c| (z, m, c)))
+            (0..ms.len()).flat_map(move |m| {
+                (0..cfg.cases.len()).flat_map(move |c| (0..nf).map(move |f| (z, m, c, f)))
+            })
         })
         .collect();
     s.reporter.info(
         me,
         &format!(
-            "{} traces ({} motions over {} zones × {} cases × {} systems), at most {} runs each",
+            "{} traces ({} motions over {} zones × {} cases{} × {} systems), at most {} runs each",
             units.len() * SYSTEMS.len(),
             motions.iter().map(Vec::len).sum::<usize>(),
             motions.len(),
             cfg.cases.len(),
+            if nf > 1 || study.building().is_some() {
+                format!(" × {nf} frames")
+            } else {
+                String::new()
+            },
             SYSTEMS.len(),
             cfg.tracing.max_runs()
         ),
@@ -112,14 +143,16 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let bar = s.reporter.progress(me, units.len() as u64);
     let outs: Vec<UnitOut> = units
         .par_iter()
-        .map(|&(z, m, c)| -> Result<UnitOut, PipelineError> {
+        .map(|&(z, m, c, f)| -> Result<UnitOut, PipelineError> {
             s.check_cancelled(me)?;
             let rec = &motions[z][m];
             let case = &cfg.cases[c];
+            let frame = frames[f].as_ref();
             let fail = |system: &'static str, why: String| IdaStageError::Simulation {
                 zone: study.cfg.zones[z].name.clone(),
                 motion: rec.name.clone(),
                 case: c,
+                frame: frame.map_or(String::new(), |f| format!(", {f}")),
                 system,
                 why,
             };
@@ -129,13 +162,14 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             let padded = padded(&accel, rec.dt_s, cfg.pad_s);
             let c_y = cfg.strength_ratio(&targets[z], case);
             let systems = cfg
-                .systems(&physics, case, c_y)
+                .systems(&physics, case, c_y, frame)
                 .map_err(|e| fail(SYSTEMS[0].key(), e.to_string()))?;
+            let heights = frame.map(|f| f.storey_heights_m.as_slice());
             let traces = systems
                 .iter()
                 .zip(SYSTEMS)
                 .map(|(sys, kind)| {
-                    trace_system(cfg, sys, &padded, rec.dt_s, record_sa_g)
+                    trace_system(cfg, sys, heights, &padded, rec.dt_s, record_sa_g)
                         .map_err(|e| fail(kind.key(), e.to_string()))
                 })
                 .collect::<Result<Vec<_>, _>>()?;
@@ -164,11 +198,11 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             secs * 1e9 * threads as f64 / samples.into_inner().max(1) as f64
         ),
     );
-    let axes = axes_of(cfg);
+    let axes = axes_of(cfg, study.building());
     let mut zones = Vec::new();
     let mut at = 0;
     for (z, zc) in study.cfg.zones.iter().enumerate() {
-        let count = motions[z].len() * cfg.cases.len();
+        let count = motions[z].len() * cfg.cases.len() * nf;
         let slice = &outs[at..at + count];
         at += count;
         let c_y: Vec<f64> = cfg
@@ -176,15 +210,19 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             .iter()
             .map(|c| cfg.strength_ratio(&targets[z], c))
             .collect();
+        let storey_c_y = storey_c_y(study, &axes, &c_y);
+        let mut vars = zone_vars(cfg, &axes, motions[z].len(), slice, c_y);
+        vars.storey_c_y = storey_c_y;
         zones.push(ZoneIda {
             name: zc.name.clone(),
             target: zc.target.clone(),
             records: motions[z].iter().map(|m| m.name.clone()).collect(),
-            vars: zone_vars(cfg, &axes, motions[z].len(), slice, c_y),
+            vars,
         });
     }
-    let c_y_rule = c_y_rule(cfg);
-    let settings = settings_attrs(cfg, &physics, &c_y_rule);
+    let c_y_rule = c_y_rule(cfg, study.building().is_some());
+    let building_json = super::sweep::building_attr(study);
+    let settings = settings_attrs(cfg, &physics, &c_y_rule, building_json.as_deref());
     let meta = IdaMeta {
         fingerprint: fp,
         motions_fingerprint: study.fingerprint(StageId::Motions)?,
@@ -198,16 +236,43 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     Ok(Outcome::Wrote(vec![path]))
 }
 
-/// How the structure's strength is set, in words.
-fn c_y_rule(cfg: &IdaConfig) -> String {
-    match (&cfg.structure.c_y, &cfg.structure.design) {
+/// `storey_c_y` `[case, storeys, storey]` of a building study (NaN above each building).
+fn storey_c_y(study: &Study, axes: &IdaAxes, c_y: &[f64]) -> Option<ArrayD<f64>> {
+    let b = axes.building.as_ref()?;
+    let section = study.cfg.building.as_ref()?;
+    let mut a = array(&[c_y.len(), b.storeys.len(), axes.max_storeys()], f64::NAN);
+    for (c, &cy) in c_y.iter().enumerate() {
+        for (k, &n) in b.storeys.iter().enumerate() {
+            let f = section.frame(n, crate::grid::StackFloor::Roof);
+            let ratios = storey_strength_ratios(cy, &f.floor_masses, &f.storey_heights_m);
+            for (i, r) in ratios.into_iter().enumerate() {
+                a[[c, k, i]] = r;
+            }
+        }
+    }
+    Some(a)
+}
+
+/// How the structure's strength is set, in words (in a building: the base-shear coefficient
+/// and its distribution over the height).
+fn c_y_rule(cfg: &IdaConfig, building: bool) -> String {
+    let base = match (&cfg.structure.c_y, &cfg.structure.design) {
         (Some(c), _) => format!("C_y = {c}"),
         (None, Some(d)) => format!(
             "C_y = (Z/2)(I/R)(Sa/g)(T_p) of the zone's IS 1893 target, I = {}, R = {}",
             d.importance, d.response_reduction
         ),
         (None, None) => String::new(),
+    };
+    if !building {
+        return base;
     }
+    format!(
+        "{base}, the base-shear coefficient on the bare floors' weight (T_p = T_1, the bare \
+         building's first-mode period); storey strengths F_y,i = V_i = sum_(j>=i) Q_j with \
+         Q_j = V_B m_j h_j^2 / sum_k m_k h_k^2 (IS 1893 (Part 1):2016 Clause 7.6.3), h_j the \
+         height of floor j"
+    )
 }
 
 /// The settings `ida.h5` states as file attributes.
@@ -215,6 +280,7 @@ fn settings_attrs<'a>(
     cfg: &IdaConfig,
     physics: &Physics,
     c_y_rule: &'a str,
+    building_json: Option<&'a str>,
 ) -> Vec<(&'static str, Attr<'a>)> {
     let t = &cfg.tracing;
     let mut settings: Vec<(&str, Attr)> = super::sweep::physics_attrs(physics).to_vec();
@@ -225,7 +291,20 @@ fn settings_attrs<'a>(
             "post_yield_ratio",
             Attr::F64(cfg.structure.post_yield_ratio),
         ),
-        ("collapse_ductility", Attr::F64(cfg.collapse_ductility)),
+    ]);
+    match (
+        building_json,
+        cfg.collapse_ductility,
+        cfg.collapse_drift_ratio,
+    ) {
+        (Some(b), _, Some(r)) => settings.extend([
+            ("building", Attr::Str(b)),
+            ("collapse_drift_ratio", Attr::F64(r)),
+        ]),
+        (_, Some(d), _) => settings.push(("collapse_ductility", Attr::F64(d))),
+        _ => {}
+    }
+    settings.extend([
         ("slip_limit_m", Attr::F64(cfg.slip_limit_m)),
         ("pad_s", Attr::F64(cfg.pad_s)),
         ("first_sa_g", Attr::F64(t.first_sa_g)),
@@ -249,8 +328,8 @@ fn settings_attrs<'a>(
     settings
 }
 
-/// The axes `ida.h5` has for the `ida:` section `cfg`.
-fn axes_of(cfg: &IdaConfig) -> IdaAxes {
+/// The axes `ida.h5` has for the `ida:` section `cfg` (in a building study of `building`).
+fn axes_of(cfg: &IdaConfig, building: Option<&BuildingAxes>) -> IdaAxes {
     IdaAxes {
         systems: SYSTEMS.iter().map(|s| s.key().to_string()).collect(),
         case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
@@ -258,10 +337,11 @@ fn axes_of(cfg: &IdaConfig) -> IdaAxes {
         case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
         runs: cfg.tracing.max_runs(),
         sa_grid_g: cfg.grid_sa_g(),
-        demands: cfg.demand_names(),
+        demands: cfg.demand_names(building.is_some()),
         limit_states: cfg.limit_states.iter().map(|l| l.name.clone()).collect(),
         limit_state_definitions: cfg.limit_states.iter().map(|l| l.definition()).collect(),
         fractiles: FRACTILES.to_vec(),
+        building: building.cloned(),
     }
 }
 
@@ -270,7 +350,7 @@ fn axes_of(cfg: &IdaConfig) -> IdaAxes {
 fn read_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
     let path = study.path(StageId::Ida.output());
     let (axes, z) = read_zone_ida(&path, zone)?;
-    if axes != axes_of(section(study)?) {
+    if axes != axes_of(section(study)?, study.building()) {
         let why = format!("zone_{zone}: its axes differ from the config's `ida:` section");
         return Err(StoreError::corrupt(&path, why).into());
     }
@@ -289,7 +369,9 @@ fn zone_vars(
     units: &[UnitOut],
     c_y: Vec<f64>,
 ) -> IdaVars {
-    let (ns, nc, nr) = (SYSTEMS.len(), cfg.cases.len(), axes.runs);
+    // Cases and frames folded into one axis, case-major (crate::store::ida).
+    let (ns, nc, nr) = (SYSTEMS.len(), cfg.cases.len() * axes.frames(), axes.runs);
+    let layout = cfg.layout(axes.building.is_some());
     let (nd, ng, nl) = (
         axes.demands.len(),
         axes.sa_grid_g.len(),
@@ -297,7 +379,8 @@ fn zone_vars(
     );
     let grid = &axes.sa_grid_g;
     let mut v = IdaVars {
-        c_y: ArrayD::from_shape_vec(IxDyn(&[nc]), c_y).expect("one per case"),
+        c_y: ArrayD::from_shape_vec(IxDyn(&[cfg.cases.len()]), c_y).expect("one per case"),
+        storey_c_y: None,
         record_sa_g: array(&[records, nc], f64::NAN),
         run_sa_g: array(&[ns, records, nc, nr], f64::NAN),
         run_demand: array(&[ns, records, nc, nr, nd], f64::NAN),
@@ -361,17 +444,19 @@ fn zone_vars(
                 let (mut x, mut trials, mut exceed) = (Vec::new(), Vec::new(), Vec::new());
                 for (j, &sa) in grid.iter().enumerate() {
                     let (mut nj, mut zj) = (0u32, 0u32);
+                    let (d0, over_blocks) = layout.of_limit(ls);
                     for r in 0..records {
-                        let value = match (ls.ductility, ls.slip_m) {
-                            (Some(_), _) => v.curve[[s, r, c, j, 0]],
-                            _ => (0..n)
-                                .map(|i| v.curve[[s, r, c, j, 2 + i]])
-                                .fold(f64::NEG_INFINITY, f64::max),
+                        let value = if over_blocks {
+                            (0..n)
+                                .map(|i| v.curve[[s, r, c, j, d0 + i]])
+                                .fold(f64::NEG_INFINITY, f64::max)
+                        } else {
+                            v.curve[[s, r, c, j, d0]]
                         };
                         if value.is_nan() {
                             continue;
                         }
-                        let threshold = ls.ductility.or(ls.slip_m).unwrap_or(f64::INFINITY);
+                        let threshold = ls.threshold();
                         nj += 1;
                         zj += u32::from(value >= threshold);
                     }
@@ -414,6 +499,8 @@ fn zone_vars(
 pub struct FragilityRow {
     pub zone: String,
     pub case: usize,
+    /// The frame of a building study (`3 storeys, stack on the roof`).
+    pub frame: Option<String>,
     pub system: String,
     pub limit_state: String,
     pub theta_sa_g: f64,
@@ -431,14 +518,17 @@ pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError
     for zone in &study.cfg.zones {
         let (axes, z) = read_zone(study, &zone.name)?;
         let v = &z.vars;
-        for c in 0..axes.case_period_s.len() {
+        let labels = frame_labels(study);
+        let nf = labels.len();
+        for c in 0..axes.case_period_s.len() * nf {
             for (s, system) in axes.systems.iter().enumerate() {
                 for (l, limit) in axes.limit_states.iter().enumerate() {
                     let at = [s, c, l];
                     let code = v.fit_status[at];
                     rows.push(FragilityRow {
                         zone: zone.name.clone(),
-                        case: c,
+                        case: c / nf,
+                        frame: labels[c % nf].clone(),
                         system: system.clone(),
                         limit_state: limit.clone(),
                         theta_sa_g: v.theta_sa_g[at],
@@ -457,11 +547,24 @@ pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError
     Ok(rows)
 }
 
-/// The median ductility of the stack and of the rigidly attached load at one intensity.
+/// The frames' labels in stored order (`[None]` on one storey).
+fn frame_labels(study: &Study) -> Vec<Option<String>> {
+    frames_of(study)
+        .into_iter()
+        .map(|f| f.map(|f| f.to_string()))
+        .collect()
+}
+
+/// The median primary demand (ductility on one storey, the peak interstorey drift ratio in a
+/// building) of the stack and of the rigidly attached load at one intensity.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MedianDuctility {
     pub zone: String,
     pub case: usize,
+    /// The frame of a building study (`3 storeys, stack on the roof`).
+    pub frame: Option<String>,
+    /// The demand compared: `ductility` or `peak_drift_ratio`.
+    pub demand: String,
     pub period_s: f64,
     pub alpha: Vec<f64>,
     pub mu: Vec<f64>,
@@ -501,22 +604,30 @@ pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineE
     study.require(StageId::Ida)?;
     let targets = stored_targets(study)?;
     let mut rows = Vec::new();
+    let labels = frame_labels(study);
+    let nf = labels.len();
     for (zone, target) in study.cfg.zones.iter().zip(&targets) {
         let (axes, z) = read_zone(study, &zone.name)?;
         let median = FRACTILES.iter().position(|&p| p == 0.5).unwrap_or(1);
-        for c in 0..axes.case_period_s.len() {
+        for cf in 0..axes.case_period_s.len() * nf {
+            let c = cf / nf;
             let curve = |s: usize| -> Vec<f64> {
                 (0..axes.sa_grid_g.len())
-                    .map(|j| z.vars.fractile_curve[[s, c, median, j, 0]])
+                    .map(|j| z.vars.fractile_curve[[s, cf, median, j, DemandLayout::PRIMARY]])
                     .collect()
             };
             let (stack, rigid) = (curve(0), curve(1));
             let target_sa_g = target.sa_g(axes.case_period_s[c]);
             let n = axes.case_alpha[c].len();
+            let slip = DemandLayout {
+                building: axes.building.is_some(),
+                blocks: n,
+            }
+            .first_slip();
             let stack_max_slip_m = z
                 .vars
                 .run_demand
-                .slice(ndarray::s![0, .., c, .., 2..2 + n])
+                .slice(ndarray::s![0, .., cf, .., slip..slip + n])
                 .iter()
                 .copied()
                 .filter(|v| !v.is_nan())
@@ -526,6 +637,8 @@ pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineE
                 rows.push(MedianDuctility {
                     zone: zone.name.clone(),
                     case: c,
+                    frame: labels[cf % nf].clone(),
+                    demand: axes.demands[DemandLayout::PRIMARY].clone(),
                     period_s: axes.case_period_s[c],
                     alpha: axes.case_alpha[c].clone(),
                     mu: axes.case_mu[c].clone(),
@@ -550,64 +663,79 @@ pub fn figure(study: &Study) -> Result<String, PipelineError> {
     })
 }
 
-/// The first case's ductility against intensity, one panel per zone: every record's curve
-/// (faint) and the 16–50–84 % fractiles of the stack and of the rigidly attached load.
-/// Collapsed values (`+∞`) are drawn at the collapse ductility.
+/// The first case's ductility (in a building: peak interstorey drift ratio) against intensity,
+/// one panel per zone (and frame): every record's curve (faint) and the 16–50–84 % fractiles
+/// of the stack and of the rigidly attached load. Collapsed values (`+∞`) are drawn at the
+/// collapse ductility (drift ratio).
 pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, PipelineError> {
     use crate::render::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Ida)?;
-    let cap = section(study)?.collapse_ductility;
+    let cfg = section(study)?;
+    let building = study.building().is_some();
+    let (cap, y_label) = if building {
+        let cap = cfg.collapse_drift_ratio.unwrap_or(f64::NAN);
+        (cap, "peak interstorey drift ratio")
+    } else {
+        let cap = cfg.collapse_ductility.unwrap_or(f64::NAN);
+        (cap, "ductility u_m/u_y")
+    };
     let clip = |v: f64| if v.is_infinite() { cap } else { v };
+    let labels = frame_labels(study);
+    let d = DemandLayout::PRIMARY;
     let mut panels = Vec::new();
     for zone in &study.cfg.zones {
         let (axes, z) = read_zone(study, &zone.name)?;
         let x = axes.sa_grid_g.clone();
-        let mut series = Vec::new();
-        for s in 0..axes.systems.len() {
-            for r in 0..z.records.len() {
-                let y: Vec<f64> = (0..x.len())
-                    .map(|j| clip(z.vars.curve[[s, r, 0, j, 0]]))
-                    .collect();
-                series.push(Series::faint(x.clone(), y));
+        // The first case in every frame: folded index `f` (crate::store::ida).
+        for (f, label) in labels.iter().enumerate() {
+            let mut series = Vec::new();
+            for s in 0..axes.systems.len() {
+                for r in 0..z.records.len() {
+                    let y: Vec<f64> = (0..x.len())
+                        .map(|j| clip(z.vars.curve[[s, r, f, j, d]]))
+                        .collect();
+                    series.push(Series::faint(x.clone(), y));
+                }
             }
-        }
-        for (s, name) in axes.systems.iter().enumerate() {
-            let q = |k: usize| -> Vec<f64> {
-                (0..x.len())
-                    .map(|j| clip(z.vars.fractile_curve[[s, 0, k, j, 0]]))
-                    .collect()
-            };
-            series.push(Series::band(
-                format!("{name}: 16–84 %"),
-                x.clone(),
-                q(0),
-                q(2),
+            for (s, name) in axes.systems.iter().enumerate() {
+                let q = |k: usize| -> Vec<f64> {
+                    (0..x.len())
+                        .map(|j| clip(z.vars.fractile_curve[[s, f, k, j, d]]))
+                        .collect()
+                };
+                series.push(Series::band(
+                    format!("{name}: 16–84 %"),
+                    x.clone(),
+                    q(0),
+                    q(2),
+                ));
+                let line = Series::line(format!("{name}: median"), x.clone(), q(1));
+                series.push(if s == 0 {
+                    line
+                } else {
+                    line.stroke(Stroke::Dashed, 2)
+                });
+            }
+            let a = &axes;
+            let at = label.as_ref().map_or(String::new(), |l| format!(", {l}"));
+            panels.push(Panel::xy(
+                format!(
+                    "zone {}{at}: T_p = {} s, α = {:?}, μ = {:?}, C_y = {:.3}",
+                    zone.name,
+                    a.case_period_s[0],
+                    a.case_alpha[0],
+                    a.case_mu[0],
+                    z.vars.c_y[[0]]
+                ),
+                Axis::new("Sa(T_p, 5 %), g"),
+                Axis::new(y_label).range(0.0, cap),
+                series,
             ));
-            let line = Series::line(format!("{name}: median"), x.clone(), q(1));
-            series.push(if s == 0 {
-                line
-            } else {
-                line.stroke(Stroke::Dashed, 2)
-            });
         }
-        let a = &axes;
-        panels.push(Panel::xy(
-            format!(
-                "zone {}: T_p = {} s, α = {:?}, μ = {:?}, C_y = {:.3}",
-                zone.name,
-                a.case_period_s[0],
-                a.case_alpha[0],
-                a.case_mu[0],
-                z.vars.c_y[[0]]
-            ),
-            Axis::new("Sa(T_p, 5 %), g"),
-            Axis::new("ductility u_m/u_y").range(0.0, cap),
-            series,
-        ));
     }
     Ok(Figure::grid(
         "IDA curves: sliding stack vs rigidly attached load",
         panels,
-        1,
+        labels.len().min(3),
     ))
 }

@@ -393,9 +393,11 @@ impl Study {
             return Ok(());
         }
         let why = match stage {
-            StageId::Motions | StageId::Sweep | StageId::Tnew | StageId::Fit => return Ok(()),
-            StageId::Report | StageId::Ida => {
-                "cannot yet take a building study (motions, sweep, tnew and fit can)"
+            StageId::Motions | StageId::Sweep | StageId::Tnew | StageId::Fit | StageId::Ida => {
+                return Ok(());
+            }
+            StageId::Report => {
+                "cannot yet take a building study (motions, sweep, tnew, fit and ida can)"
             }
         };
         Err(PipelineError::NotForBuilding {

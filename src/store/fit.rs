@@ -106,6 +106,8 @@ pub struct FrameSpec {
     pub floor_masses: Vec<f64>,
     /// Relative storey stiffnesses, storey 1 first.
     pub storey_stiffnesses: Vec<f64>,
+    /// Storey heights, m, storey 1 first.
+    pub storey_heights_m: Vec<f64>,
     /// The stack's relative height `z_stack`.
     pub z_stack: f64,
 }
@@ -116,6 +118,7 @@ impl FrameSpec {
         Some(Frame {
             floor_masses: self.floor_masses.clone(),
             storey_stiffnesses: self.storey_stiffnesses.clone(),
+            storey_heights_m: self.storey_heights_m.clone(),
             stack_floor: self.stack_floor.parse().ok()?,
         })
     }
@@ -126,6 +129,7 @@ impl FrameSpec {
             stack_floor: f.stack_floor.to_string(),
             floor_masses: f.floor_masses.clone(),
             storey_stiffnesses: f.storey_stiffnesses.clone(),
+            storey_heights_m: f.storey_heights_m.clone(),
             z_stack: f.stack_height_ratio(),
         }
     }

@@ -18,6 +18,16 @@
 //!     theta (g), beta, theta_ci_low, theta_ci_high (g), beta_ci_low, beta_ci_high,
 //!     fit_status (CF flags) [system, case, limit_state]
 //! ```
+//! In a building study (docs/model.md, "Incremental dynamic analysis", "In a building") every
+//! variable over `case` is over `case, storeys, stack_floor` instead (the frames, dimension
+//! scales as in `sweep.h5`; `c_y`, the base-shear coefficient, stays over `case`), and
+//! ```text
+//!     storey (number, 1 = the lowest) coordinate
+//!     storey_c_y [case, storeys, storey]: C_y,i of each storey (NaN above the building)
+//! ```
+//! In memory ([`IdaVars`]) the frames are folded into the case axis, case-major
+//! (`case·frames + frame`, frames as [`BuildingAxes::frame`] orders them).
+//!
 //! Runs a trace did not make are NaN (255 for the flags). Variables are chunked per system,
 //! deflate+shuffle compressed, Fletcher32-checksummed, written in a fixed order with object
 //! times not tracked, so the same inputs give the same bytes.
@@ -27,7 +37,9 @@ use super::h5::{
     Attr, GroupReader, attach_scale, attr_str, coordinate, set_scale, write_attrs, write_flags,
     write_stage_file, write_strings, write_var,
 };
-use ndarray::ArrayD;
+use super::sweep::{building_coordinates, read_building_coordinates};
+use crate::grid::BuildingAxes;
+use ndarray::{ArrayD, IxDyn};
 use std::path::Path;
 
 /// The axes every zone shares.
@@ -44,12 +56,28 @@ pub struct IdaAxes {
     pub limit_states: Vec<String>,
     pub limit_state_definitions: Vec<String>,
     pub fractiles: Vec<f64>,
+    /// The frames of a building study.
+    pub building: Option<BuildingAxes>,
+}
+
+impl IdaAxes {
+    /// Frames per case (1 on one storey).
+    pub fn frames(&self) -> usize {
+        self.building.as_ref().map_or(1, BuildingAxes::frames)
+    }
+
+    /// The largest storey count (the length of `storey`).
+    pub fn max_storeys(&self) -> usize {
+        (self.building.as_ref()).map_or(1, |b| b.storeys.iter().copied().max().unwrap_or(1))
+    }
 }
 
 /// One zone's variables (shapes in the module doc).
 #[derive(Debug, Clone, PartialEq)]
 pub struct IdaVars {
     pub c_y: ArrayD<f64>,
+    /// `[case, storeys, storey]`, in a building study.
+    pub storey_c_y: Option<ArrayD<f64>>,
     pub record_sa_g: ArrayD<f64>,
     pub run_sa_g: ArrayD<f64>,
     pub run_demand: ArrayD<f64>,
@@ -149,15 +177,65 @@ struct Coordinates {
     demand: hdf5::Dataset,
     limit: hdf5::Dataset,
     fractile: hdf5::Dataset,
+    /// `storeys`, `stack_floor` and `storey`, in a building study.
+    building: Option<[hdf5::Dataset; 3]>,
+}
+
+impl Coordinates {
+    /// `before`, then the case's dimensions (`case`, or `case, storeys, stack_floor` in a
+    /// building study), then `after`.
+    fn around<'a>(
+        &'a self,
+        before: &[&'a hdf5::Dataset],
+        after: &[&'a hdf5::Dataset],
+    ) -> Vec<&'a hdf5::Dataset> {
+        let mut v = before.to_vec();
+        v.push(&self.case);
+        if let Some([n, f, _]) = &self.building {
+            v.extend([n, f]);
+        }
+        v.extend_from_slice(after);
+        v
+    }
+}
+
+/// `a` with its axis `at` of `cases × frames` split into `[cases, storeys, stack_floor]`
+/// (`frames` the latter two; `None`: `a` itself).
+fn split<T: Clone>(a: &ArrayD<T>, at: usize, frames: Option<[usize; 2]>) -> ArrayD<T> {
+    let Some([n, f]) = frames else {
+        return a.clone();
+    };
+    let mut shape = a.shape().to_vec();
+    let cases = shape[at] / (n * f);
+    shape.splice(at..=at, [cases, n, f]);
+    a.as_standard_layout()
+        .into_owned()
+        .into_shape_with_order(IxDyn(&shape))
+        .expect("cases × frames")
+}
+
+/// The inverse of [`split`].
+fn fold<T: Clone>(a: ArrayD<T>, at: usize, frames: Option<[usize; 2]>) -> ArrayD<T> {
+    if frames.is_none() {
+        return a;
+    }
+    let mut shape = a.shape().to_vec();
+    let merged: usize = shape[at..at + 3].iter().product();
+    shape.splice(at..at + 3, [merged]);
+    a.as_standard_layout()
+        .into_owned()
+        .into_shape_with_order(IxDyn(&shape))
+        .expect("cases × frames")
 }
 
 fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hdf5::Result<()> {
     let g = f.create_group(&format!("zone_{}", z.name))?;
     attr_str(&g, "target", &z.target)?;
     let dims = write_coordinates(&g, axes, z)?;
-    write_cases(&g, axes, &z.vars, &dims)?;
-    write_runs(&g, &z.vars, &dims)?;
-    write_fits(&g, &z.vars, &dims, meta)
+    let frames = axes.building.as_ref().map(BuildingAxes::shape);
+    write_cases(&g, axes, &z.vars, &dims, frames)?;
+    write_runs(&g, &z.vars, &dims, frames)?;
+    write_fits(&g, &z.vars, &dims, meta, frames)
 }
 
 /// A variable over the coordinates `dims`, chunked by [`chunk_of`].
@@ -259,6 +337,16 @@ fn write_coordinates(g: &hdf5::Group, axes: &IdaAxes, z: &ZoneIda) -> hdf5::Resu
         "exceeded when (a collapse exceeds every limit state)",
     )?;
     attach_scale(&ds, &limit, 0)?;
+    let building = match &axes.building {
+        None => None,
+        Some(b) => {
+            let [n, f] = <[hdf5::Dataset; 2]>::try_from(building_coordinates(g, b)?)
+                .expect("storeys and stack_floor");
+            let storeys: Vec<f64> = (1..=axes.max_storeys()).map(|i| i as f64).collect();
+            let storey = coordinate(g, "storey", &storeys, "1", "storey (1 = the lowest)")?;
+            Some([n, f, storey])
+        }
+    };
     Ok(Coordinates {
         system,
         record,
@@ -269,11 +357,18 @@ fn write_coordinates(g: &hdf5::Group, axes: &IdaAxes, z: &ZoneIda) -> hdf5::Resu
         demand,
         limit,
         fractile,
+        building,
     })
 }
 
 /// The cases and their strengths, and each record's intensity.
-fn write_cases(g: &hdf5::Group, axes: &IdaAxes, v: &IdaVars, d: &Coordinates) -> hdf5::Result<()> {
+fn write_cases(
+    g: &hdf5::Group,
+    axes: &IdaAxes,
+    v: &IdaVars,
+    d: &Coordinates,
+    frames: Option<[usize; 2]>,
+) -> hdf5::Result<()> {
     let shape = (
         axes.case_alpha.len(),
         axes.case_alpha.first().map_or(0, Vec::len),
@@ -311,25 +406,47 @@ fn write_cases(g: &hdf5::Group, axes: &IdaAxes, v: &IdaVars, d: &Coordinates) ->
         &v.c_y,
         &[&d.case],
         "1",
-        "yield strength ratio F_y/(m_p g) of the structure",
+        if d.building.is_some() {
+            "base-shear coefficient V_B/(g sum_j m_j) of the bare building (the strength of storey 1)"
+        } else {
+            "yield strength ratio F_y/(m_p g) of the structure"
+        },
     )?;
+    if let (Some(c), Some([n, _, storey])) = (&v.storey_c_y, &d.building) {
+        put(
+            g,
+            "storey_c_y",
+            c,
+            &[&d.case, n, storey],
+            "1",
+            "storey strength ratio F_y,i/(g sum_{j>=i} m_j) from c_y by IS 1893 (Part 1):2016 \
+             Clause 7.6.3 (NaN above the building)",
+        )?;
+    }
     put(
         g,
         "record_Sa",
-        &v.record_sa_g,
-        &[&d.record, &d.case],
+        &split(&v.record_sa_g, 1, frames),
+        &d.around(&[&d.record], &[]),
         "g",
         "Sa(T_p, 5 %) of the unscaled motion",
     )
 }
 
 /// The traced runs, the curves on the common grid and their fractiles.
-fn write_runs(g: &hdf5::Group, v: &IdaVars, d: &Coordinates) -> hdf5::Result<()> {
-    let sys_run = [&d.system, &d.record, &d.case, &d.run];
+fn write_runs(
+    g: &hdf5::Group,
+    v: &IdaVars,
+    d: &Coordinates,
+    frames: Option<[usize; 2]>,
+) -> hdf5::Result<()> {
+    let sys_run = d.around(&[&d.system, &d.record], &[&d.run]);
+    let at = |a: &ArrayD<f64>| split(a, 2, frames);
+    let at_flags = |a: &ArrayD<u8>| split(a, 2, frames);
     put(
         g,
         "run_Sa",
-        &v.run_sa_g,
+        &at(&v.run_sa_g),
         &sys_run,
         "g",
         "intensity of each traced run",
@@ -337,23 +454,27 @@ fn write_runs(g: &hdf5::Group, v: &IdaVars, d: &Coordinates) -> hdf5::Result<()>
     put(
         g,
         "run_demand",
-        &v.run_demand,
-        &[&d.system, &d.record, &d.case, &d.run, &d.demand],
+        &at(&v.run_demand),
+        &d.around(&[&d.system, &d.record], &[&d.run, &d.demand]),
         "demand",
         "demands of each traced run (units in the demand names)",
     )?;
     put_flags(
         g,
         "run_collapsed",
-        &v.run_collapsed,
+        &at_flags(&v.run_collapsed),
         &sys_run,
-        "the run reached the collapse ductility",
+        if frames.is_some() {
+            "the run reached the collapse drift ratio"
+        } else {
+            "the run reached the collapse ductility"
+        },
         &YES_NO,
     )?;
     put_flags(
         g,
         "run_slip_exceeded",
-        &v.run_slip_exceeded,
+        &at_flags(&v.run_slip_exceeded),
         &sys_run,
         "some block's peak slip reached slip_limit_m",
         &YES_NO,
@@ -361,36 +482,42 @@ fn write_runs(g: &hdf5::Group, v: &IdaVars, d: &Coordinates) -> hdf5::Result<()>
     put(
         g,
         "collapse_Sa",
-        &v.collapse_sa_g,
-        &[&d.system, &d.record, &d.case],
+        &at(&v.collapse_sa_g),
+        &d.around(&[&d.system, &d.record], &[]),
         "g",
         "lowest collapsing intensity of the trace (NaN: no collapse up to the cap)",
     )?;
     put(
         g,
         "curve",
-        &v.curve,
-        &[&d.system, &d.record, &d.case, &d.sa, &d.demand],
+        &at(&v.curve),
+        &d.around(&[&d.system, &d.record], &[&d.sa, &d.demand]),
         "demand",
         "IDA curve on the common grid (linear between runs; +inf from the collapse on; NaN above the last run)",
     )?;
     put(
         g,
         "fractile_curve",
-        &v.fractile_curve,
-        &[&d.system, &d.case, &d.fractile, &d.sa, &d.demand],
+        &split(&v.fractile_curve, 1, frames),
+        &d.around(&[&d.system], &[&d.fractile, &d.sa, &d.demand]),
         "demand",
         "fractiles of the curves over the records (type 7; collapsed records count as +inf)",
     )
 }
 
 /// The stripes, the fragility fits and their intervals.
-fn write_fits(g: &hdf5::Group, v: &IdaVars, d: &Coordinates, meta: &IdaMeta) -> hdf5::Result<()> {
-    let fr = [&d.system, &d.case, &d.limit, &d.sa];
+fn write_fits(
+    g: &hdf5::Group,
+    v: &IdaVars,
+    d: &Coordinates,
+    meta: &IdaMeta,
+    frames: Option<[usize; 2]>,
+) -> hdf5::Result<()> {
+    let fr = d.around(&[&d.system], &[&d.limit, &d.sa]);
     put(
         g,
         "exceed_fraction",
-        &v.exceed_fraction,
+        &split(&v.exceed_fraction, 1, frames),
         &fr,
         "1",
         "fraction of the records whose curve exceeds the limit state (the stripe data of the fit)",
@@ -398,12 +525,12 @@ fn write_fits(g: &hdf5::Group, v: &IdaVars, d: &Coordinates, meta: &IdaMeta) -> 
     put(
         g,
         "fragility_curve",
-        &v.fragility_curve,
+        &split(&v.fragility_curve, 1, frames),
         &fr,
         "1",
         "fitted lognormal fragility Phi(ln(Sa/theta)/beta)",
     )?;
-    let fit = [&d.system, &d.case, &d.limit];
+    let fit = d.around(&[&d.system], &[&d.limit]);
     for (name, data, units, long) in [
         (
             "theta",
@@ -437,12 +564,12 @@ fn write_fits(g: &hdf5::Group, v: &IdaVars, d: &Coordinates, meta: &IdaMeta) -> 
             "95 % Wald interval of beta, upper end",
         ),
     ] {
-        put(g, name, data, &fit, units, long)?;
+        put(g, name, &split(data, 1, frames), &fit, units, long)?;
     }
     put_flags(
         g,
         "fit_status",
-        &v.fit_status,
+        &split(&v.fit_status, 1, frames),
         &fit,
         "how the fragility fit ended",
         meta.fit_flags,
@@ -479,7 +606,13 @@ pub fn read_zone_ida(path: &Path, zone: &str) -> Result<(IdaAxes, ZoneIda), Stor
         limit_states,
         limit_state_definitions,
         fractiles: g.vector("fractile")?,
+        building: if g.group().link_exists("storeys") {
+            Some(read_building_coordinates(&g)?)
+        } else {
+            None
+        },
     };
+    let frames = axes.building.as_ref().map(BuildingAxes::shape);
     let (s, r, c, n) = (axes.systems.len(), records.len(), cases, axes.runs);
     let (d, sa, l, q) = (
         axes.demands.len(),
@@ -487,26 +620,52 @@ pub fn read_zone_ida(path: &Path, zone: &str) -> Result<(IdaAxes, ZoneIda), Stor
         axes.limit_states.len(),
         axes.fractiles.len(),
     );
-    let fit = [s, c, l];
+    // Each variable over `[before.., case, after..]` as stored, folded back to one case axis.
+    let shape = |before: &[usize], after: &[usize]| -> Vec<usize> {
+        let mut v = before.to_vec();
+        v.push(c);
+        v.extend(frames.into_iter().flatten());
+        v.extend_from_slice(after);
+        v
+    };
+    let f64s = |name: &str, before: &[usize], after: &[usize]| -> Result<ArrayD<f64>, StoreError> {
+        Ok(fold(
+            g.array(name, &shape(before, after))?,
+            before.len(),
+            frames,
+        ))
+    };
+    let flags = |name: &str, before: &[usize], after: &[usize]| -> Result<ArrayD<u8>, StoreError> {
+        Ok(fold(
+            g.array(name, &shape(before, after))?,
+            before.len(),
+            frames,
+        ))
+    };
+    let storey_c_y = match &axes.building {
+        None => None,
+        Some(b) => Some(g.array("storey_c_y", &[c, b.storeys.len(), axes.max_storeys()])?),
+    };
     let vars = IdaVars {
         c_y: g.array("c_y", &[c])?,
-        record_sa_g: g.array("record_Sa", &[r, c])?,
-        run_sa_g: g.array("run_Sa", &[s, r, c, n])?,
-        run_demand: g.array("run_demand", &[s, r, c, n, d])?,
-        run_collapsed: g.array("run_collapsed", &[s, r, c, n])?,
-        run_slip_exceeded: g.array("run_slip_exceeded", &[s, r, c, n])?,
-        collapse_sa_g: g.array("collapse_Sa", &[s, r, c])?,
-        curve: g.array("curve", &[s, r, c, sa, d])?,
-        fractile_curve: g.array("fractile_curve", &[s, c, q, sa, d])?,
-        exceed_fraction: g.array("exceed_fraction", &[s, c, l, sa])?,
-        fragility_curve: g.array("fragility_curve", &[s, c, l, sa])?,
-        theta_sa_g: g.array("theta", &fit)?,
-        beta: g.array("beta", &fit)?,
-        theta_ci_low_sa_g: g.array("theta_ci_low", &fit)?,
-        theta_ci_high_sa_g: g.array("theta_ci_high", &fit)?,
-        beta_ci_low: g.array("beta_ci_low", &fit)?,
-        beta_ci_high: g.array("beta_ci_high", &fit)?,
-        fit_status: g.array("fit_status", &fit)?,
+        storey_c_y,
+        record_sa_g: f64s("record_Sa", &[r], &[])?,
+        run_sa_g: f64s("run_Sa", &[s, r], &[n])?,
+        run_demand: f64s("run_demand", &[s, r], &[n, d])?,
+        run_collapsed: flags("run_collapsed", &[s, r], &[n])?,
+        run_slip_exceeded: flags("run_slip_exceeded", &[s, r], &[n])?,
+        collapse_sa_g: f64s("collapse_Sa", &[s, r], &[])?,
+        curve: f64s("curve", &[s, r], &[sa, d])?,
+        fractile_curve: f64s("fractile_curve", &[s], &[q, sa, d])?,
+        exceed_fraction: f64s("exceed_fraction", &[s], &[l, sa])?,
+        fragility_curve: f64s("fragility_curve", &[s], &[l, sa])?,
+        theta_sa_g: f64s("theta", &[s], &[l])?,
+        beta: f64s("beta", &[s], &[l])?,
+        theta_ci_low_sa_g: f64s("theta_ci_low", &[s], &[l])?,
+        theta_ci_high_sa_g: f64s("theta_ci_high", &[s], &[l])?,
+        beta_ci_low: f64s("beta_ci_low", &[s], &[l])?,
+        beta_ci_high: f64s("beta_ci_high", &[s], &[l])?,
+        fit_status: flags("fit_status", &[s], &[l])?,
     };
     let z = ZoneIda {
         name: zone.to_string(),

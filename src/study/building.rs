@@ -6,6 +6,7 @@
 //!   storeys: [1, 3, 6]             # one value or a list (a grid axis, `storeys`)
 //!   floor_masses: [1, 1, 1]        # relative, floor 1 first (only with one `storeys` value)
 //!   storey_stiffnesses: [3, 2, 1]  # relative, storey 1 first (idem) [default: all 1]
+//!   storey_heights_m: 3.5          # every storey, or a list storey 1 first (idem) [default 3]
 //! grid:
 //!   period_s: [0.3, 0.6]           # the bare building's first-mode period
 //!   stack_floor: [1, roof, all]    # a floor number, `roof`, `all`, or a list (an axis)
@@ -60,6 +61,11 @@ pub struct BuildingSection {
     /// Relative storey stiffnesses, storey 1 first [default: all 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub storey_stiffnesses: Option<Vec<f64>>,
+    /// Storey heights, m: one for every storey, or a list storey 1 first (only with one
+    /// `storeys` value) [default: [`DEFAULT_STOREY_HEIGHT_M`]]. They turn drifts into drift
+    /// ratios.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub storey_heights_m: Option<OneOrList<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub period: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -70,13 +76,21 @@ pub struct BuildingSection {
     pub post_yield_ratio: Option<f64>,
 }
 
+/// A storey's height when the config gives none, m.
+pub const DEFAULT_STOREY_HEIGHT_M: f64 = 3.0;
+
+/// The range of a storey height, m.
+pub const STOREY_HEIGHT_RANGE_M: (f64, f64) = (0.1, 1000.0);
+
 /// The building a case of a building study stands in: the bare building's relative floor
-/// masses and storey stiffnesses (its first-mode period is the case's `T_p`) and the floors
-/// carrying the case's stack.
+/// masses and storey stiffnesses (its first-mode period is the case's `T_p`), its storey
+/// heights and the floors carrying the case's stack.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
     pub floor_masses: Vec<f64>,
     pub storey_stiffnesses: Vec<f64>,
+    /// Storey heights, m, storey 1 first.
+    pub storey_heights_m: Vec<f64>,
     pub stack_floor: StackFloor,
 }
 
@@ -91,17 +105,17 @@ impl Frame {
     }
 
     /// The relative height `z = h/H` of the stack's floor, `h` its height above the ground and
-    /// `H` the roof's, storeys of equal height; with a stack on every floor, their mean
+    /// `H` the roof's (from `storey_heights_m`); with a stack on every floor, their mean
     /// weighted by the stacks' masses (each stack's mass is `α` times its floor's): the height
     /// of the stacks' centre of mass over `H`. 1 on one storey.
     pub fn stack_height_ratio(&self) -> f64 {
-        let n = self.storeys() as f64;
+        let height = |f: usize| self.storey_heights_m[..f].iter().sum::<f64>();
+        let roof = height(self.storeys());
         let floors = self.floors();
         let weight = |f: usize| self.floor_masses[f - 1];
         let total: f64 = floors.iter().map(|&f| weight(f)).sum();
-        floors
-            .iter()
-            .map(|&f| weight(f) * f as f64 / n)
+        (floors.iter())
+            .map(|&f| weight(f) * height(f) / roof)
             .sum::<f64>()
             / total
     }
@@ -218,6 +232,29 @@ impl BuildingSection {
                 );
             }
         }
+        if let Some(h) = &self.storey_heights_m {
+            let key = "building.storey_heights_m";
+            let v = h.to_vec();
+            if let OneOrList::List(_) = h
+                && (storeys.len() != 1 || v.len() != storeys[0])
+            {
+                return err(
+                    key,
+                    format!(
+                        "lists {} values; a list needs one per storey, and so one \
+                         `building.storeys` value (give one number for every storey)",
+                        v.len()
+                    ),
+                );
+            }
+            let (lo, hi) = STOREY_HEIGHT_RANGE_M;
+            if let Some(x) = v
+                .iter()
+                .find(|x| !(x.is_finite() && (lo..=hi).contains(*x)))
+            {
+                return err(key, format!("{x} m must be in [{lo}, {hi}] m"));
+            }
+        }
         let lowest = storeys[0];
         let keys = stack_floor.map_or(vec![FloorKey::Name("roof".into())], OneOrList::to_vec);
         if keys.is_empty() {
@@ -265,6 +302,11 @@ impl BuildingSection {
             floor_masses: (self.floor_masses.clone()).unwrap_or_else(|| vec![1.0; storeys]),
             storey_stiffnesses: (self.storey_stiffnesses.clone())
                 .unwrap_or_else(|| vec![1.0; storeys]),
+            storey_heights_m: match &self.storey_heights_m {
+                None => vec![DEFAULT_STOREY_HEIGHT_M; storeys],
+                Some(OneOrList::One(h)) => vec![*h; storeys],
+                Some(OneOrList::List(v)) => v.clone(),
+            },
             stack_floor,
         }
     }
@@ -278,6 +320,7 @@ mod tests {
         Frame {
             floor_masses: vec![1.0; n],
             storey_stiffnesses: vec![1.0; n],
+            storey_heights_m: vec![DEFAULT_STOREY_HEIGHT_M; n],
             stack_floor,
         }
     }
@@ -323,6 +366,7 @@ mod tests {
         let all = Frame {
             floor_masses: vec![1.0, 2.0, 0.5, 1.5],
             storey_stiffnesses: vec![4.0, 3.0, 2.0, 1.0],
+            storey_heights_m: vec![3.0; 4],
             stack_floor: StackFloor::All,
         };
         let got = all.t_rigid_s(&case);
@@ -340,8 +384,16 @@ mod tests {
         let heavy = Frame {
             floor_masses: vec![3.0, 1.0, 1.0],
             storey_stiffnesses: vec![1.0; 3],
+            storey_heights_m: vec![3.0; 3],
             stack_floor: StackFloor::All,
         };
         assert!((heavy.stack_height_ratio() - (1.0 + 2.0 / 3.0 + 1.0) / 5.0).abs() < 1e-15);
+        // A 4.5 m first storey under two of 3 m: floor 1 at 4.5/10.5.
+        let tall = Frame {
+            storey_heights_m: vec![4.5, 3.0, 3.0],
+            stack_floor: StackFloor::Floor(1),
+            ..heavy
+        };
+        assert!((tall.stack_height_ratio() - 4.5 / 10.5).abs() < 1e-15);
     }
 }

@@ -438,7 +438,10 @@ impl StudyConfig {
             let targets: Vec<_> = (0..self.zones.len())
                 .map(|i| (self.zones[i].name.clone(), self.target(i).clone()))
                 .collect();
-            ida.validate(&physics, &targets)?;
+            let frames: Option<Vec<Frame>> = frames
+                .as_ref()
+                .map(|a| (0..a.frames()).filter_map(|i| self.frame(a, i)).collect());
+            ida.validate(&physics, &targets, frames.as_deref())?;
         }
         let seeds = &self.motions.seeds;
         if seeds.stochastic.is_some() == seeds.records.is_some() {
@@ -515,11 +518,6 @@ impl StudyConfig {
             }
             return Ok(None);
         };
-        if self.ida.is_some() {
-            let why = "the IDA of a building is not yet supported in a study: remove `ida` \
-                       (or `building`)";
-            return Err(("ida".into(), why.into()));
-        }
         let axes = b.axes(stack_floor)?;
         if let Some(g) = &self.grid {
             let periods = g.period_s.values();

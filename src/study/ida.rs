@@ -8,10 +8,24 @@
 //! are traced in `Sa(T_p, 5 %)` of the record, `T_p` the bare structure's period, so their
 //! curves share one intensity axis. No skip rule is used: a stack that never slides is the
 //! rigid system only while the structure stays elastic.
+//!
+//! In a building study (docs/model.md, "Incremental dynamic analysis", "In a building") every
+//! case is traced in every frame of the study (`building.storeys` × `grid.stack_floor`): the
+//! storeys yield with the strengths [`storey_strength_ratios`] gives the base-shear coefficient
+//! `C_y`, `T_p` is the bare building's first-mode period `T_1`, the rigid system is the frame
+//! with its stacks attached to their floors (same springs), and collapse is a peak interstorey
+//! drift ratio of `collapse_drift_ratio`. A building of one storey runs as the one-storey model.
 
+use super::building::Frame;
 use super::physics::{Physics, SystemKind};
+use super::storey_strength::storey_strength_ratios;
 use crate::case::Case;
-use crate::dynamics::{ExactOptions, G, Ground, SimError, System, Yielding, simulate_exact};
+use crate::dynamics::building::{
+    Building, BuildingError, BuildingResponse, StoreyYielding, simulate_building,
+};
+use crate::dynamics::{
+    ExactOptions, G, Ground, ModelError, SimError, System, Yielding, simulate_exact,
+};
 use crate::ida::trace::{HuntFill, Trace, hunt_fill};
 use crate::limits::{
     MAX_ALPHA, MAX_BLOCKS, MAX_IDA_CASES, MAX_IDA_GRID_POINTS, MAX_IDA_PAD_S, MAX_IDA_TRACE_RUNS,
@@ -20,6 +34,7 @@ use crate::limits::{
 use crate::spectrum::TargetSpectrum;
 use crate::spectrum::target::ZoneScaling;
 use serde::{Deserialize, Serialize};
+use thiserror::Error;
 
 /// The `ida:` section of a study file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -35,8 +50,13 @@ pub struct IdaConfig {
     /// (zero excluded).
     pub grid_points: usize,
     /// A run with a ductility at or above this counts as collapse (the model has no negative
-    /// stiffness, so no dynamic instability ends a curve by itself).
-    pub collapse_ductility: f64,
+    /// stiffness, so no dynamic instability ends a curve by itself); one storey only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collapse_ductility: Option<f64>,
+    /// In a building study: a run whose peak interstorey drift ratio reaches this counts as
+    /// collapse (the usual proxy, e.g. 0.1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collapse_drift_ratio: Option<f64>,
     /// A block "falls off" when its peak slip relative to what it sits on reaches this, m.
     pub slip_limit_m: f64,
     pub limit_states: Vec<LimitState>,
@@ -79,17 +99,95 @@ pub struct LimitState {
     /// Exceeded when some interface's peak slip reaches this, m (or the run collapses).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub slip_m: Option<f64>,
+    /// In a building study: exceeded when the peak interstorey drift ratio reaches this (or
+    /// the run collapses).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drift_ratio: Option<f64>,
 }
 
 impl LimitState {
-    /// `ductility >= 2` or `slip_m >= 0.3`.
+    /// `ductility >= 2`, `peak slip >= 0.3 m` or `peak drift ratio >= 0.02`.
     pub fn definition(&self) -> String {
-        match (self.ductility, self.slip_m) {
-            (Some(d), _) => format!("ductility >= {d}"),
-            (None, Some(s)) => format!("peak slip >= {s} m"),
-            (None, None) => String::new(),
+        match (self.ductility, self.slip_m, self.drift_ratio) {
+            (Some(d), _, _) => format!("ductility >= {d}"),
+            (None, Some(s), _) => format!("peak slip >= {s} m"),
+            (None, None, Some(r)) => format!("peak drift ratio >= {r}"),
+            (None, None, None) => String::new(),
         }
     }
+
+    /// The threshold, whichever it is.
+    pub fn threshold(&self) -> f64 {
+        (self.ductility.or(self.slip_m).or(self.drift_ratio)).unwrap_or(f64::INFINITY)
+    }
+}
+
+/// Where each demand sits among a run's demands ([`IdaConfig::demand_names`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DemandLayout {
+    /// In a building study: the drift ratios and floor accelerations come first.
+    pub building: bool,
+    pub blocks: usize,
+}
+
+impl DemandLayout {
+    /// The demand the curves are drawn in and collapse is judged on: the ductility on one
+    /// storey, the peak interstorey drift ratio in a building.
+    pub const PRIMARY: usize = 0;
+
+    pub fn ductility(&self) -> usize {
+        if self.building { 3 } else { 0 }
+    }
+
+    /// The peak slip of block 0 (the others follow).
+    pub fn first_slip(&self) -> usize {
+        if self.building { 4 } else { 2 }
+    }
+
+    /// The demand `limit` is judged on, and whether it is the largest peak slip of the blocks.
+    pub fn of_limit(&self, limit: &LimitState) -> (usize, bool) {
+        match (limit.ductility, limit.slip_m) {
+            (Some(_), _) => (self.ductility(), false),
+            (None, Some(_)) => (self.first_slip(), true),
+            (None, None) => (Self::PRIMARY, false),
+        }
+    }
+
+    /// Names in stored order (units in the names).
+    pub fn names(&self) -> Vec<String> {
+        let n = self.blocks;
+        let mut v: Vec<String> = if self.building {
+            [
+                "peak_drift_ratio",
+                "residual_drift_ratio",
+                "peak_floor_accel_g",
+                "ductility",
+            ]
+            .map(String::from)
+            .to_vec()
+        } else {
+            vec!["ductility".to_string(), "residual_drift_m".to_string()]
+        };
+        v.extend((1..=n).map(|i| format!("peak_slip_{i}_m")));
+        v.extend((1..=n).map(|i| format!("residual_slip_{i}_m")));
+        v
+    }
+}
+
+/// A system as traced: the one-storey model, or a building of several storeys.
+#[derive(Debug, Clone)]
+pub enum Traced {
+    One(System),
+    Building(Box<Building>),
+}
+
+/// A system of an IDA case that cannot be built.
+#[derive(Debug, Error)]
+pub enum IdaSystemError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error(transparent)]
+    Building(#[from] BuildingError),
 }
 
 /// The two systems of a case (module doc), in stored order.
@@ -109,13 +207,17 @@ impl IdaConfig {
         self.cases.first().map_or(0, |c| c.alpha.len())
     }
 
+    /// Where each demand of a run sits, in a building study or not.
+    pub fn layout(&self, building: bool) -> DemandLayout {
+        DemandLayout {
+            building,
+            blocks: self.blocks(),
+        }
+    }
+
     /// Names of the demands of every run, in stored order.
-    pub fn demand_names(&self) -> Vec<String> {
-        let n = self.blocks();
-        let mut v = vec!["ductility".to_string(), "residual_drift_m".to_string()];
-        v.extend((1..=n).map(|i| format!("peak_slip_{i}_m")));
-        v.extend((1..=n).map(|i| format!("residual_slip_{i}_m")));
-        v
+    pub fn demand_names(&self, building: bool) -> Vec<String> {
+        self.layout(building).names()
     }
 
     /// `C_y` of `case` in the zone with target `target` (validated: IS 1893 when `design`).
@@ -134,32 +236,59 @@ impl IdaConfig {
         }
     }
 
-    /// The systems of [`SYSTEMS`] of `case` on the bilinear structure of strength ratio `c_y`.
+    /// The systems of [`SYSTEMS`] of `case` on the bilinear structure of strength ratio `c_y`
+    /// (in `frame`: the building whose storeys have [`storey_strength_ratios`] of the base
+    /// shear coefficient `c_y`; one storey is the one-storey model).
     pub fn systems(
         &self,
         physics: &Physics,
         case: &Case,
         c_y: f64,
-    ) -> Result<Vec<System>, crate::dynamics::ModelError> {
-        let yielding = Yielding::bilinear(c_y, self.structure.post_yield_ratio);
-        SYSTEMS
-            .iter()
-            .map(|&kind| physics.system(kind, case, Some(yielding)))
-            .collect()
+        frame: Option<&Frame>,
+    ) -> Result<Vec<Traced>, IdaSystemError> {
+        let r = self.structure.post_yield_ratio;
+        match frame {
+            Some(f) if f.storeys() > 1 => {
+                let yielding = StoreyYielding {
+                    strength_ratios: storey_strength_ratios(
+                        c_y,
+                        &f.floor_masses,
+                        &f.storey_heights_m,
+                    ),
+                    post_yield_ratio: r,
+                };
+                SYSTEMS
+                    .iter()
+                    .map(|&kind| {
+                        let b = physics.yielding_building(kind, case, f, Some(yielding.clone()))?;
+                        Ok(Traced::Building(Box::new(b)))
+                    })
+                    .collect()
+            }
+            _ => {
+                let yielding = Yielding::bilinear(c_y, r);
+                SYSTEMS
+                    .iter()
+                    .map(|&kind| Ok(Traced::One(physics.system(kind, case, Some(yielding))?)))
+                    .collect()
+            }
+        }
     }
 
     /// Every check that needs no record; `Err((key, why))` with keys under `ida.`.
-    /// `targets` are the zones' target spectra (the design strength needs IS 1893 ones).
+    /// `targets` are the zones' target spectra (the design strength needs IS 1893 ones);
+    /// `frames` the frames of a building study (`None`: one storey).
     pub fn validate(
         &self,
         physics: &Physics,
         targets: &[(String, TargetSpectrum)],
+        frames: Option<&[Frame]>,
     ) -> Result<(), (String, String)> {
         self.validate_structure(targets)?;
-        self.validate_cases(physics, targets)?;
+        self.validate_cases(physics, targets, frames)?;
         self.validate_tracing()?;
-        self.validate_curves()?;
-        self.validate_limit_states()
+        self.validate_curves(frames.is_some())?;
+        self.validate_limit_states(frames.is_some())
     }
 
     /// `structure`: one strength, by `c_y` or by design (IS 1893 targets only), and `r`.
@@ -221,6 +350,7 @@ impl IdaConfig {
         &self,
         physics: &Physics,
         targets: &[(String, TargetSpectrum)],
+        frames: Option<&[Frame]>,
     ) -> Result<(), (String, String)> {
         let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
         if self.cases.is_empty() || self.cases.len() > MAX_IDA_CASES {
@@ -272,14 +402,21 @@ impl IdaConfig {
             physics
                 .check(total)
                 .map_err(|why| (format!("ida.{}", key("alpha")), why))?;
+            let frames: Vec<Option<&Frame>> = match frames {
+                None => vec![None],
+                Some(f) => f.iter().map(Some).collect(),
+            };
             for (zone, t) in targets {
                 let c_y = self.strength_ratio(t, c);
-                self.systems(physics, c, c_y).map_err(|e| {
-                    (
-                        "ida.structure".to_string(),
-                        format!("zone {zone}, case {i}: {e}"),
-                    )
-                })?;
+                for frame in &frames {
+                    self.systems(physics, c, c_y, *frame).map_err(|e| {
+                        let at = frame.map_or(String::new(), |f| format!(" ({f})"));
+                        (
+                            "ida.structure".to_string(),
+                            format!("zone {zone}, case {i}{at}: {e}"),
+                        )
+                    })?;
+                }
             }
         }
         Ok(())
@@ -332,8 +469,9 @@ impl IdaConfig {
         Ok(())
     }
 
-    /// The curves and their end: `grid_points`, `collapse_ductility`, `slip_limit_m`, `pad_s`.
-    fn validate_curves(&self) -> Result<(), (String, String)> {
+    /// The curves and their end: `grid_points`, `collapse_ductility` (one storey) or
+    /// `collapse_drift_ratio` (a building), `slip_limit_m`, `pad_s`.
+    fn validate_curves(&self, building: bool) -> Result<(), (String, String)> {
         let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
         if self.grid_points < 2 || self.grid_points > MAX_IDA_GRID_POINTS {
             return err(
@@ -341,12 +479,43 @@ impl IdaConfig {
                 format!("{} must be 2 to {MAX_IDA_GRID_POINTS}", self.grid_points),
             );
         }
-        let d = self.collapse_ductility;
-        if !(d.is_finite() && d > 1.0 && d <= MAX_TARGET_DUCTILITY) {
-            return err(
-                "collapse_ductility",
-                format!("{d} must be > 1 and ≤ {MAX_TARGET_DUCTILITY}"),
-            );
+        match (building, self.collapse_ductility, self.collapse_drift_ratio) {
+            (false, Some(d), None) => {
+                if !(d.is_finite() && d > 1.0 && d <= MAX_TARGET_DUCTILITY) {
+                    return err(
+                        "collapse_ductility",
+                        format!("{d} must be > 1 and ≤ {MAX_TARGET_DUCTILITY}"),
+                    );
+                }
+            }
+            (false, _, Some(_)) => {
+                return err(
+                    "collapse_drift_ratio",
+                    "is for a building study; one storey collapses at `collapse_ductility`".into(),
+                );
+            }
+            (false, None, None) => return err("collapse_ductility", "is missing".into()),
+            (true, None, Some(r)) => {
+                if !(r.is_finite() && r > 0.0 && r <= 1.0) {
+                    return err("collapse_drift_ratio", format!("{r} must be in (0, 1]"));
+                }
+            }
+            (true, Some(_), _) => {
+                return err(
+                    "collapse_ductility",
+                    "a building study's collapse is its peak interstorey drift ratio: give \
+                     `collapse_drift_ratio` instead (e.g. 0.1)"
+                        .into(),
+                );
+            }
+            (true, None, None) => {
+                return err(
+                    "collapse_drift_ratio",
+                    "is missing: a building study's collapse is its peak interstorey drift \
+                     ratio (e.g. 0.1)"
+                        .into(),
+                );
+            }
         }
         let sl = self.slip_limit_m;
         if !(sl.is_finite() && sl > 0.0) {
@@ -361,8 +530,9 @@ impl IdaConfig {
         Ok(())
     }
 
-    /// `limit_states`: at least one, named once each, with one finite threshold.
-    fn validate_limit_states(&self) -> Result<(), (String, String)> {
+    /// `limit_states`: at least one, named once each, with one finite threshold (a drift ratio
+    /// only in a building study).
+    fn validate_limit_states(&self, building: bool) -> Result<(), (String, String)> {
         let err = |k: &str, w: String| Err((format!("ida.{k}"), w));
         if self.limit_states.is_empty() {
             return err("limit_states", "needs at least one limit state".into());
@@ -372,13 +542,23 @@ impl IdaConfig {
             let earlier = self.limit_states[..i].iter().map(|o| o.name.as_str());
             crate::limits::check_name(&l.name, earlier)
                 .map_err(|why| (format!("ida.{key}.name"), why))?;
-            match (l.ductility, l.slip_m) {
-                (Some(v), None) if v.is_finite() && v > 0.0 => {}
-                (None, Some(v)) if v.is_finite() && v > 0.0 => {}
-                (Some(_), Some(_)) | (None, None) => {
-                    return err(&key, "give exactly one of `ductility` and `slip_m`".into());
+            if l.drift_ratio.is_some() && !building {
+                return err(
+                    &format!("{key}.drift_ratio"),
+                    "is for a building study (a `building:` section)".into(),
+                );
+            }
+            let given = [l.ductility, l.slip_m, l.drift_ratio];
+            match given.iter().flatten().collect::<Vec<_>>()[..] {
+                [v] if v.is_finite() && *v > 0.0 => {}
+                [_] => return err(&key, "the threshold must be finite and > 0".into()),
+                _ if building => {
+                    return err(
+                        &key,
+                        "give exactly one of `ductility`, `slip_m` and `drift_ratio`".into(),
+                    );
                 }
-                _ => return err(&key, "the threshold must be finite and > 0".into()),
+                _ => return err(&key, "give exactly one of `ductility` and `slip_m`".into()),
             }
         }
         Ok(())
@@ -411,9 +591,11 @@ pub fn sa_g(
 
 /// Traces one system under one record: `padded_mps2` is the record followed by the pad of zeros,
 /// `record_sa_g` the unscaled record's `Sa(T_p, 5 %)`; every run scales the whole record.
+/// `storey_heights_m`: the frame's, in a building study (its demands are then drift ratios).
 pub fn trace_system(
     cfg: &IdaConfig,
-    sys: &System,
+    sys: &Traced,
+    storey_heights_m: Option<&[f64]>,
     padded_mps2: &[f64],
     dt_s: f64,
     record_sa_g: f64,
@@ -422,39 +604,79 @@ pub fn trace_system(
         energy_balance: false,
         ..ExactOptions::default()
     };
-    let n = cfg.blocks();
     let mut accel = Vec::with_capacity(padded_mps2.len());
     hunt_fill(&cfg.tracing, |sa| {
         let lambda = sa / record_sa_g;
         accel.clear();
         accel.extend(padded_mps2.iter().map(|a| lambda * a));
-        let r = simulate_exact(
-            sys,
-            &Ground {
-                dt_s,
-                accel_mps2: &accel,
-            },
-            &opts,
-        )?;
-        let ductility = r.ductility.unwrap_or(f64::NAN);
-        let mut values = vec![ductility, r.residual_displacement_m.abs()];
-        let slips = |v: &[f64]| -> Vec<f64> {
-            let mut s: Vec<f64> = v.iter().map(|x| x.abs()).collect();
-            s.resize(n, 0.0);
-            s
+        let ground = Ground {
+            dt_s,
+            accel_mps2: &accel,
         };
-        let peak = slips(&r.peak_slip_m);
-        let slip_exceeded = peak.iter().any(|&s| s >= cfg.slip_limit_m);
-        values.extend(peak);
-        values.extend(slips(&r.residual_slip_m));
-        Ok((
-            RunDemand {
-                values,
-                slip_exceeded,
-            },
-            ductility >= cfg.collapse_ductility,
-        ))
+        let r = match sys {
+            Traced::One(s) => BuildingResponse::from_one_storey(simulate_exact(s, &ground, &opts)?),
+            Traced::Building(b) => simulate_building(b, &ground, &opts)?,
+        };
+        Ok(run_demand(cfg, &r, storey_heights_m))
     })
+}
+
+/// The demands of one run (in the order of [`IdaConfig::demand_names`]) and whether it counts
+/// as collapse. Each block's slip is the largest over the stacks (one per loaded floor; the
+/// same blocks on each), in absolute value.
+pub fn run_demand(
+    cfg: &IdaConfig,
+    r: &BuildingResponse,
+    storey_heights_m: Option<&[f64]>,
+) -> (RunDemand, bool) {
+    let n = cfg.blocks();
+    let ductility = r.storey_ductility.as_ref().map_or(f64::NAN, |d| {
+        d.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    });
+    let slips = |v: &[f64]| -> Vec<f64> {
+        let mut s = vec![0.0f64; n];
+        for (k, x) in v.iter().enumerate() {
+            s[k % n] = s[k % n].max(x.abs());
+        }
+        s
+    };
+    let peak = slips(&r.peak_slip_m);
+    let slip_exceeded = peak.iter().any(|&s| s >= cfg.slip_limit_m);
+    let (mut values, collapsed) = match storey_heights_m {
+        None => (
+            vec![ductility, r.storey_residual_drift_m[0].abs()],
+            ductility >= cfg.collapse_ductility.unwrap_or(f64::INFINITY),
+        ),
+        Some(h) => {
+            let ratio = |d: &[f64]| -> f64 {
+                d.iter()
+                    .zip(h)
+                    .map(|(d, h)| d.abs() / h)
+                    .fold(0.0, f64::max)
+            };
+            let drift = ratio(&r.storey_peak_drift_m);
+            let accel = r
+                .floor_peak_abs_accel_mps2
+                .iter()
+                .copied()
+                .fold(0.0, f64::max)
+                / G;
+            let values = vec![drift, ratio(&r.storey_residual_drift_m), accel, ductility];
+            (
+                values,
+                drift >= cfg.collapse_drift_ratio.unwrap_or(f64::INFINITY),
+            )
+        }
+    };
+    values.extend(peak);
+    values.extend(slips(&r.residual_slip_m));
+    (
+        RunDemand {
+            values,
+            slip_exceeded,
+        },
+        collapsed,
+    )
 }
 
 /// The record followed by `pad_s` of zeros, m/s².
@@ -464,4 +686,65 @@ pub fn padded(accel_mps2: &[f64], dt_s: f64, pad_s: f64) -> Vec<f64> {
     v.extend_from_slice(accel_mps2);
     v.resize(accel_mps2.len() + extra, 0.0);
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_layout_s_indices_name_their_demands() {
+        for building in [false, true] {
+            let l = DemandLayout {
+                building,
+                blocks: 3,
+            };
+            let names = l.names();
+            assert_eq!(names.len(), if building { 4 } else { 2 } + 2 * 3);
+            assert_eq!(names[l.ductility()], "ductility");
+            assert_eq!(names[l.first_slip()], "peak_slip_1_m");
+            assert_eq!(names[l.first_slip() + 3], "residual_slip_1_m");
+            let primary = if building {
+                "peak_drift_ratio"
+            } else {
+                "ductility"
+            };
+            assert_eq!(names[DemandLayout::PRIMARY], primary);
+        }
+    }
+
+    /// A building's demands from a response set by hand: two storeys of 3 m and 4 m, two stacks
+    /// of two blocks (a stack on each floor).
+    #[test]
+    fn a_building_s_demands_are_its_largest_ratios_and_slips() {
+        let cfg: IdaConfig = serde_yaml::from_str(
+            "structure: { c_y: 0.3, post_yield_ratio: 0.05 }\n\
+             cases: [{ period_s: 1.0, alpha: [0.5, 0.5], mu: [0.2, 0.1] }]\n\
+             tracing: { first_sa_g: 0.1, step_increment_sa_g: 0.1, bracket_runs: 1, \
+             fill_runs: 1, cap_sa_g: 1.0 }\n\
+             grid_points: 10\n\
+             collapse_drift_ratio: 0.02\n\
+             slip_limit_m: 0.3\n\
+             limit_states: [{ name: LS, drift_ratio: 0.01 }]\n",
+        )
+        .unwrap();
+        let mut r = BuildingResponse::zeroed(2, 4);
+        r.storey_peak_drift_m = vec![0.066, 0.04]; // 0.022 and 0.01 of the heights
+        r.storey_residual_drift_m = vec![-0.003, 0.008]; // 0.001 and 0.002
+        r.floor_peak_abs_accel_mps2 = vec![G, 2.5 * G];
+        r.storey_ductility = Some(vec![3.0, 1.5]);
+        r.peak_slip_m = vec![0.1, -0.05, 0.2, 0.01];
+        r.residual_slip_m = vec![-0.04, 0.0, 0.02, -0.03];
+        let (d, collapsed) = run_demand(&cfg, &r, Some(&[3.0, 4.0]));
+        let want = [0.022, 0.002, 2.5, 3.0, 0.2, 0.05, 0.04, 0.03];
+        for (got, want) in d.values.iter().zip(want) {
+            assert!((got - want).abs() <= 1e-15, "{:?}", d.values);
+        }
+        assert_eq!(d.values.len(), want.len());
+        assert!(collapsed && !d.slip_exceeded);
+        r.storey_peak_drift_m[0] = 0.059; // 0.0197: below the cap 0.02
+        r.peak_slip_m[3] = -0.3;
+        let (d, collapsed) = run_demand(&cfg, &r, Some(&[3.0, 4.0]));
+        assert!(!collapsed && d.slip_exceeded);
+    }
 }

@@ -7,6 +7,7 @@
 //! * [`ida`]: the `ida:` section, a case's systems on a yielding structure, one traced unit.
 //! * [`motions`]: seeds, spectral matching per zone, the set checks.
 //! * [`physics`]: the physics of a case: damping basis, shared settings, its three systems.
+//! * [`storey_strength`]: a building's storey strengths from a base-shear coefficient (IS 1893).
 //! * [`sweep`]: the skip rules, one work unit.
 //! * [`tnew`]: `T_new` from the mean displacement spectrum; the fit's samples.
 
@@ -16,5 +17,6 @@ pub mod config;
 pub mod ida;
 pub mod motions;
 pub mod physics;
+pub mod storey_strength;
 pub mod sweep;
 pub mod tnew;

@@ -9,7 +9,8 @@
 use super::building::Frame;
 use crate::case::Case;
 use crate::dynamics::building::{
-    Building, BuildingError, BuildingResponse, BuildingSpec, StackSpec, simulate_building,
+    Building, BuildingError, BuildingResponse, BuildingSpec, StackSpec, StoreyYielding,
+    simulate_building,
 };
 use crate::dynamics::{
     ExactOptions, Ground, ModelError, Response, SimError, System, SystemSpec, Yielding,
@@ -227,12 +228,26 @@ impl Physics {
         case: &Case,
         frame: &Frame,
     ) -> Result<Building, BuildingError> {
+        self.yielding_building(kind, case, frame, None)
+    }
+
+    /// [`Physics::building`] with storeys that yield as `yielding` says (`None`: elastic). The
+    /// rigid system keeps the storeys' springs, so all three share each storey's `F_y,i`
+    /// ([`Building::with_stacks_attached`]).
+    pub fn yielding_building(
+        &self,
+        kind: SystemKind,
+        case: &Case,
+        frame: &Frame,
+        yielding: Option<StoreyYielding>,
+    ) -> Result<Building, BuildingError> {
         let total = [case.alpha_total()];
         let (alpha, mu) = match kind {
             SystemKind::SingleBlock | SystemKind::Rigid => (&total[..], &case.mu[..1]),
             SystemKind::Stack => (&case.alpha[..], &case.mu[..]),
         };
         let mut spec = self.bare_building(case.period_s, frame);
+        spec.yielding = yielding;
         spec.stacks = frame
             .floors()
             .into_iter()
