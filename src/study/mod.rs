@@ -14,6 +14,7 @@ pub mod building;
 pub mod cases;
 pub mod config;
 pub mod ida;
+pub mod lambda;
 pub mod motions;
 pub mod physics;
 pub mod sweep;
