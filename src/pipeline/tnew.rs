@@ -29,6 +29,7 @@ use crate::study::physics::{CaseError, Physics, SystemKind};
 use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
 use ndarray::{ArrayD, Axis};
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use thiserror::Error;
 
 /// Step of the period grid of the mean displacement spectrum, s.
@@ -84,12 +85,47 @@ fn effective_fractions(
         .collect();
     let grounds = &grounds[..];
     let mean = |v: &[f64], c: usize| (0..m).map(|k| v[k * cases + c]).sum::<f64>() / m as f64;
-    (0..cases)
-        .into_par_iter()
-        .map(|c| {
-            let frame = frames[c / per_frame]
-                .as_ref()
-                .expect("a building study has a frame per case");
+    let frame_of = |c: usize| {
+        frames[c / per_frame]
+            .as_ref()
+            .expect("a building study has a frame per case")
+    };
+    // Frames that are one building (the same storeys and loaded floors: on one storey floor 1,
+    // the roof and every floor) have the same sweep results, so the same λ: each is computed
+    // for the first of them only.
+    let same = |f: usize| frames[f].as_ref().map(|fr| (fr.storeys(), fr.floors()));
+    let first: Vec<usize> = (0..frames.len())
+        .map(|f| (0..f).find(|&g| same(g) == same(f)).unwrap_or(f))
+        .collect();
+    let own: Vec<usize> = (0..cases)
+        .filter(|&c| first[c / per_frame] == c / per_frame)
+        .collect();
+    // V̄(0) depends on the frame, T_p and α (through the damping matrix) but not on μ: once per
+    // key, the first case of each standing for it.
+    let bare_key = |c: usize| {
+        let case = grid.case(c % per_frame);
+        (
+            c / per_frame,
+            case.period_s.to_bits(),
+            case.alpha_total().to_bits(),
+        )
+    };
+    let mut keyed = BTreeMap::new();
+    for &c in &own {
+        keyed.entry(bare_key(c)).or_insert(c);
+    }
+    let keyed: Vec<((usize, u64, u64), usize)> = keyed.into_iter().collect();
+    let bare: BTreeMap<(usize, u64, u64), f64> = keyed
+        .par_iter()
+        .map(|&(key, c)| {
+            let case = grid.case(c % per_frame);
+            lambda::mean_base_shear(physics, &case, frame_of(c), 0.0, grounds).map(|v| (key, v))
+        })
+        .collect::<Result<_, _>>()?;
+    let computed: Vec<Fraction> = own
+        .par_iter()
+        .map(|&c| {
+            let frame = frame_of(c);
             let case = grid.case(c % per_frame);
             // One storey's sweep runs the one-storey integrator, which gives no base shear.
             let (stack, rigid) = if frame.storeys() == 1 {
@@ -99,8 +135,8 @@ fn effective_fractions(
             } else {
                 (mean(base_shear_stack, c), mean(base_shear_rigid, c))
             };
+            let bare = bare[&bare_key(c)];
             let at = |l| lambda::mean_base_shear(physics, &case, frame, l, grounds);
-            let bare = at(0.0)?;
             let (lambda, flag) = if slides[c] {
                 lambda::solve(stack, bare, rigid, at)?
             } else {
@@ -114,7 +150,11 @@ fn effective_fractions(
                 flag,
             })
         })
-        .collect()
+        .collect::<Result<_, CaseError>>()?;
+    let at: BTreeMap<usize, usize> = own.iter().enumerate().map(|(i, &c)| (c, i)).collect();
+    Ok((0..cases)
+        .map(|c| computed[at[&(first[c / per_frame] * per_frame + c % per_frame)]])
+        .collect())
 }
 
 /// The fingerprint `tnew.h5` must carry.
@@ -262,6 +302,18 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                     zone: zc.name.clone(),
                     source: Box::new(source),
                 })?;
+                let counts: Vec<String> = (LAMBDA_FLAGS.iter())
+                    .map(|(code, word)| {
+                        let k = l.iter().filter(|x| x.flag as u8 == *code).count();
+                        format!("{word} {k}")
+                    })
+                    .collect();
+                s.reporter.info(
+                    me,
+                    &format!("zone {}: effective live-load fraction λ: {}", zc.name, {
+                        counts.join(", ")
+                    }),
+                );
                 Some(LambdaVars {
                     base_shear_stack_mean: shaped(l.iter().map(|x| x.stack).collect()),
                     base_shear_rigid_mean: shaped(l.iter().map(|x| x.rigid).collect()),
