@@ -262,6 +262,10 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
         String::from_utf8_lossy(&o.stdout),
         "['storeys', 'stack_floor', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2'] ['storeys']\n"
     );
+    // λ's root searches run in parallel: one thread writes the same bytes.
+    let two = std::fs::read(out.join("tnew.h5")).unwrap();
+    ok(slidestack(&["tnew", cfg_s, "--out", out_s, "--force"], "1"));
+    assert_eq!(std::fs::read(out.join("tnew.h5")).unwrap(), two);
     // λ: in [0, 1], 1 where nothing slid, the same on one storey's three floors; labelled.
     let l = t.lambda.as_ref().unwrap();
     let (lam, flag) = (l.lambda.as_slice().unwrap(), l.flag.as_slice().unwrap());
