@@ -128,6 +128,14 @@ pub struct Answer {
     pub sa_new_grid_g: Option<f64>,
     pub sa_new_fit_g: Option<f64>,
     pub sa_new_paper_g: Option<f64>,
+    /// A building study's effective live-load fraction `λ` of the stack's mass, by
+    /// multilinear interpolation in the frame's cases (`None` outside the grid or where a
+    /// corner has none) …
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lambda_grid: Option<f64>,
+    /// … and from the zone's fitted equation for `λ`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lambda_fit: Option<f64>,
     /// Anything the designer should know about these numbers.
     pub notes: Vec<String>,
 }
@@ -150,6 +158,10 @@ pub struct ZoneDesign {
     /// one-storey features, a study of one frame).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub building: Option<(FrameSpec, Option<BuildingFeatures>)>,
+    /// A building study's `λ` per case of the frame (grid's flat order) and its fitted
+    /// equation.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lambda: Option<(Vec<f64>, Option<Fitted>)>,
 }
 
 impl ZoneDesign {
@@ -173,6 +185,7 @@ impl ZoneDesign {
             t_new_s,
             paper,
             building: None,
+            lambda: None,
         }
     }
 }
@@ -233,7 +246,7 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         }
     }
     let fit = read_fit(&fit_yaml)?.ok_or_else(|| missing("fit.yaml"))?;
-    if fit.fingerprint != crate::pipeline::fit::fingerprint(&tnew_fp) {
+    if fit.fingerprint != crate::pipeline::fit::fingerprint(&tnew_fp, building) {
         return Err(DesignError::Mismatch { file: fit_yaml });
     }
     let (zones, blocks) = zones_and_blocks(&tnew)?;
@@ -249,18 +262,27 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
     let target = read_zone_target(&motions, &q.zone)?;
     let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
     let t_new: Vec<f64> = t.vars.t_new.iter().copied().collect();
-    let (t_new, frame) = match (q.building, axes) {
+    let (t_new, frame, lambda) = match (q.building, axes) {
         (Some((storeys, floor)), Some(axes)) => {
             let f = frame_index(&fit, &axes, storeys, floor, &fit_yaml)?;
-            let per = grid.cases();
+            let cases = f * grid.cases()..(f + 1) * grid.cases();
             let features = BuildingFeatures::of_names(&fit.features, blocks);
             let frame = (fit.frames[f].clone(), features);
-            (t_new[f * per..(f + 1) * per].to_vec(), Some(frame))
+            let lambda = t.lambda.as_ref().map(|l| {
+                let values: Vec<f64> = l.lambda.iter().copied().collect();
+                let fitted = zone_fit.and_then(|z| z.lambda.as_ref()).map(|f| Fitted {
+                    form: f.form,
+                    params: f.coefficients.iter().map(|c| c.1).collect(),
+                });
+                (values[cases.clone()].to_vec(), fitted)
+            });
+            (t_new[cases].to_vec(), Some(frame), lambda)
         }
-        _ => (t_new, None),
+        _ => (t_new, None, None),
     };
     let mut data = ZoneDesign::new(&q.zone, target, grid, t_new, zone_fit);
     data.building = frame;
+    data.lambda = lambda;
     answer(&data, q)
 }
 
@@ -373,11 +395,24 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
     };
     let t_new_fit_s = z.fit.as_ref().map(|f| {
         f.predict(&Sample {
-            x: fit_x,
+            x: fit_x.clone(),
             t_rigid_s,
             t_new_s: f64::NAN,
         })
     });
+    let (lambda_grid, lambda_fit) = match &z.lambda {
+        Some((values, fitted)) => (
+            z.grid.interpolate(values, &point).ok().flatten(),
+            fitted.as_ref().map(|f| {
+                f.predict(&Sample {
+                    x: fit_x,
+                    t_rigid_s,
+                    t_new_s: f64::NAN,
+                })
+            }),
+        ),
+        None => (None, None),
+    };
     let t_new_paper_s = z.paper.and_then(|p| p.evaluate(&x));
     let target = &z.target;
     let sa = |t: Option<f64>| t.filter(|t| t.is_finite()).map(|t| target.sa_g(t));
@@ -401,6 +436,8 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
         sa_new_grid_g: sa(t_new_grid_s),
         sa_new_fit_g: sa(t_new_fit_s),
         sa_new_paper_g: sa(t_new_paper_s),
+        lambda_grid,
+        lambda_fit,
         notes,
     })
 }

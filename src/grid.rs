@@ -194,6 +194,11 @@ impl BuildingAxes {
         self.storeys.len() * self.stack_floor.len()
     }
 
+    /// `N_max`: the largest storey count, the length of the stored per-floor axes.
+    pub fn max_storeys(&self) -> usize {
+        self.storeys.iter().copied().max().unwrap_or(0)
+    }
+
     /// Frame `index` (row-major, the stack floor fastest).
     pub fn frame(&self, index: usize) -> (usize, StackFloor) {
         let per = self.stack_floor.len();

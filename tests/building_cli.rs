@@ -67,6 +67,28 @@ fn the_worked_example_prints_the_building_contract() {
         v["storey_peak_drift_m"][0],
         v["floor_peak_displacement_m"][0]
     );
+    // Drift ratios over the default 3 m storeys; the base shear of three storeys. (Within
+    // 2 ulp: serde_json's default float parsing may be 1 ulp off.)
+    let close = |a: f64, b: f64| assert!((a - b).abs() <= 4.5e-16 * b.abs(), "{a} vs {b}");
+    for i in 0..3 {
+        let d = v["storey_peak_drift_m"][i].as_f64().unwrap();
+        close(v["storey_peak_drift_ratio"][i].as_f64().unwrap(), d / 3.0);
+        assert_eq!(v["building"]["storey_heights_m"][i].as_f64().unwrap(), 3.0);
+    }
+    assert!(v["peak_base_shear_ratio"].as_f64().unwrap() > 0.0);
+    // Given heights, storey 1 first.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string("configs/building.yaml")
+        .unwrap()
+        .replace(
+            "  structure: elastic\n",
+            "  structure: elastic\n  storey_heights_m: [4.5, 3, 3]\n",
+        );
+    let case = case_file(dir.path(), "heights.yaml", &text);
+    let w = json(&["simulate", "--config", &case, "--json"]);
+    let d = w["storey_peak_drift_m"][0].as_f64().unwrap();
+    close(w["storey_peak_drift_ratio"][0].as_f64().unwrap(), d / 4.5);
+    assert_eq!(w["storey_peak_drift_m"], v["storey_peak_drift_m"]);
 }
 
 /// One storey and one stack as a building are the case without `building`, bit for bit (the
@@ -267,6 +289,14 @@ fn bad_building_input_is_refused_naming_the_file_and_key() {
                 "building:\n  storeys: 3\n  period: 0.6\n  floor_masses: [1, -2, 1]\n{good_stack}"
             ),
             "building.floor_masses[1]",
+        ),
+        (
+            format!("{good_building}  storey_heights_m: [3, 3]\n{good_stack}"),
+            "building.storey_heights_m lists 2 values but the building has 3 storeys",
+        ),
+        (
+            format!("{good_building}  storey_heights_m: 200\n{good_stack}"),
+            "building.storey_heights_m[0] must be within 0.5 … 100 m",
         ),
         (
             "building:\n  storeys: 61\n  period: 2.0\n".to_string(),

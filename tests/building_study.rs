@@ -5,9 +5,14 @@
 
 mod common;
 
+use slidestack::dynamics::{ExactOptions, G, Ground};
 use slidestack::grid::StackFloor;
+use slidestack::store::motions::read_zone_motions;
 use slidestack::store::sweep::{ZoneSweep, read_zone_sweep};
 use slidestack::store::tnew::read_zone_tnew_in;
+use slidestack::study::building::Frame;
+use slidestack::study::lambda::LambdaFlag;
+use slidestack::study::physics::{Physics, SystemKind};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -139,6 +144,94 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
          interface [1, 3] ['1', 'roof', 'all']\nTrue\n"
     );
 
+    // Per-floor demands and base shear: labelled, NaN above a one-storey building's roof.
+    let script = r#"import sys, xarray as xr
+ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')
+for v in ['floor_accel_stack', 'floor_accel_rigid', 'drift_ratio_stack',
+          'drift_ratio_rigid', 'base_shear_stack', 'base_shear_rigid']:
+    print(v, list(ds[v].dims)[1:3], list(ds[v].dims)[-1])
+a = ds['floor_accel_stack'].isel(motion=0, T_p=0, alpha_1=0, alpha_2=0, mu_1=0, mu_2=0)
+print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', floor=2).isnull()),
+      bool((a.sel(storeys=3, stack_floor='roof') > 0).all()))
+"#;
+    let o = Command::new(repo(".venv-test/bin/python"))
+        .args(["-c", script, out.join("sweep.h5").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout),
+        "floor_accel_stack ['storeys', 'stack_floor'] floor\n\
+         floor_accel_rigid ['storeys', 'stack_floor'] floor\n\
+         drift_ratio_stack ['storeys', 'stack_floor'] storey\n\
+         drift_ratio_rigid ['storeys', 'stack_floor'] storey\n\
+         base_shear_stack ['storeys', 'stack_floor'] mu_2\n\
+         base_shear_rigid ['storeys', 'stack_floor'] mu_2\n\
+         [1, 2, 3] True True\n"
+    );
+
+    // The profiles are a direct run's: every case of one motion, three storeys, stack on the
+    // roof, against `Physics::simulate_building` of the system the skip rule names.
+    let bv = z.vars.building.as_ref().unwrap();
+    let recs = read_zone_motions(&out.join("motions.h5"), "V").unwrap();
+    let accel = recs[1].accel_mps2(1.0);
+    let ground = Ground::new(recs[1].dt_s, &accel);
+    let frame = Frame {
+        floor_masses: vec![1.0; 3],
+        storey_stiffnesses: vec![1.0; 3],
+        storey_heights_m: vec![3.0; 3],
+        stack_floor: StackFloor::Roof,
+    };
+    let opts = ExactOptions {
+        energy_balance: false,
+        ..ExactOptions::default()
+    };
+    let f = 4; // storeys 3, stack_floor roof
+    let mut checked = [0; 3];
+    for c in 0..per_frame {
+        let at = (6 + f) * per_frame + c; // motion 1
+        let case = grid.case(c);
+        let rule = z.vars.skip_rule.as_slice().unwrap()[at];
+        let single = z.vars.single_rule.as_slice().unwrap()[at] == 1;
+        let kind = match rule {
+            0 => SystemKind::Stack,
+            2 if !single => SystemKind::SingleBlock,
+            _ => SystemKind::Rigid,
+        };
+        checked[rule as usize] += 1;
+        let run = |kind| {
+            Physics::DEFAULT
+                .simulate_building(kind, &case, &frame, &ground, &opts)
+                .unwrap()
+        };
+        let (s, r) = (run(kind), run(SystemKind::Rigid));
+        let row = |v: &ndarray::ArrayD<f64>| v.as_slice().unwrap()[at * 3..at * 3 + 3].to_vec();
+        let g = |v: &[f64]| v.iter().map(|a| a / G).collect::<Vec<_>>();
+        let d = |v: &[f64]| v.iter().map(|x| x / 3.0).collect::<Vec<_>>();
+        assert_eq!(
+            row(&bv.floor_accel_stack),
+            g(&s.floor_peak_abs_accel_mps2),
+            "{c}"
+        );
+        assert_eq!(
+            row(&bv.floor_accel_rigid),
+            g(&r.floor_peak_abs_accel_mps2),
+            "{c}"
+        );
+        assert_eq!(row(&bv.drift_ratio_stack), d(&s.storey_peak_drift_m), "{c}");
+        assert_eq!(row(&bv.drift_ratio_rigid), d(&r.storey_peak_drift_m), "{c}");
+        assert_eq!(
+            bv.base_shear_stack.as_slice().unwrap()[at],
+            frame.base_shear_ratio(s.peak_base_shear_n)
+        );
+        assert_eq!(
+            bv.base_shear_rigid.as_slice().unwrap()[at],
+            frame.base_shear_ratio(r.peak_base_shear_n)
+        );
+    }
+    eprintln!("profiles checked by skip rule (simulated, no slip, single block): {checked:?}");
+    assert!(checked[0] > 0);
+
     // T_new per frame: the first mode's, labelled; in one storey the three floors agree.
     ok(slidestack(&["tnew", cfg_s, "--out", out_s], "2"));
     let (_, frames, t) = read_zone_tnew_in(&out.join("tnew.h5"), "V", 2, true).unwrap();
@@ -168,6 +261,48 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
     assert_eq!(
         String::from_utf8_lossy(&o.stdout),
         "['storeys', 'stack_floor', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2'] ['storeys']\n"
+    );
+    // λ's root searches run in parallel: one thread writes the same bytes.
+    let two = std::fs::read(out.join("tnew.h5")).unwrap();
+    ok(slidestack(&["tnew", cfg_s, "--out", out_s, "--force"], "1"));
+    assert_eq!(std::fs::read(out.join("tnew.h5")).unwrap(), two);
+    // λ: in [0, 1], 1 where nothing slid, the same on one storey's three floors; labelled.
+    let l = t.lambda.as_ref().unwrap();
+    let (lam, flag) = (l.lambda.as_slice().unwrap(), l.flag.as_slice().unwrap());
+    let slides = t.vars.slides.as_slice().unwrap();
+    assert_eq!(lam[..per_frame], lam[per_frame..2 * per_frame]);
+    assert_eq!(lam[..per_frame], lam[2 * per_frame..3 * per_frame]);
+    for c in 0..6 * per_frame {
+        if slides[c] == 0.0 {
+            assert!(lam[c] == 1.0 && flag[c] == LambdaFlag::NoSlide as u8);
+        } else {
+            assert!(
+                (0.0..=1.0).contains(&lam[c]) && flag[c] <= 2,
+                "{c}: {}",
+                lam[c]
+            );
+        }
+    }
+    let roots = flag
+        .iter()
+        .filter(|&&f| f == LambdaFlag::Root as u8)
+        .count();
+    let sliding = slides.iter().filter(|&&s| s > 0.0).count();
+    eprintln!("λ flags: {roots} roots of {sliding} sliding cases");
+    assert!(roots > 0);
+    let o = ok(Command::new(repo(".venv-test/bin/python"))
+        .args([
+            "-c",
+            "import sys, xarray as xr\n\
+             t = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')\n\
+             print(list(t['lambda'].dims)[:2], t['lambda_flag'].attrs['flag_meanings'])\n",
+            out.join("tnew.h5").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap());
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout),
+        "['storeys', 'stack_floor'] root below_range_clamped above_range_clamped no_slide\n"
     );
 
     // The report cannot yet take this building study and says so, naming the key, before work.
@@ -350,6 +485,14 @@ fn one_storey_buildings_are_the_one_storey_study() {
         if let Some(f) = map.remove("frames") {
             assert_eq!(f[0]["storeys"].as_u64(), Some(1));
         }
+        // A building study also fits its effective live-load fraction λ.
+        for z in map
+            .get_mut("zones")
+            .and_then(|z| z.as_sequence_mut())
+            .unwrap()
+        {
+            z.as_mapping_mut().unwrap().remove("lambda");
+        }
         v
     };
     let (fa, fb) = (fit(&a), fit(&b));
@@ -406,7 +549,17 @@ fn one_storey_buildings_are_the_one_storey_study() {
 fn a_building_study_refuses_what_it_cannot_do_naming_the_key() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let cases: [(&str, &str, &str); 7] = [
+    let cases: [(&str, &str, &str); 9] = [
+        (
+            "building: { storeys: [2, 3], storey_heights_m: [4, 3] }\n",
+            "",
+            "`building.storey_heights_m`: lists 2 values; a list needs one per storey",
+        ),
+        (
+            "building: { storeys: 2, storey_heights_m: 0.1 }\n",
+            "",
+            "`building.storey_heights_m`: 0.1: a storey height must be within 0.5 … 100 m",
+        ),
         (
             "",
             "  stack_floor: roof\n",

@@ -81,6 +81,7 @@ fn write_sweep_file(path: &Path) {
             slip_peak: zeros(&[2, 2, 1, 2, 1]),
             skip_rule: zeros(&shape),
             single_rule: zeros(&shape),
+            building: None,
         },
     };
     let meta = SweepMeta {
@@ -139,6 +140,7 @@ fn tnew_zone(band: u8) -> ZoneTnew {
         period_sd_s: vec![0.1, 0.2, 0.3],
         sd_mean_m: vec![0.0; 3],
         roof_participation: Vec::new(),
+        lambda: None,
     }
 }
 
@@ -149,6 +151,7 @@ fn write_tnew_with(path: &Path, zone: ZoneTnew, flags: &[(u8, &str)]) {
         motions_fingerprint: "m",
         flag_codes: "",
         band_flags: flags,
+        lambda_flags: &[],
         mu_static_ratio: 1.0,
         settings: &[],
     };

@@ -1,4 +1,5 @@
-//! The sweep's skip rules against brute force: every system of every case simulated.
+//! The sweep's skip rules against brute force: every system of every case simulated (in a
+//! building, its per-floor profiles and base shear too).
 
 mod common;
 
@@ -40,7 +41,7 @@ fn skip_rules_equal_brute_force_in_a_building() {
         let frame = Frame {
             floor_masses: vec![1.0, 1.0, 0.8],
             storey_stiffnesses: vec![3.0, 2.0, 1.0],
-            storey_heights_m: vec![3.0; 3],
+            storey_heights_m: vec![4.0, 3.0, 3.0],
             stack_floor,
         };
         skip_rules_hold(Some(&frame), 1);
@@ -84,6 +85,48 @@ fn skip_rules_hold(frame: Option<&Frame>, records: usize) {
                     for i in 0..g.blocks() {
                         let k = c * g.blocks() + i;
                         assert!((fast.slip_peak[k] - slow.slip_peak[k]).abs() < 1e-9);
+                    }
+                    // A building's profiles and base shear, with and without sliding.
+                    let levels = frame.map_or(0, Frame::storeys);
+                    for (what, a, b) in [
+                        (
+                            "floor_accel_stack",
+                            &fast.floor_accel_stack,
+                            &slow.floor_accel_stack,
+                        ),
+                        (
+                            "floor_accel_rigid",
+                            &fast.floor_accel_rigid,
+                            &slow.floor_accel_rigid,
+                        ),
+                        (
+                            "drift_ratio_stack",
+                            &fast.drift_ratio_stack,
+                            &slow.drift_ratio_stack,
+                        ),
+                        (
+                            "drift_ratio_rigid",
+                            &fast.drift_ratio_rigid,
+                            &slow.drift_ratio_rigid,
+                        ),
+                    ] {
+                        assert_eq!(a.len(), levels * g.cases_per_unit(), "{what}");
+                        for j in c * levels..(c + 1) * levels {
+                            close(a[j], b[j], what);
+                        }
+                    }
+                    if frame.is_some() {
+                        close(
+                            fast.base_shear_stack[c],
+                            slow.base_shear_stack[c],
+                            "V_stack",
+                        );
+                        close(
+                            fast.base_shear_rigid[c],
+                            slow.base_shear_rigid[c],
+                            "V_rigid",
+                        );
+                        assert!(fast.base_shear_stack[c] > 0.0);
                     }
                     let fe = (fast.friction_energy[c] - slow.friction_energy[c]).abs();
                     assert!(

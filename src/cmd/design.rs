@@ -98,6 +98,14 @@ fn print_table(a: &Answer) {
         t(a.t_new_paper_s),
         g(a.sa_new_paper_g)
     );
+    if a.lambda_grid.is_some() || a.lambda_fit.is_some() {
+        let f = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.3}"));
+        println!(
+            "effective live-load fraction λ: {} (the study's grid), {} (fitted)",
+            f(a.lambda_grid),
+            f(a.lambda_fit)
+        );
+    }
     for n in &a.notes {
         println!("note: {n}");
     }

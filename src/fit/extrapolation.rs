@@ -9,7 +9,7 @@
 //! sequence (bases the first `k` primes), which fill the box evenly and are the same on every
 //! run. `T_rigid = T_p·√(1 + Σα)` (paper Eqs. 10–13).
 
-use super::{Fitted, Sample};
+use super::{Fitted, Form, Sample};
 use serde::{Deserialize, Serialize};
 
 /// The margin of the box beyond the grid, as a fraction of each feature's extreme values.
@@ -139,6 +139,9 @@ pub struct BoxCheck {
 /// with every floor's mass scaled by `1 + Σα`, an upper bound of the period with the stack on
 /// any of its floors (Rayleigh's quotient: that mass matrix exceeds the loaded one), and the
 /// band's upper limit with it.
+///
+/// A [`Form::Fraction`] (a building's `λ`) must stay in `[0, 1]`; its check's
+/// `min_t_new_over_t_p` and `max_t_new_over_t_rigid` then hold the smallest and largest `λ`.
 pub fn check_box(fitted: &Fitted, bx: &DesignBox, quasi: usize, margin: f64) -> BoxCheck {
     let k = bx.lower.len();
     let blocks = k.saturating_sub(1 + bx.building) / 2;
@@ -162,6 +165,12 @@ pub fn check_box(fitted: &Fitted, bx: &DesignBox, quasi: usize, margin: f64) -> 
         let fail = if !t.is_finite() {
             c.non_finite += 1;
             true
+        } else if fitted.form == Form::Fraction {
+            c.min_t_new_over_t_p = c.min_t_new_over_t_p.min(t);
+            c.max_t_new_over_t_rigid = c.max_t_new_over_t_rigid.max(t);
+            let out = !(0.0..=1.0).contains(&t);
+            c.outside += usize::from(out);
+            out
         } else {
             c.min_t_new_over_t_p = c.min_t_new_over_t_p.min(t / t_p);
             c.max_t_new_over_t_rigid = c.max_t_new_over_t_rigid.max(t / t_rigid);

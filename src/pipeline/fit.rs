@@ -52,15 +52,21 @@ pub enum FitStageError {
     NoForm { zone: String, reasons: String },
 }
 
-/// The fingerprint `fit.h5` and `fit.yaml` must carry.
-pub fn fingerprint(tnew_fingerprint: &str) -> String {
+/// The fingerprint `fit.h5` and `fit.yaml` must carry (`building`: of a building study, which
+/// also fits `λ`).
+pub fn fingerprint(tnew_fingerprint: &str, building: bool) -> String {
     let forms: Vec<&str> = Form::ALL.iter().map(|f| f.name()).collect();
-    hash_parts(&[
-        tnew_fingerprint,
-        &format!("folds={FOLDS}"),
-        &format!("forms={}", forms.join(",")),
-        &format!("box={BOX_MARGIN},{BOX_POINTS}"),
-    ])
+    let mut parts = vec![
+        tnew_fingerprint.to_string(),
+        format!("folds={FOLDS}"),
+        format!("forms={}", forms.join(",")),
+        format!("box={BOX_MARGIN},{BOX_POINTS}"),
+    ];
+    if building {
+        parts.push(format!("lambda={}", Form::Fraction.name()));
+    }
+    let parts: Vec<&str> = parts.iter().map(String::as_str).collect();
+    hash_parts(&parts)
 }
 
 /// Names of a form's parameters, in [`crate::fit::Fitted::params`] order.
@@ -238,6 +244,10 @@ struct ZoneData {
     data: Vec<Sample>,
     every: Vec<(usize, Sample)>,
     one_storey: Vec<Sample>,
+    /// A building study's `λ` as the samples' "`T_new`": the cases fitted, and every case
+    /// with its frame's index.
+    lambda: Vec<Sample>,
+    lambda_every: Vec<(usize, Sample)>,
 }
 
 /// The first `1 + 2n` features of a building sample: the one-storey equation's (`T_p = T_1`).
@@ -264,8 +274,10 @@ fn frame_fits(
     blocks: usize,
     building: &FormFit,
     one_storey: Option<&FormFit>,
+    lambda: Option<&FormFit>,
 ) -> Vec<FrameFit> {
     let (building, one_storey) = (fitted(building), one_storey.map(fitted));
+    let lambda = lambda.map(fitted);
     (frames.iter().enumerate())
         .map(|(f, frame)| {
             let cases: Vec<&Sample> = (z.every.iter())
@@ -284,6 +296,13 @@ fn frame_fits(
                 one_storey: (one_storey.as_ref())
                     .and_then(|o| of(&|s| Some(o.predict(&stack_sample(s, blocks))))),
                 published: of(&|s| paper_equation(&z.zone, &s.x[..1 + 2 * blocks])),
+                lambda: lambda.as_ref().map(|l| {
+                    let (observed, predicted): (Vec<f64>, Vec<f64>) = (z.lambda_every.iter())
+                        .filter(|(g, _)| *g == f)
+                        .map(|(_, s)| (s.t_new_s, l.predict(s)))
+                        .unzip();
+                    metrics(&observed, &predicted)
+                }),
             }
         })
         .collect()
@@ -367,12 +386,22 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let t_rigid: Vec<f64> = t.vars.t_rigid.iter().copied().collect();
         let t_new: Vec<f64> = t.vars.t_new.iter().copied().collect();
         let z = match building {
-            None => ZoneData {
-                zone: zc.name.clone(),
-                data: samples(grid, &t_rigid, &t_new),
-                every: Vec::new(),
-                one_storey: Vec::new(),
-            },
+            None => {
+                // A one-storey study has no λ; a building study of one frame fits it with the
+                // one-storey features.
+                let lambda: Vec<Sample> = (t.lambda.as_ref()).map_or_else(Vec::new, |l| {
+                    let lambda: Vec<f64> = l.lambda.iter().copied().collect();
+                    samples(grid, &vec![1.0; lambda.len()], &lambda)
+                });
+                ZoneData {
+                    zone: zc.name.clone(),
+                    data: samples(grid, &t_rigid, &t_new),
+                    every: Vec::new(),
+                    one_storey: Vec::new(),
+                    lambda_every: lambda.iter().map(|s| (0, s.clone())).collect(),
+                    lambda,
+                }
+            }
             Some(f) => {
                 let every = building_samples(grid, &frames, f, &t_rigid, &t_new);
                 let data = (every.iter())
@@ -384,11 +413,26 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                     let cases = o * per..(o + 1) * per;
                     samples(grid, &t_rigid[cases.clone()], &t_new[cases])
                 });
+                // λ where it is finite, as the fraction form's "T_new"; the features as T_new's.
+                let lambda_every: Vec<(usize, Sample)> = match &t.lambda {
+                    Some(l) => {
+                        let lambda: Vec<f64> = l.lambda.iter().copied().collect();
+                        let ones = vec![1.0; lambda.len()];
+                        building_samples(grid, &frames, f, &ones, &lambda)
+                    }
+                    None => Vec::new(),
+                };
+                let lambda = (lambda_every.iter())
+                    .filter(|(f, _)| !repeats[*f])
+                    .map(|(_, s)| s.clone())
+                    .collect();
                 ZoneData {
                     zone: zc.name.clone(),
                     data,
                     every,
                     one_storey,
+                    lambda,
+                    lambda_every,
                 }
             }
         };
@@ -423,7 +467,22 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             })
         })
         .collect();
+    let lambda_fits: Vec<_> = zone_data
+        .par_iter()
+        .map(|d| {
+            (!d.lambda.is_empty()).then(|| {
+                assess(Form::Fraction, &d.lambda, &features, &bx).map_err(|source| {
+                    FitStageError::Fit {
+                        zone: d.zone.clone(),
+                        form: Form::Fraction.name(),
+                        source,
+                    }
+                })
+            })
+        })
+        .collect();
     let mut results = results.into_iter();
+    let mut lambda_fits = lambda_fits.into_iter();
     let mut zones = Vec::new();
     for z in &zone_data {
         let (zone, data) = (&z.zone, &z.data);
@@ -459,9 +518,42 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 recommended.name()
             ),
         );
+        let lambda = match lambda_fits.next().expect("one per zone").transpose()? {
+            Some(Ok(f)) => {
+                let (m, cv, b) = (&f.all_cases, &f.cross_validated, &f.box_check);
+                s.reporter.info(
+                    me,
+                    &format!(
+                        "zone {zone}: λ ({} cases) R² {:.4}  RMSE {:.4}  ({FOLDS}-fold CV: R² \
+                         {:.4}, RMSE {:.4})  solver {}  λ in [{:.3}, {:.3}] on the box",
+                        z.lambda.len(),
+                        m.r2,
+                        m.rmse,
+                        cv.r2,
+                        cv.rmse,
+                        if f.solver.converged {
+                            "converged"
+                        } else {
+                            "NOT converged"
+                        },
+                        b.min_t_new_over_t_p,
+                        b.max_t_new_over_t_rigid
+                    ),
+                );
+                Some(f)
+            }
+            Some(Err(nf)) => {
+                s.reporter
+                    .warn(me, &format!("zone {zone}: λ not fitted: {}", nf.reason));
+                None
+            }
+            None => None,
+        };
         let best = forms.iter().find(|f| f.form == recommended);
         let frame_fits = match (building, best) {
-            (Some(_), Some(best)) => frame_fits(z, &frames, n, best, one_storey.as_ref()),
+            (Some(_), Some(best)) => {
+                frame_fits(z, &frames, n, best, one_storey.as_ref(), lambda.as_ref())
+            }
             _ => Vec::new(),
         };
         for f in &frame_fits {
@@ -469,12 +561,14 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             s.reporter.info(
                 me,
                 &format!(
-                    "zone {zone}, {}: {} cases, R² {:.4} (one-storey equation {}, published {})",
+                    "zone {zone}, {}: {} cases, R² {:.4} (one-storey equation {}, published {}); \
+                     λ R² {}",
                     f.frame,
                     f.cases,
                     f.building.r2,
                     r2(&f.one_storey),
-                    r2(&f.published)
+                    r2(&f.published),
+                    r2(&f.lambda)
                 ),
             );
         }
@@ -488,6 +582,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             not_fitted,
             frames: frame_fits,
             one_storey,
+            lambda,
         });
     }
     let report = FitReport {

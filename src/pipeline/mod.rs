@@ -344,7 +344,7 @@ impl Study {
             Some(_) => {
                 let sweep = sweep::fingerprint(&cfg, &motions_fp);
                 let tnew = tnew::fingerprint(&sweep);
-                let fit = fit::fingerprint(&tnew);
+                let fit = fit::fingerprint(&tnew, building.is_some());
                 let report = report::fingerprint(&fit, &motions_fp, ida.as_deref());
                 Some([sweep, tnew, fit, report])
             }

@@ -22,7 +22,9 @@ use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::motions::read_zone_motions;
-use crate::store::sweep::{SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep};
+use crate::store::sweep::{
+    BuildingVars, SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep,
+};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, unit_path, write_unit};
 use crate::study::config::{Seeds, StudyConfig};
 use crate::study::physics::{CaseError, Physics, SystemKind};
@@ -169,8 +171,9 @@ impl Units<'_> {
             let found: Vec<usize> = (c.f64s.iter().map(Vec::len))
                 .chain(c.u8s.iter().map(Vec::len))
                 .collect();
-            let want = column_lengths(self.grid.cases_per_unit(), self.grid.blocks());
-            if found != want || c.f64s.len() != F64_COLUMNS {
+            let nmax = self.study.building().map(BuildingAxes::max_storeys);
+            let want = column_lengths(self.grid.cases_per_unit(), self.grid.blocks(), nmax);
+            if found != want || c.f64s.len() != want.len() - 2 {
                 return Err(StoreError::shape(&path, "columns", &found, &want));
             }
         }
@@ -178,33 +181,55 @@ impl Units<'_> {
     }
 }
 
-const F64_COLUMNS: usize = 6;
-
 /// The lengths of the columns [`to_columns`] writes for a unit of `cases` cases of `blocks`
-/// blocks: [`F64_COLUMNS`] `f64` columns (the slip, per interface, last), then two code columns.
-fn column_lengths(cases: usize, blocks: usize) -> Vec<usize> {
-    vec![
-        cases,
-        cases,
-        cases,
-        cases,
-        cases,
-        cases * blocks,
-        cases,
-        cases,
-    ]
+/// blocks: six `f64` columns (the slip, per interface, last), in a building study whose largest
+/// building has `nmax` storeys six more (four per floor or storey, padded to `nmax`, then the
+/// two base shears), then two code columns.
+fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>) -> Vec<usize> {
+    let mut v = vec![cases, cases, cases, cases, cases, cases * blocks];
+    if let Some(n) = nmax {
+        v.extend([cases * n; 4]);
+        v.extend([cases; 2]);
+    }
+    v.extend([cases; 2]);
+    v
 }
 
-fn to_columns(r: &UnitResult) -> Columns {
+/// `[case][level]` rows of `n` values each, padded with NaN to `nmax` per case.
+fn padded(rows: &[f64], n: usize, nmax: usize) -> Vec<f64> {
+    (rows.chunks(n.max(1)))
+        .flat_map(|r| {
+            r.iter()
+                .copied()
+                .chain(std::iter::repeat_n(f64::NAN, nmax - r.len()))
+        })
+        .collect()
+}
+
+/// A unit's columns; `frame`: `(N, N_max)` of a building study's unit.
+fn to_columns(r: &UnitResult, frame: Option<(usize, usize)>) -> Columns {
+    let mut f64s = vec![
+        r.u_stack.clone(),
+        r.u_single.clone(),
+        r.u_rigid.clone(),
+        r.a_stack.clone(),
+        r.friction_energy.clone(),
+        r.slip_peak.clone(),
+    ];
+    if let Some((n, nmax)) = frame {
+        for rows in [
+            &r.floor_accel_stack,
+            &r.floor_accel_rigid,
+            &r.drift_ratio_stack,
+            &r.drift_ratio_rigid,
+        ] {
+            f64s.push(padded(rows, n, nmax));
+        }
+        f64s.push(r.base_shear_stack.clone());
+        f64s.push(r.base_shear_rigid.clone());
+    }
     Columns {
-        f64s: vec![
-            r.u_stack.clone(),
-            r.u_single.clone(),
-            r.u_rigid.clone(),
-            r.a_stack.clone(),
-            r.friction_energy.clone(),
-            r.slip_peak.clone(),
-        ],
+        f64s,
         u8s: vec![r.skip_rule.clone(), r.single_rule.clone()],
     }
 }
@@ -291,7 +316,8 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
             })?;
             sims.fetch_add(r.simulations, Ordering::Relaxed);
             samples.fetch_add(r.simulations * accel.len(), Ordering::Relaxed);
-            write_unit(&units.path(u), &units.id(u), &to_columns(&r))?;
+            let sizes = (study.building()).map(|b| (b.frame(u.frame).0, b.max_storeys()));
+            write_unit(&units.path(u), &units.id(u), &to_columns(&r, sizes))?;
             bar.inc();
             Ok(())
         })?;
@@ -390,6 +416,21 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
                 .collect();
             array(flat, shape, &dir)
         };
+        let building_vars = match building {
+            None => None,
+            Some(b) => {
+                let mut per_floor = shape.clone();
+                per_floor.push(b.max_storeys());
+                Some(BuildingVars {
+                    floor_accel_stack: f(6, &per_floor)?,
+                    floor_accel_rigid: f(7, &per_floor)?,
+                    drift_ratio_stack: f(8, &per_floor)?,
+                    drift_ratio_rigid: f(9, &per_floor)?,
+                    base_shear_stack: f(10, &shape)?,
+                    base_shear_rigid: f(11, &shape)?,
+                })
+            }
+        };
         let codes = |i: usize| -> Result<ArrayD<u8>, PipelineError> {
             let flat: Vec<u8> = cols.iter().flat_map(|c| c.u8s[i].iter().copied()).collect();
             array(flat, &shape, &dir)
@@ -407,6 +448,7 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
                 slip_peak: f(5, &shape_i)?,
                 skip_rule: codes(0)?,
                 single_rule: codes(1)?,
+                building: building_vars,
             },
         });
     }
@@ -498,6 +540,13 @@ fn same_bits(a: &ZoneSweep, b: &ZoneSweep) -> bool {
         && f(&va.slip_peak, &vb.slip_peak)
         && va.skip_rule == vb.skip_rule
         && va.single_rule == vb.single_rule
+        && match (&va.building, &vb.building) {
+            (None, None) => true,
+            (Some(x), Some(y)) => {
+                (x.vars().iter().zip(y.vars())).all(|(p, q)| p.0 == q.0 && f(p.1, q.1))
+            }
+            _ => false,
+        }
 }
 
 /// Removes the unit files (after `sweep.h5` was verified, or left over from an interrupted

@@ -6,21 +6,30 @@
 //! In a building study (docs/model.md, "A study over buildings") every frame (`storeys`,
 //! `stack_floor`) is done alike, with the first mode's `T_1,rigid` and the mean peak roof
 //! displacement divided by `Γ_1·φ_1,N` (the first mode's equivalent-SDOF displacement) before
-//! `T_new` is read off the spectrum; one storey is today's arithmetic, bit for bit.
+//! `T_new` is read off the spectrum; one storey is today's arithmetic, bit for bit. A building
+//! study's cases also get their effective live-load fraction `λ` ([`crate::study::lambda`]),
+//! which simulates the linear building with part of the stack attached (the stage's only
+//! simulations; on one storey also the stack and the rigid system, whose base shear the
+//! sweep's one-storey integrator does not give).
 //!
 //! Fingerprint: the sweep's, and the step of the spectrum's period grid.
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
+use crate::dynamics::Ground;
 use crate::grid::Grid;
+use crate::ground_motion::Record;
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::read_zone_sweep;
-use crate::store::tnew::{TnewMeta, TnewVars, ZoneTnew, read_zone_tnew_in, write_tnew};
+use crate::store::tnew::{LambdaVars, TnewMeta, TnewVars, ZoneTnew, read_zone_tnew_in, write_tnew};
 use crate::study::building::Frame;
+use crate::study::lambda::{self, LAMBDA_FLAGS, LambdaFlag};
+use crate::study::physics::{CaseError, Physics, SystemKind};
 use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
 use ndarray::{ArrayD, Axis};
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use thiserror::Error;
 
 /// Step of the period grid of the mean displacement spectrum, s.
@@ -34,6 +43,118 @@ pub enum TnewError {
         motion: String,
         source: SpectrumError,
     },
+    #[error("zone {zone}: the effective live-load fraction: {source}")]
+    Lambda {
+        zone: String,
+        source: Box<CaseError>,
+    },
+}
+
+/// One case's effective live-load fraction and the mean base shears it comes from.
+#[derive(Debug, Clone, Copy)]
+struct Fraction {
+    stack: f64,
+    rigid: f64,
+    bare: f64,
+    lambda: f64,
+    flag: LambdaFlag,
+}
+
+/// The effective live-load fraction of every case (flat over `[frame][case]`) of a building
+/// study's zone ([`crate::study::lambda`]): `V̄_stack` and `V̄(1)` are the means over the
+/// motions (summed in motion order, then divided, as [`lambda::mean_base_shear`] sums) of the
+/// sweep's `base_shear_stack`/`base_shear_rigid` (`[motion][frame][case]`; on one storey,
+/// where those are NaN, simulated here by the building's integrator); `V̄(0)` and the values
+/// between are simulated. Cases in parallel, each on its own: the same numbers whatever the
+/// threads.
+fn effective_fractions(
+    physics: &Physics,
+    grid: &Grid,
+    frames: &[Option<Frame>],
+    motions: &[Record],
+    base_shear_stack: &[f64],
+    base_shear_rigid: &[f64],
+    slides: &[bool],
+) -> Result<Vec<Fraction>, CaseError> {
+    let per_frame = grid.cases();
+    let cases = frames.len() * per_frame;
+    let m = motions.len();
+    let accel: Vec<Vec<f64>> = motions.iter().map(|r| r.accel_mps2(1.0)).collect();
+    let grounds: Vec<Ground> = (motions.iter().zip(&accel))
+        .map(|(r, a)| Ground::new(r.dt_s, a))
+        .collect();
+    let grounds = &grounds[..];
+    let mean = |v: &[f64], c: usize| (0..m).map(|k| v[k * cases + c]).sum::<f64>() / m as f64;
+    let frame_of = |c: usize| {
+        frames[c / per_frame]
+            .as_ref()
+            .expect("a building study has a frame per case")
+    };
+    // Frames that are one building (the same storeys and loaded floors: on one storey floor 1,
+    // the roof and every floor) have the same sweep results, so the same λ: each is computed
+    // for the first of them only.
+    let same = |f: usize| frames[f].as_ref().map(|fr| (fr.storeys(), fr.floors()));
+    let first: Vec<usize> = (0..frames.len())
+        .map(|f| (0..f).find(|&g| same(g) == same(f)).unwrap_or(f))
+        .collect();
+    let own: Vec<usize> = (0..cases)
+        .filter(|&c| first[c / per_frame] == c / per_frame)
+        .collect();
+    // V̄(0) depends on the frame, T_p and α (through the damping matrix) but not on μ: once per
+    // key, the first case of each standing for it.
+    let bare_key = |c: usize| {
+        let case = grid.case(c % per_frame);
+        (
+            c / per_frame,
+            case.period_s.to_bits(),
+            case.alpha_total().to_bits(),
+        )
+    };
+    let mut keyed = BTreeMap::new();
+    for &c in &own {
+        keyed.entry(bare_key(c)).or_insert(c);
+    }
+    let keyed: Vec<((usize, u64, u64), usize)> = keyed.into_iter().collect();
+    let bare: BTreeMap<(usize, u64, u64), f64> = keyed
+        .par_iter()
+        .map(|&(key, c)| {
+            let case = grid.case(c % per_frame);
+            lambda::mean_base_shear(physics, &case, frame_of(c), 0.0, grounds).map(|v| (key, v))
+        })
+        .collect::<Result<_, _>>()?;
+    let computed: Vec<Fraction> = own
+        .par_iter()
+        .map(|&c| {
+            let frame = frame_of(c);
+            let case = grid.case(c % per_frame);
+            // One storey's sweep runs the one-storey integrator, which gives no base shear.
+            let (stack, rigid) = if frame.storeys() == 1 {
+                let run =
+                    |kind| lambda::mean_system_base_shear(physics, kind, &case, frame, grounds);
+                (run(SystemKind::Stack)?, run(SystemKind::Rigid)?)
+            } else {
+                (mean(base_shear_stack, c), mean(base_shear_rigid, c))
+            };
+            let bare = bare[&bare_key(c)];
+            let at = |l| lambda::mean_base_shear(physics, &case, frame, l, grounds);
+            let (lambda, flag) = if slides[c] {
+                lambda::solve(stack, bare, rigid, at)?
+            } else {
+                (1.0, LambdaFlag::NoSlide)
+            };
+            Ok(Fraction {
+                stack,
+                rigid,
+                bare,
+                lambda,
+                flag,
+            })
+        })
+        .collect::<Result<_, CaseError>>()?;
+    let at: BTreeMap<usize, usize> = own.iter().enumerate().map(|(i, &c)| (c, i)).collect();
+    Ok((0..cases)
+        .map(|c| computed[at[&(first[c / per_frame] * per_frame + c % per_frame)]])
+        .collect())
 }
 
 /// The fingerprint `tnew.h5` must carry.
@@ -165,6 +286,47 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let shaped = |v: Vec<f64>| {
             ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
         };
+        let lambda = match &v.building {
+            None => None,
+            Some(bv) => {
+                let l = effective_fractions(
+                    &physics,
+                    grid,
+                    &frames,
+                    &motions[z],
+                    bv.base_shear_stack.as_slice().expect("standard layout"),
+                    bv.base_shear_rigid.as_slice().expect("standard layout"),
+                    &slides,
+                )
+                .map_err(|source| TnewError::Lambda {
+                    zone: zc.name.clone(),
+                    source: Box::new(source),
+                })?;
+                let counts: Vec<String> = (LAMBDA_FLAGS.iter())
+                    .map(|(code, word)| {
+                        let k = l.iter().filter(|x| x.flag as u8 == *code).count();
+                        format!("{word} {k}")
+                    })
+                    .collect();
+                s.reporter.info(
+                    me,
+                    &format!("zone {}: effective live-load fraction λ: {}", zc.name, {
+                        counts.join(", ")
+                    }),
+                );
+                Some(LambdaVars {
+                    base_shear_stack_mean: shaped(l.iter().map(|x| x.stack).collect()),
+                    base_shear_rigid_mean: shaped(l.iter().map(|x| x.rigid).collect()),
+                    base_shear_bare_mean: shaped(l.iter().map(|x| x.bare).collect()),
+                    lambda: shaped(l.iter().map(|x| x.lambda).collect()),
+                    flag: ArrayD::from_shape_vec(
+                        shape.clone(),
+                        l.iter().map(|x| x.flag as u8).collect(),
+                    )
+                    .expect("one code per case"),
+                })
+            }
+        };
         let counts = BandCounts::new(&band, &t_new, &t_rigid);
         s.reporter.info(
             me,
@@ -189,6 +351,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             period_sd_s: period_sd_s.clone(),
             sd_mean_m,
             roof_participation: per_storeys.clone(),
+            lambda,
         });
     }
     let building_json = super::sweep::building_attr(study);
@@ -202,6 +365,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         motions_fingerprint: study.fingerprint(StageId::Motions)?,
         flag_codes: TNEW_FLAG_CODES,
         band_flags: &BAND_FLAGS,
+        lambda_flags: &LAMBDA_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,
         settings: &settings,
     };

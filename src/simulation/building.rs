@@ -14,6 +14,7 @@ use crate::limits::MAX_STOREYS;
 use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
 use crate::simulation::{Integrator, StructureKind};
 use crate::store::HistoryLayout;
+use crate::study::building::{DEFAULT_STOREY_HEIGHT_M, OneOrList, STOREY_HEIGHT_RANGE_M};
 use serde::{Deserialize, Serialize};
 
 /// The `building:` key of a case file.
@@ -39,6 +40,36 @@ pub struct BuildingSettings {
     /// `r` of every storey (bilinear).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub post_yield_ratio: Option<f64>,
+    /// Storey heights, m: one value for every storey or a list, storey 1 first [default:
+    /// [`DEFAULT_STOREY_HEIGHT_M`]]; they give the drift ratios.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub storey_heights_m: Option<OneOrList<f64>>,
+}
+
+impl BuildingSettings {
+    /// The storey heights, m, storey 1 first; `Err` names the key.
+    pub fn storey_heights(&self) -> Result<Vec<f64>, String> {
+        let n = self.storeys;
+        let h = match &self.storey_heights_m {
+            None => vec![DEFAULT_STOREY_HEIGHT_M; n],
+            Some(OneOrList::One(h)) => vec![*h; n],
+            Some(OneOrList::List(v)) if v.len() == n => v.clone(),
+            Some(OneOrList::List(v)) => {
+                return Err(format!(
+                    "building.storey_heights_m lists {} values but the building has {n} storeys",
+                    v.len()
+                ));
+            }
+        };
+        let (lo, hi) = STOREY_HEIGHT_RANGE_M;
+        match h.iter().position(|x| !(lo..=hi).contains(x)) {
+            Some(i) => Err(format!(
+                "building.storey_heights_m[{i}] must be within {lo} … {hi} m, got {:?}",
+                h[i]
+            )),
+            None => Ok(h),
+        }
+    }
 }
 
 /// The floor a stack stands on: `1 … N`, or `roof` (floor `N`).
@@ -76,6 +107,7 @@ pub fn building_spec(
             "building.storeys must be 1 … {MAX_STOREYS}, got {n}"
         ));
     }
+    b.storey_heights()?;
     let yielding = match (
         b.structure.unwrap_or(StructureKind::Elastic),
         &b.yield_strength_ratios,
@@ -214,6 +246,8 @@ pub struct BuildingEcho {
     pub stiffness_n_per_m: Vec<f64>,
     /// `F_y,i/k_i`, m; null when elastic.
     pub yield_drift_m: Option<Vec<f64>>,
+    /// Storey heights, m, storey 1 first.
+    pub storey_heights_m: Vec<f64>,
 }
 
 /// One stack: as stated, and its response.
@@ -251,6 +285,11 @@ pub struct BuildingSummary {
     pub floor_peak_abs_accel_g: Vec<f64>,
     /// Storey 1 first: `δ_i = u_i − u_{i−1}`.
     pub storey_peak_drift_m: Vec<f64>,
+    /// `max|δ_i|/h_i`, storey 1 first.
+    pub storey_peak_drift_ratio: Vec<f64>,
+    /// Peak base shear `F_1 + 1ᵀ·C·u̇` over the bare building's weight (docs/model.md, "Base
+    /// shear, drift ratio, floor acceleration"); null where the one-storey integrator ran.
+    pub peak_base_shear_ratio: Option<f64>,
     /// `max|δ_i|/(F_y,i/k_i)`; null when elastic.
     pub storey_ductility: Option<Vec<f64>>,
     pub storey_residual_drift_m: Vec<f64>,
@@ -296,6 +335,10 @@ pub fn building_summary(
         })
         .collect();
     let e = &r.energy;
+    let heights = settings
+        .storey_heights()
+        .expect("checked when the building was resolved");
+    let weight_n = G * spec.floor_masses.iter().sum::<f64>();
     BuildingSummary {
         record: record.0.to_string(),
         dt_s: record.1,
@@ -317,11 +360,17 @@ pub fn building_summary(
             yield_drift_m: b
                 .springs()
                 .map(|s| s.iter().map(|sp| sp.yield_drift_m).collect()),
+            storey_heights_m: heights.clone(),
         },
         modes_s: b.periods_s().to_vec(),
         floor_peak_displacement_m: r.floor_peak_displacement_m.clone(),
         floor_peak_abs_accel_g: r.floor_peak_abs_accel_mps2.iter().map(|a| a / G).collect(),
         storey_peak_drift_m: r.storey_peak_drift_m.clone(),
+        storey_peak_drift_ratio: (r.storey_peak_drift_m.iter().zip(&heights))
+            .map(|(d, h)| d / h)
+            .collect(),
+        peak_base_shear_ratio: (!r.peak_base_shear_n.is_nan())
+            .then(|| r.peak_base_shear_n / weight_n),
         storey_ductility: r.storey_ductility.clone(),
         storey_residual_drift_m: r.storey_residual_drift_m.clone(),
         stacks,

@@ -17,10 +17,13 @@
 //!          /zone_<name>/<form>/coefficients   attrs: names
 //!          /zone_<name>/<form>/standard_errors attrs: names
 //!          /zone_<name>/published             attrs: r2, r, rmse_s, mse_s2, mae_s, n
+//!          /zone_<name>/lambda                (a building study) the fraction form for λ, as a
+//!                                             form's group (its "T_new" is λ)
 //!          /zone_<name>/frame_<i>             (a building study of several frames, frame i of
 //!                                             fit.yaml's `frames`) attrs: frame, the
 //!                                             recommended form's metrics on its cases (r2, …),
-//!                                             one_storey_r2, …, published_r2, …
+//!                                             one_storey_r2, …, published_r2, …,
+//!                                             lambda_r2, …
 //! ```
 
 use super::h5::{attr_f64, attr_str, write_1d, write_stage_file};
@@ -93,6 +96,9 @@ pub struct FrameFit {
     pub one_storey: Option<Metrics>,
     /// The paper's published equation (`T_p = T_1`) on this frame's cases, when it applies.
     pub published: Option<Metrics>,
+    /// The zone's fitted `λ` ([`ZoneFit::lambda`]) on this frame's cases.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lambda: Option<Metrics>,
 }
 
 /// A frame of a building study, all `design` needs to evaluate the fitted forms there: its
@@ -159,6 +165,11 @@ pub struct ZoneFit {
     /// the study's one-storey frame.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub one_storey: Option<FormFit>,
+    /// A building study's design equation for the effective live-load fraction `λ`
+    /// ([`Form::Fraction`], the same features as `T_new`'s), fitted to every case of its
+    /// distinct frames with a `λ`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lambda: Option<FormFit>,
 }
 
 impl ZoneFit {
@@ -204,6 +215,57 @@ fn write_metrics(g: &hdf5::Location, prefix: &str, m: &Metrics) -> hdf5::Result<
     Ok(())
 }
 
+/// One fitted form as group `name` of `g`.
+fn write_form(g: &hdf5::Group, name: &str, fr: &FormFit) -> hdf5::Result<()> {
+    let sub = g.create_group(name)?;
+    attr_str(&sub, "equation", &fr.equation)?;
+    attr_str(&sub, "objective", &fr.objective)?;
+    attr_str(
+        &sub,
+        "solver",
+        match fr.solver.method {
+            Method::TrustRegion => "trust-region",
+            Method::NelderMead => "nelder-mead",
+            Method::ProjectedNelderMead => "nelder-mead-projected",
+        },
+    )?;
+    let b = &fr.box_check;
+    for (k, v) in [
+        ("converged", f64::from(u8::from(fr.solver.converged))),
+        ("iterations", fr.solver.iterations as f64),
+        ("relative_offset", fr.solver.relative_offset),
+        ("residual_std", fr.residual_std),
+        ("condition_number", fr.condition_number),
+        ("box_passed", f64::from(u8::from(b.passed))),
+        ("box_points", b.points as f64),
+        ("box_min_t_new_over_t_p", b.min_t_new_over_t_p),
+        ("box_max_t_new_over_t_rigid", b.max_t_new_over_t_rigid),
+    ] {
+        attr_f64(&sub, k, v)?;
+    }
+    let values: Vec<f64> = fr.coefficients.iter().map(|c| c.1).collect();
+    let names: Vec<String> = fr.coefficients.iter().map(|c| c.0.clone()).collect();
+    let ds = write_1d(
+        &sub,
+        "coefficients",
+        &values,
+        "mixed (s, s per unit feature)",
+        "fitted coefficients",
+    )?;
+    attr_str(&ds, "names", &names.join(", "))?;
+    let se = write_1d(
+        &sub,
+        "standard_errors",
+        &fr.standard_errors,
+        "mixed (as the coefficients)",
+        "standard error of each coefficient, from the Jacobian at the optimum",
+    )?;
+    attr_str(&se, "names", &names.join(", "))?;
+    write_metrics(&sub, "", &fr.all_cases)?;
+    write_metrics(&sub, "cv_", &fr.cross_validated)?;
+    Ok(())
+}
+
 /// Writes `fit.h5` at `h5` and `fit.yaml` at `yaml`.
 pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError> {
     write_stage_file(
@@ -220,52 +282,10 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
                 attr_str(&g, "recommended_form", z.recommended.name())?;
                 attr_str(&g, "recommendation", &z.recommendation)?;
                 for fr in &z.forms {
-                    let sub = g.create_group(fr.form.name())?;
-                    attr_str(&sub, "equation", &fr.equation)?;
-                    attr_str(&sub, "objective", &fr.objective)?;
-                    attr_str(
-                        &sub,
-                        "solver",
-                        match fr.solver.method {
-                            Method::TrustRegion => "trust-region",
-                            Method::NelderMead => "nelder-mead",
-                            Method::ProjectedNelderMead => "nelder-mead-projected",
-                        },
-                    )?;
-                    let b = &fr.box_check;
-                    for (k, v) in [
-                        ("converged", f64::from(u8::from(fr.solver.converged))),
-                        ("iterations", fr.solver.iterations as f64),
-                        ("relative_offset", fr.solver.relative_offset),
-                        ("residual_std", fr.residual_std),
-                        ("condition_number", fr.condition_number),
-                        ("box_passed", f64::from(u8::from(b.passed))),
-                        ("box_points", b.points as f64),
-                        ("box_min_t_new_over_t_p", b.min_t_new_over_t_p),
-                        ("box_max_t_new_over_t_rigid", b.max_t_new_over_t_rigid),
-                    ] {
-                        attr_f64(&sub, k, v)?;
-                    }
-                    let values: Vec<f64> = fr.coefficients.iter().map(|c| c.1).collect();
-                    let names: Vec<String> = fr.coefficients.iter().map(|c| c.0.clone()).collect();
-                    let ds = write_1d(
-                        &sub,
-                        "coefficients",
-                        &values,
-                        "mixed (s, s per unit feature)",
-                        "fitted coefficients",
-                    )?;
-                    attr_str(&ds, "names", &names.join(", "))?;
-                    let se = write_1d(
-                        &sub,
-                        "standard_errors",
-                        &fr.standard_errors,
-                        "mixed (as the coefficients)",
-                        "standard error of each coefficient, from the Jacobian at the optimum",
-                    )?;
-                    attr_str(&se, "names", &names.join(", "))?;
-                    write_metrics(&sub, "", &fr.all_cases)?;
-                    write_metrics(&sub, "cv_", &fr.cross_validated)?;
+                    write_form(&g, fr.form.name(), fr)?;
+                }
+                if let Some(fr) = &z.lambda {
+                    write_form(&g, "lambda", fr)?;
                 }
                 if let Some(m) = &z.published {
                     let sub = g.create_group("published")?;
@@ -280,6 +300,9 @@ pub fn write_fit(h5: &Path, yaml: &Path, r: &FitReport) -> Result<(), StoreError
                     }
                     if let Some(m) = &fr.published {
                         write_metrics(&sub, "published_", m)?;
+                    }
+                    if let Some(m) = &fr.lambda {
+                        write_metrics(&sub, "lambda_", m)?;
                     }
                 }
             }
@@ -323,7 +346,11 @@ pub fn read_fit(yaml: &Path) -> Result<Option<FitReport>, StoreError> {
         .count();
     for z in &report.zones {
         let forms = z.forms.iter().map(|f| (f, k));
-        for (f, k) in forms.chain(z.one_storey.iter().map(|f| (f, k - building))) {
+        let one_storey = z.one_storey.iter().map(|f| (f, k - building));
+        for (f, k) in forms
+            .chain(one_storey)
+            .chain(z.lambda.iter().map(|f| (f, k)))
+        {
             let want = [f.form.parameter_count(k)];
             for (what, found) in [
                 ("coefficients", f.coefficients.len()),

@@ -12,7 +12,17 @@
 //! A building study (docs/model.md, "A study over buildings") has two more coordinates,
 //! `storeys` (numbers) and `stack_floor` (strings: a floor number, `roof`, `all`), as dimensions
 //! after `motion`: `[motion, storeys, stack_floor, T_p, …]`; the structure's peaks are then the
-//! roof's.
+//! roof's. It also stores, with and without sliding (`_stack`, `_rigid`: the stack rigidly
+//! attached), each floor's and storey's peaks over the coordinates `floor` and `storey`
+//! (`1 … N_max`, the largest `storeys`; a building of fewer storeys is NaN above its roof,
+//! the variables' fill value), and the peak base shear:
+//! ```text
+//!     floor_accel_stack, floor_accel_rigid (g)     [motion, storeys, stack_floor, T_p, …, floor]
+//!     drift_ratio_stack, drift_ratio_rigid (1)     [… , storey]
+//!     base_shear_stack, base_shear_rigid (1)       [motion, storeys, stack_floor, T_p, …]
+//! ```
+//! One padded array per variable rather than one per storey count keeps every variable on the
+//! grid's dimensions (xarray selects `storeys=3` and gets floors 1 … 3 and NaN above).
 //!
 //! Variables are chunked by work unit (one motion, one `T_p`), deflate+shuffle compressed,
 //! Fletcher32-checksummed, with NaN (255 for the codes) as fill value. Objects are written in a
@@ -55,6 +65,71 @@ pub struct SweepVars {
     pub slip_peak: ArrayD<f64>,
     pub skip_rule: ArrayD<u8>,
     pub single_rule: ArrayD<u8>,
+    /// A building study's per-floor peaks and base shear (`None` on one storey).
+    pub building: Option<BuildingVars>,
+}
+
+/// A building study's per-floor and per-storey peaks (a trailing `floor` or `storey` axis of
+/// length `N_max`, NaN above a building's roof) and base shear, with the stack (`_stack`) and
+/// with it rigidly attached (`_rigid`); docs/model.md, "Base shear, drift ratio, floor
+/// acceleration".
+#[derive(Debug, Clone, PartialEq)]
+pub struct BuildingVars {
+    /// Peak absolute acceleration of each floor, g.
+    pub floor_accel_stack: ArrayD<f64>,
+    pub floor_accel_rigid: ArrayD<f64>,
+    /// Peak interstorey drift over the storey's height, per storey.
+    pub drift_ratio_stack: ArrayD<f64>,
+    pub drift_ratio_rigid: ArrayD<f64>,
+    /// Peak base shear over the bare building's weight (NaN in a building of one storey).
+    pub base_shear_stack: ArrayD<f64>,
+    pub base_shear_rigid: ArrayD<f64>,
+}
+
+impl BuildingVars {
+    /// `(name, data, units, long name)` of every variable, in the order they are written.
+    pub fn vars(&self) -> [(&'static str, &ArrayD<f64>, &'static str, &'static str); 6] {
+        [
+            (
+                "floor_accel_stack",
+                &self.floor_accel_stack,
+                "g",
+                "peak absolute acceleration of each floor with the sliding stack",
+            ),
+            (
+                "floor_accel_rigid",
+                &self.floor_accel_rigid,
+                "g",
+                "peak absolute acceleration of each floor with the stack rigidly attached",
+            ),
+            (
+                "drift_ratio_stack",
+                &self.drift_ratio_stack,
+                "1",
+                "peak interstorey drift over the storey height, with the sliding stack",
+            ),
+            (
+                "drift_ratio_rigid",
+                &self.drift_ratio_rigid,
+                "1",
+                "peak interstorey drift over the storey height, with the stack rigidly attached",
+            ),
+            (
+                "base_shear_stack",
+                &self.base_shear_stack,
+                "1",
+                "peak base shear over the bare building's weight, with the sliding stack \
+                 (NaN on one storey: its integrator does not give it)",
+            ),
+            (
+                "base_shear_rigid",
+                &self.base_shear_rigid,
+                "1",
+                "peak base shear over the bare building's weight, with the stack rigidly \
+                 attached (NaN on one storey: its integrator does not give it)",
+            ),
+        ]
+    }
 }
 
 /// One zone of `sweep.h5`.
@@ -290,6 +365,40 @@ fn write_zone(
         &[(0, "simulated"), (1, "equals_rigid")],
     )?;
     attach_all(&ds, &scales)?;
+    if let (Some(b), Some(bv)) = (building, &v.building) {
+        let levels: Vec<f64> = (1..=b.max_storeys()).map(|j| j as f64).collect();
+        let floor = coordinate(&g, "floor", &levels, "1", "floor (1 the lowest)")?;
+        let storey = coordinate(
+            &g,
+            "storey",
+            &levels,
+            "1",
+            "storey (1 the lowest: between the ground and floor 1)",
+        )?;
+        let mut chunk_f = chunk.clone();
+        chunk_f.push(levels.len());
+        for (name, data, units, long) in bv.vars() {
+            let per = if name.starts_with("floor") {
+                Some(&floor)
+            } else if name.starts_with("drift") {
+                Some(&storey)
+            } else {
+                None
+            };
+            let ds = write_var(
+                &g,
+                name,
+                data.view(),
+                if per.is_some() { &chunk_f } else { &chunk },
+                units,
+                long,
+            )?;
+            attach_all(&ds, &scales)?;
+            if let Some(p) = per {
+                attach_scale(&ds, p, scales.len())?;
+            }
+        }
+    }
     Ok(())
 }
 
@@ -312,7 +421,23 @@ pub fn read_zone_sweep(
     shape.extend(grid.shape());
     let mut per_interface = shape.clone();
     per_interface.push(blocks);
+    let building_vars = match &axes {
+        None => None,
+        Some(a) => {
+            let mut per_floor = shape.clone();
+            per_floor.push(a.max_storeys());
+            Some(BuildingVars {
+                floor_accel_stack: g.array("floor_accel_stack", &per_floor)?,
+                floor_accel_rigid: g.array("floor_accel_rigid", &per_floor)?,
+                drift_ratio_stack: g.array("drift_ratio_stack", &per_floor)?,
+                drift_ratio_rigid: g.array("drift_ratio_rigid", &per_floor)?,
+                base_shear_stack: g.array("base_shear_stack", &shape)?,
+                base_shear_rigid: g.array("base_shear_rigid", &shape)?,
+            })
+        }
+    };
     let vars = SweepVars {
+        building: building_vars,
         u_stack: g.array("u_stack", &shape)?,
         u_single: g.array("u_single", &shape)?,
         u_rigid: g.array("u_rigid", &shape)?,

@@ -11,7 +11,13 @@
 //! ```
 //! A building study's variables have the dimensions `storeys` and `stack_floor` in front
 //! (coordinates as in `sweep.h5`), and `roof_participation` `[storeys]` is `Γ_1·φ_1,N`, by which
-//! the mean peak roof displacement is divided before `T_new` is read off the spectrum.
+//! the mean peak roof displacement is divided before `T_new` is read off the spectrum. It also
+//! holds the effective live-load fraction (docs/model.md, "The effective live-load fraction
+//! λ"), per case:
+//! ```text
+//!     base_shear_stack_mean, base_shear_rigid_mean, base_shear_bare_mean (1),
+//!     lambda (1), lambda_flag (CF flags)       [storeys, stack_floor, T_p, alpha…, mu…]
+//! ```
 
 use super::h5::{
     Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, group, open, write_attrs,
@@ -51,6 +57,53 @@ pub struct ZoneTnew {
     pub sd_mean_m: Vec<f64>,
     /// A building study's `Γ_1·φ_1,N` per storey count (empty on one storey).
     pub roof_participation: Vec<f64>,
+    /// A building study's effective live-load fraction (`None` on one storey).
+    pub lambda: Option<LambdaVars>,
+}
+
+/// The effective live-load fraction of every case of a building study and the mean peak base
+/// shears it comes from, each over the bare building's weight (docs/model.md, "The effective
+/// live-load fraction λ"); shaped as [`TnewVars`]' variables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LambdaVars {
+    /// `V̄_stack`: with the sliding stack.
+    pub base_shear_stack_mean: ArrayD<f64>,
+    /// `V̄(1)`: with the whole stack rigidly attached.
+    pub base_shear_rigid_mean: ArrayD<f64>,
+    /// `V̄(0)`: with the stack's mass absent (the building's own damping matrix).
+    pub base_shear_bare_mean: ArrayD<f64>,
+    pub lambda: ArrayD<f64>,
+    /// How `λ` was found (codes in `flag_values`/`flag_meanings`).
+    pub flag: ArrayD<u8>,
+}
+
+impl LambdaVars {
+    fn vars(&self) -> [(&'static str, &ArrayD<f64>, &'static str); 4] {
+        [
+            (
+                "base_shear_stack_mean",
+                &self.base_shear_stack_mean,
+                "mean over the motions of the peak base shear over the bare building's weight, \
+                 with the sliding stack",
+            ),
+            (
+                "base_shear_rigid_mean",
+                &self.base_shear_rigid_mean,
+                "the same with the stack rigidly attached (lambda = 1)",
+            ),
+            (
+                "base_shear_bare_mean",
+                &self.base_shear_bare_mean,
+                "the same with the stack's mass absent (lambda = 0)",
+            ),
+            (
+                "lambda",
+                &self.lambda,
+                "effective live-load fraction: the fraction of the stack's mass which, rigidly \
+                 attached, gives base_shear_stack_mean (lambda_flag says how it was found)",
+            ),
+        ]
+    }
 }
 
 /// Provenance written on `tnew.h5`.
@@ -65,6 +118,8 @@ pub struct TnewMeta<'a> {
     pub flag_codes: &'a str,
     /// `(code, word)` pairs of the `T_new_band` codes.
     pub band_flags: &'a [(u8, &'a str)],
+    /// `(code, word)` pairs of the `lambda_flag` codes (a building study's).
+    pub lambda_flags: &'a [(u8, &'a str)],
     /// Static friction = this × kinetic.
     pub mu_static_ratio: f64,
     pub settings: &'a [(&'a str, Attr<'a>)],
@@ -206,6 +261,22 @@ fn write_zone(
         meta.band_flags,
     )?;
     attach_all(&ds, &scales)?;
+    if let Some(l) = &z.lambda {
+        for (name, data, long) in l.vars() {
+            let ds = write_var(&g, name, data.view(), &chunk, "1", long)?;
+            attach_all(&ds, &scales)?;
+        }
+        let ds = write_flags(
+            &g,
+            "lambda_flag",
+            l.flag.view(),
+            &chunk,
+            "how lambda was found: a root of the mean base shear between lambda 0 and 1, \
+             clamped to an end when the stack's lies outside their values, 1 when nothing slid",
+            meta.lambda_flags,
+        )?;
+        attach_all(&ds, &scales)?;
+    }
     let p = coordinate(
         &g,
         "period_sd",
@@ -278,6 +349,16 @@ pub fn read_zone_tnew_in(
             ),
         ));
     }
+    let lambda = match axes {
+        None => None,
+        Some(_) => Some(LambdaVars {
+            base_shear_stack_mean: g.array("base_shear_stack_mean", &shape)?,
+            base_shear_rigid_mean: g.array("base_shear_rigid_mean", &shape)?,
+            base_shear_bare_mean: g.array("base_shear_bare_mean", &shape)?,
+            lambda: g.array("lambda", &shape)?,
+            flag: g.array("lambda_flag", &shape)?,
+        }),
+    };
     let period_sd_s = g.vector("period_sd")?;
     let sd_mean_m = g.array("sd_mean", &[period_sd_s.len()])?;
     let z = ZoneTnew {
@@ -287,6 +368,7 @@ pub fn read_zone_tnew_in(
         period_sd_s,
         sd_mean_m: sd_mean_m.iter().copied().collect(),
         roof_participation,
+        lambda,
     };
     Ok((grid, axes, z))
 }

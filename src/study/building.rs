@@ -6,7 +6,8 @@
 //!   storeys: [1, 3, 6]             # one value or a list (a grid axis, `storeys`)
 //!   floor_masses: [1, 1, 1]        # relative, floor 1 first (only with one `storeys` value)
 //!   storey_stiffnesses: [3, 2, 1]  # relative, storey 1 first (idem) [default: all 1]
-//!   storey_heights_m: 3.5          # every storey, or a list storey 1 first (idem) [default 3]
+//!   storey_heights_m: 3.0          # m: one value (every storey) or a list, storey 1 first
+//!                                  # (a list only with one `storeys` value) [default: 3.0]
 //! grid:
 //!   period_s: [0.3, 0.6]           # the bare building's first-mode period
 //!   stack_floor: [1, roof, all]    # a floor number, `roof`, `all`, or a list (an axis)
@@ -16,6 +17,7 @@
 //! of the basis); its period the grid's `period_s`; its storeys elastic.
 
 use crate::case::Case;
+use crate::dynamics::G;
 use crate::dynamics::building::model::modes;
 use crate::grid::{BuildingAxes, StackFloor};
 use crate::limits::{MAX_AXIS_VALUES, MAX_STOREYS, excerpt};
@@ -61,9 +63,8 @@ pub struct BuildingSection {
     /// Relative storey stiffnesses, storey 1 first [default: all 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub storey_stiffnesses: Option<Vec<f64>>,
-    /// Storey heights, m: one for every storey, or a list storey 1 first (only with one
-    /// `storeys` value) [default: [`DEFAULT_STOREY_HEIGHT_M`]]. They turn drifts into drift
-    /// ratios.
+    /// Storey heights, m: one value for every storey or a list, storey 1 first [default:
+    /// [`DEFAULT_STOREY_HEIGHT_M`]]; they turn drifts into drift ratios.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub storey_heights_m: Option<OneOrList<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -76,11 +77,12 @@ pub struct BuildingSection {
     pub post_yield_ratio: Option<f64>,
 }
 
-/// A storey's height when the config gives none, m.
+/// A storey's height when the config gives none, m (a common floor-to-floor height of
+/// framed buildings; it only scales the drift ratios).
 pub const DEFAULT_STOREY_HEIGHT_M: f64 = 3.0;
 
-/// The range of a storey height, m.
-pub const STOREY_HEIGHT_RANGE_M: (f64, f64) = (0.1, 1000.0);
+/// Storey heights a config may give, m: beyond this range a value is a typing error.
+pub const STOREY_HEIGHT_RANGE_M: (f64, f64) = (0.5, 100.0);
 
 /// The building a case of a building study stands in: the bare building's relative floor
 /// masses and storey stiffnesses (its first-mode period is the case's `T_p`), its storey
@@ -97,6 +99,12 @@ pub struct Frame {
 impl Frame {
     pub fn storeys(&self) -> usize {
         self.floor_masses.len()
+    }
+
+    /// A base shear `v_n` (N, the floor masses taken as kg) over the bare building's weight
+    /// `g·Σm_j`.
+    pub fn base_shear_ratio(&self, v_n: f64) -> f64 {
+        v_n / (G * self.floor_masses.iter().sum::<f64>())
     }
 
     /// The floors carrying a stack, 1-based, lowest first.
@@ -234,25 +242,24 @@ impl BuildingSection {
         }
         if let Some(h) = &self.storey_heights_m {
             let key = "building.storey_heights_m";
-            let v = h.to_vec();
-            if let OneOrList::List(_) = h
+            let (lo, hi) = STOREY_HEIGHT_RANGE_M;
+            if let OneOrList::List(v) = h
                 && (storeys.len() != 1 || v.len() != storeys[0])
             {
                 return err(
                     key,
                     format!(
                         "lists {} values; a list needs one per storey, and so one \
-                         `building.storeys` value (give one number for every storey)",
+                         `building.storeys` value (or give one height for every storey)",
                         v.len()
                     ),
                 );
             }
-            let (lo, hi) = STOREY_HEIGHT_RANGE_M;
-            if let Some(x) = v
-                .iter()
-                .find(|x| !(x.is_finite() && (lo..=hi).contains(*x)))
-            {
-                return err(key, format!("{x} m must be in [{lo}, {hi}] m"));
+            if let Some(x) = h.to_vec().iter().find(|x| !(lo..=hi).contains(*x)) {
+                return err(
+                    key,
+                    format!("{x:?}: a storey height must be within {lo} … {hi} m"),
+                );
             }
         }
         let lowest = storeys[0];
@@ -366,7 +373,7 @@ mod tests {
         let all = Frame {
             floor_masses: vec![1.0, 2.0, 0.5, 1.5],
             storey_stiffnesses: vec![4.0, 3.0, 2.0, 1.0],
-            storey_heights_m: vec![3.0; 4],
+            storey_heights_m: vec![4.0, 3.0, 3.0, 3.0],
             stack_floor: StackFloor::All,
         };
         let got = all.t_rigid_s(&case);

@@ -15,6 +15,7 @@ pub mod building;
 pub mod cases;
 pub mod config;
 pub mod ida;
+pub mod lambda;
 pub mod motions;
 pub mod physics;
 pub mod storey_strength;

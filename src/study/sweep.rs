@@ -17,7 +17,11 @@
 //!
 //! In a building ([`Frame`]) each rule holds as stated, the rigid system's acceleration being
 //! that of every floor carrying a stack (docs/model.md, "A study over buildings", gives the
-//! reasoning); the structure's peaks are then the roof's.
+//! reasoning); the structure's peaks are then the roof's. A building's per-floor and per-storey
+//! peaks and its base shear, for a stack a rule stands in for, are those of the system it
+//! stands in with (the rigid system, or the single block): the rule that makes the stack that
+//! system makes every response of it that system's (checked against brute force,
+//! tests/sweep.rs).
 
 use super::building::Frame;
 use super::physics::{CaseError, Physics, SystemKind};
@@ -66,6 +70,13 @@ struct Peaks {
     slip_m: Vec<f64>,
     /// Energy dissipated by friction, J per kg of the bare structure's mass.
     friction: f64,
+    /// In a building: each floor's peak absolute acceleration, g, floor 1 first.
+    floor_a_g: Vec<f64>,
+    /// In a building: each storey's peak drift ratio `max|δ_i|/h_i`, storey 1 first.
+    drift_ratio: Vec<f64>,
+    /// In a building: peak base shear over the bare building's weight `g·Σm_j` (NaN on one
+    /// storey, whose integrator does not give it).
+    base_shear: f64,
 }
 
 impl Peaks {
@@ -76,11 +87,14 @@ impl Peaks {
             a_hold_mps2: r.peak_abs_accel_mps2[0],
             slip_m: r.peak_slip_m,
             friction: r.energy.friction,
+            floor_a_g: Vec::new(),
+            drift_ratio: Vec::new(),
+            base_shear: f64::NAN,
         }
     }
 
-    /// `blocks` blocks per stack, on `floors` (1-based).
-    fn of_building(r: BuildingResponse, floors: &[usize], blocks: usize) -> Self {
+    /// `blocks` blocks per stack, in `frame` (on its floors).
+    fn of_building(r: BuildingResponse, frame: &Frame, floors: &[usize], blocks: usize) -> Self {
         let roof = r.floor_peak_displacement_m.len() - 1;
         let a_hold_mps2 = floors
             .iter()
@@ -99,6 +113,11 @@ impl Peaks {
             a_hold_mps2,
             slip_m,
             friction: r.energy.friction,
+            floor_a_g: r.floor_peak_abs_accel_mps2.iter().map(|a| a / G).collect(),
+            drift_ratio: (r.storey_peak_drift_m.iter().zip(&frame.storey_heights_m))
+                .map(|(d, h)| d / h)
+                .collect(),
+            base_shear: frame.base_shear_ratio(r.peak_base_shear_n),
         }
     }
 }
@@ -121,6 +140,38 @@ pub struct UnitResult {
     pub single_rule: Vec<u8>,
     /// Simulations run for this unit (not stored; for rates).
     pub simulations: usize,
+    /// In a building (empty on one storey): each floor's peak absolute acceleration, g,
+    /// `[case][floor]` row-major, the frame's `N` floors per case, with the stack and with it
+    /// rigidly attached.
+    pub floor_accel_stack: Vec<f64>,
+    pub floor_accel_rigid: Vec<f64>,
+    /// In a building: each storey's peak drift ratio, `[case][storey]`, idem.
+    pub drift_ratio_stack: Vec<f64>,
+    pub drift_ratio_rigid: Vec<f64>,
+    /// In a building: peak base shear over the bare building's weight, per case, idem (NaN in
+    /// a building of one storey).
+    pub base_shear_stack: Vec<f64>,
+    pub base_shear_rigid: Vec<f64>,
+}
+
+impl UnitResult {
+    /// Appends a building's per-floor and per-storey peaks of the stack system `s` and the rigid
+    /// system `r` (nothing on one storey, where both are empty).
+    fn push_profiles(&mut self, s: &Peaks, r: &Peaks) {
+        self.floor_accel_stack.extend_from_slice(&s.floor_a_g);
+        self.floor_accel_rigid.extend_from_slice(&r.floor_a_g);
+        self.drift_ratio_stack.extend_from_slice(&s.drift_ratio);
+        self.drift_ratio_rigid.extend_from_slice(&r.drift_ratio);
+        if frame_of(s) {
+            self.base_shear_stack.push(s.base_shear);
+            self.base_shear_rigid.push(r.base_shear);
+        }
+    }
+}
+
+/// Whether peaks were taken in a building (they carry the per-floor profiles).
+fn frame_of(p: &Peaks) -> bool {
+    !p.floor_a_g.is_empty()
 }
 
 /// Options for [`run_unit`].
@@ -158,7 +209,7 @@ pub fn run_unit(
                 SystemKind::Rigid => 0,
             };
             (physics.simulate_building(kind, case, f, ground, &exact))
-                .map(|r| Peaks::of_building(r, floors, blocks))
+                .map(|r| Peaks::of_building(r, f, floors, blocks))
         }
         _ => (physics.simulate(kind, case, ground, &exact)).map(Peaks::of_structure),
     };
@@ -213,6 +264,14 @@ pub fn run_unit(
         out.u_single.push(u_single);
         out.single_rule.push(u8::from(single_holds));
         out.skip_rule.push(rule as u8);
+        // The stack's profiles come from the same system as its other peaks.
+        let profile = match (rule, &resp) {
+            (_, Some(s)) => s,
+            (SkipRule::NoSlip, None) => r,
+            (_, None) if single_holds => r,
+            (_, None) => &single[&skey],
+        };
+        out.push_profiles(profile, r);
         match (rule, &resp) {
             (_, Some(s)) => {
                 out.u_stack.push(s.u_m);

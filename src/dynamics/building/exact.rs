@@ -121,9 +121,12 @@ enum Row {
     /// `ü_j` without the load (`(A·z)_{N+j}`): with the load's constant, a floor's absolute
     /// acceleration.
     Accel,
+    /// The base shear without the storey's force offset, `k_t,1·δ_1 + 1ᵀ·C·u̇` (docs/model.md,
+    /// "Base shear"); kept for `j = 0` only.
+    Shear,
 }
 
-const ROWS: usize = 5;
+const ROWS: usize = 6;
 
 /// A mode's basis, its rows and what a whole sample interval needs of it.
 struct Mode {
@@ -136,9 +139,19 @@ struct Mode {
 }
 
 impl Mode {
-    fn new(modes: StateModes, dt: f64) -> Self {
+    /// `shear_u`, `shear_v`: the base shear's coefficients on the floors' displacements (N/m)
+    /// and velocities (N·s/m), [`Row::Shear`].
+    fn new(modes: StateModes, dt: f64, shear_u: &[f64], shear_v: &[f64]) -> Self {
         let (n, m) = (modes.n, modes.modes());
         let mut rows = vec![Cx(0.0, 0.0); ROWS * n * m];
+        for r in 0..m {
+            let mut sum = Cx(0.0, 0.0);
+            for j in 0..n {
+                let (u, v) = (modes.row(j)[r], modes.row(n + j)[r]);
+                sum = sum.add(u.scale(shear_u[j])).add(v.scale(shear_v[j]));
+            }
+            rows[(Row::Shear as usize * n) * m + r] = sum;
+        }
         for j in 0..n {
             for r in 0..m {
                 let u = modes.row(j)[r];
@@ -293,8 +306,12 @@ struct Integrator<'b> {
     z: Vec<f64>,
     p0: Vec<f64>,
     events: Vec<Event>,
-    /// Peak functions: floor displacements, storey drifts, floor accelerations.
+    /// Peak functions: floor displacements, storey drifts, floor accelerations, base shear.
     peaks: Vec<Func>,
+    /// `1ᵀ·C`, N·s/m per floor: the damping forces' sum per unit velocity of each floor.
+    damping_sum: Vec<f64>,
+    /// Scratch: the base shear's displacement coefficients in the current mode, N/m.
+    shear_u: Vec<f64>,
     slip_start: Vec<f64>,
     out: BuildingResponse,
     energy: Energy,
@@ -413,6 +430,10 @@ impl<'b> Integrator<'b> {
             p0: vec![0.0; n],
             events: Vec::new(),
             peaks: Vec::new(),
+            damping_sum: (0..n)
+                .map(|l| (0..n).map(|j| b.damping()[j * n + l]).sum())
+                .collect(),
+            shear_u: vec![0.0; n],
             slip_start: vec![0.0; nb],
             out,
             energy: Energy {
@@ -702,9 +723,12 @@ impl<'b> Integrator<'b> {
         let mode = match self.cache.get(&self.key) {
             Some(m) => Rc::clone(m),
             None => {
+                self.shear_u[0] = self.k_t[0];
                 let m = Rc::new(Mode::new(
                     StateModes::new(&self.floor_mass, &self.k_t, b.damping())?,
                     self.dt,
+                    &self.shear_u,
+                    &self.damping_sum,
                 ));
                 self.cache.insert(self.key.clone(), Rc::clone(&m));
                 m
@@ -883,6 +907,16 @@ impl<'b> Integrator<'b> {
             g.f0 = Self::value_at(mode, &g, &self.p_start).0;
             peaks.push(g);
         }
+        let damper: f64 = (self.damping_sum.iter().zip(&self.v))
+            .map(|(c, v)| c * v)
+            .sum();
+        peaks.push(Func {
+            row: Some((Row::Shear, 0)),
+            scale: 1.0,
+            poly: [self.offsets[0], 0.0, 0.0, 0.0],
+            f0: self.storeys[0].force(self.x[0]) + damper,
+            df0: None,
+        });
         self.events = events;
         self.peaks = peaks;
     }
@@ -914,13 +948,14 @@ impl<'b> Integrator<'b> {
         let (n, nb) = (self.n, self.b.blocks());
         let dt = self.dt;
         // Peaks: floor displacements, storey drifts, floor accelerations (with the blocks that
-        // ride on each floor).
+        // ride on each floor), base shear.
         for idx in 0..self.peaks.len() {
             let g = self.peaks[idx];
             let (kind, j) = (idx / n, idx % n);
             let best = match kind {
                 0 => self.out.floor_peak_displacement_m[j],
                 1 => self.out.storey_peak_drift_m[j],
+                3 => self.out.peak_base_shear_n,
                 _ => {
                     let mut floor = self.out.floor_peak_abs_accel_mps2[j];
                     for q in 0..nb {
@@ -942,6 +977,7 @@ impl<'b> Integrator<'b> {
                 match kind {
                     0 => self.out.floor_peak_displacement_m[j] = peak,
                     1 => self.out.storey_peak_drift_m[j] = peak,
+                    3 => self.out.peak_base_shear_n = peak,
                     _ => {
                         let p = &mut self.out.floor_peak_abs_accel_mps2[j];
                         *p = p.max(peak);

@@ -459,11 +459,20 @@ impl Building {
     /// (so the same `F_y`), no interfaces. The sliding stacks' reference system, as the rigid
     /// system is on one storey (docs/model.md, "Derived quantities").
     pub fn with_stacks_attached(&self) -> Building {
+        self.with_stacks_attached_fraction(1.0)
+    }
+
+    /// [`Self::with_stacks_attached`] with only the fraction `lambda` (0 … 1) of every block's
+    /// mass attached and the rest absent from the dynamics (the same `K`, `C` and springs): the
+    /// building whose seismic weight counts `λ` of the live load (docs/model.md, "The effective
+    /// live-load fraction λ"). `lambda = 1` is [`Self::with_stacks_attached`] bit for bit
+    /// (`1·m = m`).
+    pub fn with_stacks_attached_fraction(&self, lambda: f64) -> Building {
         let n = self.storeys;
         let mut masses = self.masses[..n].to_vec();
         for s in &self.stacks {
             for q in 0..s.blocks {
-                masses[s.floor] += self.masses[n + s.first + q];
+                masses[s.floor] += lambda * self.masses[n + s.first + q];
             }
         }
         let mut spec = self.spec.clone();

@@ -16,6 +16,11 @@ pub struct BuildingResponse {
     pub storey_ductility: Option<Vec<f64>>,
     /// Signed `δ_i` at the record's end, m.
     pub storey_residual_drift_m: Vec<f64>,
+    /// Peak `|V|`, N, of the base shear `V = F_1 + 1ᵀ·C·u̇` (the first storey's spring force
+    /// and the dampers' forces on the ground; by equilibrium every body's mass times its
+    /// absolute acceleration, summed: docs/model.md, "Base shear"). NaN where the integrator
+    /// does not give it (the one-storey integrator's response, [`Self::from_one_storey`]).
+    pub peak_base_shear_n: f64,
     /// Peak absolute acceleration of every block, m/s² (stacks in order, bottom-up).
     pub block_peak_abs_accel_mps2: Vec<f64>,
     /// Peak `|slip|` of every interface relative to the body below, m.
@@ -43,6 +48,7 @@ impl BuildingResponse {
             floor_peak_abs_accel_mps2: vec![0.0; storeys],
             storey_peak_drift_m: vec![0.0; storeys],
             storey_residual_drift_m: vec![0.0; storeys],
+            peak_base_shear_n: 0.0,
             block_peak_abs_accel_mps2: vec![0.0; blocks],
             peak_slip_m: vec![0.0; blocks],
             residual_slip_m: vec![0.0; blocks],
@@ -60,6 +66,7 @@ impl BuildingResponse {
             storey_peak_drift_m: vec![r.peak_displacement_m],
             storey_ductility: r.ductility.map(|d| vec![d]),
             storey_residual_drift_m: vec![r.residual_displacement_m],
+            peak_base_shear_n: f64::NAN,
             block_peak_abs_accel_mps2: r.peak_abs_accel_mps2[1..=blocks].to_vec(),
             peak_slip_m: r.peak_slip_m,
             residual_slip_m: r.residual_slip_m,
@@ -84,6 +91,7 @@ impl BuildingResponse {
         ];
         let e = &self.energy;
         let finite = lists.iter().all(|l| l.iter().all(|x| x.is_finite()))
+            && !self.peak_base_shear_n.is_infinite()
             && self
                 .storey_ductility
                 .as_ref()

@@ -506,6 +506,10 @@ impl<'b> Rk4<'b> {
                             let p = &mut out.block_peak_abs_accel_mps2[q];
                             *p = p.max(abs[n + q].abs());
                         }
+                        // Newton's sum over every body, independent of the exact integrator's
+                        // storey and damper forces.
+                        let v: f64 = (b.masses().iter().zip(&abs)).map(|(m, a)| m * a).sum();
+                        out.peak_base_shear_n = out.peak_base_shear_n.max(v.abs());
                     }
                     self.rates(&xs, &vs, ag, &mut ke[st]);
                 }
