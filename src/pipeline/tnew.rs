@@ -100,8 +100,8 @@ fn effective_fractions(
     let own: Vec<usize> = (0..cases)
         .filter(|&c| first[c / per_frame] == c / per_frame)
         .collect();
-    // V̄(0) depends on the frame, T_p and α (through the damping matrix) but not on μ: once per
-    // key, the first case of each standing for it.
+    // V̄(λ) depends on the frame, T_p and α (through the damping matrix) but not on μ: its
+    // scan once per key, the first case of each standing for it.
     let bare_key = |c: usize| {
         let case = grid.case(c % per_frame);
         (
@@ -115,11 +115,13 @@ fn effective_fractions(
         keyed.entry(bare_key(c)).or_insert(c);
     }
     let keyed: Vec<((usize, u64, u64), usize)> = keyed.into_iter().collect();
-    let bare: BTreeMap<(usize, u64, u64), f64> = keyed
+    let scans: BTreeMap<(usize, u64, u64), Vec<(f64, f64)>> = keyed
         .par_iter()
         .map(|&(key, c)| {
             let case = grid.case(c % per_frame);
-            lambda::mean_base_shear(physics, &case, frame_of(c), 0.0, grounds).map(|v| (key, v))
+            let at = |l| lambda::mean_base_shear(physics, &case, frame_of(c), l, grounds);
+            // V̄(1) is the sweep's rigid mean; the scan's end is only a placeholder here.
+            lambda::scan(at(0.0)?, f64::NAN, at).map(|v| (key, v))
         })
         .collect::<Result<_, _>>()?;
     let computed: Vec<Fraction> = own
@@ -135,10 +137,12 @@ fn effective_fractions(
             } else {
                 (mean(base_shear_stack, c), mean(base_shear_rigid, c))
             };
-            let bare = bare[&bare_key(c)];
+            let mut scan = scans[&bare_key(c)].clone();
+            let bare = scan[0].1;
+            scan.last_mut().expect("the scan has its ends").1 = rigid;
             let at = |l| lambda::mean_base_shear(physics, &case, frame, l, grounds);
             let (lambda, flag) = if slides[c] {
-                lambda::solve(stack, bare, rigid, at)?
+                lambda::solve_on(stack, &scan, at)?
             } else {
                 (1.0, LambdaFlag::NoSlide)
             };

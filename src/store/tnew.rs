@@ -271,8 +271,9 @@ fn write_zone(
             "lambda_flag",
             l.flag.view(),
             &chunk,
-            "how lambda was found: a root of the mean base shear between lambda 0 and 1, \
-             clamped to an end when the stack's lies outside their values, 1 when nothing slid",
+            "how lambda was found: the largest root of the mean base shear on [0, 1] (one or \
+             several crossings on a 0.1 scan), the scan point nearest when none, 1 when nothing \
+             slid",
             meta.lambda_flags,
         )?;
         attach_all(&ds, &scales)?;
