@@ -430,6 +430,7 @@ fn fit_report(coefficients: usize) -> FitReport {
             not_fitted: Vec::new(),
             frames: Vec::new(),
             one_storey: None,
+            lambda: None,
         }],
         frames: Vec::new(),
     }
