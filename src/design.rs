@@ -21,7 +21,7 @@ use crate::fit::{BuildingFeatures, Fitted, PaperEquation, Sample, features};
 use crate::grid::{BuildingAxes, Grid, OutsideGrid, StackFloor};
 use crate::spectrum::target::TargetSpectrum;
 use crate::store::StoreError;
-use crate::store::fit::{FitReport, FrameSpec, ZoneFit, read_fit};
+use crate::store::fit::{FitReport, FormFit, FrameSpec, ZoneFit, read_fit};
 use crate::store::h5::stored_fingerprint;
 use crate::store::motions::read_zone_target;
 use crate::store::tnew::{
@@ -177,10 +177,7 @@ impl ZoneDesign {
         Self {
             zone: zone.to_string(),
             target,
-            fit: fit.and_then(|z| z.recommended_fit()).map(|f| Fitted {
-                form: f.form,
-                params: f.coefficients.iter().map(|c| c.1).collect(),
-            }),
+            fit: fit.and_then(|z| z.recommended_fit()).map(FormFit::fitted),
             grid,
             t_new_s,
             paper,
@@ -270,10 +267,9 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
             let frame = (fit.frames[f].clone(), features);
             let lambda = t.lambda.as_ref().map(|l| {
                 let values: Vec<f64> = l.lambda.iter().copied().collect();
-                let fitted = zone_fit.and_then(|z| z.lambda.as_ref()).map(|f| Fitted {
-                    form: f.form,
-                    params: f.coefficients.iter().map(|c| c.1).collect(),
-                });
+                let fitted = zone_fit
+                    .and_then(|z| z.lambda.as_ref())
+                    .map(FormFit::fitted);
                 (values[cases.clone()].to_vec(), fitted)
             });
             (t_new[cases].to_vec(), Some(frame), lambda)

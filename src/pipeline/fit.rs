@@ -26,8 +26,8 @@
 use super::{Outcome, PipelineError, Session, StageId};
 use crate::fit::extrapolation::{BOX_MARGIN, BOX_POINTS};
 use crate::fit::{
-    BuildingFeatures, DesignBox, FitError, Fitted, Form, Metrics, Sample, check_box,
-    cross_validate, feature_names, fit, metrics, paper_equation, uncertainty,
+    BuildingFeatures, DesignBox, FitError, Form, Metrics, Sample, check_box, cross_validate,
+    feature_names, fit, metrics, paper_equation, uncertainty,
 };
 use crate::grid::Grid;
 use crate::store::fingerprint::fingerprint as hash_parts;
@@ -258,14 +258,6 @@ fn stack_sample(s: &Sample, blocks: usize) -> Sample {
     }
 }
 
-/// A stored form as a function.
-fn fitted(f: &FormFit) -> Fitted {
-    Fitted {
-        form: f.form,
-        params: f.coefficients.iter().map(|c| c.1).collect(),
-    }
-}
-
 /// The recommended building equation, the one-storey equation and the paper's on each frame's
 /// cases.
 fn frame_fits(
@@ -276,8 +268,8 @@ fn frame_fits(
     one_storey: Option<&FormFit>,
     lambda: Option<&FormFit>,
 ) -> Vec<FrameFit> {
-    let (building, one_storey) = (fitted(building), one_storey.map(fitted));
-    let lambda = lambda.map(fitted);
+    let (building, one_storey) = (building.fitted(), one_storey.map(FormFit::fitted));
+    let lambda = lambda.map(FormFit::fitted);
     (frames.iter().enumerate())
         .map(|(f, frame)| {
             let cases: Vec<&Sample> = (z.every.iter())
@@ -403,11 +395,15 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 }
             }
             Some(f) => {
+                // The cases of the distinct frames, the ones fitted.
+                let distinct = |every: &[(usize, Sample)]| -> Vec<Sample> {
+                    (every.iter())
+                        .filter(|(f, _)| !repeats[*f])
+                        .map(|(_, s)| s.clone())
+                        .collect()
+                };
                 let every = building_samples(grid, &frames, f, &t_rigid, &t_new);
-                let data = (every.iter())
-                    .filter(|(f, _)| !repeats[*f])
-                    .map(|(_, s)| s.clone())
-                    .collect();
+                let data = distinct(&every);
                 let per = grid.cases();
                 let one_storey = one_storey_frame.map_or_else(Vec::new, |o| {
                     let cases = o * per..(o + 1) * per;
@@ -422,10 +418,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                     }
                     None => Vec::new(),
                 };
-                let lambda = (lambda_every.iter())
-                    .filter(|(f, _)| !repeats[*f])
-                    .map(|(_, s)| s.clone())
-                    .collect();
+                let lambda = distinct(&lambda_every);
                 ZoneData {
                     zone: zc.name.clone(),
                     data,

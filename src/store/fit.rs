@@ -29,7 +29,7 @@
 use super::h5::{attr_f64, attr_str, write_1d, write_stage_file};
 use super::{StoreError, checksum};
 use crate::fit::{
-    BoxCheck, BuildingFeatures, Form, HEIGHT_FEATURE, Method, Metrics, STOREYS_FEATURE,
+    BoxCheck, BuildingFeatures, Fitted, Form, HEIGHT_FEATURE, Method, Metrics, STOREYS_FEATURE,
     SolverReport, feature_names,
 };
 use crate::study::building::Frame;
@@ -71,6 +71,16 @@ pub struct FormFit {
     /// beyond the grid.
     #[serde(default)]
     pub box_check: BoxCheck,
+}
+
+impl FormFit {
+    /// The fitted form as a function of the features.
+    pub fn fitted(&self) -> Fitted {
+        Fitted {
+            form: self.form,
+            params: self.coefficients.iter().map(|c| c.1).collect(),
+        }
+    }
 }
 
 /// A form the stage did not fit, and why.

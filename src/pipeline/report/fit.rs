@@ -3,7 +3,7 @@
 
 use super::text::{fixed, mean, paper_equation_name, sig};
 use super::{Files, Inputs, ReportError, Zone};
-use crate::fit::{Fitted, Sample};
+use crate::fit::Sample;
 use crate::grid::Grid;
 use crate::render::chart::{Axis, Figure, Mark, PALETTE, Panel, Series, Stroke};
 use crate::render::page::{Section, para, table_with_id};
@@ -187,10 +187,7 @@ fn residuals(z: &Zone, grid: &Grid, files: &mut Files) -> Result<String, ReportE
 /// band, side by side within each `T_p` column so none hides another, with the mean and the
 /// 5th/95th percentiles per `T_p`.
 fn residual_panel(z: &Zone, ff: &FormFit, grid: &Grid, data: &[Sample], bands: &[u8]) -> Panel {
-    let f = Fitted {
-        form: ff.form,
-        params: ff.coefficients.iter().map(|c| c.1).collect(),
-    };
+    let f = ff.fitted();
     let resid: Vec<f64> = data.iter().map(|s| s.t_new_s - f.predict(s)).collect();
     let mut series = Vec::new();
     let present: Vec<&(u8, String)> = z
