@@ -306,14 +306,6 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
          several_roots_largest\n"
     );
 
-    // The report cannot yet take this building study and says so, naming the key, before work.
-    let o = slidestack(&["report", cfg_s, "--out", out_s], "1");
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("`building`: the `report` stage cannot yet take a building study"),
-        "{}",
-        stderr(&o)
-    );
     several_frames_are_fitted_and_designed_for(&out);
 }
 

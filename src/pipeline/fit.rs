@@ -32,7 +32,7 @@ use crate::fit::{
 use crate::grid::Grid;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::fit::{FitReport, FormFit, FrameFit, FrameSpec, NotFitted, ZoneFit, write_fit};
-use crate::study::building::Frame;
+use crate::study::building::{Frame, fit_features, repeats};
 use crate::study::tnew::{building_samples, samples};
 use rayon::prelude::*;
 use thiserror::Error;
@@ -182,16 +182,6 @@ fn design_box(grid: &Grid, building: Option<(BuildingFeatures, &[Frame])>) -> De
         bx.upper[j] = bx.upper[j].min(1.0);
     }
     bx
-}
-
-/// Which building features vary over `frames` (`None`: not a study of several frames).
-fn building_features(blocks: usize, frames: &[Frame]) -> Option<BuildingFeatures> {
-    let varies = |v: Vec<f64>| v.iter().any(|x| *x != v[0]);
-    (frames.len() > 1).then(|| BuildingFeatures {
-        blocks,
-        storeys: varies(frames.iter().map(|f| f.storeys() as f64).collect()),
-        height: varies(frames.iter().map(Frame::stack_height_ratio).collect()),
-    })
 }
 
 /// One line on a fitted form: its metrics, cross-validated ones, solver and box check.
@@ -348,14 +338,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let me = StageId::Fit;
     let grid = study.grid(me)?;
     let n = grid.blocks();
-    let frames: Vec<Frame> = (study.building())
-        .map(|b| {
-            (0..b.frames())
-                .filter_map(|f| study.cfg.frame(b, f))
-                .collect()
-        })
-        .unwrap_or_default();
-    let building = building_features(n, &frames);
+    let frames: Vec<Frame> = study.frames().into_iter().flatten().collect();
+    let building = fit_features(n, &frames);
     let features = building.map_or_else(|| feature_names(n), BuildingFeatures::names);
     let one_storey_features = feature_names(n);
     let bx = design_box(grid, building.map(|f| (f, frames.as_slice())));
@@ -363,15 +347,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     // A building study's one-storey frame, where the one-storey equation is fitted (its
     // stack floors are all the same building).
     let one_storey_frame = building.and(frames.iter().position(|f| f.storeys() == 1));
-    // A frame that is an earlier one's building (on one storey floor 1, the roof and every
-    // floor are one; on N, floor N is the roof) would count its cases twice in the fit.
-    let repeats: Vec<bool> = (0..frames.len())
-        .map(|f| {
-            let same =
-                |g: &Frame| g.storeys() == frames[f].storeys() && g.floors() == frames[f].floors();
-            frames[..f].iter().any(same)
-        })
-        .collect();
+    let repeats = repeats(&frames);
     let mut zone_data = Vec::new();
     for zc in &study.cfg.zones {
         let t = super::tnew::read_zone(study, &zc.name)?;

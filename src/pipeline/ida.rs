@@ -26,7 +26,6 @@ use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
 use crate::store::motions::read_zone_target;
-use crate::study::building::Frame;
 use crate::study::config::StudyConfig;
 use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
 use crate::study::physics::Physics;
@@ -93,14 +92,6 @@ fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
         })
 }
 
-/// The frames of the study, in [`BuildingAxes::frame`] order (`[None]` on one storey).
-fn frames_of(study: &Study) -> Vec<Option<Frame>> {
-    match study.building() {
-        None => vec![None],
-        Some(b) => (0..b.frames()).map(|i| study.cfg.frame(b, i)).collect(),
-    }
-}
-
 /// Builds `ida.h5`.
 pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let study = &s.study;
@@ -110,7 +101,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let motions = super::sweep::load_motions(study)?;
     let physics = study.physics();
     let targets = stored_targets(study)?;
-    let frames = frames_of(study);
+    let frames = study.frames();
     let nf = frames.len();
     let units: Vec<(usize, usize, usize, usize)> = motions
         .iter()
@@ -549,7 +540,8 @@ pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError
 
 /// The frames' labels in stored order (`[None]` on one storey).
 fn frame_labels(study: &Study) -> Vec<Option<String>> {
-    frames_of(study)
+    study
+        .frames()
         .into_iter()
         .map(|f| f.map(|f| f.to_string()))
         .collect()

@@ -36,6 +36,7 @@ pub mod tnew;
 
 use crate::grid::{BuildingAxes, Grid};
 use crate::store::{StoreError, atomic};
+use crate::study::building::Frame;
 use crate::study::config::{ConfigError, StudyConfig};
 use crate::study::physics::{Physics, SystemKind};
 use lock::{LockError, LockMode, OutputLock};
@@ -131,15 +132,6 @@ pub enum PipelineError {
     },
     #[error("{}: the `{stage}` stage needs a `grid` section", config.display())]
     NoGrid { config: PathBuf, stage: StageId },
-    #[error(
-        "{}: `building`: the `{stage}` stage {why} (docs/model.md, \"A study over buildings\")",
-        config.display()
-    )]
-    NotForBuilding {
-        config: PathBuf,
-        stage: StageId,
-        why: &'static str,
-    },
     #[error(transparent)]
     Motions(#[from] motions::MotionsError),
     #[error(transparent)]
@@ -165,7 +157,6 @@ impl PipelineError {
             | PipelineError::BadInput { .. }
             | PipelineError::Setting { .. }
             | PipelineError::NoGrid { .. }
-            | PipelineError::NotForBuilding { .. }
             | PipelineError::Ida(ida::IdaStageError::NoSection { .. }) => true,
             PipelineError::Sweep(e) => e.is_bad_input(),
             PipelineError::Motions(motions::MotionsError::Unmatched(_)) => true,
@@ -343,7 +334,7 @@ impl Study {
         let rest = match &cfg.grid {
             Some(_) => {
                 let sweep = sweep::fingerprint(&cfg, &motions_fp);
-                let tnew = tnew::fingerprint(&sweep);
+                let tnew = tnew::fingerprint(&sweep, building.is_some());
                 let fit = fit::fingerprint(&tnew, building.is_some());
                 let report = report::fingerprint(&fit, &motions_fp, ida.as_deref());
                 Some([sweep, tnew, fit, report])
@@ -387,24 +378,13 @@ impl Study {
         self.building.as_ref()
     }
 
-    /// Refuses a building study in a stage that cannot yet take it, before any work.
-    pub fn refuse_building(&self, stage: StageId) -> Result<(), PipelineError> {
-        if self.building.is_none() {
-            return Ok(());
+    /// The frames of a building study in stored order (storeys, then stack floor fastest);
+    /// `[None]` on one storey.
+    pub fn frames(&self) -> Vec<Option<Frame>> {
+        match &self.building {
+            None => vec![None],
+            Some(b) => (0..b.frames()).map(|f| self.cfg.frame(b, f)).collect(),
         }
-        let why = match stage {
-            StageId::Motions | StageId::Sweep | StageId::Tnew | StageId::Fit | StageId::Ida => {
-                return Ok(());
-            }
-            StageId::Report => {
-                "cannot yet take a building study (motions, sweep, tnew, fit and ida can)"
-            }
-        };
-        Err(PipelineError::NotForBuilding {
-            config: self.config_path.clone(),
-            stage,
-            why,
-        })
     }
 
     /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`).
@@ -590,7 +570,6 @@ pub enum Outcome {
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
 pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
     s.check_cancelled(stage)?;
-    s.study.refuse_building(stage)?;
     s.study.fingerprint(stage)?;
     for &up in stage.upstream() {
         s.study.require(up)?;

@@ -77,6 +77,12 @@ impl SweepStageError {
     }
 }
 
+/// What a building study's `sweep.h5` stores, part of its fingerprint: a file written before
+/// the per-floor peaks and the base shear were (the first building sweeps) is out of date, not
+/// read as if it held them. Change it when the stored building variables change.
+const BUILDING_OUTPUTS: &str =
+    "roof peaks, per-floor accelerations, per-storey drift ratios, base shear";
+
 /// The fingerprint `sweep.h5` must carry.
 pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> String {
     let mut section = serde_json::json!({
@@ -85,6 +91,7 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> String {
     // Only when given, so that a one-storey study keeps its fingerprint.
     if let Some(b) = &cfg.building {
         section["building"] = serde_json::json!(b);
+        section["building_outputs"] = serde_json::json!(BUILDING_OUTPUTS);
     }
     hash_parts(&[&section.to_string(), motions_fingerprint])
 }

@@ -161,9 +161,19 @@ fn effective_fractions(
         .collect())
 }
 
-/// The fingerprint `tnew.h5` must carry.
-pub fn fingerprint(sweep_fingerprint: &str) -> String {
-    hash_parts(&[sweep_fingerprint, &format!("sd_step_s={SD_STEP_S}")])
+/// How a building study's `tnew.h5` finds `λ` (and that it stores it with the mean base
+/// shears), part of its fingerprint: a file of an earlier algorithm, or of none, is out of date.
+/// Change it when `λ`'s definition or root search changes.
+const LAMBDA_METHOD: &str = "lambda=largest root of the mean peak base shear, scan k/10 + Brent";
+
+/// The fingerprint `tnew.h5` must carry (`building`: of a building study, which stores `λ`).
+pub fn fingerprint(sweep_fingerprint: &str, building: bool) -> String {
+    let step = format!("sd_step_s={SD_STEP_S}");
+    if building {
+        hash_parts(&[sweep_fingerprint, &step, LAMBDA_METHOD])
+    } else {
+        hash_parts(&[sweep_fingerprint, &step])
+    }
 }
 
 /// The periods of the mean displacement spectrum: they reach past every `T_rigid` of the grid
@@ -208,10 +218,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let n = grid.blocks();
     let physics = study.physics();
     let building = study.building();
-    let frames: Vec<Option<Frame>> = match building {
-        None => vec![None],
-        Some(b) => (0..b.frames()).map(|f| study.cfg.frame(b, f)).collect(),
-    };
+    let frames = study.frames();
     // Γ_1·φ_1,N per frame, and per storey count (stored).
     let participation: Vec<f64> = (frames.iter())
         .map(|f| f.as_ref().map_or(1.0, Frame::roof_participation))

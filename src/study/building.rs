@@ -19,6 +19,7 @@
 use crate::case::Case;
 use crate::dynamics::G;
 use crate::dynamics::building::model::modes;
+use crate::fit::BuildingFeatures;
 use crate::grid::{BuildingAxes, StackFloor};
 use crate::limits::{MAX_AXIS_VALUES, MAX_STOREYS, excerpt};
 use serde::{Deserialize, Serialize};
@@ -163,6 +164,31 @@ impl Frame {
         let rigid = modes(&loaded, &self.storey_stiffnesses).0[0];
         case.period_s * (bare / rigid).sqrt()
     }
+}
+
+/// Which of a study's frames (stored order) repeat an earlier one's building: on one storey
+/// floor 1, the roof and every floor are one building, and on `N` storeys floor `N` is the
+/// roof. The fit and the report count such a frame's cases once.
+pub fn repeats(frames: &[Frame]) -> Vec<bool> {
+    (0..frames.len())
+        .map(|f| {
+            let same =
+                |g: &Frame| g.storeys() == frames[f].storeys() && g.floors() == frames[f].floors();
+            frames[..f].iter().any(same)
+        })
+        .collect()
+}
+
+/// The fit's features of a study of `frames` (`blocks` blocks): `N` and `z_stack` after the
+/// one-storey ones, each only where it varies over the frames (docs/fit.md, "A study over
+/// buildings"); `None` for a study of one frame, fitted with the one-storey features.
+pub fn fit_features(blocks: usize, frames: &[Frame]) -> Option<BuildingFeatures> {
+    let varies = |v: Vec<f64>| v.iter().any(|x| *x != v[0]);
+    (frames.len() > 1).then(|| BuildingFeatures {
+        blocks,
+        storeys: varies(frames.iter().map(|f| f.storeys() as f64).collect()),
+        height: varies(frames.iter().map(Frame::stack_height_ratio).collect()),
+    })
 }
 
 /// `3 storeys, stack on floor 2` (or `on the roof`, `on every floor`).

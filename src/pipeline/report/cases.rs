@@ -14,7 +14,7 @@ use plotters::style::RGBColor;
 pub(super) fn section71_section(inp: &Inputs, files: &mut Files) -> Result<Section, ReportError> {
     let physics = &inp.physics;
     let n = inp.grid.blocks();
-    let first = &inp.zones[0].section71;
+    let first = &inp.zones[0].paper().section71;
     let mut body = para(&format!(
         "The paper's Section 7.1 example: {}{}. Each system runs under every motion of the zone \
          with the study's physics (ζ = {} of the {} basis, μ_s = {} × μ_k).",
@@ -113,7 +113,7 @@ pub(super) fn section71_section(inp: &Inputs, files: &mut Files) -> Result<Secti
 /// Histories of the structure in the three systems under the zone's median motion, then all
 /// three around their peaks.
 fn histories(z: &Zone, physics: &Physics, files: &mut Files) -> Result<String, ReportError> {
-    let c = &z.section71;
+    let c = &z.paper().section71;
     let k = c.median_motion();
     let rec = &z.motions[k];
     // Histories under the median motion, then all three around their peaks.
@@ -197,7 +197,7 @@ fn histories(z: &Zone, physics: &Physics, files: &mut Files) -> Result<String, R
 
 /// The construction of `T_new` (paper Fig. 12) and its row of the Section 7.1 table.
 fn construction(z: &Zone, files: &mut Files) -> Result<(String, Vec<String>), ReportError> {
-    let c = &z.section71;
+    let c = &z.paper().section71;
     let (u, tr, tn, flag) = section71_tnew(z);
     let paper = (PAPER_SECTION_7_1.0 == z.name).then_some(PAPER_SECTION_7_1);
     let t = &z.tnew.period_sd_s;
@@ -293,7 +293,7 @@ fn construction(z: &Zone, files: &mut Files) -> Result<(String, Vec<String>), Re
 
 /// The energy partition of the three systems, mean over the motions: table rows and a panel.
 fn energy(z: &Zone, n: usize) -> (Vec<Vec<String>>, Panel) {
-    let c = &z.section71;
+    let c = &z.paper().section71;
     let mut rows = Vec::new();
     let mut segs: Vec<(String, Vec<f64>)> = vec![("viscous damping".into(), Vec::new())];
     for i in 0..n {
@@ -367,10 +367,10 @@ fn energy(z: &Zone, n: usize) -> (Vec<Vec<String>>, Panel) {
 }
 
 pub(super) fn table2_section(inp: &Inputs) -> Section {
-    let c0 = &inp.zones[0].table2;
+    let c0 = &inp.zones[0].paper().table2;
     let mut rows = Vec::new();
     for z in &inp.zones {
-        let c = &z.table2;
+        let c = &z.paper().table2;
         let (single, stack) = (
             c.mean_peak(SystemKind::SingleBlock),
             c.mean_peak(SystemKind::Stack),

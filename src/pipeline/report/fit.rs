@@ -3,23 +3,39 @@
 
 use super::text::{fixed, mean, paper_equation_name, sig};
 use super::{Files, Inputs, ReportError, Zone};
-use crate::fit::Sample;
+use crate::fit::{Form, Metrics, Sample};
 use crate::grid::Grid;
 use crate::render::chart::{Axis, Figure, Mark, PALETTE, Panel, Series, Stroke};
 use crate::render::page::{Section, para, table_with_id};
 use crate::store::fit::FormFit;
+use crate::study::building::{Frame, fit_features, repeats};
 use crate::study::cases::PAPER_TABLE_3;
-use crate::study::tnew::samples;
+use crate::study::tnew::{building_samples, samples};
 use plotters::style::RGBColor;
 
 pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, ReportError> {
-    let mut body = para(&format!(
-        "Table 3 of the paper next to ours: the paper's fit quality of its Eqs. 16–17, those \
-         equations as printed evaluated on our T_new, and each form fitted here (features {}; \
-         5-fold cross-validated columns from fits that did not see the predicted cases).",
-        inp.fit.features.join(", ")
-    ));
-    let table3: Vec<Vec<String>> = inp.zones.iter().flat_map(table3_rows).collect();
+    let building = inp.study.building().is_some();
+    let mut body = para(&if building {
+        format!(
+            "The design equation for T_new of the first mode, fitted over every case of the \
+             study's distinct frames with the building's features ({}; docs/fit.md, \"A study \
+             over buildings\"): the paper's Eqs. 16–17 as printed with T_p = T_1, and each form \
+             fitted here (5-fold cross-validated columns from fits that did not see the \
+             predicted cases).",
+            inp.fit.features.join(", ")
+        )
+    } else {
+        format!(
+            "Table 3 of the paper next to ours: the paper's fit quality of its Eqs. 16–17, those \
+             equations as printed evaluated on our T_new, and each form fitted here (features \
+             {}; 5-fold cross-validated columns from fits that did not see the predicted \
+             cases).",
+            inp.fit.features.join(", ")
+        )
+    });
+    let table3: Vec<Vec<String>> = (inp.zones.iter())
+        .flat_map(|z| table3_rows(z, !building))
+        .collect();
     body += &table_with_id(
         "table3",
         &[
@@ -36,7 +52,17 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
         &table3,
     );
     for z in &inp.zones {
-        body += &coefficients(z);
+        if let Some(ff) = z.fit.recommended_fit() {
+            body += &coefficients(z, ff, "T_new's recommended");
+        }
+    }
+    if building {
+        body += &frames_table(inp);
+        for z in &inp.zones {
+            if let Some(ff) = &z.fit.lambda {
+                body += &coefficients(z, ff, "λ's");
+            }
+        }
     }
     body += &para(
         "Residuals (computed − predicted T_new) of every fitted form against T_p, the \
@@ -45,17 +71,71 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
          T_p.",
     );
     for z in &inp.zones {
-        body += &residuals(z, inp.grid, files)?;
+        body += &residuals(z, inp, files)?;
     }
     Ok(Section::new("fit", "Design equations (Table 3)", body))
 }
 
-/// A zone's rows of Table 3: the paper's, its equation on our `T_new`, each fitted form.
-fn table3_rows(z: &Zone) -> Vec<Vec<String>> {
+/// The building equations frame by frame: `T_new`'s (the recommended form with the building's
+/// features), the one-storey equation's and the paper's there, and `λ`'s.
+fn frames_table(inp: &Inputs) -> String {
+    let f3 =
+        |m: Option<&Metrics>, v: fn(&Metrics) -> f64| m.map_or("–".into(), |m| fixed(v(m), 3));
+    let mut rows = Vec::new();
+    for z in &inp.zones {
+        for f in &z.fit.frames {
+            rows.push(vec![
+                z.name.clone(),
+                f.frame.clone(),
+                f.cases.to_string(),
+                f3(Some(&f.building), |m| m.r2),
+                f3(Some(&f.building), |m| m.rmse),
+                f3(f.one_storey.as_ref(), |m| m.r2),
+                f3(f.one_storey.as_ref(), |m| m.rmse),
+                f3(f.published.as_ref(), |m| m.r2),
+                f3(f.lambda.as_ref(), |m| m.r2),
+                f3(f.lambda.as_ref(), |m| m.rmse),
+            ]);
+        }
+    }
+    if rows.is_empty() {
+        return String::new();
+    }
+    para(
+        "Frame by frame: the building equation for T_new (the recommended form above, fitted \
+         over every frame) beside the one-storey equation (every form fitted to the study's \
+         one-storey frame with the one-storey features and recommended as on one storey, read at \
+         T_p = T_1), which holds where the first mode dominates and fails where the stack \
+         changes the building's higher modes, and the paper's equation as printed; then λ's \
+         fitted fraction equation (fit.yaml, zones[].frames).",
+    ) + &table_with_id(
+        "frames",
+        &[
+            "zone",
+            "frame",
+            "cases",
+            "building equation R²",
+            "building equation RMSE (s)",
+            "one-storey equation R²",
+            "one-storey equation RMSE (s)",
+            "paper's equation R²",
+            "λ equation R²",
+            "λ equation RMSE",
+        ],
+        &rows,
+    )
+}
+
+/// A zone's rows of Table 3: the paper's (`paper`: on one storey), its equation on our
+/// `T_new`, each fitted form.
+fn table3_rows(z: &Zone, paper: bool) -> Vec<Vec<String>> {
     let f3 = |v: f64| fixed(v, 3);
     let zf = &z.fit;
     let mut rows = Vec::new();
-    if let Some((_, p)) = PAPER_TABLE_3.iter().find(|p| p.0 == z.name) {
+    if let Some((_, p)) = (PAPER_TABLE_3.iter())
+        .find(|p| p.0 == z.name)
+        .filter(|_| paper)
+    {
         let mut row = vec![z.name.clone(), "paper Table 3".into()];
         row.extend(p.iter().map(|&v| f3(v)));
         row.extend(["–".to_string(), "–".to_string()]);
@@ -99,12 +179,8 @@ fn table3_rows(z: &Zone) -> Vec<Vec<String>> {
     rows
 }
 
-/// The recommended form's coefficients with their standard errors (nothing without one).
-fn coefficients(z: &Zone) -> String {
-    let zf = &z.fit;
-    let Some(ff) = zf.recommended_fit() else {
-        return String::new();
-    };
+/// A fitted form's coefficients with their standard errors (`what`: `T_new's recommended`).
+fn coefficients(z: &Zone, ff: &FormFit, what: &str) -> String {
     let rows: Vec<Vec<String>> = ff
         .coefficients
         .iter()
@@ -127,13 +203,17 @@ fn coefficients(z: &Zone) -> String {
             ]
         })
         .collect();
+    let (id, cases) = match ff.form {
+        Form::Fraction => (format!("lambda_coefficients_{}", z.name), "cases with a λ"),
+        _ => (format!("coefficients_{}", z.name), "cases"),
+    };
     para(&format!(
-        "Zone {}: coefficients of the recommended {} form ({} cases).",
+        "Zone {}: coefficients of {what} {} form (fitted to {} {cases}).",
         z.name,
         ff.form.name(),
-        zf.cases
+        ff.all_cases.n
     )) + &table_with_id(
-        &format!("coefficients_{}", z.name),
+        &id,
         &[
             "coefficient",
             "value",
@@ -144,28 +224,49 @@ fn coefficients(z: &Zone) -> String {
     )
 }
 
-/// A zone's figure of the residuals of every fitted form, the recommended one first.
-fn residuals(z: &Zone, grid: &Grid, files: &mut Files) -> Result<String, ReportError> {
-    let v = &z.tnew.vars;
+/// The fit's samples of a zone with each one's `T_new` band code: every case with a `T_new`,
+/// in a study of several frames those of its distinct frames with the building's features
+/// (as the fit stage takes them).
+fn fitted_samples(z: &Zone, inp: &Inputs) -> (Vec<Sample>, Vec<u8>) {
+    let (grid, v) = (inp.grid, &z.tnew.vars);
     let tn: Vec<f64> = v.t_new.iter().copied().collect();
     let tr: Vec<f64> = v.t_rigid.iter().copied().collect();
     let band: Vec<u8> = v.band.iter().copied().collect();
-    let data = samples(grid, &tr, &tn);
-    let bands: Vec<u8> = (0..tn.len())
-        .filter(|&c| tn[c].is_finite())
-        .map(|c| band[c])
-        .collect();
+    let with_t_new = (0..tn.len()).filter(|&c| tn[c].is_finite());
+    let frames: Vec<Frame> = inp.study.frames().into_iter().flatten().collect();
+    match fit_features(grid.blocks(), &frames) {
+        None => (
+            samples(grid, &tr, &tn),
+            with_t_new.map(|c| band[c]).collect(),
+        ),
+        Some(features) => {
+            let repeated = repeats(&frames);
+            let every = building_samples(grid, &frames, features, &tr, &tn);
+            (every.into_iter().zip(with_t_new))
+                .filter(|((f, _), _)| !repeated[*f])
+                .map(|((_, s), c)| (s, band[c]))
+                .unzip()
+        }
+    }
+}
+
+/// A zone's figure of the residuals of every fitted form, the recommended one first.
+fn residuals(z: &Zone, inp: &Inputs, files: &mut Files) -> Result<String, ReportError> {
+    let grid = inp.grid;
+    let building = inp.study.building().is_some();
+    let (data, bands) = fitted_samples(z, inp);
     let mut forms: Vec<_> = z.fit.forms.iter().collect();
     forms.sort_by_key(|f| f.form != z.fit.recommended);
     let panels: Vec<Panel> = forms
         .into_iter()
-        .map(|ff| residual_panel(z, ff, grid, &data, &bands))
+        .map(|ff| residual_panel(z, ff, grid, &data, &bands, building))
         .collect();
     let cols = panels.len().min(2);
     let fig = Figure::grid(
         format!(
-            "Zone {}: residuals of the design equations for T_new",
-            z.name
+            "Zone {}: residuals of the design equations for T_new{}",
+            z.name,
+            if building { ", every frame" } else { "" }
         ),
         panels,
         cols,
@@ -186,7 +287,14 @@ fn residuals(z: &Zone, grid: &Grid, files: &mut Files) -> Result<String, ReportE
 /// One form's residuals against `T_p` over the cases `data` (band codes `bands`): the cases by
 /// band, side by side within each `T_p` column so none hides another, with the mean and the
 /// 5th/95th percentiles per `T_p`.
-fn residual_panel(z: &Zone, ff: &FormFit, grid: &Grid, data: &[Sample], bands: &[u8]) -> Panel {
+fn residual_panel(
+    z: &Zone,
+    ff: &FormFit,
+    grid: &Grid,
+    data: &[Sample],
+    bands: &[u8],
+    building: bool,
+) -> Panel {
     let f = ff.fitted();
     let resid: Vec<f64> = data.iter().map(|s| s.t_new_s - f.predict(s)).collect();
     let mut series = Vec::new();
@@ -267,7 +375,7 @@ fn residual_panel(z: &Zone, ff: &FormFit, grid: &Grid, data: &[Sample], bands: &
             metrics.rmse,
             metrics.r2
         ),
-        Axis::new("T_p (s)"),
+        Axis::new(if building { "T_1 (s)" } else { "T_p (s)" }),
         Axis::new("computed − predicted T_new (s)"),
         series,
     )

@@ -22,6 +22,7 @@
 //! Fingerprint: the fit's and the motions' (which carry everything upstream), `ida.h5`'s with an
 //! `ida:` section, and the report's own version.
 
+mod building;
 mod cases;
 mod design;
 mod fit;
@@ -39,10 +40,11 @@ use crate::render::chart::{self, ChartError, Figure};
 use crate::render::page::{Section, document, escape, figure, list, para, table_with_id};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
-use crate::store::fit::{FitReport, ZoneFit, read_fit};
+use crate::store::fit::{FitReport, FrameFit, ZoneFit, read_fit};
 use crate::store::motions::{ZoneSpectra, read_zone_spectra};
 use crate::store::report::write_report_dir;
 use crate::store::tnew::{ZoneTnew, read_band_flags};
+use crate::study::building::repeats;
 use crate::study::cases::{PAPER_SECTION_7_1, PAPER_TABLE_2, PAPER_TABLE_3, SECTION_7_1, TABLE_2};
 use crate::study::physics::{CaseError, Physics, SystemKind};
 use crate::study::tnew::BAND_FLAGS;
@@ -52,7 +54,7 @@ use grid::{drr_section, tnew_section};
 use motions::motions_section;
 use runs::{CaseRun, section71_tnew};
 use select::Selection;
-use text::{fixed, joined, num};
+use text::{fixed, joined, num, nums};
 use thiserror::Error;
 
 /// Changes when the report's contents change.
@@ -92,11 +94,25 @@ struct Zone {
     tnew: ZoneTnew,
     band_flags: Vec<(u8, String)>,
     fit: ZoneFit,
+    /// The paper's named one-storey cases run on the zone's motions (`None` in a building
+    /// study, whose report has the building section instead).
+    paper: Option<PaperCases>,
+}
+
+/// The paper's Section 7.1 and Table 2 cases of one zone.
+struct PaperCases {
     section71: CaseRun,
     table2: CaseRun,
 }
 
 impl Zone {
+    /// The paper's cases: only the one-storey report's sections ask, and it has them.
+    fn paper(&self) -> &PaperCases {
+        self.paper
+            .as_ref()
+            .expect("the paper's cases are run for a one-storey study")
+    }
+
     /// Column `case` of a `[T_p, case…]` variable: one value per `T_p`.
     fn column(&self, v: &ndarray::ArrayD<f64>, per: usize, case: usize) -> Vec<f64> {
         v.iter().skip(case).step_by(per).copied().collect()
@@ -160,8 +176,13 @@ impl<'a> Inputs<'a> {
                 name: zc.name.clone(),
                 spectra,
                 band_flags,
-                section71: CaseRun::new(&physics, &SECTION_7_1, n, &motions)?,
-                table2: CaseRun::new(&physics, &TABLE_2, n, &motions)?,
+                paper: match study.building() {
+                    Some(_) => None,
+                    None => Some(PaperCases {
+                        section71: CaseRun::new(&physics, &SECTION_7_1, n, &motions)?,
+                        table2: CaseRun::new(&physics, &TABLE_2, n, &motions)?,
+                    }),
+                },
                 motions,
                 tnew,
                 fit: zf,
@@ -201,10 +222,79 @@ impl Files {
     }
 }
 
-fn summary(inp: &Inputs) -> String {
+/// The study in a few lines: config, motions, grid, the buildings of a building study, physics.
+fn facts(inp: &Inputs) -> Vec<String> {
     let study = inp.study;
     let g = inp.grid;
     let ph = &inp.physics;
+    let period = if study.building().is_some() {
+        "T_1"
+    } else {
+        "T_p"
+    };
+    let motions: Vec<String> = inp
+        .zones
+        .iter()
+        .map(|z| format!("{} in Zone {}", z.motions.len(), z.name))
+        .collect();
+    let mut facts = vec![
+        // Not the output directory: a study's report is the same wherever it is written.
+        format!("Config {}.", study.config_path.display()),
+        format!("Matched motions: {}.", motions.join(", ")),
+        format!(
+            "Grid: {period} {} to {} s ({} values); {}; {}; {} cases per {}.",
+            num(g.periods_s[0]),
+            num(g.periods_s[g.periods_s.len() - 1]),
+            g.periods_s.len(),
+            g.alpha
+                .iter()
+                .enumerate()
+                .map(|(i, a)| format!("α_{} ∈ {{{}}}", i + 1, joined(a)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            g.mu.iter()
+                .enumerate()
+                .map(|(i, a)| format!("μ_{} ∈ {{{}}}", i + 1, joined(a)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            g.cases(),
+            if study.building().is_some() {
+                "frame"
+            } else {
+                "zone"
+            }
+        ),
+        format!(
+            "Physics: viscous damping ζ = {} of the {} basis (one damper for the stack, single \
+             block and rigid systems); static friction = {} × kinetic.",
+            ph.damping,
+            ph.basis.name(),
+            ph.mu_static_ratio
+        ),
+    ];
+    let frames: Vec<_> = study.frames().into_iter().flatten().collect();
+    let repeated = repeats(&frames);
+    let mut shown: Vec<usize> = Vec::new();
+    for (f, r) in frames.iter().zip(repeated) {
+        if r || shown.contains(&f.storeys()) {
+            continue;
+        }
+        shown.push(f.storeys());
+        facts.push(format!(
+            "Building of {} storey{}: relative floor masses {}, storey stiffnesses {}, storey \
+             heights {} m (floor 1 first); its first-mode period is the grid's T_1.",
+            f.storeys(),
+            if f.storeys() == 1 { "" } else { "s" },
+            nums(&f.floor_masses),
+            nums(&f.storey_stiffnesses),
+            nums(&f.storey_heights_m)
+        ));
+    }
+    facts
+}
+
+fn summary(inp: &Inputs) -> String {
+    let g = inp.grid;
     let mut rows = Vec::new();
     for z in &inp.zones {
         let (u, _, tn, _) = section71_tnew(z);
@@ -221,7 +311,7 @@ fn summary(inp: &Inputs) -> String {
             p71.map_or("–".into(), |p| format!("{:.2}", p.1 * 100.0)),
             format!("{:.2}", u * 100.0),
         ]);
-        let c = &z.table2;
+        let c = &z.paper().table2;
         let red =
             100.0 * (1.0 - c.mean_peak(SystemKind::Stack) / c.mean_peak(SystemKind::SingleBlock));
         let p2 = PAPER_TABLE_2.iter().find(|p| p.0 == z.name);
@@ -243,41 +333,7 @@ fn summary(inp: &Inputs) -> String {
             ]);
         }
     }
-    let motions: Vec<String> = inp
-        .zones
-        .iter()
-        .map(|z| format!("{} in Zone {}", z.motions.len(), z.name))
-        .collect();
-    let facts = vec![
-        // Not the output directory: a study's report is the same wherever it is written.
-        format!("Config {}.", study.config_path.display()),
-        format!("Matched motions: {}.", motions.join(", ")),
-        format!(
-            "Grid: T_p {} to {} s ({} values); {}; {}; {} cases per zone.",
-            num(g.periods_s[0]),
-            num(g.periods_s[g.periods_s.len() - 1]),
-            g.periods_s.len(),
-            g.alpha
-                .iter()
-                .enumerate()
-                .map(|(i, a)| format!("α_{} ∈ {{{}}}", i + 1, joined(a)))
-                .collect::<Vec<_>>()
-                .join(", "),
-            g.mu.iter()
-                .enumerate()
-                .map(|(i, a)| format!("μ_{} ∈ {{{}}}", i + 1, joined(a)))
-                .collect::<Vec<_>>()
-                .join(", "),
-            g.cases()
-        ),
-        format!(
-            "Physics: viscous damping ζ = {} of the {} basis (one damper for the stack, single \
-             block and rigid systems); static friction = {} × kinetic.",
-            ph.damping,
-            ph.basis.name(),
-            ph.mu_static_ratio
-        ),
-    ];
+    let facts = facts(inp);
     let example = if g.blocks() == 2 {
         format!(
             " (the paper's Section 9 worked example: <a href='design.html?{q}'>design.html?{q}</a>)",
@@ -295,22 +351,96 @@ fn summary(inp: &Inputs) -> String {
         + &table_with_id("summary", &["quantity", "zone", "paper", "ours"], &rows)
 }
 
-fn not_shown() -> Section {
-    Section::new(
-        "not-shown",
-        "Not reproduced here",
-        list(&[
-            "Figs 1–3 (the model's sketches) and Figs 6–8 (the ABAQUS validation): the solver is \
-             checked against independent references instead (docs/accuracy)."
+/// A building study's summary: the facts, how to get design numbers, and per zone the fit of
+/// the design equations over the frames.
+fn building_summary(inp: &Inputs) -> String {
+    let mut rows = Vec::new();
+    for z in &inp.zones {
+        let zf = &z.fit;
+        if let Some(ff) = zf.recommended_fit() {
+            rows.push(vec![
+                format!(
+                    "T_new: the building equation ({} form), R² over every frame",
+                    ff.form.name()
+                ),
+                z.name.clone(),
+                format!("{:.3}", ff.all_cases.r2),
+            ]);
+        }
+        let lowest = |m: &dyn Fn(&FrameFit) -> Option<f64>| {
+            (zf.frames.iter())
+                .filter_map(|f| m(f).map(|r| (r, f.frame.as_str())))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+        };
+        for (what, m) in [
+            (
+                "T_new: the building equation",
+                (|f: &FrameFit| Some(f.building.r2)) as fn(&FrameFit) -> Option<f64>,
+            ),
+            ("T_new: the one-storey equation", |f: &FrameFit| {
+                f.one_storey.as_ref().map(|m| m.r2)
+            }),
+            ("T_new: the paper's equation as printed", |f: &FrameFit| {
+                f.published.as_ref().map(|m| m.r2)
+            }),
+            ("λ: the fitted fraction equation", |f: &FrameFit| {
+                f.lambda.as_ref().map(|m| m.r2)
+            }),
+        ] {
+            if let Some((r2, frame)) = lowest(&m) {
+                rows.push(vec![
+                    format!("{what}, lowest R² of a frame ({frame})"),
+                    z.name.clone(),
+                    format!("{r2:.3}"),
+                ]);
+            }
+        }
+    }
+    let design = "<p id='design-link'>Design numbers of one building of the study: \
+         <code>slidestack design --study OUT --zone Z --period T_1 --alpha … --mu … --storeys N \
+         --floor F</code> (T_new, T_1,rigid and λ; <code>--floor roof</code> accepted). The \
+         design page does not yet take a building study.</p>";
+    design.to_string()
+        + &list(&facts(inp))
+        + &para(
+            "The design equations over the frames (fit.yaml; per frame in the design equations' \
+             section):",
+        )
+        + &table_with_id("summary", &["quantity", "zone", "ours"], &rows)
+}
+
+/// What the report leaves out (`building`: of a building study).
+fn not_shown(building: bool) -> Section {
+    let mut items = vec![
+        "Figs 1–3 (the model's sketches) and Figs 6–8 (the ABAQUS validation): the solver is \
+         checked against independent references instead (docs/accuracy)."
+            .to_string(),
+    ];
+    if building {
+        items.push(
+            "The paper's one-storey cases and figures (Section 7.1 and Fig. 12, Table 2, Figs \
+             9–11 and 16–17, Table 3's paper column): a building study's report has the building \
+             section instead; a one-storey config (configs/paper.yaml) gives them."
                 .into(),
-            "Fig. 9 (histories of the Table 2 case under record #11): the paper's records are not \
-             available; the histories shown are the Section 7.1 case's."
+        );
+        items.push(
+            "The design page: a building study's design numbers come from `slidestack design \
+             --storeys N --floor F`."
                 .into(),
-            "Figs 13–15 (the OLE validation of the T_new method against reference [12]).".into(),
-            "Table 1 (the paper's PEER NGA records): this study's motions come from its config."
+        );
+    } else {
+        items.push(
+            "Fig. 9 (histories of the Table 2 case under record #11): the paper's records are \
+             not available; the histories shown are the Section 7.1 case's."
                 .into(),
-        ]),
-    )
+        );
+    }
+    items
+        .push("Figs 13–15 (the OLE validation of the T_new method against reference [12]).".into());
+    items.push(
+        "Table 1 (the paper's PEER NGA records): this study's motions come from its config.".into(),
+    );
+    Section::new("not-shown", "Not reproduced here", list(&items))
 }
 
 /// Builds the report.
@@ -319,20 +449,31 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let inp = Inputs::load(study)?;
     let sel = Selection::new(inp.grid);
     let mut files = Files::default();
-    let sections = vec![
-        motions_section(&inp, &mut files)?,
-        section71_section(&inp, &mut files)?,
-        table2_section(&inp),
-        drr_section(&inp, &sel, &mut files)?,
-        tnew_section(&inp, &sel, &mut files)?,
-        fit_section(&inp, &mut files)?,
-    ];
-    let mut sections = sections;
+    let building = study.building().is_some();
+    let mut sections = vec![motions_section(&inp, &mut files)?];
+    if building {
+        sections.push(building::building_section(&inp, &mut files)?);
+    } else {
+        sections.extend([
+            section71_section(&inp, &mut files)?,
+            table2_section(&inp),
+            drr_section(&inp, &sel, &mut files)?,
+            tnew_section(&inp, &sel, &mut files)?,
+        ]);
+    }
+    sections.push(fit_section(&inp, &mut files)?);
     if study.configured(StageId::Ida) {
         sections.push(ida::ida_section(study, &mut files)?);
     }
-    sections.push(not_shown());
-    design::design_file(&inp, &mut files)?;
+    sections.push(not_shown(building));
+    if !building {
+        design::design_file(&inp, &mut files)?;
+    }
+    let summary = if building {
+        building_summary(&inp)
+    } else {
+        summary(&inp)
+    };
     let html = document(
         &format!(
             "slidestack report: {}",
@@ -341,7 +482,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 |f| { f.to_string_lossy().into_owned() }
             )
         ),
-        &summary(&inp),
+        &summary,
         &sections,
     );
     let mut out = files.files;

@@ -101,7 +101,7 @@ impl CaseRun {
 
 /// The Section 7.1 case's `T_new` in one zone: the mean peak displacement, `T_rigid`, `T_new`.
 pub(super) fn section71_tnew(z: &Zone) -> (f64, f64, f64, TnewFlag) {
-    let c = &z.section71;
+    let c = &z.paper().section71;
     let u = c.mean_peak(SystemKind::Stack);
     let tr = c.case.t_rigid_s();
     let (tn, flag) = t_new(&z.tnew.period_sd_s, &z.tnew.sd_mean_m, u, tr, c.slides());

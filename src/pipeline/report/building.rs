@@ -1,0 +1,495 @@
+//! The building section of a building study's report (docs/model.md, "A study over
+//! buildings"): does the sliding stack lower the building's demands, and how does that depend on
+//! the floor it stands on? Per zone and distinct frame, from `sweep.h5` and `tnew.h5`:
+//!
+//! * a table of the medians over the frame's cases of the ratios "mean over the motions of a
+//!   peak with the sliding stack / the same with the stack rigidly attached" (roof displacement,
+//!   peak interstorey drift ratio, peak floor acceleration, peak base shear), with the share of
+//!   cases below 1, and of `λ` and `T_new/T_1`;
+//! * `T_new/T_1` and `λ` against `T_1`, a panel per storey count, a line per stack floor (the
+//!   median over the mass ratios and friction coefficients, the 10th–90th percentile band);
+//! * the drift-ratio and floor-acceleration profiles over the height, with and without sliding
+//!   (per storey or floor, the median over the frame's cases of the mean over the motions).
+//!
+//! A frame that repeats an earlier one's building ([`repeats`]) is shown once.
+
+use super::text::fixed;
+use super::{Files, Inputs, ReportError};
+use crate::grid::{BuildingAxes, StackFloor};
+use crate::pipeline::{PipelineError, StageId};
+use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
+use crate::render::page::{Section, para, table_with_id};
+use crate::store::StoreError;
+use crate::store::sweep::read_zone_sweep;
+use crate::study::building::{Frame, repeats};
+use plotters::style::RGBColor;
+
+/// The `p`-th percentile (0–100) of the finite values of `v`, linearly interpolated between
+/// order statistics (NumPy's default, `nanpercentile`); NaN when none is finite.
+pub(super) fn percentile(v: &[f64], p: f64) -> f64 {
+    let mut x: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if x.is_empty() {
+        return f64::NAN;
+    }
+    x.sort_by(f64::total_cmp);
+    let pos = p / 100.0 * (x.len() - 1) as f64;
+    let (lo, frac) = (pos.floor() as usize, pos - pos.floor());
+    match x.get(lo + 1) {
+        Some(hi) if frac > 0.0 => x[lo] + frac * (hi - x[lo]),
+        _ => x[lo],
+    }
+}
+
+/// The share of the finite values of `v` below 1.
+fn share_below_1(v: &[f64]) -> f64 {
+    let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    finite.iter().filter(|&&x| x < 1.0).count() as f64 / finite.len() as f64
+}
+
+/// A peak with the stack and with it rigidly attached: per case the mean over the motions.
+struct Pair {
+    stack: Vec<f64>,
+    rigid: Vec<f64>,
+}
+
+impl Pair {
+    /// Per case, stack over rigid.
+    fn ratio(&self) -> Vec<f64> {
+        self.stack
+            .iter()
+            .zip(&self.rigid)
+            .map(|(s, r)| s / r)
+            .collect()
+    }
+}
+
+/// One distinct frame of one zone, per case of the grid (flat order).
+struct FrameCases {
+    frame: Frame,
+    roof: Pair,
+    /// The largest storey's peak drift ratio, the largest floor's peak acceleration (g).
+    drift: Pair,
+    accel: Pair,
+    shear: Pair,
+    lambda: Vec<f64>,
+    /// `T_new / T_1`.
+    t_ratio: Vec<f64>,
+    /// Per storey (drift ratio) and floor (acceleration, g), the median over the cases.
+    drift_profile: (Vec<f64>, Vec<f64>),
+    accel_profile: (Vec<f64>, Vec<f64>),
+}
+
+/// One zone's distinct frames.
+struct BuildingZone {
+    name: String,
+    frames: Vec<FrameCases>,
+}
+
+/// Reads what the section needs of every zone, checking that `sweep.h5` holds the study's
+/// grid and frames.
+fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
+    let study = inp.study;
+    let grid = inp.grid;
+    let axes = study
+        .building()
+        .expect("the building section of a building study");
+    let frames: Vec<Frame> = study.frames().into_iter().flatten().collect();
+    let repeated = repeats(&frames);
+    let path = study.path(StageId::Sweep.output());
+    let per = grid.cases();
+    let n_max = axes.max_storeys();
+    let mut out = Vec::new();
+    for z in &inp.zones {
+        let (g, a, sweep) = read_zone_sweep(&path, &z.name, grid.blocks(), true)?;
+        if g != *grid || a.as_ref() != Some(axes) {
+            let why = format!("zone_{}: its grid differs from the config's", z.name);
+            return Err(StoreError::corrupt(&path, why).into());
+        }
+        let Some(b) = &sweep.vars.building else {
+            let why = format!("zone_{}: has no per-floor peaks", z.name);
+            return Err(StoreError::corrupt(&path, why).into());
+        };
+        let Some(lambda) = &z.tnew.lambda else {
+            let why = format!("zone_{}: has no λ", z.name);
+            return Err(StoreError::corrupt(&study.path("tnew.h5"), why).into());
+        };
+        let motions = sweep.motions.len();
+        let fr = axes.frames();
+        let flat = |v: &ndarray::ArrayD<f64>| v.iter().copied().collect::<Vec<f64>>();
+        let (u_stack, u_rigid) = (flat(&sweep.vars.u_stack), flat(&sweep.vars.u_rigid));
+        let (d_stack, d_rigid) = (flat(&b.drift_ratio_stack), flat(&b.drift_ratio_rigid));
+        let (a_stack, a_rigid) = (flat(&b.floor_accel_stack), flat(&b.floor_accel_rigid));
+        let (v_stack, v_rigid) = (
+            flat(&lambda.base_shear_stack_mean),
+            flat(&lambda.base_shear_rigid_mean),
+        );
+        let (lam, t_new) = (flat(&lambda.lambda), flat(&z.tnew.vars.t_new));
+        let mut zone_frames = Vec::new();
+        for (f, frame) in frames.iter().enumerate() {
+            if repeated[f] {
+                continue;
+            }
+            let n = frame.storeys();
+            // Mean over the motions of `value(m, case)`, per case.
+            let over_motions = |value: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
+                (0..per)
+                    .map(|c| (0..motions).map(|m| value(m, c)).sum::<f64>() / motions as f64)
+                    .collect()
+            };
+            let at = |m: usize, c: usize| (m * fr + f) * per + c;
+            let peak_over = |v: &[f64], m: usize, c: usize| {
+                let i = at(m, c) * n_max;
+                v[i..i + n]
+                    .iter()
+                    .copied()
+                    .fold(f64::NEG_INFINITY, f64::max)
+            };
+            let profile = |v: &[f64]| -> Vec<f64> {
+                (0..n)
+                    .map(|j| percentile(&over_motions(&|m, c| v[at(m, c) * n_max + j]), 50.0))
+                    .collect()
+            };
+            let in_frame = |v: &[f64]| v[f * per..(f + 1) * per].to_vec();
+            zone_frames.push(FrameCases {
+                frame: frame.clone(),
+                roof: Pair {
+                    stack: over_motions(&|m, c| u_stack[at(m, c)]),
+                    rigid: over_motions(&|m, c| u_rigid[at(m, c)]),
+                },
+                drift: Pair {
+                    stack: over_motions(&|m, c| peak_over(&d_stack, m, c)),
+                    rigid: over_motions(&|m, c| peak_over(&d_rigid, m, c)),
+                },
+                accel: Pair {
+                    stack: over_motions(&|m, c| peak_over(&a_stack, m, c)),
+                    rigid: over_motions(&|m, c| peak_over(&a_rigid, m, c)),
+                },
+                shear: Pair {
+                    stack: in_frame(&v_stack),
+                    rigid: in_frame(&v_rigid),
+                },
+                lambda: in_frame(&lam),
+                t_ratio: (0..per)
+                    .map(|c| t_new[f * per + c] / grid.case(c).period_s)
+                    .collect(),
+                drift_profile: (profile(&d_stack), profile(&d_rigid)),
+                accel_profile: (profile(&a_stack), profile(&a_rigid)),
+            });
+        }
+        out.push(BuildingZone {
+            name: z.name.clone(),
+            frames: zone_frames,
+        });
+    }
+    Ok(out)
+}
+
+/// The answer table's header.
+pub(super) const ANSWER_HEADER: [&str; 9] = [
+    "zone",
+    "building, stack on",
+    "cases",
+    "roof displacement (DRR_1)",
+    "peak interstorey drift ratio",
+    "peak floor acceleration",
+    "peak base shear",
+    "λ [25th, 75th percentile]",
+    "T_new/T_1",
+];
+
+/// `3 storeys, roof` (`1 storey` alone).
+fn frame_name(f: &Frame) -> String {
+    let n = f.storeys();
+    if n == 1 {
+        return "1 storey".into();
+    }
+    format!("{n} storeys, {}", floor_name(f.stack_floor))
+}
+
+/// `floor 2`, `roof`, `every floor`.
+fn floor_name(s: StackFloor) -> String {
+    match s {
+        StackFloor::Floor(j) => format!("floor {j}"),
+        StackFloor::Roof => "roof".into(),
+        StackFloor::All => "every floor".into(),
+    }
+}
+
+fn answer_rows(zones: &[BuildingZone]) -> Vec<Vec<String>> {
+    let med = |v: &[f64]| fixed(percentile(v, 50.0), 3);
+    let with_share = |v: &[f64]| {
+        format!(
+            "{} ({:.0} %)",
+            fixed(percentile(v, 50.0), 3),
+            100.0 * share_below_1(v)
+        )
+    };
+    let mut rows = Vec::new();
+    for z in zones {
+        for f in &z.frames {
+            let l = &f.lambda;
+            rows.push(vec![
+                z.name.clone(),
+                frame_name(&f.frame),
+                f.roof.stack.len().to_string(),
+                med(&f.roof.ratio()),
+                with_share(&f.drift.ratio()),
+                with_share(&f.accel.ratio()),
+                med(&f.shear.ratio()),
+                format!(
+                    "{} [{}, {}]",
+                    fixed(percentile(l, 50.0), 2),
+                    fixed(percentile(l, 25.0), 2),
+                    fixed(percentile(l, 75.0), 2)
+                ),
+                med(&f.t_ratio),
+            ]);
+        }
+    }
+    rows
+}
+
+/// The storey counts of a zone's frames, increasing, and each one's frames.
+fn by_storeys(z: &BuildingZone) -> Vec<(usize, Vec<&FrameCases>)> {
+    let mut out: Vec<(usize, Vec<&FrameCases>)> = Vec::new();
+    for f in &z.frames {
+        let n = f.frame.storeys();
+        match out.iter_mut().find(|(m, _)| *m == n) {
+            Some((_, v)) => v.push(f),
+            None => out.push((n, vec![f])),
+        }
+    }
+    out
+}
+
+/// `T_new/T_1` and `λ` against `T_1`: a panel per storey count and quantity.
+fn against_period(
+    z: &BuildingZone,
+    inp: &Inputs,
+    files: &mut Files,
+) -> Result<String, ReportError> {
+    let grid = inp.grid;
+    let tp = &grid.periods_s;
+    let per_t = grid.cases_per_unit();
+    let groups = by_storeys(z);
+    // Per T_1, the percentile p over the frame's cases (T_1 the slowest axis).
+    let over_t = |v: &[f64], p: f64| -> Vec<f64> {
+        (0..tp.len())
+            .map(|i| percentile(&v[i * per_t..(i + 1) * per_t], p))
+            .collect()
+    };
+    let black = RGBColor(0, 0, 0);
+    let mut panels = Vec::new();
+    for (title, y_label, value, reference) in [
+        (
+            "T_new/T_1",
+            "T_new / T_1 (–)",
+            (|f: &FrameCases| f.t_ratio.clone()) as fn(&FrameCases) -> Vec<f64>,
+            Some(("T_new = T_1 (bare building)", 1.0)),
+        ),
+        (
+            "λ",
+            "λ (–)",
+            |f: &FrameCases| f.lambda.clone(),
+            Some(("λ = 1 (the whole stack as seismic mass)", 1.0)),
+        ),
+    ] {
+        for (n, frames) in &groups {
+            let mut series = Vec::new();
+            for (k, f) in frames.iter().enumerate() {
+                let v = value(f);
+                let colour = PALETTE[k % PALETTE.len()];
+                let name = if *n == 1 {
+                    "one storey".to_string()
+                } else {
+                    format!("stack on {}", floor_name(f.frame.stack_floor))
+                };
+                series.push(
+                    Series::band(
+                        format!("{name}: 10th–90th percentile"),
+                        tp.clone(),
+                        over_t(&v, 10.0),
+                        over_t(&v, 90.0),
+                    )
+                    .colour(colour),
+                );
+                series.push(
+                    Series::line(format!("{name}: median"), tp.clone(), over_t(&v, 50.0))
+                        .colour(colour)
+                        .stroke(Stroke::Solid, 2),
+                );
+            }
+            if let Some((label, y)) = reference {
+                series.push(
+                    Series::hline(label, tp[0], tp[tp.len() - 1], y)
+                        .colour(black)
+                        .stroke(Stroke::Dotted, 1),
+                );
+            }
+            let storeys = if *n == 1 { "storey" } else { "storeys" };
+            panels.push(Panel::xy(
+                format!("{title}, {n} {storeys}"),
+                Axis::new("T_1 (s)"),
+                Axis::new(y_label),
+                series,
+            ));
+        }
+    }
+    let fig = Figure::grid(
+        format!("Zone {}: T_new/T_1 and λ against T_1", z.name),
+        panels,
+        groups.len(),
+    )
+    .panel_px(420, 300);
+    files.figure(
+        &format!("building_period_{}.svg", z.name),
+        &fig,
+        &format!(
+            "Zone {}: T_new of the first mode over the bare building's T_1 (top) and the \
+             effective live-load fraction λ (bottom) against T_1, a panel per storey count, a \
+             colour per stack floor: the median over the mass ratios and friction coefficients \
+             at each T_1 and the band of their 10th to 90th percentiles.",
+            z.name
+        ),
+    )
+}
+
+/// The drift-ratio and floor-acceleration profiles over the height of every building of more
+/// than one storey, with the sliding stack (solid) and with it rigidly attached (dashed).
+fn profiles(z: &BuildingZone, files: &mut Files) -> Result<Option<String>, ReportError> {
+    let groups: Vec<_> = by_storeys(z).into_iter().filter(|(n, _)| *n > 1).collect();
+    if groups.is_empty() {
+        return Ok(None);
+    }
+    let mut panels = Vec::new();
+    for (title, x_label, scale, profile) in [
+        (
+            "peak interstorey drift ratio",
+            "peak drift ratio (%)",
+            100.0,
+            (|f: &FrameCases| &f.drift_profile) as fn(&FrameCases) -> &(Vec<f64>, Vec<f64>),
+        ),
+        (
+            "peak floor acceleration",
+            "peak absolute acceleration (g)",
+            1.0,
+            |f: &FrameCases| &f.accel_profile,
+        ),
+    ] {
+        for (n, frames) in &groups {
+            let levels: Vec<f64> = (1..=*n).map(|j| j as f64).collect();
+            let mut series = Vec::new();
+            for (k, f) in frames.iter().enumerate() {
+                let (stack, rigid) = profile(f);
+                let colour = PALETTE[k % PALETTE.len()];
+                let name = format!("stack on {}", floor_name(f.frame.stack_floor));
+                let scaled = |v: &[f64]| v.iter().map(|x| x * scale).collect::<Vec<f64>>();
+                series.push(
+                    Series::line(
+                        format!("{name}, rigidly attached"),
+                        scaled(rigid),
+                        levels.clone(),
+                    )
+                    .colour(colour)
+                    .stroke(Stroke::Dashed, 1),
+                );
+                series.push(
+                    Series::line(format!("{name}, sliding"), scaled(stack), levels.clone())
+                        .colour(colour)
+                        .stroke(Stroke::Solid, 2),
+                );
+            }
+            let level = if scale == 1.0 { "floor" } else { "storey" };
+            panels.push(Panel::xy(
+                format!("{title}, {n} storeys"),
+                Axis::new(x_label),
+                Axis::new(level).range(0.5, *n as f64 + 0.5),
+                series,
+            ));
+        }
+    }
+    let fig = Figure::grid(
+        format!(
+            "Zone {}: drift and floor acceleration over the height",
+            z.name
+        ),
+        panels,
+        groups.len(),
+    )
+    .panel_px(420, 320);
+    let html = files.figure(
+        &format!("building_profiles_{}.svg", z.name),
+        &fig,
+        &format!(
+            "Zone {}: per storey the peak interstorey drift ratio (top) and per floor the peak \
+             absolute acceleration (bottom), the median over the frame's cases of the mean over \
+             the motions, with the sliding stack (solid) and with it rigidly attached (dashed), \
+             a panel per storey count, a colour per stack floor.",
+            z.name
+        ),
+    )?;
+    Ok(Some(html))
+}
+
+/// The building section.
+pub(super) fn building_section(inp: &Inputs, files: &mut Files) -> Result<Section, PipelineError> {
+    let zones = load(inp)?;
+    let axes: &BuildingAxes = inp.study.building().expect("a building study");
+    let mut body = para(&format!(
+        "Does a sliding stack lower a building's demands as it lowers one storey's, and how \
+         does it depend on the floor it stands on? Storey counts {}, the stack on {}; each ratio \
+         is the mean over the motions of a peak with the sliding stack over the same with the \
+         stack rigidly attached, and the table gives its median over the frame's {} cases \
+         (the grid's T_1, α and μ) and, for the drift and the floor acceleration, the share of \
+         cases below 1. The peak drift ratio is the largest storey's, the peak floor \
+         acceleration the largest floor's; the peak base shear is the mean over the motions \
+         (tnew.h5). λ is the effective live-load fraction (the part of the stack's mass that, \
+         rigidly attached, gives the sliding stack's mean peak base shear; clamped to [0, 1], \
+         docs/model.md). A frame that is an earlier one's building (on one storey every stack \
+         floor) is shown once.",
+        axes.storeys
+            .iter()
+            .map(|n| n.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        axes.stack_floor
+            .iter()
+            .map(|s| floor_name(*s))
+            .collect::<Vec<_>>()
+            .join(", "),
+        inp.grid.cases()
+    ));
+    body += &table_with_id("building-answer", &ANSWER_HEADER, &answer_rows(&zones));
+    for z in &zones {
+        body += &against_period(z, inp, files)?;
+        if let Some(p) = profiles(z, files)? {
+            body += &p;
+        }
+    }
+    Ok(Section::new(
+        "building",
+        "The building: demands with and without sliding, T_new and λ",
+        body,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentiles_as_numpy() {
+        // numpy.nanpercentile([3, 1, nan, 2, 10], [0, 25, 50, 90, 100]) = 1, 1.75, 2.5, 7.9, 10
+        let v = [3.0, 1.0, f64::NAN, 2.0, 10.0];
+        let got: Vec<f64> = [0.0, 25.0, 50.0, 90.0, 100.0]
+            .iter()
+            .map(|&p| percentile(&v, p))
+            .collect();
+        let want = [1.0, 1.75, 2.5, 7.9, 10.0];
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-12, "{got:?}");
+        }
+        assert!(percentile(&[f64::NAN], 50.0).is_nan());
+        assert_eq!(share_below_1(&[0.5, 1.0, f64::NAN, 2.0]), 1.0 / 3.0);
+    }
+}
