@@ -117,14 +117,11 @@ fn check_figure(name: &str, svg: &str, opt: &usvg::Options, png_dir: Option<&Pat
     }
 }
 
-#[test]
-fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
-    let out = dir.path().join("quick");
-    let (c, o) = (cfg.to_str().unwrap(), out.to_str().unwrap());
-    slidestack(&["run", c, "--out", o]);
-    let report = out.join("report");
+/// `report/index.html` as every report must be: well-formed, referencing only files of the
+/// report directory that its manifest lists, showing every figure of the directory, each one
+/// rendered with data in every plot area and its legend beside them. Returns the page's text,
+/// the files it references and its figures.
+fn checked_page(report: &Path) -> (String, Vec<String>, Vec<String>) {
     let html = std::fs::read_to_string(report.join("index.html")).unwrap();
     let doc = roxmltree::Document::parse_with_options(
         &html,
@@ -165,7 +162,7 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
             shown.push(v.to_string());
         }
     }
-    let mut svgs: Vec<String> = std::fs::read_dir(&report)
+    let mut svgs: Vec<String> = std::fs::read_dir(report)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|n| n.ends_with(".svg"))
@@ -174,22 +171,6 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
     for s in &svgs {
         assert!(shown.contains(s), "{s} is not shown on the page");
     }
-    assert!(
-        shown.iter().any(|s| s == "design.html"),
-        "no link to the design page"
-    );
-    for want in [
-        "spectra_III.svg",
-        "history_V.svg",
-        "tnew_construction_III.svg",
-        "energy.svg",
-        "drr_V.svg",
-        "tnew_III.svg",
-        "residuals_V.svg",
-    ] {
-        assert!(svgs.iter().any(|s| s == want), "{want} missing: {svgs:?}");
-    }
-
     // Every figure rendered, with data in each plot area and its legend beside them.
     let png_dir = std::env::var_os("SLIDESTACK_REPORT_PNG").map(std::path::PathBuf::from);
     if let Some(d) = &png_dir {
@@ -215,6 +196,41 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
     for s in &svgs {
         let text = std::fs::read_to_string(report.join(s)).unwrap();
         check_figure(s, &text, &opt, png_dir.as_deref());
+    }
+    (html, shown, svgs)
+}
+
+#[test]
+fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
+    let out = dir.path().join("quick");
+    let (c, o) = (cfg.to_str().unwrap(), out.to_str().unwrap());
+    slidestack(&["run", c, "--out", o]);
+    let report = out.join("report");
+    let (html, shown, svgs) = checked_page(&report);
+    let doc = roxmltree::Document::parse_with_options(
+        &html,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(
+        shown.iter().any(|s| s == "design.html"),
+        "no link to the design page"
+    );
+    for want in [
+        "spectra_III.svg",
+        "history_V.svg",
+        "tnew_construction_III.svg",
+        "energy.svg",
+        "drr_V.svg",
+        "tnew_III.svg",
+        "residuals_V.svg",
+    ] {
+        assert!(svgs.iter().any(|s| s == want), "{want} missing: {svgs:?}");
     }
 
     // Table 3: the paper's rows are the paper's, ours are fit.yaml's.
@@ -341,4 +357,196 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
             "{name} differs on a rerun"
         );
     }
+}
+
+/// The median of the finite values of `v` (the mean of the middle two of an even count).
+fn median(v: impl Iterator<Item = f64>) -> f64 {
+    let mut x: Vec<f64> = v.filter(|x| x.is_finite()).collect();
+    x.sort_by(f64::total_cmp);
+    let n = x.len();
+    if n % 2 == 1 {
+        x[n / 2]
+    } else {
+        (x[n / 2 - 1] + x[n / 2]) / 2.0
+    }
+}
+
+/// A building study's report (`configs/mdof-quick.yaml` through `run`, the stage no longer
+/// refusing it): every page check of the one-storey report; the building section's figures and
+/// none of the one-storey paper cases'; the answer table's medians recomputed here from
+/// `sweep.h5` and `tnew.h5` read through their own axes (the report walks flat strides); the
+/// fit's per-frame table that of `fit.yaml`; the same bytes from a forced rebuild.
+/// Tolerance: half a unit of the printed last digit (3 decimals: 5e-4; λ's 2: 5e-3; shares in
+/// whole percent: 0.5).
+#[test]
+fn a_building_studys_report_shows_the_files_numbers() {
+    use ndarray::{ArrayD, Axis, IxDyn};
+    use slidestack::store::sweep::read_zone_sweep;
+    use slidestack::store::tnew::read_zone_tnew_in;
+
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/mdof-quick.yaml");
+    let out = dir.path().join("mdof-quick");
+    let (c, o) = (cfg.to_str().unwrap(), out.to_str().unwrap());
+    slidestack(&["run", c, "--out", o]);
+    let report = out.join("report");
+    let (html, _, svgs) = checked_page(&report);
+    let doc = roxmltree::Document::parse_with_options(
+        &html,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for zone in ["III", "V"] {
+        for want in [
+            "building_period",
+            "building_profiles",
+            "residuals",
+            "spectra",
+        ] {
+            let want = format!("{want}_{zone}.svg");
+            assert!(svgs.contains(&want), "{want} missing: {svgs:?}");
+        }
+    }
+    for one_storey in ["history_", "drr_", "tnew_", "energy"] {
+        assert!(
+            !svgs.iter().any(|s| s.starts_with(one_storey)),
+            "a one-storey figure in a building report: {svgs:?}"
+        );
+    }
+
+    let rows = table(&doc, "building-answer");
+    let close_to = |shown: &str, want: f64, tol: f64, what: &str| {
+        let first = shown.split_whitespace().next().unwrap();
+        close(first, want, tol, what);
+    };
+    let mut checked = 0;
+    for zone in ["III", "V"] {
+        let (_, axes, sw) = read_zone_sweep(&out.join("sweep.h5"), zone, 2, true).unwrap();
+        let (grid, _, t) = read_zone_tnew_in(&out.join("tnew.h5"), zone, 2, true).unwrap();
+        let axes = axes.unwrap();
+        let b = sw.vars.building.as_ref().unwrap();
+        let l = t.lambda.as_ref().unwrap();
+        for (si, &n) in axes.storeys.iter().enumerate() {
+            for (fi, floor) in axes.stack_floor.iter().enumerate() {
+                // One storey: every stack floor is the same building, shown once.
+                if n == 1 && fi > 0 {
+                    continue;
+                }
+                let label = match (n, floor.to_string().as_str()) {
+                    (1, _) => "1 storey".to_string(),
+                    (_, "all") => format!("{n} storeys, every floor"),
+                    (_, "roof") => format!("{n} storeys, roof"),
+                    (_, j) => format!("{n} storeys, floor {j}"),
+                };
+                let row = rows
+                    .iter()
+                    .find(|r| r[0] == zone && r[1] == label)
+                    .unwrap_or_else(|| panic!("no row {zone}, {label}: {rows:?}"));
+                // [motion, storeys, stack_floor, T_p, cases…(, level)] → this frame.
+                let frame =
+                    |a: &ArrayD<f64>| a.index_axis(Axis(1), si).index_axis(Axis(1), fi).to_owned();
+                let over_motions = |a: ArrayD<f64>| a.mean_axis(Axis(0)).unwrap();
+                // The largest storey or floor of the building (NaN above its roof).
+                let peak = |a: &ArrayD<f64>| {
+                    let f = frame(a);
+                    let last = Axis(f.ndim() - 1);
+                    f.slice_axis(last, (0..n).into())
+                        .fold_axis(last, f64::NEG_INFINITY, |m, &x| m.max(x))
+                };
+                let ratios = |s: ArrayD<f64>, r: ArrayD<f64>| {
+                    (&s / &r).iter().copied().collect::<Vec<f64>>()
+                };
+                let roof = ratios(
+                    over_motions(frame(&sw.vars.u_stack)),
+                    over_motions(frame(&sw.vars.u_rigid)),
+                );
+                let drift = ratios(
+                    over_motions(peak(&b.drift_ratio_stack)),
+                    over_motions(peak(&b.drift_ratio_rigid)),
+                );
+                let accel = ratios(
+                    over_motions(peak(&b.floor_accel_stack)),
+                    over_motions(peak(&b.floor_accel_rigid)),
+                );
+                let in_frame =
+                    |a: &ArrayD<f64>| a.index_axis(Axis(0), si).index_axis(Axis(0), fi).to_owned();
+                let shear = ratios(
+                    in_frame(&l.base_shear_stack_mean),
+                    in_frame(&l.base_shear_rigid_mean),
+                );
+                let lambda: Vec<f64> = in_frame(&l.lambda).iter().copied().collect();
+                let t_new = in_frame(&t.vars.t_new);
+                let t_ratio: Vec<f64> = t_new
+                    .indexed_iter()
+                    .map(|(ix, v): (IxDyn, &f64)| v / grid.periods_s[ix[0]])
+                    .collect();
+                let share = |v: &[f64]| {
+                    100.0 * v.iter().filter(|&&x| x < 1.0).count() as f64 / v.len() as f64
+                };
+                let what = |c: &str| format!("zone {zone}, {label}: {c}");
+                assert_eq!(row[2], roof.len().to_string());
+                close_to(&row[3], median(roof.iter().copied()), 5e-4, &what("roof"));
+                close_to(&row[4], median(drift.iter().copied()), 5e-4, &what("drift"));
+                close_to(
+                    &row[5],
+                    median(accel.iter().copied()),
+                    5e-4,
+                    &what("acceleration"),
+                );
+                close_to(
+                    &row[6],
+                    median(shear.iter().copied()),
+                    5e-4,
+                    &what("base shear"),
+                );
+                close_to(&row[7], median(lambda.iter().copied()), 5e-3, &what("λ"));
+                close_to(
+                    &row[8],
+                    median(t_ratio.iter().copied()),
+                    5e-4,
+                    &what("T_new/T_1"),
+                );
+                for (cell, v) in [(&row[4], &drift), (&row[5], &accel)] {
+                    let pct: &str = cell.split('(').nth(1).unwrap().split(' ').next().unwrap();
+                    close(pct, share(v), 0.5 + 1e-9, &what("share below 1"));
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, rows.len(), "rows the files do not give: {rows:?}");
+    assert_eq!(checked, 2 * 4);
+
+    // The fit frame by frame: fit.yaml's metrics.
+    let fit = read_fit(&out.join("fit.yaml")).unwrap().unwrap();
+    let frames = table(&doc, "frames");
+    for z in &fit.zones {
+        assert!(!z.frames.is_empty());
+        for f in &z.frames {
+            let r = frames
+                .iter()
+                .find(|r| r[0] == z.zone && r[1] == f.frame)
+                .unwrap_or_else(|| panic!("no frame row {} {}", z.zone, f.frame));
+            assert_eq!(r[2], f.cases.to_string());
+            close(&r[3], f.building.r2, 5e-4, "building R²");
+            close(
+                &r[5],
+                f.one_storey.as_ref().unwrap().r2,
+                5e-4,
+                "one-storey R²",
+            );
+            close(&r[8], f.lambda.as_ref().unwrap().r2, 5e-4, "λ R²");
+        }
+    }
+
+    // A forced rebuild writes the same bytes.
+    let manifest = std::fs::read(report.join("MANIFEST.sha256")).unwrap();
+    slidestack(&["report", c, "--out", o, "--force"]);
+    assert_eq!(
+        std::fs::read(report.join("MANIFEST.sha256")).unwrap(),
+        manifest
+    );
 }
