@@ -371,26 +371,33 @@ fn median(v: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
-/// A building study's report (`configs/mdof-quick.yaml` through `run`, the stage no longer
-/// refusing it): every page check of the one-storey report; the building section's figures and
-/// none of the one-storey paper cases'; the answer table's medians recomputed here from
-/// `sweep.h5` and `tnew.h5` read through their own axes (the report walks flat strides); the
-/// fit's per-frame table that of `fit.yaml`; the same bytes from a forced rebuild.
+/// A building study's report (`configs/mdof-quick.yaml` with `configs/mdof-ida-quick.yaml`'s
+/// `ida:` section, through `run`): every page check of the one-storey report; the building
+/// section's figures and none of the one-storey paper cases'; the answer table's medians
+/// recomputed here from `sweep.h5` and `tnew.h5` read through their own axes (the report walks
+/// flat strides); the fit's per-frame table that of `fit.yaml`; the IDA's fragilities those of
+/// `ida.h5`, each building once; the same bytes from a forced rebuild.
 /// Tolerance: half a unit of the printed last digit (3 decimals: 5e-4; λ's 2: 5e-3; shares in
 /// whole percent: 0.5).
 #[test]
 fn a_building_studys_report_shows_the_files_numbers() {
     use ndarray::{ArrayD, Axis, IxDyn};
+    use slidestack::store::ida::read_zone_ida;
     use slidestack::store::sweep::read_zone_sweep;
     use slidestack::store::tnew::read_zone_tnew_in;
 
     let dir = tempfile::tempdir().unwrap();
-    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/mdof-quick.yaml");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let grid = std::fs::read_to_string(root.join("configs/mdof-quick.yaml")).unwrap();
+    let ida = std::fs::read_to_string(root.join("configs/mdof-ida-quick.yaml")).unwrap();
+    let cfg = dir.path().join("mdof-quick-ida.yaml");
+    std::fs::write(&cfg, grid + &ida[ida.find("\nida:").unwrap()..]).unwrap();
     let out = dir.path().join("mdof-quick");
     let (c, o) = (cfg.to_str().unwrap(), out.to_str().unwrap());
     slidestack(&["run", c, "--out", o]);
     let report = out.join("report");
     let (html, _, svgs) = checked_page(&report);
+    assert!(svgs.iter().any(|s| s == "ida.svg"), "{svgs:?}");
     let doc = roxmltree::Document::parse_with_options(
         &html,
         roxmltree::ParsingOptions {
@@ -520,12 +527,15 @@ fn a_building_studys_report_shows_the_files_numbers() {
     assert_eq!(checked, rows.len(), "rows the files do not give: {rows:?}");
     assert_eq!(checked, 2 * 4);
 
-    // The fit frame by frame: fit.yaml's metrics.
+    // The fit frame by frame: fit.yaml's metrics, each building once (on one storey every
+    // stack floor is the first's).
     let fit = read_fit(&out.join("fit.yaml")).unwrap().unwrap();
     let frames = table(&doc, "frames");
+    assert_eq!(frames.len(), 2 * 4, "{frames:?}");
+    let once = |name: &str| !name.starts_with("1 storey,") || name == "1 storey, stack on floor 1";
     for z in &fit.zones {
-        assert!(!z.frames.is_empty());
-        for f in &z.frames {
+        assert_eq!(z.frames.len(), 6);
+        for f in z.frames.iter().filter(|f| once(&f.frame)) {
             let r = frames
                 .iter()
                 .find(|r| r[0] == z.zone && r[1] == f.frame)
@@ -542,6 +552,48 @@ fn a_building_studys_report_shows_the_files_numbers() {
         }
     }
 
+    // The IDA's fragilities: ida.h5's θ and β (frames folded into the case axis, case-major),
+    // each building once.
+    let rows = table(&doc, "ida-fragility");
+    let mut frames_seen = Vec::new();
+    for zone in ["III", "V"] {
+        let (axes, z) = read_zone_ida(&out.join("ida.h5"), zone).unwrap();
+        let b = axes.building.as_ref().unwrap();
+        let per = b.stack_floor.len();
+        for f in 0..b.frames() {
+            let (n, floor) = (b.storeys[f / per], b.stack_floor[f % per]);
+            let label = match (n, floor.to_string().as_str()) {
+                (1, _) => format!(
+                    "1 storey, {}",
+                    frame_tail(&b.stack_floor[f % per].to_string())
+                ),
+                (_, j) => format!("{n} storeys, {}", frame_tail(j)),
+            };
+            let zrows: Vec<&Vec<String>> = rows
+                .iter()
+                .filter(|r| r[0] == zone && r[1] == "0" && r[2] == label)
+                .collect();
+            if n == 1 && f % per > 0 {
+                assert!(zrows.is_empty(), "{label} shown twice");
+                continue;
+            }
+            assert_eq!(
+                zrows.len(),
+                axes.systems.len() * axes.limit_states.len(),
+                "{label}"
+            );
+            for r in zrows {
+                let s = axes.systems.iter().position(|x| *x == r[3]).unwrap();
+                let l = axes.limit_states.iter().position(|x| *x == r[4]).unwrap();
+                let what = format!("zone {zone}, {label}, {}, {}", r[3], r[4]);
+                close(&r[5], z.vars.theta_sa_g[[s, f, l]], 5e-4, &what);
+                close(&r[7], z.vars.beta[[s, f, l]], 5e-4, &what);
+            }
+            frames_seen.push(label);
+        }
+    }
+    assert_eq!(frames_seen.len(), 2 * 4);
+
     // A forced rebuild writes the same bytes.
     let manifest = std::fs::read(report.join("MANIFEST.sha256")).unwrap();
     slidestack(&["report", c, "--out", o, "--force"]);
@@ -549,4 +601,13 @@ fn a_building_studys_report_shows_the_files_numbers() {
         std::fs::read(report.join("MANIFEST.sha256")).unwrap(),
         manifest
     );
+}
+
+/// The end of a frame's label after the storey count (`Frame`'s `Display`).
+fn frame_tail(floor: &str) -> String {
+    match floor {
+        "roof" => "stack on the roof".into(),
+        "all" => "a stack on every floor".into(),
+        j => format!("stack on floor {j}"),
+    }
 }

@@ -673,6 +673,8 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
     };
     let clip = |v: f64| if v.is_infinite() { cap } else { v };
     let labels = frame_labels(study);
+    // Each building once (on one storey every stack floor is the first's).
+    let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
     let d = DemandLayout::PRIMARY;
     let mut panels = Vec::new();
     for zone in &study.cfg.zones {
@@ -680,6 +682,9 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
         let x = axes.sa_grid_g.clone();
         // The first case in every frame: folded index `f` (crate::store::ida).
         for (f, label) in labels.iter().enumerate() {
+            if building && !distinct.contains(&f) {
+                continue;
+            }
             let mut series = Vec::new();
             for s in 0..axes.systems.len() {
                 for r in 0..z.records.len() {

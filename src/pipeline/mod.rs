@@ -387,6 +387,17 @@ impl Study {
         }
     }
 
+    /// A building study's frames that are not an earlier one's building
+    /// ([`crate::study::building::repeats`]), with their stored index; what the fit counts and
+    /// the report shows. Empty on one storey.
+    pub fn distinct_frames(&self) -> Vec<(usize, Frame)> {
+        let frames: Vec<Frame> = self.frames().into_iter().flatten().collect();
+        let repeated = crate::study::building::repeats(&frames);
+        (frames.into_iter().enumerate())
+            .filter(|(f, _)| !repeated[*f])
+            .collect()
+    }
+
     /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`).
     pub fn physics(&self) -> Physics {
         self.cfg.physics()

@@ -11,7 +11,7 @@
 //! * the drift-ratio and floor-acceleration profiles over the height, with and without sliding
 //!   (per storey or floor, the median over the frame's cases of the mean over the motions).
 //!
-//! A frame that repeats an earlier one's building ([`repeats`]) is shown once.
+//! A frame that repeats an earlier one's building is shown once ([`crate::pipeline::Study::distinct_frames`]).
 
 use super::text::fixed;
 use super::{Files, Inputs, ReportError};
@@ -21,7 +21,7 @@ use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
 use crate::render::page::{Section, para, table_with_id};
 use crate::store::StoreError;
 use crate::store::sweep::read_zone_sweep;
-use crate::study::building::{Frame, repeats};
+use crate::study::building::Frame;
 use plotters::style::RGBColor;
 
 /// The `p`-th percentile (0–100) of the finite values of `v`, linearly interpolated between
@@ -93,8 +93,7 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
     let axes = study
         .building()
         .expect("the building section of a building study");
-    let frames: Vec<Frame> = study.frames().into_iter().flatten().collect();
-    let repeated = repeats(&frames);
+    let frames = study.distinct_frames();
     let path = study.path(StageId::Sweep.output());
     let per = grid.cases();
     let n_max = axes.max_storeys();
@@ -125,10 +124,7 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
         );
         let (lam, t_new) = (flat(&lambda.lambda), flat(&z.tnew.vars.t_new));
         let mut zone_frames = Vec::new();
-        for (f, frame) in frames.iter().enumerate() {
-            if repeated[f] {
-                continue;
-            }
+        for &(f, ref frame) in &frames {
             let n = frame.storeys();
             // Mean over the motions of `value(m, case)`, per case.
             let over_motions = |value: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
@@ -437,7 +433,8 @@ pub(super) fn building_section(inp: &Inputs, files: &mut Files) -> Result<Sectio
     let axes: &BuildingAxes = inp.study.building().expect("a building study");
     let mut body = para(&format!(
         "Does a sliding stack lower a building's demands as it lowers one storey's, and how \
-         does it depend on the floor it stands on? Storey counts {}, the stack on {}; each ratio \
+         does it depend on the floor it stands on? Buildings of {} storeys, the stack on {} \
+         (one storey: its only floor); each ratio \
          is the mean over the motions of a peak with the sliding stack over the same with the \
          stack rigidly attached, and the table gives its median over the frame's {} cases \
          (the grid's T_1, α and μ) and, for the drift and the floor acceleration, the share of \
@@ -456,7 +453,7 @@ pub(super) fn building_section(inp: &Inputs, files: &mut Files) -> Result<Sectio
             .iter()
             .map(|s| floor_name(*s))
             .collect::<Vec<_>>()
-            .join(", "),
+            .join(" or "),
         inp.grid.cases()
     ));
     body += &table_with_id("building-answer", &ANSWER_HEADER, &answer_rows(&zones));

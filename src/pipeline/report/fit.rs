@@ -64,16 +64,26 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
             }
         }
     }
-    body += &para(
-        "Residuals (computed − predicted T_new) of every fitted form against T_p, the \
+    body += &para(&format!(
+        "Residuals (computed − predicted T_new) of every fitted form against T_p{}, the \
          recommended one first; each case coloured by its T_new band category (the categories \
          side by side within each T_p column), with the mean and the 5th/95th percentiles per \
          T_p.",
-    );
+        if building {
+            " (the bare building's T_1; every case of the distinct frames)"
+        } else {
+            ""
+        }
+    ));
     for z in &inp.zones {
         body += &residuals(z, inp, files)?;
     }
-    Ok(Section::new("fit", "Design equations (Table 3)", body))
+    let title = if building {
+        "Design equations over the buildings"
+    } else {
+        "Design equations (Table 3)"
+    };
+    Ok(Section::new("fit", title, body))
 }
 
 /// The building equations frame by frame: `T_new`'s (the recommended form with the building's
@@ -81,9 +91,13 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
 fn frames_table(inp: &Inputs) -> String {
     let f3 =
         |m: Option<&Metrics>, v: fn(&Metrics) -> f64| m.map_or("–".into(), |m| fixed(v(m), 3));
+    // fit.yaml lists every frame; one that repeats an earlier one's building is shown once.
+    let distinct: Vec<String> = (inp.study.distinct_frames().iter())
+        .map(|(_, f)| f.to_string())
+        .collect();
     let mut rows = Vec::new();
     for z in &inp.zones {
-        for f in &z.fit.frames {
+        for f in z.fit.frames.iter().filter(|f| distinct.contains(&f.frame)) {
             rows.push(vec![
                 z.name.clone(),
                 f.frame.clone(),

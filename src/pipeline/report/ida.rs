@@ -40,8 +40,14 @@ pub(super) fn ida_section(study: &Study, files: &mut Files) -> Result<Section, P
     let fig = files
         .figure("ida.svg", &figure_of(study)?, caption)
         .map_err(|e: ReportError| PipelineError::from(e))?;
+    // Each building once: on one storey every stack floor is the first's.
+    let distinct: Vec<String> = (study.distinct_frames().iter())
+        .map(|(_, f)| f.to_string())
+        .collect();
+    let shown = |frame: &Option<String>| frame.as_ref().is_none_or(|f| distinct.contains(f));
     let rows: Vec<Vec<String>> = fragility_table(study)?
         .into_iter()
+        .filter(|r| shown(&r.frame))
         .map(|r| {
             let mut row = vec![
                 r.zone,
@@ -62,6 +68,7 @@ pub(super) fn ida_section(study: &Study, files: &mut Files) -> Result<Section, P
         .collect();
     let medians: Vec<Vec<String>> = median_ductility(study)?
         .into_iter()
+        .filter(|m| shown(&m.frame))
         .map(|m| {
             let value = |x: f64| {
                 if building && x.is_finite() {

@@ -44,7 +44,6 @@ use crate::store::fit::{FitReport, FrameFit, ZoneFit, read_fit};
 use crate::store::motions::{ZoneSpectra, read_zone_spectra};
 use crate::store::report::write_report_dir;
 use crate::store::tnew::{ZoneTnew, read_band_flags};
-use crate::study::building::repeats;
 use crate::study::cases::{PAPER_SECTION_7_1, PAPER_TABLE_2, PAPER_TABLE_3, SECTION_7_1, TABLE_2};
 use crate::study::physics::{CaseError, Physics, SystemKind};
 use crate::study::tnew::BAND_FLAGS;
@@ -272,11 +271,9 @@ fn facts(inp: &Inputs) -> Vec<String> {
             ph.mu_static_ratio
         ),
     ];
-    let frames: Vec<_> = study.frames().into_iter().flatten().collect();
-    let repeated = repeats(&frames);
     let mut shown: Vec<usize> = Vec::new();
-    for (f, r) in frames.iter().zip(repeated) {
-        if r || shown.contains(&f.storeys()) {
+    for (_, f) in study.distinct_frames() {
+        if shown.contains(&f.storeys()) {
             continue;
         }
         shown.push(f.storeys());
