@@ -26,7 +26,7 @@ use plotters::style::RGBColor;
 
 /// The `p`-th percentile (0–100) of the finite values of `v`, linearly interpolated between
 /// order statistics (NumPy's default, `nanpercentile`); NaN when none is finite.
-pub(super) fn percentile(v: &[f64], p: f64) -> f64 {
+fn percentile(v: &[f64], p: f64) -> f64 {
     let mut x: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
     if x.is_empty() {
         return f64::NAN;
@@ -181,7 +181,7 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
 }
 
 /// The answer table's header.
-pub(super) const ANSWER_HEADER: [&str; 9] = [
+const ANSWER_HEADER: [&str; 9] = [
     "zone",
     "building, stack on",
     "cases",

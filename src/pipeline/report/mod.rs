@@ -14,6 +14,12 @@
 //! * with an `ida:` section: the first IDA case's curves, the fragility fits and the median
 //!   ductility of the stack against the rigidly attached load (from `ida.h5`).
 //!
+//! A building study's report (`building:`) has the matched motions, the building section
+//! (`building.rs`: per zone and frame, the demands with and without sliding, `T_new/T_1` and `λ`
+//! against `T_1`, the drift and floor-acceleration profiles), the design equations over the
+//! frames and frame by frame, and the IDA per frame; the paper's one-storey cases are a
+//! one-storey study's.
+//!
 //! Panels and lines are picked from the grid's own axes, so any grid (other block counts
 //! included) gives a report. Every simulation uses the study's physics
 //! ([`crate::study::physics::Physics`]). The directory is replaced as a whole
