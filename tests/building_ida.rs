@@ -149,7 +149,9 @@ fn the_building_ida_runs_is_deterministic_resumes_and_is_labelled() {
         ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')\n\
         print(list(ds['fractile_curve'].dims), list(ds['theta'].dims), list(ds['run_demand'].dims))\n\
         print(list(ds['storey_c_y'].dims), list(ds['c_y'].dims), [int(v) for v in ds['storeys'].values], [str(v) for v in ds['stack_floor'].values])\n\
-        print([str(v) for v in ds['demand'].values[:4]])\n";
+        print([str(v) for v in ds['demand'].values[:4]])\n\
+        root = xr.open_dataset(sys.argv[1], engine='h5netcdf')\n\
+        print([a.split(' of')[0] for a in (root.attrs['intensity_measure'], ds['Sa'].attrs['long_name'], ds['record_Sa'].attrs['long_name'])])\n";
     let o = ok(Command::new(python)
         .args(["-c", script, s(&out.join("ida.h5"))])
         .output()
@@ -163,6 +165,7 @@ fn the_building_ida_runs_is_deterministic_resumes_and_is_labelled() {
              ['system', 'record', 'case', 'storeys', 'stack_floor', 'run', 'demand']",
             "['case', 'storeys', 'storey'] ['case'] [3] ['1', 'roof']",
             "['peak_drift_ratio', 'residual_drift_ratio', 'peak_floor_accel_g', 'ductility']",
+            "['Sa(T_1, 5 %)', 'Sa(T_1, 5 %)', 'Sa(T_1, 5 %)']",
         ],
         "{text}"
     );

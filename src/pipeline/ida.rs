@@ -305,7 +305,11 @@ fn settings_attrs<'a>(
         ("cap_sa_g", Attr::F64(t.cap_sa_g)),
         (
             "intensity_measure",
-            Attr::Str("Sa(T_p, 5 %) of the scaled motion, T_p the bare structure's period, g"),
+            Attr::Str(if building_json.is_some() {
+                "Sa(T_1, 5 %) of the scaled motion, T_1 the bare building's first-mode period, g"
+            } else {
+                "Sa(T_p, 5 %) of the scaled motion, T_p the bare structure's period, g"
+            }),
         ),
         (
             "fragility_method",

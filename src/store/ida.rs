@@ -309,7 +309,12 @@ fn write_coordinates(g: &hdf5::Group, axes: &IdaAxes, z: &ZoneIda) -> hdf5::Resu
         "Sa",
         &axes.sa_grid_g,
         "g",
-        "Sa(T_p, 5 %) of the scaled motion: the common intensity grid",
+        if axes.building.is_some() {
+            "Sa(T_1, 5 %) of the scaled motion (T_1 the bare building's first-mode period): the \
+             common intensity grid"
+        } else {
+            "Sa(T_p, 5 %) of the scaled motion: the common intensity grid"
+        },
     )?;
     let demand = strings_scale(
         g,
@@ -429,7 +434,11 @@ fn write_cases(
         &split(&v.record_sa_g, 1, frames),
         &d.around(&[&d.record], &[]),
         "g",
-        "Sa(T_p, 5 %) of the unscaled motion",
+        if d.building.is_some() {
+            "Sa(T_1, 5 %) of the unscaled motion (T_1 the bare building's first-mode period)"
+        } else {
+            "Sa(T_p, 5 %) of the unscaled motion"
+        },
     )
 }
 
