@@ -54,7 +54,7 @@ pub fn run(args: Args) -> Result<()> {
             r.status
         );
     }
-    let medians = ida::median_ductility(&session.study)?;
+    let medians = ida::median_demand(&session.study)?;
     println!(
         "median {} at multiples of the zone's target Sa(T_p) (the matched motions' level):",
         medians.first().map_or("ductility", |m| m.demand.as_str())

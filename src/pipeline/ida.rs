@@ -554,7 +554,7 @@ fn frame_labels(study: &Study) -> Vec<Option<String>> {
 /// The median primary demand (ductility on one storey, the peak interstorey drift ratio in a
 /// building) of the stack and of the rigidly attached load at one intensity.
 #[derive(Debug, Clone, PartialEq)]
-pub struct MedianDuctility {
+pub struct MedianDemand {
     pub zone: String,
     pub case: usize,
     /// The frame of a building study (`3 storeys, stack on the roof`).
@@ -566,7 +566,8 @@ pub struct MedianDuctility {
     pub mu: Vec<f64>,
     /// The intensity is `factor × target_sa_g`.
     pub factor: f64,
-    /// The zone's target `Sa(T_p)`, g: the level the motions are matched to.
+    /// The zone's target `Sa(T_p)` (`Sa(T_1)` in a building), g: the level the motions are
+    /// matched to.
     pub target_sa_g: f64,
     pub stack: f64,
     pub rigid: f64,
@@ -574,7 +575,7 @@ pub struct MedianDuctility {
     pub stack_max_slip_m: f64,
 }
 
-/// Multiples of the zone's target at which [`median_ductility`] compares the systems.
+/// Multiples of the zone's target at which [`median_demand`] compares the systems.
 pub const TARGET_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
 
 /// `y` on the grid `x` at `at`, linearly (`+∞` where either neighbour is; NaN outside).
@@ -595,7 +596,7 @@ fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
 
 /// The median ductility of both systems at [`TARGET_FACTORS`] × the zone's target `Sa(T_p)`,
 /// read off the median curves of `ida.h5` (NaN above the grid).
-pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineError> {
+pub fn median_demand(study: &Study) -> Result<Vec<MedianDemand>, PipelineError> {
     study.require(StageId::Motions)?;
     study.require(StageId::Ida)?;
     let targets = stored_targets(study)?;
@@ -630,7 +631,7 @@ pub fn median_ductility(study: &Study) -> Result<Vec<MedianDuctility>, PipelineE
                 .fold(0.0, f64::max);
             for factor in TARGET_FACTORS {
                 let at = factor * target_sa_g;
-                rows.push(MedianDuctility {
+                rows.push(MedianDemand {
                     zone: zone.name.clone(),
                     case: c,
                     frame: labels[cf % nf].clone(),

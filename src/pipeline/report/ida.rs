@@ -5,7 +5,7 @@
 
 use super::{Files, PipelineError, ReportError};
 use crate::pipeline::Study;
-use crate::pipeline::ida::{figure_of, fragility_table, median_ductility};
+use crate::pipeline::ida::{figure_of, fragility_table, median_demand};
 use crate::render::page::{Section, para, table_with_id};
 
 fn g3(x: f64) -> String {
@@ -66,7 +66,7 @@ pub(super) fn ida_section(study: &Study, files: &mut Files) -> Result<Section, P
             row
         })
         .collect();
-    let medians: Vec<Vec<String>> = median_ductility(study)?
+    let medians: Vec<Vec<String>> = median_demand(study)?
         .into_iter()
         .filter(|m| shown(&m.frame))
         .map(|m| {
