@@ -624,9 +624,8 @@ fn a_building_study_of_one_frame_is_fitted_and_says_which() {
         text.contains("building: 3 storeys, stack on the roof"),
         "{text}"
     );
-    let e = stderr(&slidestack(&["report", c, "--out", o], "1"));
-    assert!(
-        e.contains("`building`: the `report` stage cannot yet"),
-        "{e}"
-    );
+    // The report takes it: its building section has the one frame.
+    ok(slidestack(&["report", c, "--out", o], "1"));
+    let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    assert!(html.contains("<td>3 storeys, roof</td>"), "{html}");
 }
