@@ -624,9 +624,32 @@ fn a_building_study_of_one_frame_is_fitted_and_says_which() {
         text.contains("building: 3 storeys, stack on the roof"),
         "{text}"
     );
-    let e = stderr(&slidestack(&["report", c, "--out", o], "1"));
+    // The report takes it, its design page with the one frame (tests/design_page.rs holds a
+    // building study's page to `slidestack design`).
+    ok(slidestack(&["report", c, "--out", o], "1"));
+    let page = std::fs::read_to_string(out.join("report/design.html")).unwrap();
     assert!(
-        e.contains("`building`: the `report` stage cannot yet"),
-        "{e}"
+        page.contains("<option value='0'>3 storeys, stack on the roof</option>"),
+        "{page}"
     );
+    ok(slidestack(
+        &[
+            "design",
+            "--study",
+            o,
+            "--zone",
+            "V",
+            "--period",
+            "0.6",
+            "--alpha",
+            "1,1",
+            "--mu",
+            "0.3,0.1",
+            "--storeys",
+            "3",
+            "--floor",
+            "3",
+        ],
+        "1",
+    ));
 }
