@@ -25,9 +25,11 @@ use crate::store::fit::{FitReport, FormFit, FrameSpec, ZoneFit, read_fit};
 use crate::store::h5::stored_fingerprint;
 use crate::store::motions::read_zone_target;
 use crate::store::tnew::{
-    is_building, read_motions_fingerprint, read_zone_tnew_in, zones_and_blocks,
+    ZoneTnew, is_building, read_motions_fingerprint, read_zone_tnew_in, zones_and_blocks,
 };
+use crate::study::building::{Frame, repeats};
 use serde::Serialize;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -185,6 +187,45 @@ impl ZoneDesign {
             lambda: None,
         }
     }
+
+    /// Frame `f` (stored order) of zone `zone` of a building study: the frame's cases of the
+    /// zone's stored `T_new` and `λ` (`t` holds every frame's), `fit.yaml`'s frame and
+    /// building features, the zone's fits of `T_new` and `λ`.
+    pub fn of_frame(
+        zone: &str,
+        target: TargetSpectrum,
+        grid: Grid,
+        t: &ZoneTnew,
+        fit: &FitReport,
+        f: usize,
+    ) -> Self {
+        let cases = frame_cases(&grid, f);
+        let zone_fit = fit.zones.iter().find(|z| z.zone == zone);
+        let frame_of = |v: &ndarray::ArrayD<f64>| -> Vec<f64> {
+            v.iter()
+                .skip(cases.start)
+                .take(cases.len())
+                .copied()
+                .collect()
+        };
+        let features = BuildingFeatures::of_names(&fit.features, grid.blocks());
+        let lambda = t.lambda.as_ref().map(|l| {
+            let fitted = zone_fit
+                .and_then(|z| z.lambda.as_ref())
+                .map(FormFit::fitted);
+            (frame_of(&l.lambda), fitted)
+        });
+        let mut data = Self::new(zone, target, grid, frame_of(&t.vars.t_new), zone_fit);
+        data.building = Some((fit.frames[f].clone(), features));
+        data.lambda = lambda;
+        data
+    }
+
+    /// A building study's frame, `3 storeys, stack on the roof` (as [`Answer::building`]).
+    pub fn frame_label(&self) -> Option<String> {
+        let (spec, _) = self.building.as_ref()?;
+        Some(spec.frame()?.to_string())
+    }
 }
 
 /// `Err` unless `value` is finite and positive.
@@ -257,50 +298,97 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
     check_counts(q, blocks)?;
     let (grid, axes, t) = read_zone_tnew_in(&tnew, &q.zone, blocks, building)?;
     let target = read_zone_target(&motions, &q.zone)?;
-    let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
-    let t_new: Vec<f64> = t.vars.t_new.iter().copied().collect();
-    let (t_new, frame, lambda) = match (q.building, axes) {
+    let data = match (q.building, axes) {
         (Some((storeys, floor)), Some(axes)) => {
-            let f = frame_index(&fit, &axes, storeys, floor, &fit_yaml)?;
-            let cases = f * grid.cases()..(f + 1) * grid.cases();
-            let features = BuildingFeatures::of_names(&fit.features, blocks);
-            let frame = (fit.frames[f].clone(), features);
-            let lambda = t.lambda.as_ref().map(|l| {
-                let values: Vec<f64> = l.lambda.iter().copied().collect();
-                let fitted = zone_fit
-                    .and_then(|z| z.lambda.as_ref())
-                    .map(FormFit::fitted);
-                (values[cases.clone()].to_vec(), fitted)
-            });
-            (t_new[cases].to_vec(), Some(frame), lambda)
+            check_frames(&fit, &axes, &fit_yaml)?;
+            let f = frame_index(&fit, &axes, storeys, floor)?;
+            ZoneDesign::of_frame(&q.zone, target, grid, &t, &fit, f)
         }
-        _ => (t_new, None, None),
+        _ => {
+            let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
+            ZoneDesign::new(
+                &q.zone,
+                target,
+                grid,
+                t.vars.t_new.iter().copied().collect(),
+                zone_fit,
+            )
+        }
     };
-    let mut data = ZoneDesign::new(&q.zone, target, grid, t_new, zone_fit);
-    data.building = frame;
-    data.lambda = lambda;
     answer(&data, q)
 }
 
+/// The cases of frame `f` (stored order) among a building study's, every frame's cases
+/// flat (`[storeys, stack_floor, T_p, alpha…, mu…]` row-major).
+pub fn frame_cases(grid: &Grid, f: usize) -> Range<usize> {
+    f * grid.cases()..(f + 1) * grid.cases()
+}
+
+/// `Err` unless `fit.yaml`'s frames are `tnew.h5`'s (`axes`), in the same order.
+fn check_frames(fit: &FitReport, axes: &BuildingAxes, fit_yaml: &Path) -> Result<(), DesignError> {
+    let agrees = fit.frames.len() == axes.frames()
+        && (fit.frames.iter().enumerate()).all(|(f, a)| {
+            let (n, floor) = axes.frame(f);
+            a.storeys == n && a.stack_floor == floor.to_string()
+        });
+    if agrees {
+        Ok(())
+    } else {
+        Err(DesignError::Mismatch {
+            file: fit_yaml.to_path_buf(),
+        })
+    }
+}
+
+/// Every frame `f` of zone `zone` of a building study that [`design`] answers from, with its
+/// [`ZoneDesign`], in stored order: a frame repeating an earlier one's building
+/// ([`repeats`]) is left out, since [`design`] answers a question about it from the earlier
+/// one. `t` is the zone's `tnew.h5` (with its `axes`), `fit` the study's `fit.yaml` (read
+/// from `fit_yaml`). The report's design page embeds these.
+pub fn frame_designs(
+    zone: &str,
+    target: &TargetSpectrum,
+    grid: &Grid,
+    axes: &BuildingAxes,
+    t: &ZoneTnew,
+    fit: &FitReport,
+    fit_yaml: &Path,
+) -> Result<Vec<(usize, ZoneDesign)>, DesignError> {
+    check_frames(fit, axes, fit_yaml)?;
+    let frames: Vec<Frame> = (fit.frames.iter())
+        .map(FrameSpec::frame)
+        .collect::<Option<_>>()
+        .ok_or_else(|| DesignError::Mismatch {
+            file: fit_yaml.to_path_buf(),
+        })?;
+    Ok((repeats(&frames).into_iter().enumerate())
+        .filter(|(_, r)| !r)
+        .map(|(f, _)| {
+            let d = ZoneDesign::of_frame(zone, target.clone(), grid.clone(), t, fit, f);
+            (f, d)
+        })
+        .collect())
+}
+
+/// `3 storeys, stack on the roof` of every frame of `fit`, each in backticks: the frames a
+/// building study holds, as a refusal lists them.
+pub fn known_frames(fit: &FitReport) -> String {
+    (fit.frames.iter())
+        .filter_map(FrameSpec::frame)
+        .map(|f| format!("`{f}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The index of the frame of `storeys` storeys with the stack on `floor` among the study's
-/// (`fit.yaml`'s, `tnew.h5`'s order): the one whose stacks stand on the same floors (floor `N`
-/// is the roof).
+/// (`fit.yaml`'s, `tnew.h5`'s order, checked alike by [`check_frames`]): the first whose
+/// stacks stand on the same floors (floor `N` is the roof).
 fn frame_index(
     fit: &FitReport,
     axes: &BuildingAxes,
     storeys: usize,
     floor: StackFloor,
-    fit_yaml: &Path,
 ) -> Result<usize, DesignError> {
-    let stored: Vec<(usize, StackFloor)> = (0..axes.frames()).map(|f| axes.frame(f)).collect();
-    let agrees = fit.frames.len() == stored.len()
-        && (fit.frames.iter().zip(&stored))
-            .all(|(a, b)| a.storeys == b.0 && a.stack_floor == b.1.to_string());
-    if !agrees {
-        return Err(DesignError::Mismatch {
-            file: fit_yaml.to_path_buf(),
-        });
-    }
     let wanted = floor.floors(storeys);
     if let StackFloor::Floor(j) = floor
         && !(1..=storeys).contains(&j)
@@ -311,16 +399,13 @@ fn frame_index(
             known: format!("floors 1 … {storeys} in a building of {storeys} storeys"),
         });
     }
-    (stored.iter())
-        .position(|&(n, f)| n == storeys && f.floors(n) == wanted)
+    (0..axes.frames())
+        .map(|f| axes.frame(f))
+        .position(|(n, f)| n == storeys && f.floors(n) == wanted)
         .ok_or_else(|| DesignError::UnknownFrame {
             storeys,
             floor: floor.to_string(),
-            known: (fit.frames.iter())
-                .filter_map(FrameSpec::frame)
-                .map(|f| format!("`{f}`"))
-                .collect::<Vec<_>>()
-                .join(", "),
+            known: known_frames(fit),
         })
 }
 

@@ -628,4 +628,31 @@ fn a_building_study_of_one_frame_is_fitted_and_says_which() {
     ok(slidestack(&["report", c, "--out", o], "1"));
     let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
     assert!(html.contains("<td>3 storeys, roof</td>"), "{html}");
+    // Its design page with the one frame (tests/design_page.rs holds a building study's page
+    // to `slidestack design`).
+    let page = std::fs::read_to_string(out.join("report/design.html")).unwrap();
+    assert!(
+        page.contains("<option value='0'>3 storeys, stack on the roof</option>"),
+        "{page}"
+    );
+    ok(slidestack(
+        &[
+            "design",
+            "--study",
+            o,
+            "--zone",
+            "V",
+            "--period",
+            "0.6",
+            "--alpha",
+            "1,1",
+            "--mu",
+            "0.3,0.1",
+            "--storeys",
+            "3",
+            "--floor",
+            "3",
+        ],
+        "1",
+    ));
 }

@@ -8,10 +8,20 @@
 //! and images resolve. A page with an outside image and a thrown error shows that the probe sees
 //! both.
 //!
+//! The same on a building study (configs/mdof-quick.yaml: one and three storeys, the stack on
+//! floor 1, the roof, every floor): for questions on each kind of frame (at grid points and
+//! between them, a frame that repeats another's building, outside the grid, frames the study
+//! lacks, a floor that is none), given in the address and typed into the storey and floor
+//! inputs, every output (λ's included) and the building's name against `slidestack design
+//! --json … --storeys N --floor F`, a frame's refusal word for word.
+//!
 //! Tolerances: the page's text is the command's value printed to 3 decimals, compared as text
 //! (the printed precision); the page's full value (`data-value`) within 1e-12 relative, since
 //! the browser's `exp` and `ln` may differ from Rust's in the last bit and a few operations
-//! follow (the values agree exactly on the cases seen).
+//! follow (the values agree exactly on the cases seen). A building's `T_1,rigid` comes from the
+//! lowest eigenvalues of two 3 × 3 problems, by bisection in the page and by nalgebra's QR
+//! iteration in the command: each is within a few ulps of the matrix's norm, a relative error
+//! below ~1e-14 for these well-conditioned frames, inside the same 1e-12.
 
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
@@ -118,6 +128,16 @@ fn query(q: &Question) -> String {
 
 /// The page's elements (`probe`'s `elements`) agree with the command's answer for `q`.
 fn check_page(q: &Question, page: &Value, cli: &Result<Value, String>) {
+    check_outputs(q, &OUTPUTS, page, cli);
+}
+
+/// [`check_page`] over the outputs `outputs` of a question shown as `q`.
+fn check_outputs(
+    q: &dyn std::fmt::Debug,
+    outputs: &[&str],
+    page: &Value,
+    cli: &Result<Value, String>,
+) {
     let el = &page["elements"];
     let text = |id: &str| {
         el[id]["text"]
@@ -127,7 +147,7 @@ fn check_page(q: &Question, page: &Value, cli: &Result<Value, String>) {
     match cli {
         Ok(a) => {
             assert_eq!(text("error"), "", "{q:?}");
-            for id in OUTPUTS {
+            for &id in outputs {
                 match a[id].as_f64() {
                     None => {
                         assert_eq!(text(id), "–", "{q:?}: #{id}");
@@ -164,7 +184,7 @@ fn check_page(q: &Question, page: &Value, cli: &Result<Value, String>) {
                 "{q:?}: page `{}`, command `{stderr}`",
                 text("error")
             );
-            for id in OUTPUTS {
+            for &id in outputs {
                 assert_eq!(text(id), "–", "{q:?}: #{id}");
             }
         }
@@ -328,4 +348,236 @@ fn design_page_answers_as_the_command_does() {
     let errors = control["errors"].to_string();
     assert!(errors.contains("undefinedFunction"), "{errors}");
     assert_eq!(control["broken_images"].as_array().unwrap().len(), 1);
+}
+
+/// A building study's question: zone, `T_1`, `α`, `μ`, extrapolate, storeys, floor.
+type FrameQuestion = (
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static str,
+    bool,
+    &'static str,
+    &'static str,
+);
+
+/// The outputs of a building study's page: the one-storey page's and `λ`'s.
+const BUILDING_OUTPUTS: [&str; 8] = [
+    "t_rigid_s",
+    "t_new_grid_s",
+    "t_new_fit_s",
+    "t_new_paper_s",
+    "sa_tp_g",
+    "sa_new_g",
+    "lambda_grid",
+    "lambda_fit",
+];
+
+/// `slidestack design --json … --storeys N --floor F` for `q`, as [`command`].
+fn frame_command(study: &Path, q: &FrameQuestion) -> Result<Value, String> {
+    let (zone, period, alpha, mu, extrapolate, storeys, floor) = *q;
+    let mut c = Command::new(env!("CARGO_BIN_EXE_slidestack"));
+    c.args(["design", "--study"]).arg(study).args([
+        "--zone",
+        zone,
+        "--period",
+        period,
+        "--alpha",
+        alpha,
+        "--mu",
+        mu,
+        "--storeys",
+        storeys,
+        "--floor",
+        floor,
+        "--json",
+    ]);
+    if extrapolate {
+        c.arg("--extrapolate");
+    }
+    let o = c.output().unwrap();
+    if o.status.success() {
+        Ok(serde_json::from_slice(&o.stdout).unwrap())
+    } else {
+        assert_eq!(o.status.code(), Some(2), "{q:?}");
+        Err(String::from_utf8_lossy(&o.stderr).trim().to_string())
+    }
+}
+
+fn frame_query(q: &FrameQuestion) -> String {
+    let (zone, period, alpha, mu, extrapolate, storeys, floor) = *q;
+    let e = if extrapolate { "&extrapolate=1" } else { "" };
+    format!("?zone={zone}&period={period}&alpha={alpha}&mu={mu}&storeys={storeys}&floor={floor}{e}")
+}
+
+/// [`check_outputs`] for a building study's question, and the building the page names; a
+/// refusal of the frame as the command words it (after its `error: `; a floor that is none
+/// after the flag's name clap puts first).
+fn check_frame_page(q: &FrameQuestion, page: &Value, cli: &Result<Value, String>) {
+    let el = &page["elements"];
+    let text = |id: &str| {
+        el[id]["text"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{q:?}: no #{id}"))
+    };
+    match cli {
+        Err(stderr) if !stderr.contains(" = ") => {
+            let error = text("error");
+            assert!(
+                !error.is_empty(),
+                "{q:?}: the page answers, the command says {stderr}"
+            );
+            if stderr.contains("the study has no building") {
+                assert_eq!(stderr, &format!("error: {error}"), "{q:?}");
+            } else {
+                assert!(
+                    stderr.contains(&format!("': {error}")),
+                    "{q:?}: page `{error}`, command `{stderr}`"
+                );
+            }
+            for id in BUILDING_OUTPUTS {
+                assert_eq!(text(id), "–", "{q:?}: #{id}");
+            }
+            assert_eq!(text("building"), "–", "{q:?}");
+        }
+        _ => {
+            check_outputs(q, &BUILDING_OUTPUTS, page, cli);
+            let building = cli
+                .as_ref()
+                .map_or("–", |a| a["building"].as_str().unwrap());
+            assert_eq!(text("building"), building, "{q:?}");
+        }
+    }
+}
+
+#[test]
+fn a_building_studys_design_page_answers_as_the_command_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .arg("run")
+        .arg(root().join("configs/mdof-quick.yaml"))
+        .arg("--out")
+        .arg(&study)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = study.join("report");
+    let design = file_url(&report.join("design.html"));
+    // The grid: T_1 0.3, 0.6, 1 s; α_1 0.25, 0.5; α_2 0.5; μ_1 0.1, 0.3; μ_2 0.05, 0.2; one
+    // and three storeys; the stack on floor 1, the roof, every floor.
+    let questions: [FrameQuestion; 16] = [
+        // A grid point of each kind of frame of three storeys.
+        ("III", "0.6", "0.25,0.5", "0.1,0.05", false, "3", "roof"),
+        ("V", "0.6", "0.5,0.5", "0.3,0.2", false, "3", "1"),
+        ("III", "1", "0.25,0.5", "0.3,0.05", false, "3", "all"),
+        // Between grid points: floor 1, the roof, every floor; the roof named by its number.
+        ("V", "0.45", "0.3,0.5", "0.2,0.1", false, "3", "1"),
+        ("III", "0.8", "0.4,0.5", "0.25,0.15", false, "3", "roof"),
+        ("V", "0.37", "0.45,0.5", "0.12,0.17", false, "3", "all"),
+        ("III", "0.8", "0.4,0.5", "0.25,0.15", false, "3", "3"),
+        // One storey: floor 1; the roof and every floor are the same building.
+        ("V", "0.45", "0.3,0.5", "0.2,0.1", false, "1", "1"),
+        ("V", "0.45", "0.3,0.5", "0.2,0.1", false, "1", "roof"),
+        ("III", "0.3", "0.25,0.5", "0.1,0.05", false, "1", "all"),
+        // Outside the grid: refused, then extrapolated.
+        ("III", "1.5", "0.25,0.5", "0.1,0.05", false, "3", "roof"),
+        ("III", "1.5", "0.25,0.5", "0.1,0.05", true, "3", "roof"),
+        // Frames the study lacks: a floor of three storeys, a storey count, a floor above the
+        // roof; and a floor that is none.
+        ("V", "0.6", "0.25,0.5", "0.1,0.05", false, "3", "2"),
+        ("V", "0.6", "0.25,0.5", "0.1,0.05", false, "2", "roof"),
+        ("V", "0.6", "0.25,0.5", "0.1,0.05", false, "1", "3"),
+        ("V", "0.6", "0.25,0.5", "0.1,0.05", false, "3", "0"),
+    ];
+    let mut ids: Vec<&str> = BUILDING_OUTPUTS.to_vec();
+    ids.extend([
+        "error",
+        "fit_form",
+        "notes",
+        "building",
+        "permalink",
+        "storeys",
+        "floor",
+    ]);
+    let mut pages: Vec<Value> = questions
+        .iter()
+        .map(|q| json!({"url": format!("{design}{}", frame_query(q)), "ids": ids}))
+        .collect();
+    // Typed into the inputs: from the example, one storey with a stack on every floor and
+    // T_1 0.45 s.
+    let typed: FrameQuestion = ("III", "0.45", "0.25,0.5", "0.1,0.05", false, "1", "all");
+    pages.push(json!({
+        "url": design,
+        "ids": ids,
+        "script": "(() => { const set = (id, v, ev) => { const e = document.getElementById(id); \
+                   e.value = v; e.dispatchEvent(new Event(ev, {bubbles: true})); }; \
+                   set('storeys', '1', 'change'); set('floor', 'all', 'change'); \
+                   set('period', '0.45', 'input'); })()",
+    }));
+    // The explorer, DRR_1 of zone V on three storeys with the stack on the roof, every
+    // friction pair.
+    pages.push(json!({
+        "url": design,
+        "ids": ["fig-explorer", "x-frame"],
+        "script": "(() => { const change = (id, f) => { const e = document.getElementById(id); \
+                   f(e); e.dispatchEvent(new Event('change', {bubbles: true})); }; \
+                   change('x-quantity', e => { e.value = 'DRR_1'; }); \
+                   change('x-zone', e => { e.value = 'V'; }); \
+                   change('x-frame', e => { e.value = String(Array.from(e.options).findIndex(\
+                   o => o.text === '3 storeys, stack on the roof')); }); \
+                   change('x-mu', e => { for (const o of e.options) o.selected = true; }); })()",
+    }));
+    pages.push(
+        json!({"url": file_url(&report.join("index.html")), "ids": ["design-link", "not-shown"]}),
+    );
+    let answer = probe(&json!({ "pages": pages }));
+    let seen = answer["pages"].as_array().unwrap();
+    assert_eq!(seen.len(), questions.len() + 3);
+
+    let mut refused = 0;
+    for (q, page) in questions.iter().zip(seen) {
+        let cli = frame_command(&study, q);
+        refused += usize::from(cli.is_err());
+        check_frame_page(q, page, &cli);
+        check_quiet(page);
+    }
+    // The refusals: outside the grid, three frames the study lacks, a floor that is none.
+    assert_eq!(refused, 5);
+
+    let typed_page = &seen[questions.len()];
+    check_frame_page(&typed, typed_page, &frame_command(&study, &typed));
+    check_quiet(typed_page);
+    assert_eq!(
+        typed_page["elements"]["permalink"]["text"],
+        format!("design.html{}", frame_query(&typed))
+    );
+
+    let explorer = &seen[questions.len() + 1];
+    check_quiet(explorer);
+    let legend = explorer["elements"]["fig-explorer"]["text"]
+        .as_str()
+        .unwrap();
+    assert!(legend.contains("Zone V: DRR_1 against T_p"), "{legend}");
+    assert_eq!(explorer["elements"]["fig-explorer"]["paths"], 5, "{legend}");
+    // One choice per distinct building: 1 storey (floor 1), 3 storeys × 3 floors.
+    let frames = explorer["elements"]["x-frame"]["text"].as_str().unwrap();
+    assert_eq!(
+        frames,
+        "1 storey, stack on floor 13 storeys, stack on floor 13 storeys, stack on the roof\
+         3 storeys, a stack on every floor"
+    );
+
+    // The summary links the page with an example that is a grid point of the study, and the
+    // page is no longer among what the report leaves out.
+    let index = &seen[questions.len() + 2];
+    check_quiet(index);
+    let links: Vec<&str> = (index["links"].as_array().unwrap().iter())
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    let example = format!("{design}{}", frame_query(&questions[0]));
+    assert!(links.contains(&example.as_str()), "{links:?}");
+    assert!(links.contains(&design.as_str()), "{links:?}");
+    let not_shown = index["elements"]["not-shown"]["text"].as_str().unwrap();
+    assert!(!not_shown.contains("design page"), "{not_shown}");
 }

@@ -7,6 +7,9 @@
 const DATA = JSON.parse(document.getElementById("study-data").textContent);
 const ZONES = DATA.zones;
 const BLOCKS = ZONES[0].grid.alpha.length;
+// A building study's page: one ZONES entry per zone and frame (design.rs, frame_designs), and
+// DATA.frames: each entry's label, every frame of the study, the example query.
+const FRAMES = DATA.frames || null;
 const NS = "http://www.w3.org/2000/svg";
 const COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b",
   "#e377c2", "#7f7f7f", "#bcbd22"];
@@ -77,6 +80,12 @@ function logistic(z) {
 // fit/forms.rs, Form::regressors and Form::evaluate (no gradient).
 function predict(fit, x, tP, tRigid) {
   const p = fit.params;
+  if (fit.form === "fraction") {
+    const z = x.map(Math.log);
+    z.push(z[0] * z[0]);
+    const k = z.length;
+    return logistic(dot(p.slice(0, k), z) + p[k]);
+  }
   if (fit.form === "paper") {
     const k = x.length;
     const ex = Math.exp(dot(p.slice(k, 2 * k), x));
@@ -136,12 +145,129 @@ function saG(t, T) {
 
 const fin = (v) => (v !== null && Number.isFinite(v) ? v : null);
 
+// ---- a building study's frame ----
+
+// grid.rs, StackFloor: parsed from its text (`3`, `roof`, `all`), and StackFloor::floors.
+function parseFloor(s) {
+  if (s === "roof" || s === "all") return { floor: s };
+  if (/^\+?[0-9]+$/.test(s) && Number(s) >= 1) return { floor: Number(s) };
+  return { error: "`" + s + "` is not a floor, `roof` or `all`" };
+}
+
+function floorsOf(floor, storeys) {
+  if (floor === "roof") return [storeys];
+  if (floor === "all") return Array.from({ length: storeys }, (_, i) => i + 1);
+  return [floor];
+}
+
+const sameList = (a, b) => a.length === b.length && a.every((v, i) => v === b[i]);
+
+// design.rs, frame_index: the first frame of `storeys` storeys whose stacks stand on the floors
+// `floor` names there (ZONES holds the first of each building), or the command's refusal.
+function frameEntry(zone, storeys, floor) {
+  const wanted = floorsOf(floor, storeys);
+  const refuse = (known) => ({ error: "the study has no building of " + storeys +
+    " storeys with the stack on floor `" + floor + "`; it has " + known });
+  if (typeof floor === "number" && !(floor >= 1 && floor <= storeys)) {
+    return refuse("floors 1 … " + storeys + " in a building of " + storeys + " storeys");
+  }
+  const k = ZONES.findIndex((z) => z.zone === zone && z.building[0].storeys === storeys &&
+    sameList(floorsOf(parseFloor(z.building[0].stack_floor).floor, storeys), wanted));
+  return k < 0 ? refuse(FRAMES.known) : { z: ZONES[k], label: FRAMES.labels[k] };
+}
+
+// study/building.rs, Frame::stack_height_ratio.
+function stackHeightRatio(spec) {
+  const n = spec.floor_masses.length;
+  const height = (f) => {
+    let h = 0.0;
+    for (let i = 0; i < f; i++) h += spec.storey_heights_m[i];
+    return h;
+  };
+  const roof = height(n);
+  const floors = floorsOf(parseFloor(spec.stack_floor).floor, n);
+  const weight = (f) => spec.floor_masses[f - 1];
+  let total = 0.0;
+  for (const f of floors) total += weight(f);
+  let sum = 0.0;
+  for (const f of floors) sum += weight(f) * height(f) / roof;
+  return sum / total;
+}
+
+// The lowest eigenvalue of K·φ = ω²·M·φ (dynamics/building/model.rs, modes: the symmetric
+// tridiagonal M^{-1/2}·K·M^{-1/2}), by bisection on its Sturm sequence to the last bit
+// (a different algorithm from nalgebra's: the two agree to a few ulps of the matrix's norm).
+function lowestOmega2(masses, k) {
+  const n = masses.length;
+  const s = masses.map((m) => 1.0 / Math.sqrt(m));
+  const d = [];
+  const e = [];
+  for (let r = 0; r < n; r++) {
+    const above = r + 1 < n ? k[r + 1] : 0.0;
+    d.push(s[r] * (k[r] + above) * s[r]);
+    if (r + 1 < n) e.push(s[r] * -k[r + 1] * s[r + 1]);
+  }
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (let r = 0; r < n; r++) {
+    const off = (r > 0 ? Math.abs(e[r - 1]) : 0.0) + (r + 1 < n ? Math.abs(e[r]) : 0.0);
+    lo = Math.min(lo, d[r] - off);
+    hi = Math.max(hi, d[r] + off);
+  }
+  // How many eigenvalues lie below x.
+  const below = (x) => {
+    let count = 0;
+    let q = 1.0;
+    for (let r = 0; r < n; r++) {
+      q = d[r] - x - (r > 0 ? (e[r - 1] * e[r - 1]) / q : 0.0);
+      if (q === 0.0) q = -Number.MIN_VALUE;
+      if (q < 0.0) count++;
+    }
+    return count;
+  };
+  for (;;) {
+    const mid = 0.5 * (lo + hi);
+    if (!(mid > lo && mid < hi)) break;
+    if (below(mid) >= 1) hi = mid;
+    else lo = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// study/building.rs, Frame::t_rigid_s (T_p·sqrt(1+α) on one storey).
+function frameTRigid(spec, period, alphaTotal) {
+  const n = spec.floor_masses.length;
+  if (n === 1) return period * Math.sqrt(1.0 + alphaTotal);
+  const loaded = spec.floor_masses.slice();
+  for (const f of floorsOf(parseFloor(spec.stack_floor).floor, n)) loaded[f - 1] *= 1.0 + alphaTotal;
+  const bare = lowestOmega2(spec.floor_masses, spec.storey_stiffnesses);
+  const rigid = lowestOmega2(loaded, spec.storey_stiffnesses);
+  return period * Math.sqrt(bare / rigid);
+}
+
+// fit/mod.rs, BuildingFeatures::features (the one-storey features without a building or
+// without its features).
+function fitFeatures(z, period, alpha, mu) {
+  const x = [period, ...mu, ...alpha];
+  if (!z.building || !z.building[1]) return x;
+  const [spec, bf] = z.building;
+  if (bf.storeys) x.push(spec.storeys);
+  if (bf.height) x.push(stackHeightRatio(spec));
+  return x;
+}
+
+// T_rigid (s) of entry `z` for T_p `period` and the stack's total mass ratio `alphaTotal`.
+function tRigidOf(z, period, alphaTotal) {
+  return z.building ? frameTRigid(z.building[0], period, alphaTotal)
+    : period * Math.sqrt(1.0 + alphaTotal);
+}
+
 // design.rs, answer: {answer} or {error}.
 function answer(q) {
-  const z = ZONES.find((z) => z.zone === q.zone);
+  let z = ZONES.find((z) => z.zone === q.zone);
   if (!z) {
     return { error: "zone `" + q.zone + "` is not in the study; it has " +
-      ZONES.map((z) => z.zone).join(", ") };
+      [...new Set(ZONES.map((z) => z.zone))].join(", ") };
   }
   const bad = (what, v) => ({ error: what + " = " + rustNum(v) + " must be finite and > 0" });
   if (!(Number.isFinite(q.period) && q.period > 0)) return bad("T_p", q.period);
@@ -154,10 +280,22 @@ function answer(q) {
         BLOCKS + " blocks" };
     }
   }
+  let label = null;
+  if (FRAMES) {
+    if (q.floorError) return { error: q.floorError };
+    const f = frameEntry(q.zone, q.storeys, q.floor);
+    if (f.error) return f;
+    [z, label] = [f.z, f.label];
+  }
   let alphaTotal = 0.0;
   for (const a of q.alpha) alphaTotal += a;
-  const tRigid = q.period * Math.sqrt(1.0 + alphaTotal);
+  const tRigid = tRigidOf(z, q.period, alphaTotal);
   const notes = [];
+  if (FRAMES) {
+    notes.push("a building: T_p is its bare first-mode period T_1, T_rigid its first-mode " +
+      "period with the stacks rigidly attached, T_new the first mode's; the paper's equation is " +
+      "the one-storey one, read at T_1");
+  }
   const r = interpolate(z.grid, z.t_new_s, [q.period, ...q.alpha, ...q.mu]);
   let tGrid = null;
   if (r.outside) {
@@ -175,12 +313,22 @@ function answer(q) {
     tGrid = r.value;
   }
   const x = [q.period, ...q.mu, ...q.alpha];
-  const tFit = z.fit ? predict(z.fit, x, q.period, tRigid) : null;
+  const fitX = fitFeatures(z, q.period, q.alpha, q.mu);
+  const tFit = z.fit ? predict(z.fit, fitX, q.period, tRigid) : null;
+  let lambdaGrid = null;
+  let lambdaFit = null;
+  if (z.lambda) {
+    const [values, fitted] = z.lambda;
+    const l = interpolate(z.grid, values, [q.period, ...q.alpha, ...q.mu]);
+    lambdaGrid = l.outside || l.value === null ? null : l.value;
+    lambdaFit = fitted ? predict(fitted, fitX, q.period, tRigid) : null;
+  }
   const tPaper = paperEquation(z.paper, x);
   const sa = (t) => (fin(t) === null ? null : saG(z.target, t));
   return {
     answer: {
-      zone: z.zone, target: z.target.spec, fit_form: z.fit ? z.fit.form : "",
+      zone: z.zone, target: z.target.spec, fit_form: z.fit ? z.fit.form : "", building: label,
+      lambda_grid: lambdaGrid, lambda_fit: lambdaFit,
       t_rigid_s: tRigid, t_new_grid_s: tGrid, t_new_fit_s: tFit, t_new_paper_s: tPaper,
       sa_tp_g: saG(z.target, q.period), sa_new_g: sa(tGrid !== null ? tGrid : tFit),
       sa_new_grid_g: sa(tGrid), sa_new_fit_g: sa(tFit), sa_new_paper_g: sa(tPaper), notes,
@@ -190,11 +338,25 @@ function answer(q) {
 
 // ---- the form, the URL and the outputs ----
 
-const OUTPUTS = ["t_rigid_s", "t_new_grid_s", "t_new_fit_s", "t_new_paper_s", "sa_tp_g", "sa_new_g"];
+const OUTPUTS = ["t_rigid_s", "t_new_grid_s", "t_new_fit_s", "t_new_paper_s", "sa_tp_g", "sa_new_g"]
+  .concat(FRAMES ? ["lambda_grid", "lambda_fit"] : []);
 const $ = (id) => document.getElementById(id);
 const listOf = (s) => s.split(",").map((v) => (v.trim() === "" ? NaN : Number(v)));
 
+// A building study's storey count and floor from their text: {storeys, floor} or, as the
+// command's parsing would, {floorError}.
+function frameQuery(storeys, floor) {
+  const f = parseFloor(floor);
+  const n = /^\+?[0-9]+$/.test(storeys) ? Number(storeys) : NaN;
+  if (Number.isNaN(n)) {
+    return { storeys: NaN, floor, floorError: "`" + storeys + "` is not a storey count" };
+  }
+  if (f.error) return { storeys: n, floor, floorError: f.error };
+  return { storeys: n, floor: f.floor };
+}
+
 function defaultQuery() {
+  if (FRAMES) return fromParams(new URLSearchParams(FRAMES.example), null);
   const z = ZONES.find((z) => z.zone === "III") || ZONES[0];
   const g = z.grid;
   const mid = (a) => a[Math.floor((a.length - 1) / 2)];
@@ -206,21 +368,43 @@ function defaultQuery() {
     extrapolate: false };
 }
 
-function queryFromUrl() {
-  const q = defaultQuery();
-  const p = new URLSearchParams(window.location.search);
+// The question of address parameters `p` over `q` (a default; null: none).
+function fromParams(p, q) {
+  q = q || { zone: "", period: NaN, alpha: [], mu: [], extrapolate: false };
   if (p.has("zone")) q.zone = p.get("zone");
   if (p.has("period")) q.period = p.get("period").trim() === "" ? NaN : Number(p.get("period"));
   if (p.has("alpha")) q.alpha = listOf(p.get("alpha"));
   if (p.has("mu")) q.mu = listOf(p.get("mu"));
+  if (FRAMES) {
+    const storeys = p.has("storeys") ? p.get("storeys").trim() : String(q.storeys);
+    const floor = p.has("floor") ? p.get("floor").trim() : String(q.floor);
+    delete q.floorError;
+    Object.assign(q, frameQuery(storeys, floor));
+  }
   q.extrapolate = ["1", "true", "yes", "on"].includes((p.get("extrapolate") || "").toLowerCase());
   return q;
+}
+
+function queryFromUrl() {
+  return fromParams(new URLSearchParams(window.location.search), defaultQuery());
 }
 
 function queryString(q) {
   let s = "?zone=" + encodeURIComponent(q.zone) + "&period=" + q.period + "&alpha=" +
     q.alpha.join(",") + "&mu=" + q.mu.join(",");
+  if (FRAMES) {
+    s += "&storeys=" + encodeURIComponent(String(q.storeys)) + "&floor=" +
+      encodeURIComponent(String(q.floor));
+  }
   return q.extrapolate ? s + "&extrapolate=1" : s;
+}
+
+// Sets select `id` to `value`, adding it as an option if the page does not offer it (a storey
+// count or floor of the address that the study lacks: the answer then says so).
+function selectValue(id, value) {
+  const sel = $(id);
+  if (!Array.from(sel.options).some((o) => o.value === value)) sel.appendChild(new Option(value, value));
+  sel.value = value;
 }
 
 function fillForm(q) {
@@ -233,6 +417,10 @@ function fillForm(q) {
     $("mu_" + (i + 1)).value = m === undefined || Number.isNaN(m) ? "" : m;
   }
   $("extrapolate").checked = q.extrapolate;
+  if (FRAMES) {
+    selectValue("storeys", String(q.storeys));
+    selectValue("floor", String(q.floor));
+  }
 }
 
 function readForm() {
@@ -243,8 +431,9 @@ function readForm() {
     alpha.push(n("alpha_" + i));
     mu.push(n("mu_" + i));
   }
-  return { zone: $("zone").value, period: n("period"), alpha, mu,
+  const q = { zone: $("zone").value, period: n("period"), alpha, mu,
     extrapolate: $("extrapolate").checked };
+  return FRAMES ? Object.assign(q, frameQuery($("storeys").value, $("floor").value)) : q;
 }
 
 function show(q) {
@@ -258,6 +447,7 @@ function show(q) {
     else el.setAttribute("data-value", String(v));
   }
   $("fit_form").textContent = a.fit_form || "–";
+  if (FRAMES) $("building").textContent = a.building || "–";
   $("error").textContent = r.error || "";
   $("error").hidden = !r.error;
   const notes = $("notes");
@@ -389,10 +579,13 @@ function range(lo, hi, n) {
 }
 
 function drawCase(q, a) {
-  const z = ZONES.find((z) => z.zone === q.zone) || ZONES[0];
+  const f = FRAMES && a !== null ? frameEntry(q.zone, q.storeys, q.floor) : {};
+  const z = f.z || ZONES.find((z) => z.zone === q.zone) || ZONES[0];
   const g = z.grid;
   const ok = a !== null;
-  const root = ok ? Math.sqrt(1 + q.alpha.reduce((s, v) => s + v, 0)) : NaN;
+  // T_rigid/T_p: one value for every T_p of the building (Frame::t_rigid_s scales with it).
+  const root = !ok ? NaN
+    : FRAMES ? a.t_rigid_s / q.period : Math.sqrt(1 + q.alpha.reduce((s, v) => s + v, 0));
   const tLo = Math.min(g.periods_s[0], ok ? q.period : Infinity);
   const tHi = Math.max(g.periods_s[g.periods_s.length - 1], ok ? q.period : -Infinity);
   const ts = range(tLo, tHi, 80);
@@ -410,7 +603,7 @@ function drawCase(q, a) {
       colour: COLOURS[0] });
     if (z.fit) {
       series.push({ label: "T_new, fitted (" + z.fit.form + " form)", x: ts,
-        y: ts.map((t) => predict(z.fit, [t, ...q.mu, ...q.alpha], t, t * root)),
+        y: ts.map((t) => predict(z.fit, fitFeatures(z, t, q.alpha, q.mu), t, t * root)),
         colour: COLOURS[1], dash: "8 4" });
     }
     if (z.paper && BLOCKS === 2) {
@@ -449,8 +642,15 @@ function drawCase(q, a) {
 
 // ---- the explorer of the grid's figures ----
 
+// The explorer's ZONES entry: its zone's, in a building study its zone and frame's.
+function explorerIndex() {
+  const k = FRAMES ? Number($("x-frame").value) : 0;
+  const of = ZONES.map((z, i) => i).filter((i) => ZONES[i].zone === $("x-zone").value);
+  return of.length > k ? of[k] : 0;
+}
+
 function explorerZone() {
-  return ZONES.find((z) => z.zone === $("x-zone").value) || ZONES[0];
+  return ZONES[explorerIndex()];
 }
 
 // Flat case index within a work unit (report/select.rs, case_index).
@@ -462,7 +662,7 @@ function caseIndex(g, alphaIdx, muIdx) {
 function drawExplorer() {
   const z = explorerZone();
   const g = z.grid;
-  const drr = DATA.drr.find((d) => d.zone === z.zone);
+  const drr = DATA.drr[explorerIndex()];
   const what = $("x-quantity").value;
   const alphaIdx = g.alpha.map((_, i) => Number($("x-alpha_" + (i + 1)).value));
   const muPairs = Array.from($("x-mu").selectedOptions).map((o) => o.value.split(",").map(Number));
@@ -472,7 +672,8 @@ function drawExplorer() {
   const series = [];
   const values = what === "T_new" ? z.t_new_s : drr[what.toLowerCase()];
   if (what === "T_new") {
-    const root = Math.sqrt(1 + alphaIdx.reduce((s, i, b) => s + g.alpha[b][i], 0));
+    const alphaTotal = alphaIdx.reduce((s, i, b) => s + g.alpha[b][i], 0);
+    const root = FRAMES ? tRigidOf(z, 1.0, alphaTotal) : Math.sqrt(1 + alphaTotal);
     series.push({ label: "T_p (bare structure)", x: tp, y: tp, colour: "#000", width: 1 });
     series.push({ label: "T_rigid (load rigidly attached)", x: tp, y: tp.map((t) => t * root),
       colour: "#000", width: 1, dash: "6 4" });
@@ -540,10 +741,12 @@ function start() {
   });
   explorerAxes();
   drawExplorer();
-  $("x-zone").addEventListener("change", () => {
-    explorerAxes();
-    drawExplorer();
-  });
+  for (const id of FRAMES ? ["x-zone", "x-frame"] : ["x-zone"]) {
+    $(id).addEventListener("change", () => {
+      explorerAxes();
+      drawExplorer();
+    });
+  }
   $("explorer").addEventListener("change", drawExplorer);
 }
 

@@ -26,9 +26,11 @@ margin-right:.4em}.key.dot{width:.7em;height:.7em;border-width:3px;border-radius
 #fig-explorer{max-width:800px}a:focus,input:focus,select:focus{outline:3px solid #f90}code{overflow-wrap:anywhere}\
 @media(max-width:600px){td,th{padding:3px 5px}}";
 
-/// One row of the answers' table: a label and the `id` of its output (the JSON key of
-/// `slidestack design --json`).
-const OUTPUT_ROWS: [(&str, &str, &str); 6] = [
+/// One row of the answers' table: a label, the `id` of its output (the JSON key of
+/// `slidestack design --json`) and its unit.
+type Row = (&'static str, &'static str, &'static str);
+
+const OUTPUT_ROWS: [Row; 6] = [
     ("T_rigid: stack rigidly attached", "t_rigid_s", "s"),
     (
         "T_new: the study's grid (interpolated)",
@@ -40,6 +42,54 @@ const OUTPUT_ROWS: [(&str, &str, &str); 6] = [
     ("Design Sa at T_p", "sa_tp_g", "g"),
     ("Design Sa at T_new (grid, else fit)", "sa_new_g", "g"),
 ];
+
+/// A building study's rows: `T_1`, `T_1,rigid` and the fraction `λ`.
+const BUILDING_ROWS: [Row; 8] = [
+    (
+        "T_1,rigid: stack rigidly attached to its floor(s)",
+        "t_rigid_s",
+        "s",
+    ),
+    (
+        "T_new: the frame's cases (interpolated)",
+        "t_new_grid_s",
+        "s",
+    ),
+    ("T_new: the fitted building equation", "t_new_fit_s", "s"),
+    (
+        "T_new: the paper's Eqs. 16–17 (one storey, at T_1)",
+        "t_new_paper_s",
+        "s",
+    ),
+    ("Design Sa at T_1", "sa_tp_g", "g"),
+    ("Design Sa at T_new (grid, else fit)", "sa_new_g", "g"),
+    (
+        "λ, effective live-load fraction: the frame's cases (interpolated)",
+        "lambda_grid",
+        "",
+    ),
+    ("λ: the fitted fraction equation", "lambda_fit", ""),
+];
+
+/// A building study's inputs: the storey counts and floors its selects offer, and its
+/// distinct frames (`3 storeys, stack on the roof`) for the explorer, in stored order.
+pub struct FrameInputs {
+    pub storeys: Vec<usize>,
+    /// `1` … `N_max`, `roof`, `all`.
+    pub floors: Vec<String>,
+    pub frames: Vec<String>,
+}
+
+fn select(id: &str, label: &str, options: &[String]) -> String {
+    let options: String = options
+        .iter()
+        .map(|o| format!("<option value='{0}'>{0}</option>", escape(o)))
+        .collect();
+    format!(
+        "<div><label for='{id}'>{}</label><select id='{id}' name='{id}'>{options}</select></div>",
+        escape(label)
+    )
+}
 
 fn input(id: &str, label: &str, hint: &str) -> String {
     format!(
@@ -53,13 +103,16 @@ fn input(id: &str, label: &str, hint: &str) -> String {
 
 /// The page of a study whose stacks have `blocks` blocks and whose zones are `zones`: `title`,
 /// an introduction (HTML) and `data`, the JSON the script reads (`zones`: each zone's
-/// `design::ZoneDesign`; `drr`: each zone's `DRR_1`, `DRR_2` per case; `damping_depth`).
+/// `design::ZoneDesign`, in a building study each zone and frame's; `drr`: `DRR_1`, `DRR_2`
+/// per case of each; `damping_depth`; a building study's `frames`). `building`: a building
+/// study's storey and floor inputs.
 pub fn design_page(
     title: &str,
     intro: &str,
     zones: &[String],
     blocks: usize,
     ranges: &[String],
+    building: Option<&FrameInputs>,
     data: &str,
 ) -> String {
     let zone_options: String = zones
@@ -67,11 +120,24 @@ pub fn design_page(
         .map(|z| format!("<option value='{0}'>{0}</option>", escape(z)))
         .collect();
     let hint = |i: usize| ranges.get(i).map_or("", String::as_str);
+    let period = match building {
+        None => "T_p: period of the bare structure (s)",
+        Some(_) => "T_1: first-mode period of the bare building (s)",
+    };
     let mut inputs = format!(
         "<div><label for='zone'>Zone</label><select id='zone' name='zone'>{zone_options}</select>\
          </div>{}",
-        input("period", "T_p: period of the bare structure (s)", hint(0))
+        input("period", period, hint(0))
     );
+    if let Some(b) = building {
+        let storeys: Vec<String> = b.storeys.iter().map(usize::to_string).collect();
+        inputs += &select("storeys", "N: storeys of the building", &storeys);
+        inputs += &select(
+            "floor",
+            "Floor carrying the stack (N is the roof)",
+            &b.floors,
+        );
+    }
     for i in 1..=blocks {
         inputs += &input(
             &format!("alpha_{i}"),
@@ -91,7 +157,11 @@ pub fn design_page(
             hint(blocks + i),
         );
     }
-    let rows: String = OUTPUT_ROWS
+    let rows: &[Row] = match building {
+        None => &OUTPUT_ROWS,
+        Some(_) => &BUILDING_ROWS,
+    };
+    let rows: String = rows
         .iter()
         .map(|(label, id, unit)| {
             format!(
@@ -101,6 +171,22 @@ pub fn design_page(
             )
         })
         .collect();
+    let (frame_row, frame_select) = match building {
+        None => (String::new(), String::new()),
+        Some(b) => {
+            let options: String = (b.frames.iter().enumerate())
+                .map(|(k, f)| format!("<option value='{k}'>{}</option>", escape(f)))
+                .collect();
+            (
+                "<tr><th scope='row'>Building</th><td><output id='building'>–</output></td></tr>"
+                    .to_string(),
+                format!(
+                    "<div><label for='x-frame'>Building</label><select id='x-frame'>{options}\
+                     </select></div>"
+                ),
+            )
+        }
+    };
     let alpha_selects: String = (1..=blocks)
         .map(|i| {
             format!(
@@ -123,7 +209,7 @@ pub fn design_page(
          form)</label></p></fieldset></form>\
          <p id='error' role='alert' hidden='hidden'></p>\
          <table id='answers' aria-live='polite'><caption>The answers (as <code>slidestack design \
-         --json</code> gives them)</caption>{rows}<tr><th scope='row'>Fitted form</th>\
+         --json</code> gives them)</caption>{frame_row}{rows}<tr><th scope='row'>Fitted form</th>\
          <td><output id='fit_form'>–</output></td></tr></table><ul id='notes'></ul>\
          <p>A link to this answer: <a id='permalink' href='design.html'>design.html</a></p>\
          <div class='figs'><figure id='fig-case'></figure><figure id='fig-spectrum'></figure>\
@@ -134,6 +220,7 @@ pub fn design_page(
          against T_p. Select several friction pairs with Ctrl or Shift (or Space on the list).\
          </p><form id='explorer' action='#'><div class='inputs'>\
          <div><label for='x-zone'>Zone</label><select id='x-zone'>{zone_options}</select></div>\
+         {frame_select}\
          <div><label for='x-quantity'>Quantity</label><select id='x-quantity'>\
          <option value='T_new'>T_new (Figs 16–17)</option>\
          <option value='DRR_1'>DRR_1, the stack (Figs 10–11)</option>\

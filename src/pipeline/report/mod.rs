@@ -63,7 +63,7 @@ use text::{fixed, joined, num, nums};
 use thiserror::Error;
 
 /// Changes when the report's contents change.
-const REPORT_VERSION: &str = "report-3";
+const REPORT_VERSION: &str = "report-4";
 
 #[derive(Debug, Error)]
 pub enum ReportError {
@@ -76,6 +76,8 @@ pub enum ReportError {
     NoMotions { zone: String },
     #[error(transparent)]
     Chart(#[from] ChartError),
+    #[error(transparent)]
+    Design(#[from] crate::design::DesignError),
 }
 
 /// The fingerprint the report must carry; with an `ida:` section, `ida.h5`'s too (the report
@@ -399,11 +401,15 @@ fn building_summary(inp: &Inputs) -> String {
             }
         }
     }
-    let design = "<p id='design-link'>Design numbers of one building of the study: \
-         <code>slidestack design --study OUT --zone Z --period T_1 --alpha … --mu … --storeys N \
-         --floor F</code> (T_new, T_1,rigid and λ; <code>--floor roof</code> accepted). The \
-         design page does not yet take a building study.</p>";
-    design.to_string()
+    let q = escape(&design::building_example(inp).unwrap_or_default());
+    let design = format!(
+        "<p id='design-link'><a href='design.html'>The design page</a>: T_new, T_1,rigid, λ \
+         and the design spectral acceleration of one building of this study, in the browser \
+         (e.g. <a href='design.html?{q}'>design.html?{q}</a>), as <code>slidestack design \
+         --study OUT --zone Z --period T_1 --alpha … --mu … --storeys N --floor F</code> gives \
+         them; and an explorer of the grid's figures, frame by frame.</p>"
+    );
+    design
         + &list(&facts(inp))
         + &para(
             "The design equations over the frames (fit.yaml; per frame in the design equations' \
@@ -424,11 +430,6 @@ fn not_shown(building: bool) -> Section {
             "The paper's one-storey cases and figures (Section 7.1 and Fig. 12, Table 2, Figs \
              9–11 and 16–17, Table 3's paper column): a building study's report has the building \
              section instead; a one-storey config (configs/paper.yaml) gives them."
-                .into(),
-        );
-        items.push(
-            "The design page: a building study's design numbers come from `slidestack design \
-             --storeys N --floor F`."
                 .into(),
         );
     } else {
@@ -469,9 +470,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         sections.push(ida::ida_section(study, &mut files)?);
     }
     sections.push(not_shown(building));
-    if !building {
-        design::design_file(&inp, &mut files)?;
-    }
+    design::design_file(&inp, &mut files)?;
     let summary = if building {
         building_summary(&inp)
     } else {
