@@ -578,6 +578,15 @@ function range(lo, hi, n) {
   return Array.from({ length: n }, (_, i) => lo + ((hi - lo) * i) / (n - 1));
 }
 
+// The period axis and the bare system's line: a building's first-mode period T_1.
+function periodName() {
+  return FRAMES ? "T_1" : "T_p";
+}
+
+function bareLabel() {
+  return FRAMES ? "T_1 (bare building)" : "T_p (bare structure)";
+}
+
 function drawCase(q, a) {
   const f = FRAMES && a !== null ? frameEntry(q.zone, q.storeys, q.floor) : {};
   const z = f.z || ZONES.find((z) => z.zone === q.zone) || ZONES[0];
@@ -590,7 +599,7 @@ function drawCase(q, a) {
   const tHi = Math.max(g.periods_s[g.periods_s.length - 1], ok ? q.period : -Infinity);
   const ts = range(tLo, tHi, 80);
   const series = [
-    { label: "T_p (bare structure)", x: [tLo, tHi], y: [tLo, tHi], colour: "#000", width: 1 },
+    { label: bareLabel(), x: [tLo, tHi], y: [tLo, tHi], colour: "#000", width: 1 },
   ];
   if (ok) {
     series.push({ label: "T_rigid (load rigidly attached)", x: [tLo, tHi],
@@ -621,7 +630,8 @@ function drawCase(q, a) {
       }
     }
   }
-  chart("fig-case", "Zone " + z.zone + ": T_new against T_p", "T_p (s)", "T_new (s)", series);
+  chart("fig-case", "Zone " + z.zone + ": T_new against " + periodName(), periodName() + " (s)",
+    "T_new (s)", series);
 
   const top = Math.max(4, ok ? 1.1 * Math.max(q.period, fin(a.t_new_fit_s) || 0,
     fin(a.t_new_grid_s) || 0) : 0);
@@ -629,7 +639,7 @@ function drawCase(q, a) {
   const spec = [{ label: z.target.label, x: tt, y: tt.map((t) => saG(z.target, t)),
     colour: "#444" }];
   if (ok) {
-    spec.push({ label: "at T_p", x: [q.period], y: [a.sa_tp_g], colour: "#000", points: true,
+    spec.push({ label: "at " + periodName(), x: [q.period], y: [a.sa_tp_g], colour: "#000", points: true,
       fill: "#fff" });
     const tNew = fin(a.t_new_grid_s) !== null ? a.t_new_grid_s : a.t_new_fit_s;
     if (fin(a.sa_new_g) !== null) {
@@ -674,7 +684,7 @@ function drawExplorer() {
   if (what === "T_new") {
     const alphaTotal = alphaIdx.reduce((s, i, b) => s + g.alpha[b][i], 0);
     const root = FRAMES ? tRigidOf(z, 1.0, alphaTotal) : Math.sqrt(1 + alphaTotal);
-    series.push({ label: "T_p (bare structure)", x: tp, y: tp, colour: "#000", width: 1 });
+    series.push({ label: bareLabel(), x: tp, y: tp, colour: "#000", width: 1 });
     series.push({ label: "T_rigid (load rigidly attached)", x: tp, y: tp.map((t) => t * root),
       colour: "#000", width: 1, dash: "6 4" });
   } else {
@@ -689,8 +699,8 @@ function drawExplorer() {
   });
   const alphaText = alphaIdx.map((i, b) => "α_" + (b + 1) + " = " + g.alpha[b][i]).join(", ");
   const yLabel = what === "T_new" ? "T_new (s)" : what + " (–)";
-  chart("fig-explorer", "Zone " + z.zone + ": " + what + " against T_p, " + alphaText, "T_p (s)",
-    yLabel, series);
+  chart("fig-explorer", "Zone " + z.zone + ": " + what + " against " + periodName() + ", " +
+    alphaText, periodName() + " (s)", yLabel, series);
 }
 
 function explorerAxes() {
