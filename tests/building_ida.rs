@@ -416,3 +416,70 @@ fn design_strengths_come_from_the_zone_s_spectrum_at_t_1() {
         assert!(first.iter().all(|d| *d > 0.0), "{first:?}");
     }
 }
+
+/// `configs/mdof-ida-quick.yaml` with its stack floors `floors` (the rest as it is).
+fn mdof_ida_quick_with(dir: &Path, name: &str, floors: &str) -> PathBuf {
+    let text = std::fs::read_to_string(repo("configs/mdof-ida-quick.yaml")).unwrap();
+    let from = "stack_floor: [1, roof]";
+    assert_eq!(text.matches(from).count(), 1);
+    let path = dir.join(name);
+    std::fs::write(
+        &path,
+        text.replacen(from, &format!("stack_floor: {floors}"), 1),
+    )
+    .unwrap();
+    path
+}
+
+#[test]
+fn a_frame_that_repeats_a_building_takes_its_traces_which_are_the_traced_ones() {
+    // Floor 3 of three storeys is the roof: with both, the stage traces floor 3 and gives the
+    // roof its traces; a study of the roof alone traces the roof. Every stored trace,
+    // intensity, curve and fragility of the roof is the same to the bit either way (a trace is
+    // deterministic, and floor 3 and the roof are the same masses, stiffnesses and stack).
+    let dir = tempfile::tempdir().unwrap();
+    let m = motions(dir.path());
+    let both = mdof_ida_quick_with(dir.path(), "both.yaml", "[3, roof]");
+    let roof = mdof_ida_quick_with(dir.path(), "roof.yaml", "[roof]");
+    let (out_both, out_roof) = (dir.path().join("both"), dir.path().join("roof"));
+    for (cfg, out) in [(&both, &out_both), (&roof, &out_roof)] {
+        common::copy_motions(&m, out);
+        let o = ok(slidestack(&["ida", s(cfg), "--out", s(out)], "2"));
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(
+            text.contains("units of frames that repeat a building take its traces"),
+            cfg == &both,
+            "{text}"
+        );
+    }
+    let same = |a: ndarray::ArrayViewD<f64>, b: ndarray::ArrayViewD<f64>, what: &str| {
+        assert_eq!(a.shape(), b.shape(), "{what}");
+        for (x, y) in a.iter().zip(b.iter()) {
+            assert_eq!(x.to_bits(), y.to_bits(), "{what}: {x} vs {y}");
+        }
+    };
+    for zone_name in ["III", "V"] {
+        let (axes, z_both) = zone(&out_both, zone_name);
+        let (_, z_roof) = zone(&out_roof, zone_name);
+        assert_eq!(axes.building.as_ref().unwrap().frames(), 2);
+        let (vb, vr) = (&z_both.vars, &z_roof.vars);
+        // The case axis holds case·frames + frame: one case, so the frame's index.
+        for (what, a, b, axis) in [
+            ("run_sa_g", &vb.run_sa_g, &vr.run_sa_g, 2),
+            ("run_demand", &vb.run_demand, &vr.run_demand, 2),
+            ("curve", &vb.curve, &vr.curve, 2),
+            ("theta_sa_g", &vb.theta_sa_g, &vr.theta_sa_g, 1),
+            ("beta", &vb.beta, &vr.beta, 1),
+        ] {
+            let roof_traced = b.index_axis(ndarray::Axis(axis), 0);
+            for f in [0, 1] {
+                let what = format!("zone {zone_name}, {what}, frame {f}");
+                same(
+                    a.index_axis(ndarray::Axis(axis), f),
+                    roof_traced.clone(),
+                    &what,
+                );
+            }
+        }
+    }
+}

@@ -26,6 +26,7 @@ use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
 use crate::store::motions::read_zone_target;
+use crate::study::building::first_of_building;
 use crate::study::config::StudyConfig;
 use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
 use crate::study::physics::Physics;
@@ -76,6 +77,7 @@ fn stored_targets(study: &Study) -> Result<Vec<TargetSpectrum>, StoreError> {
 }
 
 /// One unit's result.
+#[derive(Clone)]
 struct UnitOut {
     record_sa_g: f64,
     traces: Vec<Trace<RunDemand>>,
@@ -103,7 +105,11 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let targets = stored_targets(study)?;
     let frames = study.frames();
     let nf = frames.len();
-    let units: Vec<(usize, usize, usize, usize)> = motions
+    // A frame that is an earlier one's building traces as it does, to the bit: only the first
+    // of them is traced, and the others take its traces.
+    let first = first_of_building(&frames.iter().flatten().cloned().collect::<Vec<_>>());
+    let first = |f: usize| first.get(f).copied().unwrap_or(f);
+    let all_units: Vec<(usize, usize, usize, usize)> = motions
         .iter()
         .enumerate()
         .flat_map(|(z, ms)| {
@@ -112,10 +118,15 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             })
         })
         .collect();
+    let units: Vec<(usize, usize, usize, usize)> = (all_units.iter())
+        .filter(|u| first(u.3) == u.3)
+        .copied()
+        .collect();
     s.reporter.info(
         me,
         &format!(
-            "{} traces ({} motions over {} zones × {} cases{} × {} systems), at most {} runs each",
+            "{} traces ({} motions over {} zones × {} cases{} × {} systems{}), at most {} runs \
+             each",
             units.len() * SYSTEMS.len(),
             motions.iter().map(Vec::len).sum::<usize>(),
             motions.len(),
@@ -126,6 +137,10 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 String::new()
             },
             SYSTEMS.len(),
+            match all_units.len() - units.len() {
+                0 => String::new(),
+                n => format!("; {n} units of frames that repeat a building take its traces"),
+            },
             cfg.tracing.max_runs()
         ),
     );
@@ -172,7 +187,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 traces,
             })
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<Vec<_>, _>>()?;
     bar.finish();
     let runs: usize = outs
         .iter()
@@ -189,6 +204,10 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             secs * 1e9 * threads as f64 / samples.into_inner().max(1) as f64
         ),
     );
+    let traced: std::collections::BTreeMap<_, _> = units.iter().zip(&outs).collect();
+    let outs: Vec<UnitOut> = (all_units.iter())
+        .map(|&(z, m, c, f)| traced[&(z, m, c, first(f))].clone())
+        .collect();
     let axes = axes_of(cfg, study.building());
     let mut zones = Vec::new();
     let mut at = 0;

@@ -23,7 +23,7 @@ use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::read_zone_sweep;
 use crate::store::tnew::{LambdaVars, TnewMeta, TnewVars, ZoneTnew, read_zone_tnew_in, write_tnew};
-use crate::study::building::Frame;
+use crate::study::building::{Frame, first_of_building};
 use crate::study::lambda::{self, LAMBDA_FLAGS, LambdaFlag};
 use crate::study::physics::{CaseError, Physics, SystemKind};
 use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
@@ -90,13 +90,9 @@ fn effective_fractions(
             .as_ref()
             .expect("a building study has a frame per case")
     };
-    // Frames that are one building (the same storeys and loaded floors: on one storey floor 1,
-    // the roof and every floor) have the same sweep results, so the same λ: each is computed
-    // for the first of them only.
-    let same = |f: usize| frames[f].as_ref().map(|fr| (fr.storeys(), fr.floors()));
-    let first: Vec<usize> = (0..frames.len())
-        .map(|f| (0..f).find(|&g| same(g) == same(f)).unwrap_or(f))
-        .collect();
+    // Frames that are one building have the same sweep results, so the same λ: each is
+    // computed for the first of them only.
+    let first = first_of_building(&frames.iter().flatten().cloned().collect::<Vec<_>>());
     let own: Vec<usize> = (0..cases)
         .filter(|&c| first[c / per_frame] == c / per_frame)
         .collect();

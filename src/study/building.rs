@@ -166,16 +166,23 @@ impl Frame {
     }
 }
 
-/// Which of a study's frames (stored order) repeat an earlier one's building: on one storey
-/// floor 1, the roof and every floor are one building, and on `N` storeys floor `N` is the
-/// roof. The fit and the report count such a frame's cases once.
-pub fn repeats(frames: &[Frame]) -> Vec<bool> {
+/// For each of a study's frames (stored order), the first frame that is the same building (its
+/// own index when none before is): the same storeys and loaded floors, so the same masses,
+/// stiffnesses and stacks. On one storey floor 1, the roof and every floor are one building,
+/// and on `N` storeys floor `N` is the roof. Such frames have the same results to the bit, so
+/// `tnew` and `ida` compute the first only.
+pub fn first_of_building(frames: &[Frame]) -> Vec<usize> {
+    let same = |a: &Frame, b: &Frame| a.storeys() == b.storeys() && a.floors() == b.floors();
     (0..frames.len())
-        .map(|f| {
-            let same =
-                |g: &Frame| g.storeys() == frames[f].storeys() && g.floors() == frames[f].floors();
-            frames[..f].iter().any(same)
-        })
+        .map(|f| (0..f).find(|&g| same(&frames[g], &frames[f])).unwrap_or(f))
+        .collect()
+}
+
+/// Which of a study's frames repeat an earlier one's building ([`first_of_building`]): the fit
+/// and the report count such a frame's cases once.
+pub fn repeats(frames: &[Frame]) -> Vec<bool> {
+    (first_of_building(frames).into_iter().enumerate())
+        .map(|(f, first)| first != f)
         .collect()
 }
 
