@@ -104,10 +104,31 @@ fn run_study(dir: &Path) -> PathBuf {
 /// `slidestack design --json` for `q`: `Ok(json)` or `Err(stderr)` (exit code 2).
 fn command(study: &Path, q: &Question) -> Result<Value, String> {
     let (zone, period, alpha, mu, extrapolate) = *q;
+    design_json(
+        study,
+        &[zone, period, alpha, mu],
+        &[],
+        extrapolate,
+        &format!("{q:?}"),
+    )
+}
+
+/// `slidestack design --study STUDY --zone … --period … --alpha … --mu … EXTRA --json`
+/// (`[zone, period, alpha, mu]` in `question`), `--extrapolate` if asked: `Ok(json)` or
+/// `Err(stderr)` (exit code 2; `what` names the question in a failure).
+fn design_json(
+    study: &Path,
+    question: &[&str; 4],
+    extra: &[&str],
+    extrapolate: bool,
+    what: &str,
+) -> Result<Value, String> {
+    let [zone, period, alpha, mu] = *question;
     let mut c = Command::new(env!("CARGO_BIN_EXE_slidestack"));
     c.args(["design", "--study"]).arg(study).args([
         "--zone", zone, "--period", period, "--alpha", alpha, "--mu", mu, "--json",
     ]);
+    c.args(extra);
     if extrapolate {
         c.arg("--extrapolate");
     }
@@ -115,7 +136,7 @@ fn command(study: &Path, q: &Question) -> Result<Value, String> {
     if o.status.success() {
         Ok(serde_json::from_slice(&o.stdout).unwrap())
     } else {
-        assert_eq!(o.status.code(), Some(2), "{q:?}");
+        assert_eq!(o.status.code(), Some(2), "{what}");
         Err(String::from_utf8_lossy(&o.stderr).trim().to_string())
     }
 }
@@ -376,32 +397,14 @@ const BUILDING_OUTPUTS: [&str; 8] = [
 /// `slidestack design --json … --storeys N --floor F` for `q`, as [`command`].
 fn frame_command(study: &Path, q: &FrameQuestion) -> Result<Value, String> {
     let (zone, period, alpha, mu, extrapolate, storeys, floor) = *q;
-    let mut c = Command::new(env!("CARGO_BIN_EXE_slidestack"));
-    c.args(["design", "--study"]).arg(study).args([
-        "--zone",
-        zone,
-        "--period",
-        period,
-        "--alpha",
-        alpha,
-        "--mu",
-        mu,
-        "--storeys",
-        storeys,
-        "--floor",
-        floor,
-        "--json",
-    ]);
-    if extrapolate {
-        c.arg("--extrapolate");
-    }
-    let o = c.output().unwrap();
-    if o.status.success() {
-        Ok(serde_json::from_slice(&o.stdout).unwrap())
-    } else {
-        assert_eq!(o.status.code(), Some(2), "{q:?}");
-        Err(String::from_utf8_lossy(&o.stderr).trim().to_string())
-    }
+    let extra = ["--storeys", storeys, "--floor", floor];
+    design_json(
+        study,
+        &[zone, period, alpha, mu],
+        &extra,
+        extrapolate,
+        &format!("{q:?}"),
+    )
 }
 
 fn frame_query(q: &FrameQuestion) -> String {
@@ -558,7 +561,7 @@ fn a_building_studys_design_page_answers_as_the_command_does() {
     let legend = explorer["elements"]["fig-explorer"]["text"]
         .as_str()
         .unwrap();
-    assert!(legend.contains("Zone V: DRR_1 against T_p"), "{legend}");
+    assert!(legend.contains("Zone V: DRR_1 against T_1"), "{legend}");
     assert_eq!(explorer["elements"]["fig-explorer"]["paths"], 5, "{legend}");
     // One choice per distinct building: 1 storey (floor 1), 3 storeys × 3 floors.
     let frames = explorer["elements"]["x-frame"]["text"].as_str().unwrap();

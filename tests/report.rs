@@ -117,20 +117,25 @@ fn check_figure(name: &str, svg: &str, opt: &usvg::Options, png_dir: Option<&Pat
     }
 }
 
+/// `index.html`'s text parsed (its doctype allowed); panics unless well-formed.
+fn html_document(html: &str) -> roxmltree::Document<'_> {
+    roxmltree::Document::parse_with_options(
+        html,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .expect("index.html is well-formed")
+}
+
 /// `report/index.html` as every report must be: well-formed, referencing only files of the
 /// report directory that its manifest lists, showing every figure of the directory, each one
 /// rendered with data in every plot area and its legend beside them. Returns the page's text,
 /// the files it references and its figures.
 fn checked_page(report: &Path) -> (String, Vec<String>, Vec<String>) {
     let html = std::fs::read_to_string(report.join("index.html")).unwrap();
-    let doc = roxmltree::Document::parse_with_options(
-        &html,
-        roxmltree::ParsingOptions {
-            allow_dtd: true,
-            ..Default::default()
-        },
-    )
-    .expect("index.html is well-formed");
+    let doc = html_document(&html);
 
     // The page references only files of the report directory (and its own anchors), every one
     // listed in the manifest; every figure in the directory is shown.
@@ -209,14 +214,7 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
     slidestack(&["run", c, "--out", o]);
     let report = out.join("report");
     let (html, shown, svgs) = checked_page(&report);
-    let doc = roxmltree::Document::parse_with_options(
-        &html,
-        roxmltree::ParsingOptions {
-            allow_dtd: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let doc = html_document(&html);
     assert!(
         shown.iter().any(|s| s == "design.html"),
         "no link to the design page"
@@ -398,14 +396,7 @@ fn a_building_studys_report_shows_the_files_numbers() {
     let report = out.join("report");
     let (html, _, svgs) = checked_page(&report);
     assert!(svgs.iter().any(|s| s == "ida.svg"), "{svgs:?}");
-    let doc = roxmltree::Document::parse_with_options(
-        &html,
-        roxmltree::ParsingOptions {
-            allow_dtd: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let doc = html_document(&html);
     for zone in ["III", "V"] {
         for want in [
             "building_period",
