@@ -338,6 +338,20 @@ fn several_frames_are_fitted_and_designed_for(out: &Path) {
     );
     let frames = fit["frames"].as_sequence().unwrap();
     assert_eq!(frames.len(), 6);
+    // fit.h5 labels every coefficient by its name, λ's among them (xarray).
+    let script = "import sys, xarray as xr\n\
+        for form in ['damped', 'lambda']:\n\
+        \x20   ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V/' + form)\n\
+        \x20   c = ds['coefficients']\n\
+        \x20   print(list(c.dims), list(ds['standard_errors'].dims), str(c['parameter'].values[-1]))\n";
+    let o = ok(Command::new(repo(".venv-test/bin/python"))
+        .args(["-c", script, out.join("fit.h5").to_str().unwrap()])
+        .output()
+        .unwrap());
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout),
+        "['parameter'] ['parameter'] v_0\n['parameter'] ['parameter'] w_0\n"
+    );
     let zone_v = (fit["zones"].as_sequence().unwrap().iter())
         .find(|z| z["zone"].as_str() == Some("V"))
         .unwrap();

@@ -14,8 +14,9 @@
 //!                                                     box_passed, box_points,
 //!                                                     box_min_t_new_over_t_p,
 //!                                                     box_max_t_new_over_t_rigid
-//!          /zone_<name>/<form>/coefficients   attrs: names
-//!          /zone_<name>/<form>/standard_errors attrs: names
+//!          /zone_<name>/<form>/coefficients   attrs: names     [parameter]
+//!          /zone_<name>/<form>/standard_errors attrs: names     [parameter]
+//!          /zone_<name>/<form>/parameter      the coefficients' names (dimension scale)
 //!          /zone_<name>/published             attrs: r2, r, rmse_s, mse_s2, mae_s, n
 //!          /zone_<name>/lambda                (a building study) the fraction form for λ, as a
 //!                                             form's group (its "T_new" is λ)
@@ -26,7 +27,9 @@
 //!                                             lambda_r2, …
 //! ```
 
-use super::h5::{attr_f64, attr_str, write_1d, write_stage_file};
+use super::h5::{
+    attach_scale, attr_f64, attr_str, set_scale, write_1d, write_stage_file, write_strings,
+};
 use super::{StoreError, checksum};
 use crate::fit::{
     BoxCheck, BuildingFeatures, Fitted, Form, HEIGHT_FEATURE, Method, Metrics, STOREYS_FEATURE,
@@ -263,6 +266,10 @@ fn write_form(g: &hdf5::Group, name: &str, fr: &FormFit) -> hdf5::Result<()> {
         "fitted coefficients",
     )?;
     attr_str(&ds, "names", &names.join(", "))?;
+    // The coefficients' names as their dimension's scale, so xarray labels them.
+    let parameter = write_strings(&sub, "parameter", &names, "the coefficient's name")?;
+    set_scale(&parameter, "parameter")?;
+    attach_scale(&ds, &parameter, 0)?;
     let se = write_1d(
         &sub,
         "standard_errors",
@@ -271,6 +278,7 @@ fn write_form(g: &hdf5::Group, name: &str, fr: &FormFit) -> hdf5::Result<()> {
         "standard error of each coefficient, from the Jacobian at the optimum",
     )?;
     attr_str(&se, "names", &names.join(", "))?;
+    attach_scale(&se, &parameter, 0)?;
     write_metrics(&sub, "", &fr.all_cases)?;
     write_metrics(&sub, "cv_", &fr.cross_validated)?;
     Ok(())
