@@ -290,6 +290,20 @@ fn against_period(
             Some(("λ = 1 (the whole stack as seismic mass)", 1.0)),
         ),
     ] {
+        // The row's range: every band of its panels and the reference line.
+        let (lo, hi) = (groups.iter().flat_map(|(_, fs)| fs.iter()))
+            .flat_map(|f| {
+                let v = value(f);
+                let mut ends = over_t(&v, 10.0);
+                ends.extend(over_t(&v, 90.0));
+                ends
+            })
+            .chain(reference.map(|r| r.1))
+            .filter(|x| x.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
+        let pad = 0.05 * (hi - lo).max(1e-3);
         for (n, frames) in &groups {
             let mut series = Vec::new();
             for (k, f) in frames.iter().enumerate() {
@@ -326,7 +340,7 @@ fn against_period(
             panels.push(Panel::xy(
                 format!("{title}, {n} {storeys}"),
                 Axis::new("T_1 (s)"),
-                Axis::new(y_label),
+                Axis::new(y_label).range(lo - pad, hi + pad),
                 series,
             ));
         }
@@ -372,6 +386,15 @@ fn profiles(z: &BuildingZone, files: &mut Files) -> Result<Option<String>, Repor
             |f: &FrameCases| &f.accel_profile,
         ),
     ] {
+        // The row's range, from 0: every profile of its panels.
+        let top = (groups.iter().flat_map(|(_, fs)| fs.iter()))
+            .flat_map(|f| {
+                let (s, r) = profile(f);
+                s.iter().chain(r).copied().collect::<Vec<f64>>()
+            })
+            .filter(|x| x.is_finite())
+            .fold(0.0, f64::max)
+            * scale;
         for (n, frames) in &groups {
             let levels: Vec<f64> = (1..=*n).map(|j| j as f64).collect();
             let mut series = Vec::new();
@@ -398,7 +421,7 @@ fn profiles(z: &BuildingZone, files: &mut Files) -> Result<Option<String>, Repor
             let level = if scale == 1.0 { "floor" } else { "storey" };
             panels.push(Panel::xy(
                 format!("{title}, {n} storeys"),
-                Axis::new(x_label),
+                Axis::new(x_label).range(0.0, 1.05 * top.max(f64::MIN_POSITIVE)),
                 Axis::new(level).range(0.5, *n as f64 + 0.5),
                 series,
             ));
