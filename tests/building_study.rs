@@ -50,6 +50,23 @@ fn units(dir: &Path) -> usize {
         .unwrap_or(0)
 }
 
+/// What `script` prints when the tests' Python (scripts/install-deps.sh --test: xarray,
+/// h5netcdf) runs it with `file` as its argument; panics with its stderr if it fails.
+fn python_on(script: &str, file: &Path) -> String {
+    let python = repo(".venv-test/bin/python");
+    assert!(
+        python.exists(),
+        "{} is missing: run scripts/install-deps.sh --test",
+        python.display()
+    );
+    let o = ok(Command::new(python)
+        .args(["-c", script])
+        .arg(file)
+        .output()
+        .unwrap());
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
 #[test]
 fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
     let dir = tempfile::tempdir().unwrap();
@@ -124,8 +141,6 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
     assert!(z.vars.u_stack.iter().all(|x| x.is_finite() && *x > 0.0));
 
     // xarray labels every dimension (Python environment made by scripts/install-deps.sh).
-    let python = repo(".venv-test/bin/python");
-    assert!(python.exists(), "{} is missing", python.display());
     let script = "import sys, xarray as xr\n\
         ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_III')\n\
         print(list(ds['u_stack'].dims))\n\
@@ -133,13 +148,8 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
               [str(f) for f in ds['stack_floor'].values])\n\
         print(float(ds['u_stack'].sel(storeys=3, stack_floor='roof').isel(motion=0, T_p=0, \
               alpha_1=0, alpha_2=0, mu_1=0, mu_2=0)) > 0)\n";
-    let o = Command::new(python)
-        .args(["-c", script, out.join("sweep.h5").to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
-        String::from_utf8_lossy(&o.stdout),
+        python_on(script, &out.join("sweep.h5")),
         "['motion', 'storeys', 'stack_floor', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2']\n\
          interface [1, 3] ['1', 'roof', 'all']\nTrue\n"
     );
@@ -154,13 +164,8 @@ a = ds['floor_accel_stack'].isel(motion=0, T_p=0, alpha_1=0, alpha_2=0, mu_1=0, 
 print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', floor=2).isnull()),
       bool((a.sel(storeys=3, stack_floor='roof') > 0).all()))
 "#;
-    let o = Command::new(repo(".venv-test/bin/python"))
-        .args(["-c", script, out.join("sweep.h5").to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
-        String::from_utf8_lossy(&o.stdout),
+        python_on(script, &out.join("sweep.h5")),
         "floor_accel_stack ['storeys', 'stack_floor'] floor\n\
          floor_accel_rigid ['storeys', 'stack_floor'] floor\n\
          drift_ratio_stack ['storeys', 'stack_floor'] storey\n\
@@ -248,18 +253,13 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
         let same = |v: &[f64]| v[f * per_frame..(f + 1) * per_frame] == v[..per_frame];
         assert!(same(tn) && same(t.vars.drr_1.as_slice().unwrap()));
     }
-    let o = ok(Command::new(repo(".venv-test/bin/python"))
-        .args([
-            "-c",
-            "import sys, xarray as xr\n\
-             t = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')\n\
-             print(list(t['T_new'].dims), list(t['roof_participation'].dims))\n",
-            out.join("tnew.h5").to_str().unwrap(),
-        ])
-        .output()
-        .unwrap());
     assert_eq!(
-        String::from_utf8_lossy(&o.stdout),
+        python_on(
+            "import sys, xarray as xr\n\
+                 t = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')\n\
+                 print(list(t['T_new'].dims), list(t['roof_participation'].dims))\n",
+            &out.join("tnew.h5")
+        ),
         "['storeys', 'stack_floor', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2'] ['storeys']\n"
     );
     // λ's root searches run in parallel: one thread writes the same bytes.
@@ -290,18 +290,13 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
     let sliding = slides.iter().filter(|&&s| s > 0.0).count();
     eprintln!("λ flags: {roots} roots of {sliding} sliding cases");
     assert!(roots > 0);
-    let o = ok(Command::new(repo(".venv-test/bin/python"))
-        .args([
-            "-c",
-            "import sys, xarray as xr\n\
-             t = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')\n\
-             print(list(t['lambda'].dims)[:2], t['lambda_flag'].attrs['flag_meanings'])\n",
-            out.join("tnew.h5").to_str().unwrap(),
-        ])
-        .output()
-        .unwrap());
     assert_eq!(
-        String::from_utf8_lossy(&o.stdout),
+        python_on(
+            "import sys, xarray as xr\n\
+                 t = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')\n\
+                 print(list(t['lambda'].dims)[:2], t['lambda_flag'].attrs['flag_meanings'])\n",
+            &out.join("tnew.h5")
+        ),
         "['storeys', 'stack_floor'] root below_range_clamped above_range_clamped no_slide \
          several_roots_largest\n"
     );
@@ -344,12 +339,8 @@ fn several_frames_are_fitted_and_designed_for(out: &Path) {
         \x20   ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V/' + form)\n\
         \x20   c = ds['coefficients']\n\
         \x20   print(list(c.dims), list(ds['standard_errors'].dims), str(c['parameter'].values[-1]))\n";
-    let o = ok(Command::new(repo(".venv-test/bin/python"))
-        .args(["-c", script, out.join("fit.h5").to_str().unwrap()])
-        .output()
-        .unwrap());
     assert_eq!(
-        String::from_utf8_lossy(&o.stdout),
+        python_on(script, &out.join("fit.h5")),
         "['parameter'] ['parameter'] v_0\n['parameter'] ['parameter'] w_0\n"
     );
     let zone_v = (fit["zones"].as_sequence().unwrap().iter())
