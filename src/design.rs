@@ -74,16 +74,6 @@ pub enum DesignError {
     Store(#[from] StoreError),
 }
 
-impl DesignError {
-    /// Whether the question (or a missing study) is at fault rather than the study's files.
-    pub fn is_bad_input(&self) -> bool {
-        !matches!(
-            self,
-            DesignError::Store(_) | DesignError::Mismatch { .. } | DesignError::OtherMotions { .. }
-        )
-    }
-}
-
 /// What a designer asks.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Query {

@@ -23,12 +23,14 @@
 pub mod case;
 pub mod design;
 pub mod dynamics;
+pub mod fault;
 pub mod fit;
 pub mod grid;
 pub mod ground_motion;
 pub mod ida;
 pub mod limits;
 pub mod match_files;
+pub mod methods;
 mod numeric;
 pub mod pipeline;
 pub mod render;

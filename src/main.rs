@@ -54,6 +54,12 @@ fn main() -> std::process::ExitCode {
     }
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    // The study's stages check for Ctrl-C between work units; the other commands end at once.
+    let checked = !matches!(
+        cli.command,
+        Command::Simulate(_) | Command::Spectrum(_) | Command::Match(_) | Command::Design(_)
+    );
+    cmd::interrupt::install(checked);
     let result = match cli.command {
         Command::Simulate(args) => cmd::simulate::run(*args),
         Command::Spectrum(args) => cmd::spectrum::run(args),
@@ -70,6 +76,11 @@ fn main() -> std::process::ExitCode {
         Command::Design(args) => cmd::design::run(args),
     };
     match result {
+        // A Ctrl-C that came after the work was done is still reported.
+        Ok(()) if cmd::interrupt::interrupted() => {
+            eprintln!("error: interrupted after the work was done; what it wrote is complete");
+            std::process::ExitCode::from(cmd::interrupt::EXIT_CODE)
+        }
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             let root = Cli::command();

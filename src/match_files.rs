@@ -47,19 +47,6 @@ pub enum MatchFilesError {
     },
 }
 
-impl MatchFilesError {
-    /// Whether the input (settings, target, a record) is at fault rather than the run.
-    pub fn is_bad_input(&self) -> bool {
-        matches!(
-            self,
-            MatchFilesError::Config(_)
-                | MatchFilesError::Settings { .. }
-                | MatchFilesError::Target(_)
-                | MatchFilesError::Record(_)
-        )
-    }
-}
-
 /// Matching settings from a YAML file (the keys of [`MatchSettings`]), unknown keys and
 /// impossible values refused.
 pub fn read_settings(path: &Path) -> Result<MatchSettings, MatchFilesError> {

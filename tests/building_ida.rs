@@ -9,7 +9,6 @@ mod common;
 
 use slidestack::store::ida::{IdaAxes, ZoneIda, read_zone_ida};
 use slidestack::study::storey_strength::storey_strength_ratios;
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -119,19 +118,14 @@ fn the_building_ida_runs_is_deterministic_resumes_and_is_labelled() {
     // once, atomically, at the end; a rerun computes it again).
     let killed = dir.path().join("killed");
     common::copy_motions(&m, &killed);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(["ida", s(&cfg), "--out", s(&killed)])
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
+    cmd.args(["ida", s(&cfg), "--out", s(&killed)])
         .env("RAYON_NUM_THREADS", "1")
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    std::io::BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    assert!(line.contains("traces"), "{line}");
-    std::thread::sleep(std::time::Duration::from_millis(10));
-    assert!(child.try_wait().unwrap().is_none(), "ended before the kill");
+        .stdout(Stdio::null());
+    // Held after its first trace: the stage is computing, nothing written yet.
+    let held = common::Held::arm(&mut cmd, "ida.trace:1", dir.path());
+    let mut child = cmd.spawn().unwrap();
+    held.wait(&mut child);
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(!killed.join("ida.h5").exists());

@@ -86,20 +86,18 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
     // Killed with SIGKILL once some units are on disk, then resumed.
     let killed = dir.path().join("killed");
     common::copy_motions(&out, &killed);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(["sweep", cfg_s, "--out", killed.to_str().unwrap()])
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
+    cmd.args(["sweep", cfg_s, "--out", killed.to_str().unwrap()])
         .env("RAYON_NUM_THREADS", "1")
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let start = std::time::Instant::now();
-    while units(&killed) < 3 && start.elapsed().as_secs() < 60 {
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
+        .stdout(std::process::Stdio::null());
+    // Held after its third unit is stored: exactly three are on disk at the kill.
+    let held = common::Held::arm(&mut cmd, "sweep.unit:3", dir.path());
+    let mut child = cmd.spawn().unwrap();
+    held.wait(&mut child);
     child.kill().unwrap();
     child.wait().unwrap();
     let before = units(&killed);
-    assert!((3..108).contains(&before), "{before} units before the kill");
+    assert_eq!(before, 3, "{before} units before the kill");
     assert!(!killed.join("sweep.h5").exists());
     let o = ok(slidestack(
         &["sweep", cfg_s, "--out", killed.to_str().unwrap()],

@@ -59,12 +59,16 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
     // Killed with SIGKILL once some units are on disk, then resumed.
     let killed = dir.path().join("killed");
     common::copy_motions(&out, &killed);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(["sweep", cfg_s, "--out", killed.to_str().unwrap()])
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
+    cmd.args(["sweep", cfg_s, "--out", killed.to_str().unwrap()])
         .env("RAYON_NUM_THREADS", "1")
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+        .stdout(std::process::Stdio::null());
+    // Held after its third unit is stored: exactly three are on disk at the kill.
+    let held = common::Held::arm(&mut cmd, "sweep.unit:3", dir.path());
+    let mut child = cmd.spawn().unwrap();
+    held.wait(&mut child);
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
     let units = killed.join("sweep.units");
     let count = || {
         std::fs::read_dir(&units)
@@ -77,17 +81,8 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
             })
             .unwrap_or(0)
     };
-    let start = std::time::Instant::now();
-    while count() < 3 && start.elapsed().as_secs() < 60 {
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
-    child.kill().unwrap(); // SIGKILL
-    child.wait().unwrap();
     let done_before = count();
-    assert!(
-        (3..24).contains(&done_before),
-        "{done_before} units before the kill"
-    );
+    assert_eq!(done_before, 3, "{done_before} units before the kill");
     assert!(!killed.join("sweep.h5").exists());
     let o = ok(slidestack(
         &["sweep", cfg_s, "--out", killed.to_str().unwrap()],

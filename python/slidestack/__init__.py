@@ -8,11 +8,15 @@ and the staged T_new study (motions -> sweep -> tnew -> fit -> report, ida, desi
 >>> r = slidestack.simulate(period=1.0, alpha=[0.5, 0.5], mu=[0.2, 0.1])
 >>> r["peak_displacement_m"]  # the numbers of ``slidestack simulate --json``
 
-Every function releases the GIL while it works. Bad input raises ``ValueError`` (or
-``FileNotFoundError``/``OSError`` for files) with the message the command line prints.
+Every function releases the GIL while it works. Errors carry the message the command line
+prints and the attributes ``kind``, ``file``, ``key`` and ``line``: bad input raises
+``ValueError``, a missing file ``FileNotFoundError``, other I/O ``OSError``, Ctrl-C
+``KeyboardInterrupt``, and a damaged file or a failed run ``slidestack.Error`` (a
+``RuntimeError``).
 """
 
 from ._native import (
+    Error,
     __version__,
     design,
     fit,
@@ -32,6 +36,7 @@ from ._native import (
 from ._study import open_study
 
 __all__ = [
+    "Error",
     "__version__",
     "design",
     "fit",

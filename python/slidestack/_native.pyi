@@ -8,6 +8,14 @@ import numpy.typing as npt
 
 __version__: str
 
+class Error(RuntimeError):
+    """A stored file that fails its checks, or a run that could not produce its result."""
+
+    kind: str
+    file: Optional[str]
+    key: Optional[str]
+    line: Optional[int]
+
 _Path = Union[str, os.PathLike[str]]
 _Floats = Union[Sequence[float], npt.NDArray[np.floating[Any]]]
 _Record = Union[_Path, Tuple[_Floats, float]]

@@ -1,59 +1,30 @@
 //! Library errors as Python exceptions, with the CLI's message (the error and its causes, each
-//! once): `FileNotFoundError` and `OSError` where a file could not be read or written,
-//! `ValueError` where the input is at fault, `RuntimeError` where the run failed,
-//! `KeyboardInterrupt` for a stage stopped by Ctrl-C.
+//! once). The class comes from the library's one classification ([`slidestack::fault`]):
+//! `ValueError` where the input is at fault, `FileNotFoundError` where a file is missing,
+//! `OSError` where reading, writing or locking failed, `KeyboardInterrupt` for Ctrl-C, and
+//! `slidestack.Error` (a `RuntimeError`) for a damaged file or a failed run. Each exception
+//! carries `kind` (the fault's name) and `file`, `key` and `line` (`None` where the error names
+//! none).
 
-use pyo3::PyErr;
 use pyo3::exceptions::{
     PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError,
 };
-use slidestack::design::DesignError;
-use slidestack::ground_motion::matching::MatchError;
-use slidestack::pipeline::PipelineError;
-use slidestack::simulation::SimulationError;
-use slidestack::spectrum::batch::BatchError;
-use std::error::Error;
+use pyo3::prelude::*;
+use slidestack::fault::{FaultKind, classify};
+use std::error::Error as StdError;
 
-/// Whose fault an error is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Fault {
-    Input,
-    Run,
-    Interrupted,
-}
-
-impl Fault {
-    pub fn of_simulation(e: &SimulationError) -> Self {
-        Self::input_if(e.is_bad_input())
-    }
-    pub fn of_batch(e: &BatchError) -> Self {
-        Self::input_if(e.is_bad_input())
-    }
-    pub fn of_design(e: &DesignError) -> Self {
-        Self::input_if(e.is_bad_input())
-    }
-    pub fn of_match(e: &MatchError) -> Self {
-        Self::input_if(matches!(
-            e,
-            MatchError::Setting { .. } | MatchError::Spectrum(_)
-        ))
-    }
-    pub fn of_pipeline(e: &PipelineError) -> Self {
-        match e {
-            PipelineError::Cancelled(_) => Fault::Interrupted,
-            _ => Self::input_if(e.is_bad_input()),
-        }
-    }
-    fn input_if(bad: bool) -> Self {
-        if bad { Fault::Input } else { Fault::Run }
-    }
-}
+pyo3::create_exception!(
+    slidestack,
+    Error,
+    PyRuntimeError,
+    "A stored file that fails its checks, or a run that could not produce its result."
+);
 
 /// The message the CLI prints after `error: `: the error and each cause whose text it does not
 /// already hold.
-pub fn message(e: &(dyn Error + 'static)) -> String {
+pub fn message(e: &(dyn StdError + 'static)) -> String {
     let mut text = String::new();
-    let mut cause: Option<&(dyn Error + 'static)> = Some(e);
+    let mut cause: Option<&(dyn StdError + 'static)> = Some(e);
     while let Some(c) = cause {
         let s = c.to_string();
         if !text.contains(&s) {
@@ -67,28 +38,30 @@ pub fn message(e: &(dyn Error + 'static)) -> String {
     text
 }
 
-/// The Python exception for `e`: an I/O error anywhere in its chain decides the class (a missing
-/// file is `FileNotFoundError`), else `fault` does.
-pub fn to_py_err(e: &(dyn Error + 'static), fault: Fault) -> PyErr {
+/// The Python exception for `e` (module doc).
+pub fn to_py_err(e: &(dyn StdError + 'static)) -> PyErr {
+    let fault = classify(e);
     let msg = message(e);
-    if fault == Fault::Interrupted {
-        return PyKeyboardInterrupt::new_err(msg);
-    }
-    let mut cause: Option<&(dyn Error + 'static)> = Some(e);
-    while let Some(c) = cause {
-        if let Some(io) = c.downcast_ref::<std::io::Error>() {
-            return match io.kind() {
-                std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(msg),
-                _ => PyOSError::new_err(msg),
-            };
-        }
-        if let Some(DesignError::Missing { .. }) = c.downcast_ref::<DesignError>() {
-            return PyFileNotFoundError::new_err(msg);
-        }
-        cause = c.source();
-    }
-    match fault {
-        Fault::Input => PyValueError::new_err(msg),
-        _ => PyRuntimeError::new_err(msg),
-    }
+    let err = match fault.kind {
+        FaultKind::BadInput => PyValueError::new_err(msg),
+        FaultKind::MissingFile => PyFileNotFoundError::new_err(msg),
+        FaultKind::Io => PyOSError::new_err(msg),
+        FaultKind::Interrupted => PyKeyboardInterrupt::new_err(msg),
+        FaultKind::DamagedFile | FaultKind::Failed => Error::new_err(msg),
+    };
+    Python::attach(|py| {
+        let value = err.value(py);
+        // Attributes on a fresh exception object cannot fail but for lack of memory, in which
+        // case the exception goes without them.
+        let _ = value.setattr("kind", fault.kind.name());
+        let _ = value.setattr("file", fault.file);
+        let _ = value.setattr("key", fault.key);
+        let _ = value.setattr("line", fault.line);
+    });
+    err
+}
+
+/// A panic's message as the exception of a defect.
+pub fn internal(why: &str) -> PyErr {
+    Error::new_err(format!("internal error: {why}"))
 }

@@ -7,15 +7,15 @@
 //! the study's stages run on a thread of their own so that Ctrl-C stops them
 //! ([`slidestack::pipeline::Reporter::cancelled`]).
 //!
-//! Errors: input at fault raises `ValueError` (`FileNotFoundError` for a missing file, `OSError`
-//! for other I/O), a failed run `RuntimeError`, each with the CLI's message.
+//! Errors: the library's classification as Python's exception classes, with the CLI's message
+//! ([`errors`]).
 
 mod convert;
 mod errors;
 mod pipeline;
 
 use convert::{json_to_py, to_yaml_value};
-use errors::{Fault, to_py_err};
+use errors::to_py_err;
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -63,7 +63,7 @@ fn record_arg(obj: &Bound<'_, PyAny>) -> PyResult<RecordArg> {
         .map_err(|_| PyValueError::new_err("`record[1]` (dt, s) must be a number"))?;
     Record::from_samples(ARRAY_RECORD, dt_s, accel_g)
         .map(RecordArg::Samples)
-        .map_err(|e| to_py_err(&e, Fault::Input))
+        .map_err(|e| to_py_err(&e))
 }
 
 /// One case under one ground motion: the dict `slidestack simulate --json` prints.
@@ -130,8 +130,8 @@ fn simulate<'py>(
         None => None,
     };
     let given: Settings = serde_yaml::from_value(serde_yaml::Value::Mapping(mapping))
-        .map_err(|e| to_py_err(&SimulationError::Invalid(e.to_string()), Fault::Input))?;
-    let input = |e: SimulationError| to_py_err(&e, Fault::of_simulation(&e));
+        .map_err(|e| to_py_err(&SimulationError::Invalid(e.to_string())))?;
+    let input = |e: SimulationError| to_py_err(&e);
     let base = match &config {
         Some(path) => Settings::read(path).map_err(input)?,
         None => Settings::default(),
@@ -205,7 +205,7 @@ fn read_record<'py>(
     let opts = ReadOptions { units, dt_s: dt };
     let r = py
         .detach(|| read_record_with(&path, &opts))
-        .map_err(|e| to_py_err(&e, Fault::Input))?;
+        .map_err(|e| to_py_err(&e))?;
     PyTuple::new(
         py,
         [
@@ -226,7 +226,7 @@ fn periods_arg(obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
             .collect::<Vec<_>>()
             .join(","),
     };
-    parse_periods(&spec).map_err(|e| to_py_err(&e, Fault::Input))
+    parse_periods(&spec).map_err(|e| to_py_err(&e))
 }
 
 /// Floats from a number or a sequence, and whether it was one number.
@@ -251,10 +251,10 @@ fn spectrum<'py>(
     post_yield_ratio: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let rec = Record::from_samples(ARRAY_RECORD, dt, convert::float_vec(accel_g, "accel_g")?)
-        .map_err(|e| to_py_err(&e, Fault::Input))?;
+        .map_err(|e| to_py_err(&e))?;
     let periods = match periods {
         Some(p) => periods_arg(p)?,
-        None => parse_periods(DEFAULT_PERIODS).map_err(|e| to_py_err(&e, Fault::Input))?,
+        None => parse_periods(DEFAULT_PERIODS).map_err(|e| to_py_err(&e))?,
     };
     let (dampings, one_damping) = match damping {
         Some(d) => one_or_many(d, "damping")?,
@@ -270,7 +270,7 @@ fn spectrum<'py>(
             }
             let s = py
                 .detach(|| response_spectra(&records, &periods, &dampings))
-                .map_err(|e| to_py_err(&e, Fault::of_batch(&e)))?;
+                .map_err(|e| to_py_err(&e))?;
             serde_json::to_string(&s)
         }
         Some(mu) => {
@@ -278,7 +278,7 @@ fn spectrum<'py>(
             let r = post_yield_ratio.unwrap_or(0.0);
             let s = py
                 .detach(|| ductility_spectra(&records, &periods, &dampings, &mus, r))
-                .map_err(|e| to_py_err(&e, Fault::of_batch(&e)))?;
+                .map_err(|e| to_py_err(&e))?;
             serde_json::to_string(&s)
         }
     }
@@ -313,7 +313,7 @@ fn match_<'py>(
     let rec = match record_arg(record)? {
         RecordArg::Path(p) => py
             .detach(|| read_record_with(&p, &ReadOptions::default()))
-            .map_err(|e| to_py_err(&e, Fault::Input))?,
+            .map_err(|e| to_py_err(&e))?,
         RecordArg::Samples(r) => r,
     };
     let spec: TargetSpectrum = target
@@ -330,7 +330,7 @@ fn match_<'py>(
     })?;
     let m = py
         .detach(|| match_record(&rec.accel_g, rec.dt_s, &spec, &settings))
-        .map_err(|e| to_py_err(&e, Fault::of_match(&e)))?;
+        .map_err(|e| to_py_err(&e))?;
     let d = PyDict::new(py);
     d.set_item("record", &rec.name)?;
     d.set_item("accel_g", m.accel_g.into_pyarray(py))?;
@@ -383,7 +383,7 @@ fn design<'py>(
     };
     let a = py
         .detach(|| design_query(&study, &q))
-        .map_err(|e| to_py_err(&e, Fault::of_design(&e)))?;
+        .map_err(|e| to_py_err(&e))?;
     json_to_py(
         py,
         &serde_json::to_string(&a).expect("an answer serialises"),
@@ -400,6 +400,7 @@ fn _panic() {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", slidestack::VERSION)?;
+    m.add("Error", m.py().get_type::<errors::Error>())?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(read_record, m)?)?;
     m.add_function(wrap_pyfunction!(spectrum, m)?)?;

@@ -7,8 +7,8 @@
 //! unit ([`Reporter::cancelled`]), which leaves the output directory as a killed run does.
 
 use crate::convert::{to_yaml_value, warn};
-use crate::errors::{Fault, to_py_err};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use crate::errors::{internal, to_py_err};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use slidestack::pipeline::lock::LockMode;
@@ -127,11 +127,17 @@ fn in_session<T: Send + 'static>(
             Err(_) => Err(RecvTimeoutError::Disconnected),
         });
         match next {
-            Ok(r) => break r,
+            Ok(r) => {
+                // A Ctrl-C of the last slice is reported even though the stage has finished.
+                if interrupt.is_none()
+                    && let Err(e) = py.check_signals()
+                {
+                    interrupt = Some(e);
+                }
+                break r;
+            }
             Err(RecvTimeoutError::Disconnected) => {
-                return Err(PyRuntimeError::new_err(
-                    "the stage's thread ended without a result",
-                ));
+                return Err(internal("the stage's thread ended without a result"));
             }
             Err(RecvTimeoutError::Timeout) => {}
         }
@@ -153,17 +159,21 @@ fn in_session<T: Send + 'static>(
         .unwrap_or_default();
     warn(py, &warnings)?;
     if let Some(e) = interrupt {
-        return Err(e);
+        // The stage's own word on what it kept, where it stopped for the interrupt.
+        return Err(match result {
+            Ok(Err(stopped @ PipelineError::Cancelled(_))) => to_py_err(&stopped),
+            _ => e,
+        });
     }
     match result {
-        Ok(r) => r.map_err(|e| to_py_err(&e, Fault::of_pipeline(&e))),
+        Ok(r) => r.map_err(|e| to_py_err(&e)),
         Err(panic) => {
             let why = panic
                 .downcast_ref::<String>()
                 .cloned()
                 .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
                 .unwrap_or_default();
-            Err(PyRuntimeError::new_err(format!("internal error: {why}")))
+            Err(internal(&why))
         }
     }
 }
@@ -325,7 +335,7 @@ fn status<'py>(
             let study = config.study(out)?;
             study_status(&study).map(|st| (study.out.clone(), st))
         })
-        .map_err(|e| to_py_err(&e, Fault::of_pipeline(&e)))?;
+        .map_err(|e| to_py_err(&e))?;
     let d = PyDict::new(py);
     d.set_item("output_dir", dir.display().to_string())?;
     let stages = PyDict::new(py);
@@ -338,6 +348,11 @@ fn status<'py>(
     }
     d.set_item("stages", stages)?;
     d.set_item("damaged", damaged)?;
+    let made_with = PyDict::new(py);
+    for (stage, made, now) in &st.made_with {
+        made_with.set_item(stage.name(), (made, now))?;
+    }
+    d.set_item("made_with", made_with)?;
     d.set_item("sweep_units", st.sweep_units)?;
     d.set_item("sweep_units_done", st.sweep_units_done)?;
     d.set_item("sweep_cases_per_unit", st.cases_per_unit)?;

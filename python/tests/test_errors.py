@@ -31,10 +31,13 @@ def test_a_missing_record_is_file_not_found(cli):
         slidestack.read_record("no/such.AT2")
 
 
-def test_a_directory_as_record_is_an_os_error():
-    with pytest.raises(OSError) as e:
+def test_a_directory_as_record_is_bad_input(cli):
+    want = cli_error(cli, "simulate", "--record", str(ROOT / "configs"))
+    with pytest.raises(ValueError) as e:
         slidestack.read_record(ROOT / "configs")
-    assert not isinstance(e.value, FileNotFoundError)
+    assert str(e.value) == want
+    assert e.value.kind == "bad_input"  # type: ignore[attr-defined]
+    assert e.value.file == str(ROOT / "configs")  # type: ignore[attr-defined]
 
 
 def test_a_bad_record_file_names_file_and_line(cli, tmp_path):
@@ -96,8 +99,8 @@ def test_study_errors(cli, tmp_path):
     with pytest.raises(ValueError, match="is a file"):
         slidestack.status(ROOT / "configs/quick.yaml", out=ROOT / "README.md")
     cfg = ROOT / "configs/quick.yaml"
-    want = cli_error(cli, "tnew", str(cfg), "--out", str(tmp_path / "q"), code=1)
-    with pytest.raises(RuntimeError) as e:
+    want = cli_error(cli, "tnew", str(cfg), "--out", str(tmp_path / "q"), code=2)
+    with pytest.raises(FileNotFoundError) as e:
         slidestack.tnew(cfg, out=tmp_path / "q")
     assert str(e.value) == want
 
@@ -118,3 +121,56 @@ def test_a_panic_is_an_exception_not_an_abort():
     assert type(e.value).__name__ == "PanicException"
     assert "deliberate panic" in str(e.value)
     assert slidestack.simulate()["switches"] > 0
+
+
+def small_study(tmp_path, name: str) -> dict:
+    """configs/quick.yaml's zone III, three motions, with one case (too few to fit)."""
+    return {
+        "output_dir": str(tmp_path / name),
+        "zones": [{"name": "III", "target": "is1893:zone=III,soil=I"}],
+        "motions": {"seeds": {"stochastic": {"count": 3, "seed": 2016}}},
+        "grid": {"period_s": [1.0], "alpha": [[0.5], [0.5]], "mu": [[0.1], [0.05]]},
+    }
+
+
+def test_every_kind_of_fault_has_its_class_and_names_its_place(tmp_path):
+    """The library's one classification (src/fault.rs) decides the class; `kind`, `file`,
+    `key`, `line` say what and where."""
+    # Bad input, with the key of the config.
+    cfg = small_study(tmp_path, "bad")
+    cfg["grid"]["damping"] = 2.0
+    with pytest.raises(ValueError) as e:
+        slidestack.status(cfg)
+    assert (e.value.kind, e.value.key) == ("bad_input", "grid.damping")  # type: ignore[attr-defined]
+    # Bad input, with the file and the line of a record.
+    bad = tmp_path / "bad.txt"
+    bad.write_text("0 0.1\n0.01 x\n")
+    with pytest.raises(ValueError) as e:
+        slidestack.read_record(bad)
+    assert (e.value.file, e.value.line) == (str(bad), 2)  # type: ignore[attr-defined]
+    # A missing file.
+    with pytest.raises(FileNotFoundError) as e:
+        slidestack.read_record(tmp_path / "none.AT2")
+    assert e.value.kind == "missing_file"  # type: ignore[attr-defined]
+    # I/O: an output directory that cannot be made.
+    (tmp_path / "a-file").write_text("")
+    with pytest.raises(OSError) as e:
+        slidestack.motions(small_study(tmp_path, "a-file/o"))
+    assert e.value.kind == "io"  # type: ignore[attr-defined]
+    assert not isinstance(e.value, FileNotFoundError)
+    # A run that cannot produce its result: one case cannot be fitted.
+    cfg = small_study(tmp_path, "one")
+    for stage in (slidestack.motions, slidestack.sweep, slidestack.tnew):
+        stage(cfg)
+    with pytest.raises(slidestack.Error, match="no form could be fitted") as e:
+        slidestack.fit(cfg)
+    assert e.value.kind == "failed" and isinstance(e.value, RuntimeError)  # type: ignore[attr-defined]
+    # A damaged file: a flipped byte in sweep.h5.
+    sweep = tmp_path / "one" / "sweep.h5"
+    data = bytearray(sweep.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    sweep.write_bytes(bytes(data))
+    with pytest.raises(slidestack.Error, match="does not match its checksum") as e:
+        slidestack.tnew(cfg, force=True)
+    assert e.value.kind == "damaged_file"  # type: ignore[attr-defined]
+    # Interrupted: KeyboardInterrupt (test_study.py, the Ctrl-C tests).

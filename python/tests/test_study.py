@@ -148,45 +148,88 @@ def quick_dict(out: Path, periods=None) -> dict:
 
 INTERRUPT_SCRIPT = """
 import sys, slidestack
-sys.stdout.write("start\\n"); sys.stdout.flush()
-slidestack.sweep(eval(sys.argv[1]))
+stage = getattr(slidestack, sys.argv[2])
+try:
+    stage(eval(sys.argv[1]))
+except KeyboardInterrupt as e:
+    print("KeyboardInterrupt:", e, file=sys.stderr)
+    sys.exit(3)
+print("returned")
 """
 
 
-def test_ctrl_c_stops_a_sweep_and_leaves_it_resumable(tmp_path):
+def interrupted(cfg, stage: str, point: str, tmp_path: Path) -> str:
+    """Runs `stage` of `cfg` in a child interpreter held at `point` of the test hook
+    (slidestack.pipeline.pause), sends SIGINT while it holds there, and returns its stderr; the
+    stage must end in KeyboardInterrupt (exit 3), however late the signal came."""
+    held = tmp_path / f"held-{stage}"
+    env = dict(os.environ, SLIDESTACK_PAUSE_AT=point, SLIDESTACK_PAUSE_FILE=str(held))
+    env["RAYON_NUM_THREADS"] = "1"
+    p = subprocess.Popen(
+        [sys.executable, "-c", INTERRUPT_SCRIPT, repr(cfg), stage],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    while not held.exists():
+        assert p.poll() is None, p.communicate()
+        time.sleep(0.002)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate()
+    assert p.returncode == 3, (p.returncode, out, err)
+    assert "returned" not in out
+    return err
+
+
+def test_ctrl_c_during_units_stops_a_sweep_and_leaves_it_resumable(tmp_path):
     out = tmp_path / "big"
     periods = [round(0.1 + 0.02 * i, 2) for i in range(96)]
     cfg = quick_dict(out, periods)
     slidestack.motions(cfg)
-    p = subprocess.Popen(
-        [sys.executable, "-c", INTERRUPT_SCRIPT, repr(cfg)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert p.stdout.readline() == "start\n"
-    units = out / "sweep.units"
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and not (units.exists() and any(units.iterdir())):
-        time.sleep(0.05)
-    assert p.poll() is None, "the sweep ended before it could be interrupted"
-    p.send_signal(signal.SIGINT)
-    sent = time.monotonic()
-    _, err = p.communicate(timeout=60)
-    stopped_after = time.monotonic() - sent
-    assert p.returncode != 0
-    assert "KeyboardInterrupt" in err, err
-    # One work unit per thread may finish after the signal; a unit here takes milliseconds.
-    assert stopped_after < 5, stopped_after
-    print(f"stopped {stopped_after:.2f} s after SIGINT")
+    # Held after its second unit is stored, on one thread: exactly two units are kept.
+    err = interrupted(cfg, "sweep", "sweep.unit:2", tmp_path)
+    assert "sweep: interrupted" in err, err
     st = slidestack.status(cfg)
     assert st["stages"]["sweep"] == "missing"
-    assert 0 < st["sweep_units_done"] < st["sweep_units"], st
-    # The next run resumes: it computes only the units not stored.
+    assert st["sweep_units_done"] == 2, st
     leftovers = [n for n in os.listdir(out) if ".tmp" in n]
     assert not leftovers, leftovers
+    # The next run resumes: it computes only the units not stored.
     assert slidestack.sweep(cfg)["outcome"] == "wrote"
     assert slidestack.status(cfg)["stages"]["sweep"] == "up_to_date"
+
+
+def test_ctrl_c_before_the_assembly_keeps_every_unit(tmp_path):
+    out = tmp_path / "late"
+    cfg = quick_dict(out, [0.5, 1.0])
+    slidestack.motions(cfg)
+    interrupted(cfg, "sweep", "sweep.assemble", tmp_path)
+    st = slidestack.status(cfg)
+    assert st["stages"]["sweep"] == "missing"
+    assert st["sweep_units_done"] == st["sweep_units"], st
+    assert slidestack.sweep(cfg)["outcome"] == "wrote"
+
+
+def test_ctrl_c_after_the_work_is_done_is_still_reported(tmp_path):
+    out = tmp_path / "done"
+    cfg = quick_dict(out, [0.5, 1.0])
+    slidestack.motions(cfg)
+    # The signal comes once sweep.h5 is written and verified: the file is complete and
+    # correct, and the interrupt still raises KeyboardInterrupt.
+    interrupted(cfg, "sweep", "stage.done", tmp_path)
+    assert slidestack.status(cfg)["stages"]["sweep"] == "up_to_date"
+    assert slidestack.sweep(cfg)["outcome"] == "up_to_date"
+
+
+def test_ctrl_c_stops_the_motions_stage_within_one_record(tmp_path):
+    out = tmp_path / "motions"
+    cfg = quick_dict(out, [0.5, 1.0])
+    # Held before its second record is matched (of three per zone, two zones).
+    err = interrupted(cfg, "motions", "motions.record:2", tmp_path)
+    assert "motions: interrupted" in err, err
+    assert slidestack.status(cfg)["stages"]["motions"] == "missing"
+    assert slidestack.motions(cfg)["outcome"] == "wrote"
 
 
 SWEEP_SCRIPT = """
@@ -246,8 +289,9 @@ def test_shards_and_merge_make_the_same_sweep(quick, tmp_path):
     out = tmp_path / "sharded"
     copy_motions(py_out, out)
     assert slidestack.sweep(QUICK, out=out, shard=(1, 2))["outcome"] == "shard_done"
-    with pytest.raises(RuntimeError, match="15 of 30 units are missing"):
+    with pytest.raises(FileNotFoundError, match="15 of 30 units are missing") as e:
         slidestack.merge(QUICK, out=out)  # shard 2 is missing
+    assert e.value.kind == "missing_file"  # type: ignore[attr-defined]
     assert slidestack.sweep(QUICK, out=out, shard=(2, 2))["shard"] == (2, 2)
     assert slidestack.merge(QUICK, out=out)["outcome"] == "wrote"
     assert (out / "sweep.h5").read_bytes() == (py_out / "sweep.h5").read_bytes()

@@ -3,6 +3,7 @@
 
 pub mod design;
 pub mod ida;
+pub mod interrupt;
 pub mod matching;
 pub mod run;
 pub mod simulate;
@@ -11,7 +12,8 @@ pub mod stage;
 pub mod status;
 pub mod sweep;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
+pub use slidestack::fault::BadInput;
 use slidestack::ground_motion::{ReadOptions, Record, Units, read_record_with};
 use slidestack::pipeline::lock::{LockError, LockMode};
 use slidestack::pipeline::{
@@ -67,6 +69,9 @@ impl Reporter for CliReporter {
     fn progress(&self, _stage: StageId, total: u64) -> Box<dyn Progress + '_> {
         slidestack::pipeline::terminal_progress(total)
     }
+    fn cancelled(&self) -> bool {
+        interrupt::interrupted()
+    }
 }
 
 /// One line saying what a stage did.
@@ -84,35 +89,10 @@ pub fn print_outcome(stage: StageId, outcome: &Outcome, config: &std::path::Path
     }
 }
 
-/// The process exit code for an error: 2 when the input was at fault (a bad config, file or
-/// argument), 1 when the run failed.
+/// The process exit code for an error: its kind's ([`slidestack::fault`]).
 pub fn exit_code(e: &anyhow::Error) -> u8 {
-    let bad_input = e.chain().any(|c| {
-        c.downcast_ref::<PipelineError>()
-            .is_some_and(PipelineError::is_bad_input)
-            || c.is::<slidestack::study::config::ConfigError>()
-            || c.is::<slidestack::ground_motion::RecordError>()
-            || c.is::<slidestack::spectrum::PeriodsError>()
-            || c.is::<slidestack::dynamics::ModelError>()
-            || c.downcast_ref::<slidestack::dynamics::SimError>()
-                .is_some_and(slidestack::dynamics::SimError::is_bad_input)
-            || c.downcast_ref::<slidestack::simulation::SimulationError>()
-                .is_some_and(slidestack::simulation::SimulationError::is_bad_input)
-            || c.downcast_ref::<slidestack::design::DesignError>()
-                .is_some_and(slidestack::design::DesignError::is_bad_input)
-            || c.downcast_ref::<slidestack::match_files::MatchFilesError>()
-                .is_some_and(slidestack::match_files::MatchFilesError::is_bad_input)
-            || c.downcast_ref::<slidestack::spectrum::batch::BatchError>()
-                .is_some_and(slidestack::spectrum::batch::BatchError::is_bad_input)
-            || c.is::<BadInput>()
-    });
-    if bad_input { 2 } else { 1 }
+    slidestack::fault::classify(e.as_ref()).kind.exit_code()
 }
-
-/// An argument the user got wrong (exit code 2).
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct BadInput(pub String);
 
 /// The message of an error and its causes, each cause once (a cause whose text the message
 /// already holds, from error types that repeat their source, is not printed again), with the
@@ -188,11 +168,6 @@ pub struct RecordArgs {
 impl RecordArgs {
     /// Reads every record, refusing the whole call on the first bad file (names file and line).
     pub fn read(&self) -> Result<Vec<Record>> {
-        if let Some(dt) = self.dt
-            && !(dt.is_finite() && dt > 0.0)
-        {
-            bail!("--dt must be finite and > 0, got {dt}");
-        }
         let opts = ReadOptions {
             units: self.units,
             dt_s: self.dt,

@@ -43,6 +43,12 @@ pub fn run(args: Args) -> Result<()> {
                     StageState::Damaged(why) => format!("damaged: {why}"),
                     other => other.word().replace('_', " "),
                 };
+                let detail = match st.made_with.iter().find(|m| m.0 == *stage) {
+                    Some((_, made, now)) => {
+                        format!("{detail} (made with methods {made}; this binary's are {now})")
+                    }
+                    None => detail,
+                };
                 println!("{:<8} {:<20} {detail}", stage.name(), stage.output());
             }
             if st.sweep_units > 0 {

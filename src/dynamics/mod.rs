@@ -115,17 +115,6 @@ pub enum SimError {
     Contact(#[from] contact::ContactError),
 }
 
-impl SimError {
-    /// Whether the input is at fault (a record, a step count, a system beyond the integrator's
-    /// accurate range) rather than the run.
-    pub fn is_bad_input(&self) -> bool {
-        !matches!(
-            self,
-            SimError::Zeno { .. } | SimError::Contact(_) | SimError::Diverged
-        )
-    }
-}
-
 impl Ground<'_> {
     pub fn validate(&self) -> Result<(), SimError> {
         if !(DT_RANGE_S.0..=DT_RANGE_S.1).contains(&self.dt_s) {

@@ -181,6 +181,9 @@ pub enum RecordError {
         line: usize,
         problem: Problem,
     },
+    /// A reading option out of range, named as the library names settings.
+    #[error("`{setting}` must be finite and > 0, got {value}")]
+    Setting { setting: &'static str, value: f64 },
     /// Samples given in memory ([`Record::from_samples`]), named by their label.
     #[error("{name}: {source}")]
     Samples {
@@ -282,6 +285,14 @@ pub fn read_record_file(path: &Path) -> Result<Vec<u8>, RecordError> {
 /// The record in the bytes of the file `path` (its name and extension tell the format), as
 /// [`read_record_with`] reads it.
 pub fn parse_record(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
+    if let Some(dt) = opts.dt_s
+        && !(dt.is_finite() && dt > 0.0)
+    {
+        return Err(RecordError::Setting {
+            setting: "dt",
+            value: dt,
+        });
+    }
     let file = path.display().to_string();
     let text = input_text(bytes).map_err(|source| RecordError::Io {
         file: file.clone(),

@@ -66,7 +66,7 @@ pub fn fingerprint(tnew_fingerprint: &str, building: bool) -> String {
         parts.push(format!("lambda={}", Form::Fraction.name()));
     }
     let parts: Vec<&str> = parts.iter().map(String::as_str).collect();
-    hash_parts(&parts)
+    StageId::Fit.fingerprint(&hash_parts(&parts))
 }
 
 /// Names of a form's parameters, in [`crate::fit::Fitted::params`] order.

@@ -68,7 +68,7 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
         let floors = cfg.grid.as_ref().and_then(|g| g.stack_floor.as_ref());
         section["stack_floor"] = serde_json::json!(floors);
     }
-    Some(hash_parts(&[&section.to_string(), motions_fingerprint]))
+    Some(StageId::Ida.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint])))
 }
 
 /// Every zone's target spectrum as `motions.h5` stores it: the one its motions were matched to.
@@ -182,6 +182,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             let runs: usize = traces.iter().map(|t| t.runs.len()).sum();
             samples.fetch_add(runs * padded.len(), std::sync::atomic::Ordering::Relaxed);
             bar.inc();
+            s.pass("ida.trace", me)?;
             Ok(UnitOut {
                 record_sa_g,
                 traces,

@@ -30,11 +30,13 @@ pub mod fit;
 pub mod ida;
 pub mod lock;
 pub mod motions;
+pub mod pause;
 pub mod report;
 pub mod sweep;
 pub mod tnew;
 
 use crate::grid::{BuildingAxes, Grid};
+use crate::methods::Method;
 use crate::store::{StoreError, atomic};
 use crate::study::building::Frame;
 use crate::study::config::{ConfigError, StudyConfig};
@@ -104,6 +106,28 @@ impl StageId {
     }
 }
 
+impl StageId {
+    /// The methods whose numbers the stage stores ([`crate::methods`]); their versions are in
+    /// its fingerprint.
+    pub fn methods(self) -> &'static [Method] {
+        use crate::methods::*;
+        match self {
+            StageId::Motions => &[MOTIONS, SPECTRUM],
+            StageId::Sweep => &[INTEGRATOR],
+            StageId::Tnew => &[SPECTRUM, TNEW, LAMBDA, INTEGRATOR],
+            StageId::Fit => &[FIT],
+            // The report simulates the paper's named cases.
+            StageId::Report => &[REPORT, INTEGRATOR],
+            StageId::Ida => &[INTEGRATOR, SPECTRUM, IDA],
+        }
+    }
+
+    /// The stage's fingerprint from the hash of its inputs: that hash and its methods' versions.
+    pub fn fingerprint(self, inputs_hash: &str) -> String {
+        crate::methods::fingerprint(inputs_hash, self.methods())
+    }
+}
+
 impl std::fmt::Display for StageId {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
@@ -127,6 +151,9 @@ pub enum PipelineError {
     #[error("{why}: run `slidestack {stage} {}` first", config.display())]
     Upstream {
         why: String,
+        file: PathBuf,
+        /// What was found of it (never up to date).
+        state: StageState,
         stage: StageId,
         config: PathBuf,
     },
@@ -147,22 +174,6 @@ pub enum PipelineError {
     /// The reporter asked the run to stop ([`Reporter::cancelled`]).
     #[error("{0}: interrupted; what it stored is kept and the next run resumes from there")]
     Cancelled(StageId),
-}
-
-impl PipelineError {
-    /// Whether the error is the user's input (exit code 2) rather than a failure of the run.
-    pub fn is_bad_input(&self) -> bool {
-        match self {
-            PipelineError::Config(_)
-            | PipelineError::BadInput { .. }
-            | PipelineError::Setting { .. }
-            | PipelineError::NoGrid { .. }
-            | PipelineError::Ida(ida::IdaStageError::NoSection { .. }) => true,
-            PipelineError::Sweep(e) => e.is_bad_input(),
-            PipelineError::Motions(motions::MotionsError::Unmatched(_)) => true,
-            _ => false,
-        }
-    }
 }
 
 /// What a stage found on disk.
@@ -334,7 +345,7 @@ impl Study {
         let rest = match &cfg.grid {
             Some(_) => {
                 let sweep = sweep::fingerprint(&cfg, &motions_fp);
-                let tnew = tnew::fingerprint(&sweep, building.is_some());
+                let tnew = tnew::fingerprint(&sweep);
                 let fit = fit::fingerprint(&tnew, building.is_some());
                 let report = report::fingerprint(&fit, &motions_fp, ida.as_deref());
                 Some([sweep, tnew, fit, report])
@@ -478,7 +489,7 @@ impl Study {
                 break;
             }
         }
-        let why = match state {
+        let why = match &state {
             StageState::UpToDate => unreachable!("returned above"),
             StageState::Missing => format!("{} is missing", file.display()),
             StageState::Stale => format!(
@@ -486,10 +497,12 @@ impl Study {
                 file.display(),
                 self.config_path.display()
             ),
-            StageState::Damaged(e) => e,
+            StageState::Damaged(e) => e.clone(),
         };
         Err(PipelineError::Upstream {
             why,
+            file,
+            state,
             stage: first,
             config: self.config_path.clone(),
         })
@@ -539,12 +552,14 @@ impl<'r> Session<'r> {
                 atomic::remove_stale_temps(&dir)?;
             }
         }
-        Ok(Self {
+        let session = Self {
             study,
             reporter,
             mode,
             _lock: lock,
-        })
+        };
+        session.pass("session.locked", first)?;
+        Ok(session)
     }
 
     pub fn exclusive(&self) -> bool {
@@ -557,6 +572,13 @@ impl<'r> Session<'r> {
             return Err(PipelineError::Cancelled(stage));
         }
         Ok(())
+    }
+
+    /// Passes the test hook's `point` ([`pause`]), then `Err(Cancelled)` when the run was
+    /// cancelled meanwhile.
+    pub fn pass(&self, point: &str, stage: StageId) -> Result<(), PipelineError> {
+        pause::point(point, &|| self.reporter.cancelled());
+        self.check_cancelled(stage)
     }
 }
 
@@ -601,14 +623,17 @@ pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcom
             StageState::Missing | StageState::Stale => {}
         }
     }
-    match stage {
+    let outcome = match stage {
         StageId::Motions => motions::build(s),
         StageId::Sweep => sweep::build(s, None),
         StageId::Tnew => tnew::build(s),
         StageId::Fit => fit::build(s),
         StageId::Report => report::build(s),
         StageId::Ida => ida::build(s),
-    }
+    }?;
+    // A Ctrl-C that came while the output was being finished is reported, the output kept.
+    s.pass("stage.done", stage)?;
+    Ok(outcome)
 }
 
 /// Every stage in order (`ida` only with an `ida:` section), each skipped when up to date,
@@ -633,6 +658,9 @@ pub fn run_all(
 #[derive(Debug, Clone, PartialEq)]
 pub struct Status {
     pub stages: Vec<(StageId, StageState)>,
+    /// The stale stages whose file was made with other method versions than this binary's:
+    /// `(stage, the file's methods, this binary's)`.
+    pub made_with: Vec<(StageId, String, String)>,
     /// Work units of the sweep (zones × motions × periods).
     pub sweep_units: usize,
     /// Units already stored for the current sweep.
@@ -648,11 +676,22 @@ pub struct Status {
 /// What is on disk for every stage; reads only, takes no lock.
 pub fn status(study: &Study) -> Result<Status, PipelineError> {
     let mut stages = Vec::new();
+    let mut made_with = Vec::new();
     for stage in StageId::ALL {
         if !study.configured(stage) {
             continue;
         }
-        stages.push((stage, study.state(stage)?));
+        let state = study.state(stage)?;
+        if state == StageState::Stale {
+            let want = crate::methods::tag(stage.methods());
+            let stored = study.stored(stage).ok().flatten();
+            let made = stored.as_deref().and_then(crate::methods::methods_of);
+            if made != Some(want.as_str()) {
+                let made = made.unwrap_or("a version that did not record them");
+                made_with.push((stage, made.to_string(), want));
+            }
+        }
+        stages.push((stage, state));
     }
     let (sweep_units, sweep_units_done, samples_per_motion) = match &study.grid {
         Some(_) => sweep::unit_status(study)?,
@@ -661,6 +700,7 @@ pub fn status(study: &Study) -> Result<Status, PipelineError> {
     let cases_per_unit = study.grid.as_ref().map_or(0, Grid::cases_per_unit);
     Ok(Status {
         stages,
+        made_with,
         sweep_units,
         sweep_units_done,
         cases_per_unit,

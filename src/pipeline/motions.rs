@@ -14,7 +14,7 @@ use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::motions::{StageMeta, write_motions};
 use crate::study::config::{Seeds, StudyConfig};
 use crate::study::motions::{
-    MotionsError as StudyMotionsError, SeedError, Unmatched, match_zone, seed_records,
+    MotionsError as StudyMotionsError, SeedError, Unmatched, match_zone_until, seed_records,
 };
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -72,7 +72,7 @@ pub fn fingerprint(cfg: &StudyConfig) -> String {
             Seeds::Stochastic(_) => serde_json::to_value(&cfg.motions).expect("serialisable"),
         },
     });
-    hash_parts(&[&section.to_string(), &inputs(cfg)])
+    StageId::Motions.fingerprint(&hash_parts(&[&section.to_string(), &inputs(cfg)]))
 }
 
 /// What `read` gives for each zone of the config, in order, from `motions.h5`.
@@ -108,13 +108,19 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         s.check_cancelled(me)?;
         let target = cfg.target(i);
         let start = std::time::Instant::now();
-        let zm = match_zone(&z.name, target, &seeds, &cfg.motions).map_err(|e| match e {
-            StudyMotionsError::Unmatched(u) => MotionsError::Unmatched(u),
-            StudyMotionsError::Match(source) => MotionsError::Matching {
-                zone: z.name.clone(),
-                source,
-            },
-        })?;
+        let keep_going = || s.pass("motions.record", me).is_ok();
+        let zm =
+            match_zone_until(&z.name, target, &seeds, &cfg.motions, &keep_going).map_err(|e| {
+                match e {
+                    StudyMotionsError::Stopped => PipelineError::Cancelled(me),
+                    StudyMotionsError::Unmatched(u) => MotionsError::Unmatched(u).into(),
+                    StudyMotionsError::Match(source) => MotionsError::Matching {
+                        zone: z.name.clone(),
+                        source,
+                    }
+                    .into(),
+                }
+            })?;
         let met = |b: bool| if b { "met" } else { "NOT met" };
         s.reporter.info(
             me,

@@ -71,12 +71,6 @@ pub enum SweepStageError {
     Verify { file: PathBuf, what: String },
 }
 
-impl SweepStageError {
-    pub fn is_bad_input(&self) -> bool {
-        matches!(self, SweepStageError::Shard { .. })
-    }
-}
-
 /// What a building study's `sweep.h5` stores, part of its fingerprint: a file written before
 /// the per-floor peaks and the base shear were (the first building sweeps) is out of date, not
 /// read as if it held them. Change it when the stored building variables change.
@@ -93,7 +87,7 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> String {
         section["building"] = serde_json::json!(b);
         section["building_outputs"] = serde_json::json!(BUILDING_OUTPUTS);
     }
-    hash_parts(&[&section.to_string(), motions_fingerprint])
+    StageId::Sweep.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint]))
 }
 
 /// One work unit: zone, motion, frame (0 on one storey) and period indices.
@@ -326,7 +320,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
             let sizes = (study.building()).map(|b| (b.frame(u.frame).0, b.max_storeys()));
             write_unit(&units.path(u), &units.id(u), &to_columns(&r, sizes))?;
             bar.inc();
-            Ok(())
+            s.pass("sweep.unit", me)
         })?;
     bar.finish();
     let secs = start.elapsed().as_secs_f64();
@@ -349,6 +343,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
     if let Some((k, n)) = shard {
         return Ok(Outcome::ShardDone { k, n });
     }
+    s.pass("sweep.assemble", me)?;
     assemble(s, &units, &all)
 }
 

@@ -157,19 +157,11 @@ fn effective_fractions(
         .collect())
 }
 
-/// How a building study's `tnew.h5` finds `λ` (and that it stores it with the mean base
-/// shears), part of its fingerprint: a file of an earlier algorithm, or of none, is out of date.
-/// Change it when `λ`'s definition or root search changes.
-const LAMBDA_METHOD: &str = "lambda=largest root of the mean peak base shear, scan k/10 + Brent";
-
-/// The fingerprint `tnew.h5` must carry (`building`: of a building study, which stores `λ`).
-pub fn fingerprint(sweep_fingerprint: &str, building: bool) -> String {
+/// The fingerprint `tnew.h5` must carry (`λ`'s definition and search are the `lambda` method's
+/// version).
+pub fn fingerprint(sweep_fingerprint: &str) -> String {
     let step = format!("sd_step_s={SD_STEP_S}");
-    if building {
-        hash_parts(&[sweep_fingerprint, &step, LAMBDA_METHOD])
-    } else {
-        hash_parts(&[sweep_fingerprint, &step])
-    }
+    StageId::Tnew.fingerprint(&hash_parts(&[sweep_fingerprint, &step]))
 }
 
 /// The periods of the mean displacement spectrum: they reach past every `T_rigid` of the grid
@@ -360,6 +352,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             roof_participation: per_storeys.clone(),
             lambda,
         });
+        s.pass("tnew.zone", me)?;
     }
     let building_json = super::sweep::building_attr(study);
     let mut settings = super::sweep::physics_attrs(&physics).to_vec();

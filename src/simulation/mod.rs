@@ -143,16 +143,6 @@ pub enum SimulationError {
     },
 }
 
-impl SimulationError {
-    /// Whether the input was at fault (rather than the run).
-    pub fn is_bad_input(&self) -> bool {
-        match self {
-            SimulationError::Simulation { source, .. } => source.is_bad_input(),
-            _ => true,
-        }
-    }
-}
-
 impl Settings {
     /// Reads a case file (the keys of [`Settings`]).
     pub fn read(path: &Path) -> Result<Self, SimulationError> {
@@ -682,7 +672,8 @@ mod tests {
             };
             let e = settings.resolve().unwrap_err();
             assert!(
-                matches!(&e, SimulationError::Invalid(m) if m.contains(expect)) && e.is_bad_input(),
+                matches!(&e, SimulationError::Invalid(m) if m.contains(expect))
+                    && crate::fault::classify(&e).kind == crate::fault::FaultKind::BadInput,
                 "{e}"
             );
         }

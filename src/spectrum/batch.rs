@@ -65,21 +65,6 @@ pub enum BatchError {
     },
 }
 
-impl BatchError {
-    /// Whether the input (a damping ratio, period, target or record) is at fault rather than the
-    /// run: every elastic failure is; a constant-ductility search that finds no strength is not.
-    pub fn is_bad_input(&self) -> bool {
-        match self {
-            BatchError::Damping(_) | BatchError::Spectrum { .. } => true,
-            BatchError::Ductility { source, .. } => match source {
-                DuctilityError::Simulation { source, .. } => source.is_bad_input(),
-                DuctilityError::NoResponse { .. } | DuctilityError::NotReached { .. } => false,
-                _ => true,
-            },
-        }
-    }
-}
-
 /// Refuses a damping ratio outside `[0, 1)` before any work.
 fn check_dampings(dampings: &[f64]) -> Result<(), BatchError> {
     match dampings

@@ -77,6 +77,9 @@ pub enum MotionsError {
     Match(#[from] MatchError),
     #[error(transparent)]
     Unmatched(#[from] Unmatched),
+    /// `keep_going` said stop ([`match_zone_until`]).
+    #[error("the matching was stopped")]
+    Stopped,
 }
 
 /// The seed motions of a study, in configuration order. Each record file is read once: the
@@ -133,6 +136,19 @@ pub fn match_zone(
     seeds: &[Record],
     cfg: &MotionsConfig,
 ) -> Result<ZoneMotions, MotionsError> {
+    match_zone_until(name, target, seeds, cfg, &|| true)
+}
+
+/// [`match_zone`], asking `keep_going` before each record is matched (or matched again) and
+/// stopping with [`MotionsError::Stopped`] when it says no: the Ctrl-C of a stage, within one
+/// record.
+pub fn match_zone_until(
+    name: &str,
+    target: &TargetSpectrum,
+    seeds: &[Record],
+    cfg: &MotionsConfig,
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Result<ZoneMotions, MotionsError> {
     let settings = &cfg.matching;
     let periods_s = settings.check_grid_s();
     let target_psa_g: Vec<f64> = periods_s.iter().map(|&t| target.sa_g(t)).collect();
@@ -140,7 +156,7 @@ pub fn match_zone(
         Seeds::Stochastic(s) => s.count,
         Seeds::Records(_) => seeds.len(),
     };
-    let mut matched = match_in_order(seeds, wanted, target, settings)?;
+    let mut matched = match_in_order(seeds, wanted, target, settings, keep_going)?;
     let seeds = &seeds[..matched.len()];
     let (kept, mut unmatched) = keep(name, seeds, &matched, wanted, cfg)?;
     let set = SetChecks {
@@ -149,7 +165,7 @@ pub fn match_zone(
         upper: settings.upper,
         set_mean_min: cfg.set_mean_min,
     };
-    let set_scale = set.scale_and_rematch(&mut matched, seeds, target, settings)?;
+    let set_scale = set.scale_and_rematch(&mut matched, seeds, target, settings, keep_going)?;
     let psa_g: Vec<Vec<f64>> = kept
         .iter()
         .map(|&i| {
@@ -213,7 +229,8 @@ fn match_in_order(
     wanted: usize,
     target: &TargetSpectrum,
     settings: &MatchSettings,
-) -> Result<Vec<Matched>, MatchError> {
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<Matched>, MotionsError> {
     let mut matched: Vec<Matched> = Vec::new();
     loop {
         let accepted = matched.iter().filter(|m| m.report.converged).count();
@@ -224,7 +241,12 @@ fn match_in_order(
         let to = (from + wanted - accepted).min(seeds.len());
         let batch = seeds[from..to]
             .par_iter()
-            .map(|s| match_record(&s.accel_g, s.dt_s, target, settings))
+            .map(|s| {
+                if !keep_going() {
+                    return Err(MotionsError::Stopped);
+                }
+                Ok(match_record(&s.accel_g, s.dt_s, target, settings)?)
+            })
             .collect::<Result<Vec<_>, _>>()?;
         matched.extend(batch);
     }
@@ -322,7 +344,8 @@ impl SetChecks<'_> {
         seeds: &[Record],
         target: &TargetSpectrum,
         settings: &MatchSettings,
-    ) -> Result<f64, MatchError> {
+        keep_going: &(dyn Fn() -> bool + Sync),
+    ) -> Result<f64, MotionsError> {
         // A motion matched again is aimed at the target after the scale, with half the
         // tolerance (and fallbacks above half the room to the bound): what the scale may still
         // add when the set is scaled anew stays inside the band.
@@ -360,9 +383,18 @@ impl SetChecks<'_> {
             let again = out
                 .par_iter()
                 .map(|&i| {
+                    if !keep_going() {
+                        return Err(MotionsError::Stopped);
+                    }
                     let m = &matched[i];
                     let factor = m.report.target_factor / set_scale;
-                    match_record_scaled(&m.accel_g, seeds[i].dt_s, target, factor, &tight)
+                    Ok(match_record_scaled(
+                        &m.accel_g,
+                        seeds[i].dt_s,
+                        target,
+                        factor,
+                        &tight,
+                    )?)
                 })
                 .collect::<Result<Vec<_>, _>>()?;
             for (&i, mut m) in out.iter().zip(again) {

@@ -256,3 +256,40 @@ pub fn reshape(path: &Path, variable: &str) {
     slidestack::store::checksum::write_with_sidecar(path, &bytes).unwrap();
     assert!(slidestack::store::checksum::verify(path).unwrap());
 }
+
+/// A process held still at a point of the test hook (`slidestack::pipeline::pause`): the test
+/// acts at that moment (kills, interrupts, races it), then releases it. Nothing waits on the
+/// clock: [`Held::wait`] waits for the process to say it holds, or to end (a failure).
+pub struct Held {
+    file: PathBuf,
+}
+
+impl Held {
+    /// Arms the hook on `cmd`: hold at `point` (`NAME` or `NAME:N`, the N-th pass), saying so in
+    /// a file of `dir`.
+    pub fn arm(cmd: &mut std::process::Command, point: &str, dir: &Path) -> Held {
+        let file = dir.join(format!("held-{}", point.replace(':', "-")));
+        let _ = std::fs::remove_file(&file);
+        cmd.env(slidestack::pipeline::pause::PAUSE_AT, point)
+            .env(slidestack::pipeline::pause::PAUSE_FILE, &file);
+        Held { file }
+    }
+
+    /// Returns once `child` holds at the point; panics if it ends first.
+    pub fn wait(&self, child: &mut std::process::Child) {
+        while !self.file.exists() {
+            if let Some(status) = child.try_wait().unwrap() {
+                panic!(
+                    "the process ended ({status}) before holding at {}",
+                    self.file.display()
+                );
+            }
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+    }
+
+    /// Lets the held process go on.
+    pub fn release(&self) {
+        std::fs::remove_file(&self.file).unwrap();
+    }
+}

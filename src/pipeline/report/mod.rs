@@ -62,9 +62,6 @@ use select::Selection;
 use text::{fixed, joined, num, nums};
 use thiserror::Error;
 
-/// Changes when the report's contents change.
-const REPORT_VERSION: &str = "report-5";
-
 #[derive(Debug, Error)]
 pub enum ReportError {
     #[error("the report's {source}, under {motion}")]
@@ -87,10 +84,11 @@ pub fn fingerprint(
     motions_fingerprint: &str,
     ida_fingerprint: Option<&str>,
 ) -> String {
-    match ida_fingerprint {
-        None => hash_parts(&[fit_fingerprint, motions_fingerprint, REPORT_VERSION]),
-        Some(ida) => hash_parts(&[fit_fingerprint, motions_fingerprint, REPORT_VERSION, ida]),
-    }
+    let hash = match ida_fingerprint {
+        None => hash_parts(&[fit_fingerprint, motions_fingerprint]),
+        Some(ida) => hash_parts(&[fit_fingerprint, motions_fingerprint, ida]),
+    };
+    StageId::Report.fingerprint(&hash)
 }
 
 /// One zone's inputs.

@@ -1,0 +1,108 @@
+//! The version of every method whose numbers the study stores. A stage's fingerprint names the
+//! versions of the methods it computes with ([`Method`], listed per stage by
+//! `pipeline::StageId::methods`), so a binary whose numerics changed finds the files of an
+//! earlier one out of date instead of reading them as current, and `status` names the versions
+//! a stale file was made with.
+//!
+//! **Bump a version whenever a change can alter a stored number** (not only its meaning: any
+//! bit). `tests/methods.rs` holds golden hashes of every stage's stored variables on
+//! `configs/quick.yaml`, `configs/mdof-quick.yaml` and `configs/ida-quick.yaml` beside these
+//! versions, and fails, naming the method to bump, when the numbers change and the versions do
+//! not.
+
+/// One method and its version.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Method {
+    pub name: &'static str,
+    pub version: u32,
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}-{}", self.name, self.version)
+    }
+}
+
+/// The exact event-driven integrators (one storey and building), the systems a case is run as
+/// and the sweep's skip rules (`dynamics`, `study::physics`, `study::sweep`).
+pub const INTEGRATOR: Method = Method {
+    name: "integrator",
+    version: 1,
+};
+
+/// Exact response spectra (`spectrum::response`), with the target spectra they are compared to.
+pub const SPECTRUM: Method = Method {
+    name: "spectrum",
+    version: 1,
+};
+
+/// The motions: stochastic seeds, record processing and spectral matching with the set checks
+/// (`ground_motion`, `study::motions`).
+pub const MOTIONS: Method = Method {
+    name: "motions",
+    version: 1,
+};
+
+/// `T_new`, the displacement response ratios and the bands (`study::tnew`, the tnew stage).
+pub const TNEW: Method = Method {
+    name: "tnew",
+    version: 1,
+};
+
+/// A building study's effective live-load fraction `λ` (`study::lambda`).
+pub const LAMBDA: Method = Method {
+    name: "lambda",
+    version: 1,
+};
+
+/// The design equations' fits, folds, metrics and recommendation (`fit`, the fit stage).
+pub const FIT: Method = Method {
+    name: "fit",
+    version: 1,
+};
+
+/// Incremental dynamic analysis: tracing, curves and fragilities (`ida`, `study::ida`).
+pub const IDA: Method = Method {
+    name: "ida",
+    version: 1,
+};
+
+/// The report's pages and figures.
+pub const REPORT: Method = Method {
+    name: "report",
+    version: 6,
+};
+
+/// The methods as they enter a fingerprint: `name-version` joined by spaces.
+pub fn tag(methods: &[Method]) -> String {
+    methods
+        .iter()
+        .map(Method::to_string)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// A stage's fingerprint: the hash of its inputs followed by its methods' tag in brackets, so
+/// that the methods a file was made with can be read back ([`methods_of`]).
+pub fn fingerprint(inputs_hash: &str, methods: &[Method]) -> String {
+    format!("{inputs_hash} [{}]", tag(methods))
+}
+
+/// The methods' tag of a fingerprint made by [`fingerprint`] (`None` for an older one).
+pub fn methods_of(fingerprint: &str) -> Option<&str> {
+    let (_, rest) = fingerprint.split_once(" [")?;
+    rest.strip_suffix(']')
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fingerprint_gives_back_its_methods() {
+        let fp = fingerprint("abc", &[INTEGRATOR, SPECTRUM]);
+        assert_eq!(fp, "abc [integrator-1 spectrum-1]");
+        assert_eq!(methods_of(&fp), Some("integrator-1 spectrum-1"));
+        assert_eq!(methods_of("abc"), None);
+    }
+}
