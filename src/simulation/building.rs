@@ -107,7 +107,7 @@ pub fn building_spec(
             "building.storeys must be 1 … {MAX_STOREYS}, got {n}"
         ));
     }
-    b.storey_heights()?;
+    let storey_heights_m = b.storey_heights()?;
     let yielding = match (
         b.structure.unwrap_or(StructureKind::Elastic),
         &b.yield_strength_ratios,
@@ -192,6 +192,7 @@ pub fn building_spec(
         storey_stiffnesses: b.storey_stiffnesses.clone().unwrap_or_else(|| vec![1.0; n]),
         damping_ratio: damping,
         damping_basis: basis,
+        storey_heights_m,
         yielding,
         stacks,
     })

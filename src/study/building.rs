@@ -78,12 +78,7 @@ pub struct BuildingSection {
     pub post_yield_ratio: Option<f64>,
 }
 
-/// A storey's height when the config gives none, m (a common floor-to-floor height of
-/// framed buildings; it only scales the drift ratios).
-pub const DEFAULT_STOREY_HEIGHT_M: f64 = 3.0;
-
-/// Storey heights a config may give, m: beyond this range a value is a typing error.
-pub const STOREY_HEIGHT_RANGE_M: (f64, f64) = (0.5, 100.0);
+pub use crate::dynamics::building::model::{DEFAULT_STOREY_HEIGHT_M, STOREY_HEIGHT_RANGE_M};
 
 /// The building a case of a building study stands in: the bare building's relative floor
 /// masses and storey stiffnesses (its first-mode period is the case's `T_p`), its storey

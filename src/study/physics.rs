@@ -209,6 +209,7 @@ impl Physics {
             storey_stiffnesses: frame.storey_stiffnesses.clone(),
             damping_ratio: self.damping,
             damping_basis: self.basis,
+            storey_heights_m: frame.storey_heights_m.clone(),
             yielding: None,
             stacks: Vec::new(),
         }

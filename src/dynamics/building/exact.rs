@@ -121,12 +121,16 @@ enum Row {
     /// `ü_j` without the load (`(A·z)_{N+j}`): with the load's constant, a floor's absolute
     /// acceleration.
     Accel,
-    /// The base shear without the storey's force offset, `k_t,1·δ_1 + 1ᵀ·C·u̇` (docs/model.md,
-    /// "Base shear"); kept for `j = 0` only.
+    /// Storey `j`'s shear without the storey's force offset, `k_t,j·δ_j + Σ_{i≥j} (C·u̇)_i`
+    /// (docs/model.md, "Storey shears and the overturning moment"); storey 1's is the base
+    /// shear `k_t,1·δ_1 + 1ᵀ·C·u̇`.
     Shear,
+    /// The overturning moment at the base without the storeys' force offsets, `Σ_j h_j·V_j`
+    /// over the [`Row::Shear`] rows; kept for `j = 0` only.
+    Overturning,
 }
 
-const ROWS: usize = 6;
+const ROWS: usize = 7;
 
 /// A mode's basis, its rows and what a whole sample interval needs of it.
 struct Mode {
@@ -139,18 +143,35 @@ struct Mode {
 }
 
 impl Mode {
-    /// `shear_u`, `shear_v`: the base shear's coefficients on the floors' displacements (N/m)
-    /// and velocities (N·s/m), [`Row::Shear`].
-    fn new(modes: StateModes, dt: f64, shear_u: &[f64], shear_v: &[f64]) -> Self {
+    /// `k_t`: the storeys' branch stiffnesses (N/m); `damping_above`: `N × N` row-major,
+    /// `[j][l] = Σ_{i≥j} C_il` (N·s/m), the dampers' share of storey `j`'s shear per unit
+    /// velocity of floor `l`; `heights_m`: the storey heights ([`Row::Shear`],
+    /// [`Row::Overturning`]).
+    fn new(
+        modes: StateModes,
+        dt: f64,
+        k_t: &[f64],
+        damping_above: &[f64],
+        heights_m: &[f64],
+    ) -> Self {
         let (n, m) = (modes.n, modes.modes());
         let mut rows = vec![Cx(0.0, 0.0); ROWS * n * m];
         for r in 0..m {
-            let mut sum = Cx(0.0, 0.0);
+            let mut moment = Cx(0.0, 0.0);
             for j in 0..n {
-                let (u, v) = (modes.row(j)[r], modes.row(n + j)[r]);
-                sum = sum.add(u.scale(shear_u[j])).add(v.scale(shear_v[j]));
+                let u_prev = if j > 0 {
+                    modes.row(j - 1)[r]
+                } else {
+                    Cx(0.0, 0.0)
+                };
+                let mut shear = modes.row(j)[r].sub(u_prev).scale(k_t[j]);
+                for l in 0..n {
+                    shear = shear.add(modes.row(n + l)[r].scale(damping_above[j * n + l]));
+                }
+                rows[(Row::Shear as usize * n + j) * m + r] = shear;
+                moment = moment.add(shear.scale(heights_m[j]));
             }
-            rows[(Row::Shear as usize * n) * m + r] = sum;
+            rows[(Row::Overturning as usize * n) * m + r] = moment;
         }
         for j in 0..n {
             for r in 0..m {
@@ -306,12 +327,19 @@ struct Integrator<'b> {
     z: Vec<f64>,
     p0: Vec<f64>,
     events: Vec<Event>,
-    /// Peak functions: floor displacements, storey drifts, floor accelerations, base shear.
+    /// Peak functions: floor displacements, storey drifts, floor accelerations, storey shears,
+    /// the overturning moment.
     peaks: Vec<Func>,
-    /// `1ᵀ·C`, N·s/m per floor: the damping forces' sum per unit velocity of each floor.
-    damping_sum: Vec<f64>,
-    /// Scratch: the base shear's displacement coefficients in the current mode, N/m.
-    shear_u: Vec<f64>,
+    /// `N × N`, `[j][l] = Σ_{i≥j} C_il`, N·s/m: the dampers' share of storey `j`'s shear per
+    /// unit velocity of floor `l` (row 0: `1ᵀ·C`, the base shear's).
+    damping_above: Vec<f64>,
+    /// Mass of the blocks not stuck to their floors in the current mode, kg, and its integral
+    /// over time so far, kg·s (counted this way round, a stack that never slides has exactly
+    /// 0, so its stuck share is exactly 1).
+    loose_mass_kg: f64,
+    loose_mass_time: f64,
+    /// Sample intervals of the record.
+    steps: usize,
     slip_start: Vec<f64>,
     out: BuildingResponse,
     energy: Energy,
@@ -430,10 +458,15 @@ impl<'b> Integrator<'b> {
             p0: vec![0.0; n],
             events: Vec::new(),
             peaks: Vec::new(),
-            damping_sum: (0..n)
-                .map(|l| (0..n).map(|j| b.damping()[j * n + l]).sum())
+            damping_above: (0..n * n)
+                .map(|jl| {
+                    let (j, l) = (jl / n, jl % n);
+                    (j..n).map(|i| b.damping()[i * n + l]).sum()
+                })
                 .collect(),
-            shear_u: vec![0.0; n],
+            loose_mass_kg: 0.0,
+            loose_mass_time: 0.0,
+            steps: 0,
             slip_start: vec![0.0; nb],
             out,
             energy: Energy {
@@ -445,6 +478,7 @@ impl<'b> Integrator<'b> {
 
     fn run(mut self, accel: &[f64]) -> Result<BuildingResponse, SimError> {
         let steps = accel.len() - 1;
+        self.steps = steps;
         let mut history = self
             .opts
             .history
@@ -660,6 +694,7 @@ impl<'b> Integrator<'b> {
     fn set_up_mode(&mut self) -> Result<(), SimError> {
         let (n, b) = (self.n, self.b);
         self.key.clear();
+        self.loose_mass_kg = 0.0;
         self.floor_mass.copy_from_slice(&b.masses()[..n]);
         self.f_top.fill(0.0);
         self.free.clear();
@@ -670,6 +705,9 @@ impl<'b> Integrator<'b> {
             }
             self.stuck[si] = e;
             self.key.push(e as u16);
+            for q in e..s.blocks {
+                self.loose_mass_kg += b.masses()[n + s.first + q];
+            }
             for q in 0..e {
                 self.floor_mass[s.floor] += b.masses()[n + s.first + q];
                 self.holder[s.first + q] = Holder::Floor(s.floor);
@@ -723,12 +761,12 @@ impl<'b> Integrator<'b> {
         let mode = match self.cache.get(&self.key) {
             Some(m) => Rc::clone(m),
             None => {
-                self.shear_u[0] = self.k_t[0];
                 let m = Rc::new(Mode::new(
                     StateModes::new(&self.floor_mass, &self.k_t, b.damping())?,
                     self.dt,
-                    &self.shear_u,
-                    &self.damping_sum,
+                    &self.k_t,
+                    &self.damping_above,
+                    b.storey_heights_m(),
                 ));
                 self.cache.insert(self.key.clone(), Rc::clone(&m));
                 m
@@ -907,14 +945,30 @@ impl<'b> Integrator<'b> {
             g.f0 = Self::value_at(mode, &g, &self.p_start).0;
             peaks.push(g);
         }
-        let damper: f64 = (self.damping_sum.iter().zip(&self.v))
-            .map(|(c, v)| c * v)
-            .sum();
+        let heights = self.b.storey_heights_m();
+        let (mut moment_offset, mut moment) = (0.0, 0.0);
+        for j in 0..n {
+            let damper: f64 = (self.damping_above[j * n..(j + 1) * n].iter())
+                .zip(&self.v[..n])
+                .map(|(c, v)| c * v)
+                .sum();
+            let x_prev = if j > 0 { self.x[j - 1] } else { 0.0 };
+            let shear = self.storeys[j].force(self.x[j] - x_prev) + damper;
+            peaks.push(Func {
+                row: Some((Row::Shear, j)),
+                scale: 1.0,
+                poly: [self.offsets[j], 0.0, 0.0, 0.0],
+                f0: shear,
+                df0: None,
+            });
+            moment_offset += heights[j] * self.offsets[j];
+            moment += heights[j] * shear;
+        }
         peaks.push(Func {
-            row: Some((Row::Shear, 0)),
+            row: Some((Row::Overturning, 0)),
             scale: 1.0,
-            poly: [self.offsets[0], 0.0, 0.0, 0.0],
-            f0: self.storeys[0].force(self.x[0]) + damper,
+            poly: [moment_offset, 0.0, 0.0, 0.0],
+            f0: moment,
             df0: None,
         });
         self.events = events;
@@ -947,15 +1001,17 @@ impl<'b> Integrator<'b> {
     fn advance(&mut self, mode: &Mode, ga: f64, slope: f64, end: f64) {
         let (n, nb) = (self.n, self.b.blocks());
         let dt = self.dt;
+        self.loose_mass_time += self.loose_mass_kg * end;
         // Peaks: floor displacements, storey drifts, floor accelerations (with the blocks that
-        // ride on each floor), base shear.
+        // ride on each floor), storey shears, the overturning moment.
         for idx in 0..self.peaks.len() {
             let g = self.peaks[idx];
             let (kind, j) = (idx / n, idx % n);
             let best = match kind {
                 0 => self.out.floor_peak_displacement_m[j],
                 1 => self.out.storey_peak_drift_m[j],
-                3 => self.out.peak_base_shear_n,
+                3 => self.out.storey_peak_shear_n[j],
+                4 => self.out.peak_overturning_n_m,
                 _ => {
                     let mut floor = self.out.floor_peak_abs_accel_mps2[j];
                     for q in 0..nb {
@@ -977,7 +1033,8 @@ impl<'b> Integrator<'b> {
                 match kind {
                     0 => self.out.floor_peak_displacement_m[j] = peak,
                     1 => self.out.storey_peak_drift_m[j] = peak,
-                    3 => self.out.peak_base_shear_n = peak,
+                    3 => self.out.storey_peak_shear_n[j] = peak,
+                    4 => self.out.peak_overturning_n_m = peak,
                     _ => {
                         let p = &mut self.out.floor_peak_abs_accel_mps2[j];
                         *p = p.max(peak);
@@ -1227,6 +1284,14 @@ impl<'b> Integrator<'b> {
         for i in 0..n {
             self.out.storey_residual_drift_m[i] = drift(i, &self.x);
         }
+        self.out.peak_base_shear_n = self.out.storey_peak_shear_n[0];
+        let load_kg: f64 = self.b.masses()[n..].iter().sum();
+        let duration_s = self.steps as f64 * self.dt;
+        self.out.stuck_mass_share = if load_kg > 0.0 {
+            1.0 - self.loose_mass_time / (duration_s * load_kg)
+        } else {
+            f64::NAN
+        };
         for k in 0..self.b.blocks() {
             self.out.residual_slip_m[k] = self.x[n + k] - self.x[self.b.below(k)];
         }

@@ -16,6 +16,14 @@ use crate::limits::{
 use nalgebra::{DMatrix, SymmetricEigen};
 use thiserror::Error;
 
+/// A storey's height when none is given, m (a common floor-to-floor height of framed
+/// buildings; it scales the drift ratios and the overturning moment).
+pub const DEFAULT_STOREY_HEIGHT_M: f64 = 3.0;
+
+/// Storey heights a config or case file may give, m: beyond this range a value is a typing
+/// error.
+pub const STOREY_HEIGHT_RANGE_M: (f64, f64) = (0.5, 100.0);
+
 /// A stack of blocks on one floor, as a user states it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StackSpec {
@@ -50,14 +58,18 @@ pub struct BuildingSpec {
     /// Damping ratio `ζ` of every mode of the basis.
     pub damping_ratio: f64,
     pub damping_basis: DampingBasis,
+    /// Storey heights, m, storey 1 first: they enter only the overturning moment at the base
+    /// (docs/model.md, "Storey shears and the overturning moment"). The callers check them
+    /// against the study's limits (`study::building::STOREY_HEIGHT_RANGE_M`).
+    pub storey_heights_m: Vec<f64>,
     /// `None`: every storey elastic.
     pub yielding: Option<StoreyYielding>,
     pub stacks: Vec<StackSpec>,
 }
 
 impl BuildingSpec {
-    /// A uniform bare building: `storeys` equal floor masses and storey stiffnesses, `ζ = 0.05`
-    /// in the rigid basis, elastic.
+    /// A uniform bare building: `storeys` equal floor masses and storey stiffnesses, storeys
+    /// of [`DEFAULT_STOREY_HEIGHT_M`], `ζ = 0.05` in the rigid basis, elastic.
     pub fn uniform(storeys: usize, period_s: f64) -> Self {
         Self {
             period_s,
@@ -65,6 +77,7 @@ impl BuildingSpec {
             storey_stiffnesses: vec![1.0; storeys],
             damping_ratio: 0.05,
             damping_basis: DampingBasis::Rigid,
+            storey_heights_m: vec![DEFAULT_STOREY_HEIGHT_M; storeys],
             yielding: None,
             stacks: Vec::new(),
         }
@@ -100,6 +113,8 @@ pub enum BuildingError {
     },
     #[error("damping must be finite and in [0, 1), got {0}")]
     Damping(f64),
+    #[error("building.storey_heights_m[{index}] must be finite and > 0, got {value:?}")]
+    Height { index: usize, value: f64 },
     #[error(
         "building.yield_strength_ratios[{index}] must be within {lo} … {hi}, got {value:?}",
         lo = STRENGTH_RATIO_RANGE.0,
@@ -243,6 +258,18 @@ impl Building {
                 return Err(BuildingError::Ratio { key, index, value });
             }
         }
+        if spec.storey_heights_m.len() != n {
+            return Err(BuildingError::Count {
+                key: "storey_heights_m",
+                got: spec.storey_heights_m.len(),
+                expected: n,
+            });
+        }
+        if let Some((index, &value)) = (spec.storey_heights_m.iter().enumerate())
+            .find(|(_, h)| !(h.is_finite() && **h > 0.0))
+        {
+            return Err(BuildingError::Height { index, value });
+        }
         let zeta = spec.damping_ratio;
         if !(zeta.is_finite() && (0.0..1.0).contains(&zeta)) {
             return Err(BuildingError::Damping(zeta));
@@ -367,6 +394,11 @@ impl Building {
 
     pub fn spec(&self) -> &BuildingSpec {
         &self.spec
+    }
+
+    /// Storey heights, m, storey 1 first.
+    pub fn storey_heights_m(&self) -> &[f64] {
+        &self.spec.storey_heights_m
     }
     /// Number of storeys (and floors) `N`.
     pub fn storeys(&self) -> usize {

@@ -21,6 +21,19 @@ pub struct BuildingResponse {
     /// absolute acceleration, summed: docs/model.md, "Base shear"). NaN where the integrator
     /// does not give it (the one-storey integrator's response, [`Self::from_one_storey`]).
     pub peak_base_shear_n: f64,
+    /// Peak `|V_i|` of each storey's shear `V_i = F_i + Σ_{j≥i} (C·u̇)_j`, N, storey 1 (the base
+    /// shear) first: by equilibrium, the mass times the absolute acceleration of every body on
+    /// the floors above the cut, summed (docs/model.md, "Storey shears and the overturning
+    /// moment"). NaN where the integrator does not give them.
+    pub storey_peak_shear_n: Vec<f64>,
+    /// Peak `|M|` of the overturning moment at the base, `M = Σ_i h_i·V_i` (`h_i` the storey
+    /// heights), N·m. NaN where the integrator does not give it.
+    pub peak_overturning_n_m: f64,
+    /// The stacks' mass moving with its floor (every interface below it stuck), averaged over
+    /// the record's duration, over the stacks' mass: 1 for a stack that never slides, near 0 for
+    /// one that slips all the time (NaN without stacks, or where the integrator does not give
+    /// it).
+    pub stuck_mass_share: f64,
     /// Peak absolute acceleration of every block, m/s² (stacks in order, bottom-up).
     pub block_peak_abs_accel_mps2: Vec<f64>,
     /// Peak `|slip|` of every interface relative to the body below, m.
@@ -49,6 +62,9 @@ impl BuildingResponse {
             storey_peak_drift_m: vec![0.0; storeys],
             storey_residual_drift_m: vec![0.0; storeys],
             peak_base_shear_n: 0.0,
+            storey_peak_shear_n: vec![0.0; storeys],
+            peak_overturning_n_m: 0.0,
+            stuck_mass_share: f64::NAN,
             block_peak_abs_accel_mps2: vec![0.0; blocks],
             peak_slip_m: vec![0.0; blocks],
             residual_slip_m: vec![0.0; blocks],
@@ -67,6 +83,9 @@ impl BuildingResponse {
             storey_ductility: r.ductility.map(|d| vec![d]),
             storey_residual_drift_m: vec![r.residual_displacement_m],
             peak_base_shear_n: f64::NAN,
+            storey_peak_shear_n: vec![f64::NAN],
+            peak_overturning_n_m: f64::NAN,
+            stuck_mass_share: f64::NAN,
             block_peak_abs_accel_mps2: r.peak_abs_accel_mps2[1..=blocks].to_vec(),
             peak_slip_m: r.peak_slip_m,
             residual_slip_m: r.residual_slip_m,
@@ -92,6 +111,8 @@ impl BuildingResponse {
         let e = &self.energy;
         let finite = lists.iter().all(|l| l.iter().all(|x| x.is_finite()))
             && !self.peak_base_shear_n.is_infinite()
+            && !self.peak_overturning_n_m.is_infinite()
+            && self.storey_peak_shear_n.iter().all(|x| !x.is_infinite())
             && self
                 .storey_ductility
                 .as_ref()

@@ -462,6 +462,25 @@ impl<'b> Rk4<'b> {
         };
         let stage_frac = [0.0, 0.5, 0.5, 1.0];
         let mut input_peak = 0.0f64;
+        // Each body's floor (a block: its stack's) and that floor's elevation, m: for the storey
+        // shears and the overturning moment by Newton's sum over the bodies.
+        let mut floor_of: Vec<usize> = (0..n).collect();
+        floor_of.resize(nb, 0);
+        for s in b.stacks() {
+            for q in 0..s.blocks {
+                floor_of[n + s.first + q] = s.floor;
+            }
+        }
+        let elevation: Vec<f64> = (b.storey_heights_m().iter())
+            .scan(0.0, |z, h| {
+                *z += h;
+                Some(*z)
+            })
+            .collect();
+        let mut shears = vec![0.0; n];
+        let load_kg: f64 = b.masses()[n..].iter().sum();
+        // ∫ (mass of the blocks not stuck to their floor) dt, kg·s, by sub-step.
+        let mut loose_mass_time = 0.0;
         for k in 0..steps {
             for sub in 0..substeps {
                 let frac0 = sub as f64 / substeps as f64;
@@ -473,6 +492,13 @@ impl<'b> Rk4<'b> {
                     .filter(|(a, b)| a != b)
                     .count() as u64;
                 prev.copy_from_slice(&self.contacts);
+                for s in b.stacks() {
+                    let stuck = (0..s.blocks)
+                        .take_while(|&q| self.contacts[s.first + q] == Contact::Stick)
+                        .count();
+                    let loose: f64 = (stuck..s.blocks).map(|q| b.masses()[n + s.first + q]).sum();
+                    loose_mass_time += loose * h;
+                }
                 if k == 0
                     && sub == 0
                     && let Some(hist) = history.as_mut()
@@ -506,10 +532,24 @@ impl<'b> Rk4<'b> {
                             let p = &mut out.block_peak_abs_accel_mps2[q];
                             *p = p.max(abs[n + q].abs());
                         }
-                        // Newton's sum over every body, independent of the exact integrator's
-                        // storey and damper forces.
-                        let v: f64 = (b.masses().iter().zip(&abs)).map(|(m, a)| m * a).sum();
-                        out.peak_base_shear_n = out.peak_base_shear_n.max(v.abs());
+                        // Newton's sums over the bodies above each cut, independent of the exact
+                        // integrator's storey and damper forces.
+                        shears.fill(0.0);
+                        let mut moment = 0.0;
+                        for body in 0..nb {
+                            let f = b.masses()[body] * abs[body];
+                            shears[floor_of[body]] += f;
+                            moment += elevation[floor_of[body]] * f;
+                        }
+                        for i in (0..n - 1).rev() {
+                            shears[i] += shears[i + 1];
+                        }
+                        for i in 0..n {
+                            let p = &mut out.storey_peak_shear_n[i];
+                            *p = p.max(shears[i].abs());
+                        }
+                        out.peak_base_shear_n = out.storey_peak_shear_n[0];
+                        out.peak_overturning_n_m = out.peak_overturning_n_m.max(moment.abs());
                     }
                     self.rates(&xs, &vs, ag, &mut ke[st]);
                 }
@@ -571,6 +611,11 @@ impl<'b> Rk4<'b> {
                 self.record(hist, (k + 1) as f64 * dt, acc_g[k + 1], &abs);
             }
         }
+        out.stuck_mass_share = if load_kg > 0.0 {
+            1.0 - loose_mass_time / (steps as f64 * dt * load_kg)
+        } else {
+            f64::NAN
+        };
         self.finish(out, switches, history)
     }
 
