@@ -125,9 +125,16 @@ pub struct Answer {
     /// corner has none) …
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lambda_grid: Option<f64>,
-    /// … and from the zone's fitted equation for `λ`.
+    /// … and from the zone's fitted equation for `λ` (of `max(λ, 0)`, the fraction a designer
+    /// counts).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lambda_fit: Option<f64>,
+    /// A building study's code-format fraction `λ_code` (docs/model.md, "The code-format
+    /// fraction"), by multilinear interpolation in the frame's cases: the fraction of the live
+    /// load that, counted as seismic weight with the zone's mean spectrum at the loaded first
+    /// mode, gives the sliding stack's base shear.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lambda_code_grid: Option<f64>,
     /// Anything the designer should know about these numbers.
     pub notes: Vec<String>,
 }
@@ -154,6 +161,9 @@ pub struct ZoneDesign {
     /// equation.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lambda: Option<(Vec<f64>, Option<Fitted>)>,
+    /// A building study's code-format `λ_code` per case of the frame (grid's flat order).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lambda_code: Option<Vec<f64>>,
 }
 
 impl ZoneDesign {
@@ -175,6 +185,7 @@ impl ZoneDesign {
             paper,
             building: None,
             lambda: None,
+            lambda_code: None,
         }
     }
 
@@ -208,6 +219,7 @@ impl ZoneDesign {
         let mut data = Self::new(zone, target, grid, frame_of(&t.vars.t_new), zone_fit);
         data.building = Some((fit.frames[f].clone(), features));
         data.lambda = lambda;
+        data.lambda_code = t.lambda.as_ref().map(|l| frame_of(&l.lambda_code));
         data
     }
 
@@ -484,6 +496,8 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
         ),
         None => (None, None),
     };
+    let lambda_code_grid = (z.lambda_code.as_ref())
+        .and_then(|values| z.grid.interpolate(values, &point).ok().flatten());
     let t_new_paper_s = z.paper.and_then(|p| p.evaluate(&x));
     let target = &z.target;
     let sa = |t: Option<f64>| t.filter(|t| t.is_finite()).map(|t| target.sa_g(t));
@@ -509,6 +523,7 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
         sa_new_paper_g: sa(t_new_paper_s),
         lambda_grid,
         lambda_fit,
+        lambda_code_grid,
         notes,
     })
 }

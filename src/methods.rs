@@ -27,7 +27,7 @@ impl std::fmt::Display for Method {
 /// and the sweep's skip rules (`dynamics`, `study::physics`, `study::sweep`).
 pub const INTEGRATOR: Method = Method {
     name: "integrator",
-    version: 1,
+    version: 2,
 };
 
 /// Exact response spectra (`spectrum::response`), with the target spectra they are compared to.
@@ -46,13 +46,13 @@ pub const MOTIONS: Method = Method {
 /// `T_new`, the displacement response ratios and the bands (`study::tnew`, the tnew stage).
 pub const TNEW: Method = Method {
     name: "tnew",
-    version: 1,
+    version: 2,
 };
 
-/// A building study's effective live-load fraction `λ` (`study::lambda`).
+/// A building study's attached fractions: `λ` and its kin (`study::attached`).
 pub const LAMBDA: Method = Method {
     name: "lambda",
-    version: 1,
+    version: 2,
 };
 
 /// The design equations' fits, folds, metrics and recommendation (`fit`, the fit stage).
@@ -101,8 +101,8 @@ mod tests {
     #[test]
     fn a_fingerprint_gives_back_its_methods() {
         let fp = fingerprint("abc", &[INTEGRATOR, SPECTRUM]);
-        assert_eq!(fp, "abc [integrator-1 spectrum-1]");
-        assert_eq!(methods_of(&fp), Some("integrator-1 spectrum-1"));
+        assert_eq!(fp, "abc [integrator-2 spectrum-1]");
+        assert_eq!(methods_of(&fp), Some("integrator-2 spectrum-1"));
         assert_eq!(methods_of("abc"), None);
     }
 }

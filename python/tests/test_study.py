@@ -147,7 +147,10 @@ def quick_dict(out: Path, periods=None) -> dict:
 
 
 INTERRUPT_SCRIPT = """
-import sys, slidestack
+import signal, sys, slidestack
+# A child started from a non-interactive shell's background job inherits SIGINT ignored, and
+# Python then keeps it so: install the interpreter's own handler, as an interactive one has.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 stage = getattr(slidestack, sys.argv[2])
 try:
     stage(eval(sys.argv[1]))

@@ -105,6 +105,11 @@ fn print_table(a: &Answer) {
             f(a.lambda_grid),
             f(a.lambda_fit)
         );
+        println!(
+            "code-format fraction λ_code (the share of the live load to count as seismic \
+             weight): {} (the study's grid)",
+            f(a.lambda_code_grid)
+        );
     }
     for n in &a.notes {
         println!("note: {n}");

@@ -52,6 +52,17 @@ pub enum FitStageError {
     NoForm { zone: String, reasons: String },
 }
 
+/// The fraction a designer counts, `max(λ, 0)`, of every stored `λ`: the fraction form is
+/// fitted to it (docs/fit.md). A `λ` below 0 says that the sliding stack lowers the base shear
+/// below the bare building's, and `tnew.h5` keeps it whole; a code counts no less than none of
+/// the live load.
+fn design_fractions(lambda: &ndarray::ArrayD<f64>) -> Vec<f64> {
+    lambda
+        .iter()
+        .map(|&l| if l.is_nan() { l } else { l.max(0.0) })
+        .collect()
+}
+
 /// The fingerprint `fit.h5` and `fit.yaml` must carry (`building`: of a building study, which
 /// also fits `λ`).
 pub fn fingerprint(tnew_fingerprint: &str, building: bool) -> String {
@@ -358,7 +369,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 // A one-storey study has no λ; a building study of one frame fits it with the
                 // one-storey features.
                 let lambda: Vec<Sample> = (t.lambda.as_ref()).map_or_else(Vec::new, |l| {
-                    let lambda: Vec<f64> = l.lambda.iter().copied().collect();
+                    let lambda = design_fractions(&l.lambda);
                     samples(grid, &vec![1.0; lambda.len()], &lambda)
                 });
                 ZoneData {
@@ -388,7 +399,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 // λ where it is finite, as the fraction form's "T_new"; the features as T_new's.
                 let lambda_every: Vec<(usize, Sample)> = match &t.lambda {
                     Some(l) => {
-                        let lambda: Vec<f64> = l.lambda.iter().copied().collect();
+                        let lambda = design_fractions(&l.lambda);
                         let ones = vec![1.0; lambda.len()];
                         building_samples(grid, &frames, f, &ones, &lambda)
                     }

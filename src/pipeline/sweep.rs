@@ -74,8 +74,8 @@ pub enum SweepStageError {
 /// What a building study's `sweep.h5` stores, part of its fingerprint: a file written before
 /// the per-floor peaks and the base shear were (the first building sweeps) is out of date, not
 /// read as if it held them. Change it when the stored building variables change.
-const BUILDING_OUTPUTS: &str =
-    "roof peaks, per-floor accelerations, per-storey drift ratios, base shear";
+const BUILDING_OUTPUTS: &str = "roof peaks, per-floor accelerations, per-storey drift ratios, \
+     base shear, per-storey shears, overturning moment, stuck mass share";
 
 /// The fingerprint `sweep.h5` must carry.
 pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> String {
@@ -184,13 +184,16 @@ impl Units<'_> {
 
 /// The lengths of the columns [`to_columns`] writes for a unit of `cases` cases of `blocks`
 /// blocks: six `f64` columns (the slip, per interface, last), in a building study whose largest
-/// building has `nmax` storeys six more (four per floor or storey, padded to `nmax`, then the
-/// two base shears), then two code columns.
+/// building has `nmax` storeys eleven more (four per floor or storey, padded to `nmax`, the two
+/// base shears, the two storey shears, padded, the two overturning moments and the stuck
+/// share), then two code columns.
 fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>) -> Vec<usize> {
     let mut v = vec![cases, cases, cases, cases, cases, cases * blocks];
     if let Some(n) = nmax {
         v.extend([cases * n; 4]);
         v.extend([cases; 2]);
+        v.extend([cases * n; 2]);
+        v.extend([cases; 3]);
     }
     v.extend([cases; 2]);
     v
@@ -228,6 +231,11 @@ fn to_columns(r: &UnitResult, frame: Option<(usize, usize)>) -> Columns {
         }
         f64s.push(r.base_shear_stack.clone());
         f64s.push(r.base_shear_rigid.clone());
+        f64s.push(padded(&r.storey_shear_stack, n, nmax));
+        f64s.push(padded(&r.storey_shear_rigid, n, nmax));
+        f64s.push(r.overturning_stack.clone());
+        f64s.push(r.overturning_rigid.clone());
+        f64s.push(r.stuck_share_stack.clone());
     }
     Columns {
         f64s,
@@ -430,6 +438,11 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
                     drift_ratio_rigid: f(9, &per_floor)?,
                     base_shear_stack: f(10, &shape)?,
                     base_shear_rigid: f(11, &shape)?,
+                    storey_shear_stack: f(12, &per_floor)?,
+                    storey_shear_rigid: f(13, &per_floor)?,
+                    overturning_stack: f(14, &shape)?,
+                    overturning_rigid: f(15, &shape)?,
+                    stuck_share_stack: f(16, &shape)?,
                 })
             }
         };

@@ -17,19 +17,19 @@
 use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::dynamics::Ground;
 use crate::grid::Grid;
-use crate::ground_motion::Record;
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
+use crate::store::sweep::BuildingVars;
 use crate::store::sweep::read_zone_sweep;
-use crate::store::tnew::{LambdaVars, TnewMeta, TnewVars, ZoneTnew, read_zone_tnew_in, write_tnew};
-use crate::study::building::{Frame, first_of_building};
-use crate::study::lambda::{self, LAMBDA_FLAGS, LambdaFlag};
-use crate::study::physics::{CaseError, Physics, SystemKind};
+use crate::store::tnew::{
+    AttachedVars, TnewMeta, TnewVars, ZoneTnew, read_zone_tnew_in, write_tnew,
+};
+use crate::study::attached::{self, FRACTION_FLAGS, FractionFlag};
+use crate::study::building::Frame;
 use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
 use ndarray::{ArrayD, Axis};
 use rayon::prelude::*;
-use std::collections::BTreeMap;
 use thiserror::Error;
 
 /// Step of the period grid of the mean displacement spectrum, s.
@@ -43,118 +43,51 @@ pub enum TnewError {
         motion: String,
         source: SpectrumError,
     },
-    #[error("zone {zone}: the effective live-load fraction: {source}")]
-    Lambda {
+    #[error("zone {zone}: the attached fractions: {source}")]
+    Attached {
         zone: String,
-        source: Box<CaseError>,
+        source: Box<attached::AttachedError>,
     },
 }
 
-/// One case's effective live-load fraction and the mean base shears it comes from.
-#[derive(Debug, Clone, Copy)]
-struct Fraction {
-    stack: f64,
-    rigid: f64,
-    bare: f64,
-    lambda: f64,
-    flag: LambdaFlag,
-}
-
-/// The effective live-load fraction of every case (flat over `[frame][case]`) of a building
-/// study's zone ([`crate::study::lambda`]): `V̄_stack` and `V̄(1)` are the means over the
-/// motions (summed in motion order, then divided, as [`lambda::mean_base_shear`] sums) of the
-/// sweep's `base_shear_stack`/`base_shear_rigid` (`[motion][frame][case]`; on one storey,
-/// where those are NaN, simulated here by the building's integrator); `V̄(0)` and the values
-/// between are simulated. Cases in parallel, each on its own: the same numbers whatever the
-/// threads.
-fn effective_fractions(
-    physics: &Physics,
-    grid: &Grid,
-    frames: &[Option<Frame>],
-    motions: &[Record],
-    base_shear_stack: &[f64],
-    base_shear_rigid: &[f64],
-    slides: &[bool],
-) -> Result<Vec<Fraction>, CaseError> {
-    let per_frame = grid.cases();
+/// The sweep's means over the motions (summed in motion order, then divided) of every case of
+/// a building study's zone that [`attached::zone_fractions`] needs: per case (flat over
+/// `[frame][case]`) the stack's and the rigid system's mean peaks and the mean stuck share, `None`
+/// in a building of one storey (its integrator gives neither the shears nor the share).
+fn swept(
+    bv: &BuildingVars,
+    u_stack: &ArrayD<f64>,
+    u_rigid: &ArrayD<f64>,
+    frames: &[Frame],
+    per_frame: usize,
+    motions: usize,
+) -> Vec<attached::Swept> {
     let cases = frames.len() * per_frame;
-    let m = motions.len();
-    let accel: Vec<Vec<f64>> = motions.iter().map(|r| r.accel_mps2(1.0)).collect();
-    let grounds: Vec<Ground> = (motions.iter().zip(&accel))
-        .map(|(r, a)| Ground::new(r.dt_s, a))
-        .collect();
-    let grounds = &grounds[..];
-    let mean = |v: &[f64], c: usize| (0..m).map(|k| v[k * cases + c]).sum::<f64>() / m as f64;
-    let frame_of = |c: usize| {
-        frames[c / per_frame]
-            .as_ref()
-            .expect("a building study has a frame per case")
+    let nmax = bv.storey_shear_stack.shape().last().copied().unwrap_or(0);
+    let mean = |v: &ArrayD<f64>| {
+        let sum = v.sum_axis(Axis(0)) / motions as f64;
+        sum.into_iter().collect::<Vec<f64>>()
     };
-    // Frames that are one building have the same sweep results, so the same λ: each is
-    // computed for the first of them only.
-    let first = first_of_building(&frames.iter().flatten().cloned().collect::<Vec<_>>());
-    let own: Vec<usize> = (0..cases)
-        .filter(|&c| first[c / per_frame] == c / per_frame)
-        .collect();
-    // V̄(λ) depends on the frame, T_p and α (through the damping matrix) but not on μ: its
-    // scan once per key, the first case of each standing for it.
-    let bare_key = |c: usize| {
-        let case = grid.case(c % per_frame);
-        (
-            c / per_frame,
-            case.period_s.to_bits(),
-            case.alpha_total().to_bits(),
-        )
-    };
-    let mut keyed = BTreeMap::new();
-    for &c in &own {
-        keyed.entry(bare_key(c)).or_insert(c);
-    }
-    let keyed: Vec<((usize, u64, u64), usize)> = keyed.into_iter().collect();
-    let scans: BTreeMap<(usize, u64, u64), Vec<(f64, f64)>> = keyed
-        .par_iter()
-        .map(|&(key, c)| {
-            let case = grid.case(c % per_frame);
-            let at = |l| lambda::mean_base_shear(physics, &case, frame_of(c), l, grounds);
-            // V̄(1) is the sweep's rigid mean; the scan's end is only a placeholder here.
-            lambda::scan(at(0.0)?, f64::NAN, at).map(|v| (key, v))
-        })
-        .collect::<Result<_, _>>()?;
-    let computed: Vec<Fraction> = own
-        .par_iter()
-        .map(|&c| {
-            let frame = frame_of(c);
-            let case = grid.case(c % per_frame);
-            // One storey's sweep runs the one-storey integrator, which gives no base shear.
-            let (stack, rigid) = if frame.storeys() == 1 {
-                let run =
-                    |kind| lambda::mean_system_base_shear(physics, kind, &case, frame, grounds);
-                (run(SystemKind::Stack)?, run(SystemKind::Rigid)?)
-            } else {
-                (mean(base_shear_stack, c), mean(base_shear_rigid, c))
-            };
-            let mut scan = scans[&bare_key(c)].clone();
-            let bare = scan[0].1;
-            scan.last_mut().expect("the scan has its ends").1 = rigid;
-            let at = |l| lambda::mean_base_shear(physics, &case, frame, l, grounds);
-            let (lambda, flag) = if slides[c] {
-                lambda::solve_on(stack, &scan, at)?
-            } else {
-                (1.0, LambdaFlag::NoSlide)
-            };
-            Ok(Fraction {
-                stack,
-                rigid,
-                bare,
-                lambda,
-                flag,
+    let (ss, sr) = (mean(&bv.storey_shear_stack), mean(&bv.storey_shear_rigid));
+    let (os, or) = (mean(&bv.overturning_stack), mean(&bv.overturning_rigid));
+    let share = mean(&bv.stuck_share_stack);
+    let (us, ur): (Vec<f64>, Vec<f64>) = (
+        u_stack.iter().copied().collect(),
+        u_rigid.iter().copied().collect(),
+    );
+    (0..cases)
+        .map(|c| {
+            let n = frames[c / per_frame].storeys();
+            (n > 1).then(|| {
+                let means = |roof: f64, shear: &[f64], moment: f64| attached::Means {
+                    roof_m: roof,
+                    storey_shear: shear[c * nmax..c * nmax + n].to_vec(),
+                    overturning: moment,
+                };
+                (means(us[c], &ss, os[c]), means(ur[c], &sr, or[c]), share[c])
             })
         })
-        .collect::<Result<_, CaseError>>()?;
-    let at: BTreeMap<usize, usize> = own.iter().enumerate().map(|(i, &c)| (c, i)).collect();
-    Ok((0..cases)
-        .map(|c| computed[at[&(first[c / per_frame] * per_frame + c % per_frame)]])
-        .collect())
+        .collect()
 }
 
 /// The fingerprint `tnew.h5` must carry (`λ`'s definition and search are the `lambda` method's
@@ -266,66 +199,126 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         let slides: Vec<bool> = (0..cases)
             .map(|c| slip.index_axis(Axis(1), c).iter().any(|&x| x > 0.0))
             .collect();
+        let shaped = |v: Vec<f64>| {
+            ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
+        };
+        let codes = |v: Vec<u8>| {
+            ArrayD::from_shape_vec(shape.clone(), v).expect("one code per case of the grid")
+        };
+        // The building's attached fractions (docs/model.md, "The attached fraction").
+        let fractions = match (&v.building, building) {
+            (Some(bv), Some(axes)) => {
+                let frames: Vec<Frame> = frames.iter().flatten().cloned().collect();
+                let grounds: Vec<Vec<f64>> = motions[z].iter().map(|r| r.accel_mps2(1.0)).collect();
+                let grounds: Vec<Ground> = (motions[z].iter().zip(&grounds))
+                    .map(|(r, a)| Ground::new(r.dt_s, a))
+                    .collect();
+                let swept = swept(bv, &u_stack, &u_rigid, &frames, per_frame, m);
+                let keep_going = || !s.reporter.cancelled();
+                let l = attached::zone_fractions(
+                    &physics,
+                    grid,
+                    &frames,
+                    &grounds,
+                    &swept,
+                    &slides,
+                    &keep_going,
+                )
+                .map_err(|e| match e {
+                    attached::AttachedError::Stopped => PipelineError::Cancelled(me),
+                    e => TnewError::Attached {
+                        zone: zc.name.clone(),
+                        source: Box::new(e),
+                    }
+                    .into(),
+                })?;
+                Some((l, axes.max_storeys()))
+            }
+            _ => None,
+        };
         let mut t_rigid = Vec::with_capacity(cases);
         let mut t_new = Vec::with_capacity(cases);
+        let mut t_first_mode = Vec::with_capacity(cases);
         let mut flag = Vec::with_capacity(cases);
         let mut band = Vec::with_capacity(cases);
         for (c, (&us, &slid)) in u_stack.iter().zip(&slides).enumerate() {
             let case = grid.case(c % per_frame);
-            let (tr, u) = match &frames[c / per_frame] {
+            let frame = &frames[c / per_frame];
+            let (tr, u) = match frame {
                 None => (case.t_rigid_s(), us),
                 Some(frame) => (frame.t_rigid_s(&case), us / participation[c / per_frame]),
             };
-            let (tn, f) = tnew::t_new(&period_sd_s, &sd_mean_m, u, tr, slid);
+            let (first_mode, paper_flag) = tnew::t_new(&period_sd_s, &sd_mean_m, u, tr, slid);
+            // One storey keeps the paper's T_new; a building of several storeys reads it off
+            // the attached fraction of its roof's mean peak displacement.
+            let (tn, f) = match (frame, &fractions) {
+                (Some(fr), Some((l, _))) if fr.storeys() > 1 => {
+                    let (fraction, how) = l[c].roof;
+                    tnew::of_attached(fr.t1_attached_s(&case, fraction), how)
+                }
+                _ => (first_mode, paper_flag),
+            };
             t_rigid.push(tr);
             t_new.push(tn);
+            t_first_mode.push(first_mode);
             flag.push(f64::from(f as u8));
             band.push(Band::of(case.period_s, tr, tn, f) as u8);
         }
-        let shaped = |v: Vec<f64>| {
-            ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
-        };
-        let lambda = match &v.building {
-            None => None,
-            Some(bv) => {
-                let l = effective_fractions(
-                    &physics,
-                    grid,
-                    &frames,
-                    &motions[z],
-                    bv.base_shear_stack.as_slice().expect("standard layout"),
-                    bv.base_shear_rigid.as_slice().expect("standard layout"),
-                    &slides,
-                )
-                .map_err(|source| TnewError::Lambda {
-                    zone: zc.name.clone(),
-                    source: Box::new(source),
-                })?;
-                let counts: Vec<String> = (LAMBDA_FLAGS.iter())
-                    .map(|(code, word)| {
-                        let k = l.iter().filter(|x| x.flag as u8 == *code).count();
-                        format!("{word} {k}")
-                    })
-                    .collect();
-                s.reporter.info(
-                    me,
-                    &format!("zone {}: effective live-load fraction λ: {}", zc.name, {
-                        counts.join(", ")
-                    }),
-                );
-                Some(LambdaVars {
-                    base_shear_stack_mean: shaped(l.iter().map(|x| x.stack).collect()),
-                    base_shear_rigid_mean: shaped(l.iter().map(|x| x.rigid).collect()),
-                    base_shear_bare_mean: shaped(l.iter().map(|x| x.bare).collect()),
-                    lambda: shaped(l.iter().map(|x| x.lambda).collect()),
-                    flag: ArrayD::from_shape_vec(
-                        shape.clone(),
-                        l.iter().map(|x| x.flag as u8).collect(),
-                    )
-                    .expect("one code per case"),
+        let lambda = fractions.map(|(l, nmax)| {
+            let counts: Vec<String> = (FRACTION_FLAGS.iter())
+                .map(|(code, word)| {
+                    let k = l.iter().filter(|x| x.storey[0].1 as u8 == *code).count();
+                    format!("{word} {k}")
                 })
+                .collect();
+            let below = l.iter().filter(|x| x.storey[0].0 < 0.0).count();
+            s.reporter.info(
+                me,
+                &format!(
+                    "zone {}: effective live-load fraction λ: {}; {below} below 0 (the stack \
+                     lowers the base shear below the bare building's)",
+                    zc.name,
+                    counts.join(", ")
+                ),
+            );
+            let per_case =
+                |get: &dyn Fn(&attached::CaseFractions) -> f64| shaped(l.iter().map(get).collect());
+            let flags = |get: &dyn Fn(&attached::CaseFractions) -> FractionFlag| {
+                codes(l.iter().map(|x| get(x) as u8).collect())
+            };
+            let mut storey_shape = shape.clone();
+            storey_shape.push(nmax);
+            let storey = |get: &dyn Fn(&(f64, FractionFlag)) -> f64| {
+                let v = (l.iter())
+                    .flat_map(|x| (0..nmax).map(|i| x.storey.get(i).map_or(f64::NAN, get)))
+                    .collect();
+                ArrayD::from_shape_vec(storey_shape.clone(), v).expect("one per case and storey")
+            };
+            AttachedVars {
+                base_shear_stack_mean: per_case(&|x| x.stack.storey_shear[0]),
+                base_shear_rigid_mean: per_case(&|x| x.rigid.storey_shear[0]),
+                base_shear_bare_mean: per_case(&|x| x.bare.storey_shear[0]),
+                base_shear_ratio_bare: per_case(&|x| {
+                    x.stack.storey_shear[0] / x.bare.storey_shear[0]
+                }),
+                base_shear_ratio_rigid: per_case(&|x| {
+                    x.stack.storey_shear[0] / x.rigid.storey_shear[0]
+                }),
+                stuck_share_mean: per_case(&|x| x.share),
+                lambda: per_case(&|x| x.storey[0].0),
+                flag: flags(&|x| x.storey[0].1),
+                lambda_storey: storey(&|s| s.0),
+                lambda_storey_flag: storey(&|s| f64::from(s.1 as u8))
+                    .mapv(|v| if v.is_nan() { 255 } else { v as u8 }),
+                lambda_overturning: per_case(&|x| x.overturning.0),
+                lambda_overturning_flag: flags(&|x| x.overturning.1),
+                lambda_code: per_case(&|x| x.code.0),
+                lambda_code_flag: flags(&|x| x.code.1),
+                attached_fraction_roof: per_case(&|x| x.roof.0),
+                attached_fraction_roof_flag: flags(&|x| x.roof.1),
+                t_new_first_mode: shaped(t_first_mode.clone()),
             }
-        };
+        });
         let counts = BandCounts::new(&band, &t_new, &t_rigid);
         s.reporter.info(
             me,
@@ -365,7 +358,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         motions_fingerprint: study.fingerprint(StageId::Motions)?,
         flag_codes: TNEW_FLAG_CODES,
         band_flags: &BAND_FLAGS,
-        lambda_flags: &LAMBDA_FLAGS,
+        lambda_flags: &FRACTION_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,
         settings: &settings,
     };

@@ -317,18 +317,23 @@ function answer(q) {
   const tFit = z.fit ? predict(z.fit, fitX, q.period, tRigid) : null;
   let lambdaGrid = null;
   let lambdaFit = null;
+  let lambdaCode = null;
+  const onGrid = (values) => {
+    const l = interpolate(z.grid, values, [q.period, ...q.alpha, ...q.mu]);
+    return l.outside || l.value === null ? null : l.value;
+  };
   if (z.lambda) {
     const [values, fitted] = z.lambda;
-    const l = interpolate(z.grid, values, [q.period, ...q.alpha, ...q.mu]);
-    lambdaGrid = l.outside || l.value === null ? null : l.value;
+    lambdaGrid = onGrid(values);
     lambdaFit = fitted ? predict(fitted, fitX, q.period, tRigid) : null;
   }
+  if (z.lambda_code) lambdaCode = onGrid(z.lambda_code);
   const tPaper = paperEquation(z.paper, x);
   const sa = (t) => (fin(t) === null ? null : saG(z.target, t));
   return {
     answer: {
       zone: z.zone, target: z.target.spec, fit_form: z.fit ? z.fit.form : "", building: label,
-      lambda_grid: lambdaGrid, lambda_fit: lambdaFit,
+      lambda_grid: lambdaGrid, lambda_fit: lambdaFit, lambda_code_grid: lambdaCode,
       t_rigid_s: tRigid, t_new_grid_s: tGrid, t_new_fit_s: tFit, t_new_paper_s: tPaper,
       sa_tp_g: saG(z.target, q.period), sa_new_g: sa(tGrid !== null ? tGrid : tFit),
       sa_new_grid_g: sa(tGrid), sa_new_fit_g: sa(tFit), sa_new_paper_g: sa(tPaper), notes,
@@ -339,7 +344,7 @@ function answer(q) {
 // ---- the form, the URL and the outputs ----
 
 const OUTPUTS = ["t_rigid_s", "t_new_grid_s", "t_new_fit_s", "t_new_paper_s", "sa_tp_g", "sa_new_g"]
-  .concat(FRAMES ? ["lambda_grid", "lambda_fit"] : []);
+  .concat(FRAMES ? ["lambda_grid", "lambda_fit", "lambda_code_grid"] : []);
 const $ = (id) => document.getElementById(id);
 const listOf = (s) => s.split(",").map((v) => (v.trim() === "" ? NaN : Number(v)));
 

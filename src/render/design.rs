@@ -44,7 +44,7 @@ const OUTPUT_ROWS: [Row; 6] = [
 ];
 
 /// A building study's rows: `T_1`, `T_1,rigid` and the fraction `λ`.
-const BUILDING_ROWS: [Row; 8] = [
+const BUILDING_ROWS: [Row; 9] = [
     (
         "T_1,rigid: stack rigidly attached to its floor(s)",
         "t_rigid_s",
@@ -69,6 +69,11 @@ const BUILDING_ROWS: [Row; 8] = [
         "",
     ),
     ("λ: the fitted fraction equation", "lambda_fit", ""),
+    (
+        "λ_code, the fraction to count as seismic weight: the frame's cases",
+        "lambda_code_grid",
+        "",
+    ),
 ];
 
 /// A building study's inputs: the storey counts and floors its selects offer, and its

@@ -19,7 +19,10 @@
 //! ```text
 //!     floor_accel_stack, floor_accel_rigid (g)     [motion, storeys, stack_floor, T_p, …, floor]
 //!     drift_ratio_stack, drift_ratio_rigid (1)     [… , storey]
-//!     base_shear_stack, base_shear_rigid (1)       [motion, storeys, stack_floor, T_p, …]
+//!     storey_shear_stack, storey_shear_rigid (1)   [… , storey]
+//!     base_shear_stack, base_shear_rigid (1),
+//!     overturning_stack, overturning_rigid (1),
+//!     stuck_share_stack (1)                        [motion, storeys, stack_floor, T_p, …]
 //! ```
 //! One padded array per variable rather than one per storey count keeps every variable on the
 //! grid's dimensions (xarray selects `storeys=3` and gets floors 1 … 3 and NaN above).
@@ -84,35 +87,68 @@ pub struct BuildingVars {
     /// Peak base shear over the bare building's weight (NaN in a building of one storey).
     pub base_shear_stack: ArrayD<f64>,
     pub base_shear_rigid: ArrayD<f64>,
+    /// Peak shear of each storey over the bare building's weight (storey 1's is the base
+    /// shear; NaN in a building of one storey).
+    pub storey_shear_stack: ArrayD<f64>,
+    pub storey_shear_rigid: ArrayD<f64>,
+    /// Peak overturning moment at the base over the bare building's weight times its height
+    /// (NaN in a building of one storey).
+    pub overturning_stack: ArrayD<f64>,
+    pub overturning_rigid: ArrayD<f64>,
+    /// The stack's stuck mass share: the time average of its mass moving with its floor, over
+    /// its mass (NaN in a building of one storey).
+    pub stuck_share_stack: ArrayD<f64>,
+}
+
+/// The trailing level axis of a building variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Level {
+    /// None: the case dimensions alone.
+    Case,
+    Floor,
+    Storey,
 }
 
 impl BuildingVars {
-    /// `(name, data, units, long name)` of every variable, in the order they are written.
-    pub fn vars(&self) -> [(&'static str, &ArrayD<f64>, &'static str, &'static str); 6] {
+    /// `(name, data, units, long name, level axis)` of every variable, in the order they are
+    /// written and read.
+    pub fn vars(
+        &self,
+    ) -> [(
+        &'static str,
+        &ArrayD<f64>,
+        &'static str,
+        &'static str,
+        Level,
+    ); 11] {
         [
             (
                 "floor_accel_stack",
                 &self.floor_accel_stack,
                 "g",
                 "peak absolute acceleration of each floor with the sliding stack",
+                Level::Floor,
             ),
             (
                 "floor_accel_rigid",
                 &self.floor_accel_rigid,
                 "g",
                 "peak absolute acceleration of each floor with the stack rigidly attached",
+                Level::Floor,
             ),
             (
                 "drift_ratio_stack",
                 &self.drift_ratio_stack,
                 "1",
                 "peak interstorey drift over the storey height, with the sliding stack",
+                Level::Storey,
             ),
             (
                 "drift_ratio_rigid",
                 &self.drift_ratio_rigid,
                 "1",
                 "peak interstorey drift over the storey height, with the stack rigidly attached",
+                Level::Storey,
             ),
             (
                 "base_shear_stack",
@@ -120,6 +156,7 @@ impl BuildingVars {
                 "1",
                 "peak base shear over the bare building's weight, with the sliding stack \
                  (NaN on one storey: its integrator does not give it)",
+                Level::Case,
             ),
             (
                 "base_shear_rigid",
@@ -127,6 +164,47 @@ impl BuildingVars {
                 "1",
                 "peak base shear over the bare building's weight, with the stack rigidly \
                  attached (NaN on one storey: its integrator does not give it)",
+                Level::Case,
+            ),
+            (
+                "storey_shear_stack",
+                &self.storey_shear_stack,
+                "1",
+                "peak shear of each storey over the bare building's weight, with the sliding \
+                 stack (NaN on one storey)",
+                Level::Storey,
+            ),
+            (
+                "storey_shear_rigid",
+                &self.storey_shear_rigid,
+                "1",
+                "peak shear of each storey over the bare building's weight, with the stack \
+                 rigidly attached (NaN on one storey)",
+                Level::Storey,
+            ),
+            (
+                "overturning_stack",
+                &self.overturning_stack,
+                "1",
+                "peak overturning moment at the base over the bare building's weight times its \
+                 height, with the sliding stack (NaN on one storey)",
+                Level::Case,
+            ),
+            (
+                "overturning_rigid",
+                &self.overturning_rigid,
+                "1",
+                "peak overturning moment at the base over the bare building's weight times its \
+                 height, with the stack rigidly attached (NaN on one storey)",
+                Level::Case,
+            ),
+            (
+                "stuck_share_stack",
+                &self.stuck_share_stack,
+                "1",
+                "time average of the stack's mass moving with its floor over its mass (1: it \
+                 never slid; NaN on one storey)",
+                Level::Case,
             ),
         ]
     }
@@ -377,13 +455,11 @@ fn write_zone(
         )?;
         let mut chunk_f = chunk.clone();
         chunk_f.push(levels.len());
-        for (name, data, units, long) in bv.vars() {
-            let per = if name.starts_with("floor") {
-                Some(&floor)
-            } else if name.starts_with("drift") {
-                Some(&storey)
-            } else {
-                None
+        for (name, data, units, long, level) in bv.vars() {
+            let per = match level {
+                Level::Floor => Some(&floor),
+                Level::Storey => Some(&storey),
+                Level::Case => None,
             };
             let ds = write_var(
                 &g,
@@ -433,6 +509,11 @@ pub fn read_zone_sweep(
                 drift_ratio_rigid: g.array("drift_ratio_rigid", &per_floor)?,
                 base_shear_stack: g.array("base_shear_stack", &shape)?,
                 base_shear_rigid: g.array("base_shear_rigid", &shape)?,
+                storey_shear_stack: g.array("storey_shear_stack", &per_floor)?,
+                storey_shear_rigid: g.array("storey_shear_rigid", &per_floor)?,
+                overturning_stack: g.array("overturning_stack", &shape)?,
+                overturning_rigid: g.array("overturning_rigid", &shape)?,
+                stuck_share_stack: g.array("stuck_share_stack", &shape)?,
             })
         }
     };

@@ -58,49 +58,174 @@ pub struct ZoneTnew {
     /// A building study's `Γ_1·φ_1,N` per storey count (empty on one storey).
     pub roof_participation: Vec<f64>,
     /// A building study's effective live-load fraction (`None` on one storey).
-    pub lambda: Option<LambdaVars>,
+    pub lambda: Option<AttachedVars>,
 }
 
-/// The effective live-load fraction of every case of a building study and the mean peak base
-/// shears it comes from, each over the bare building's weight (docs/model.md, "The effective
-/// live-load fraction λ"); shaped as [`TnewVars`]' variables.
+/// A building study's attached fractions of every case (docs/model.md, "The attached
+/// fraction") and the mean peaks they come from, each over the bare building; shaped as
+/// [`TnewVars`]' variables, the per-storey ones with a trailing `storey` axis of length `N_max`
+/// (NaN, and 255 for flags, above a building's roof).
 #[derive(Debug, Clone, PartialEq)]
-pub struct LambdaVars {
-    /// `V̄_stack`: with the sliding stack.
+pub struct AttachedVars {
+    /// `V̄_stack`: with the sliding stack, over the bare building's weight.
     pub base_shear_stack_mean: ArrayD<f64>,
     /// `V̄(1)`: with the whole stack rigidly attached.
     pub base_shear_rigid_mean: ArrayD<f64>,
     /// `V̄(0)`: with the stack's mass absent (the building's own damping matrix).
     pub base_shear_bare_mean: ArrayD<f64>,
+    /// `V̄_stack/V̄(0)` and `V̄_stack/V̄(1)`, unclamped.
+    pub base_shear_ratio_bare: ArrayD<f64>,
+    pub base_shear_ratio_rigid: ArrayD<f64>,
+    /// The stuck mass share's mean over the motions.
+    pub stuck_share_mean: ArrayD<f64>,
+    /// `λ`: the attached fraction of the base shear, unclamped.
     pub lambda: ArrayD<f64>,
-    /// How `λ` was found (codes in `flag_values`/`flag_meanings`).
     pub flag: ArrayD<u8>,
+    /// The attached fraction of each storey's shear (storey 1's is `λ`).
+    pub lambda_storey: ArrayD<f64>,
+    pub lambda_storey_flag: ArrayD<u8>,
+    /// The attached fraction of the overturning moment at the base.
+    pub lambda_overturning: ArrayD<f64>,
+    pub lambda_overturning_flag: ArrayD<u8>,
+    /// The code-format fraction.
+    pub lambda_code: ArrayD<f64>,
+    pub lambda_code_flag: ArrayD<u8>,
+    /// The attached fraction of the roof's mean peak displacement (a building's `T_new` is the
+    /// first-mode period with it attached).
+    pub attached_fraction_roof: ArrayD<f64>,
+    pub attached_fraction_roof_flag: ArrayD<u8>,
+    /// The earlier definition of a building's `T_new` (the roof's mean peak over the bare
+    /// building's `Γ_1·φ_1,N`, read off the mean displacement spectrum), kept for one release.
+    pub t_new_first_mode: ArrayD<f64>,
 }
 
-impl LambdaVars {
-    fn vars(&self) -> [(&'static str, &ArrayD<f64>, &'static str); 4] {
+/// Whether a variable has a trailing `storey` axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum PerStorey {
+    No,
+    Yes,
+}
+
+impl AttachedVars {
+    /// `(name, data, units, long name, per storey)` of every value variable.
+    fn vars(
+        &self,
+    ) -> [(
+        &'static str,
+        &ArrayD<f64>,
+        &'static str,
+        &'static str,
+        PerStorey,
+    ); 12] {
+        use PerStorey::*;
         [
             (
                 "base_shear_stack_mean",
                 &self.base_shear_stack_mean,
+                "1",
                 "mean over the motions of the peak base shear over the bare building's weight, \
                  with the sliding stack",
+                No,
             ),
             (
                 "base_shear_rigid_mean",
                 &self.base_shear_rigid_mean,
-                "the same with the stack rigidly attached (lambda = 1)",
+                "1",
+                "the same with the stack rigidly attached (fraction 1)",
+                No,
             ),
             (
                 "base_shear_bare_mean",
                 &self.base_shear_bare_mean,
-                "the same with the stack's mass absent (lambda = 0)",
+                "1",
+                "the same with the stack's mass absent (fraction 0)",
+                No,
+            ),
+            (
+                "base_shear_ratio_bare",
+                &self.base_shear_ratio_bare,
+                "1",
+                "base_shear_stack_mean / base_shear_bare_mean (below 1: the sliding stack lowers \
+                 the base shear below the bare building's)",
+                No,
+            ),
+            (
+                "base_shear_ratio_rigid",
+                &self.base_shear_ratio_rigid,
+                "1",
+                "base_shear_stack_mean / base_shear_rigid_mean",
+                No,
+            ),
+            (
+                "stuck_share_mean",
+                &self.stuck_share_mean,
+                "1",
+                "mean over the motions of the time average of the stack's mass moving with its \
+                 floor, over its mass (1: it never slid)",
+                No,
             ),
             (
                 "lambda",
                 &self.lambda,
-                "effective live-load fraction: the fraction of the stack's mass which, rigidly \
-                 attached, gives base_shear_stack_mean (lambda_flag says how it was found)",
+                "1",
+                "effective live-load fraction: the fraction of the stack which, rigidly attached \
+                 (below 0: removed), gives base_shear_stack_mean; unclamped (lambda_flag)",
+                No,
+            ),
+            (
+                "lambda_storey",
+                &self.lambda_storey,
+                "1",
+                "the same for each storey's mean peak shear (storey 1: lambda)",
+                Yes,
+            ),
+            (
+                "lambda_overturning",
+                &self.lambda_overturning,
+                "1",
+                "the same for the mean peak overturning moment at the base",
+                No,
+            ),
+            (
+                "lambda_code",
+                &self.lambda_code,
+                "1",
+                "code-format fraction: (W + lambda·W_L)·Sa(T_1(lambda)) / ((W + W_L)·Sa(T_1,rigid)) \
+                 = base_shear_ratio_rigid, Sa the zone's mean 5 %-damped spectrum exactly at the \
+                 period",
+                No,
+            ),
+            (
+                "attached_fraction_roof",
+                &self.attached_fraction_roof,
+                "1",
+                "the fraction of the stack which, rigidly attached, gives the mean peak roof \
+                 displacement (a building of several storeys: T_new is T_1 with it attached)",
+                No,
+            ),
+            (
+                "T_new_first_mode",
+                &self.t_new_first_mode,
+                "s",
+                "the earlier T_new of a building (kept for one release): the period whose mean \
+                 5 %-damped spectral displacement equals u_stack_mean / roof_participation",
+                No,
+            ),
+        ]
+    }
+
+    /// `(name, codes, per storey)` of every flag variable (codes: `lambda_flag`'s).
+    fn flags(&self) -> [(&'static str, &ArrayD<u8>, PerStorey); 5] {
+        use PerStorey::*;
+        [
+            ("lambda_flag", &self.flag, No),
+            ("lambda_storey_flag", &self.lambda_storey_flag, Yes),
+            ("lambda_overturning_flag", &self.lambda_overturning_flag, No),
+            ("lambda_code_flag", &self.lambda_code_flag, No),
+            (
+                "attached_fraction_roof_flag",
+                &self.attached_fraction_roof_flag,
+                No,
             ),
         ]
     }
@@ -261,22 +386,41 @@ fn write_zone(
         meta.band_flags,
     )?;
     attach_all(&ds, &scales)?;
-    if let Some(l) = &z.lambda {
-        for (name, data, long) in l.vars() {
-            let ds = write_var(&g, name, data.view(), &chunk, "1", long)?;
+    if let (Some(l), Some(b)) = (&z.lambda, building) {
+        let levels: Vec<f64> = (1..=b.max_storeys()).map(|j| j as f64).collect();
+        let storey = coordinate(&g, "storey", &levels, "1", "storey (1 the lowest)")?;
+        let mut chunk_s = chunk.clone();
+        chunk_s.push(levels.len());
+        let per = |p: PerStorey| {
+            if p == PerStorey::Yes {
+                &chunk_s
+            } else {
+                &chunk
+            }
+        };
+        for (name, data, units, long, p) in l.vars() {
+            let ds = write_var(&g, name, data.view(), per(p), units, long)?;
             attach_all(&ds, &scales)?;
+            if p == PerStorey::Yes {
+                attach_scale(&ds, &storey, scales.len())?;
+            }
         }
-        let ds = write_flags(
-            &g,
-            "lambda_flag",
-            l.flag.view(),
-            &chunk,
-            "how lambda was found: the largest root of the mean base shear on [0, 1] (one or \
-             several crossings on a 0.1 scan), the scan point nearest when none, 1 when nothing \
-             slid",
-            meta.lambda_flags,
-        )?;
-        attach_all(&ds, &scales)?;
+        for (name, codes, p) in l.flags() {
+            let ds = write_flags(
+                &g,
+                name,
+                codes.view(),
+                per(p),
+                "how the fraction was found: the root of its mean peak on a 0.1 scan (the one \
+                 nearest the stuck share of several), the scan point nearest when none, \
+                 no_slide when nothing slid",
+                meta.lambda_flags,
+            )?;
+            attach_all(&ds, &scales)?;
+            if p == PerStorey::Yes {
+                attach_scale(&ds, &storey, scales.len())?;
+            }
+        }
     }
     let p = coordinate(
         &g,
@@ -350,15 +494,31 @@ pub fn read_zone_tnew_in(
             ),
         ));
     }
-    let lambda = match axes {
+    let lambda = match &axes {
         None => None,
-        Some(_) => Some(LambdaVars {
-            base_shear_stack_mean: g.array("base_shear_stack_mean", &shape)?,
-            base_shear_rigid_mean: g.array("base_shear_rigid_mean", &shape)?,
-            base_shear_bare_mean: g.array("base_shear_bare_mean", &shape)?,
-            lambda: g.array("lambda", &shape)?,
-            flag: g.array("lambda_flag", &shape)?,
-        }),
+        Some(a) => {
+            let mut per_storey = shape.clone();
+            per_storey.push(a.max_storeys());
+            Some(AttachedVars {
+                base_shear_stack_mean: g.array("base_shear_stack_mean", &shape)?,
+                base_shear_rigid_mean: g.array("base_shear_rigid_mean", &shape)?,
+                base_shear_bare_mean: g.array("base_shear_bare_mean", &shape)?,
+                base_shear_ratio_bare: g.array("base_shear_ratio_bare", &shape)?,
+                base_shear_ratio_rigid: g.array("base_shear_ratio_rigid", &shape)?,
+                stuck_share_mean: g.array("stuck_share_mean", &shape)?,
+                lambda: g.array("lambda", &shape)?,
+                flag: g.array("lambda_flag", &shape)?,
+                lambda_storey: g.array("lambda_storey", &per_storey)?,
+                lambda_storey_flag: g.array("lambda_storey_flag", &per_storey)?,
+                lambda_overturning: g.array("lambda_overturning", &shape)?,
+                lambda_overturning_flag: g.array("lambda_overturning_flag", &shape)?,
+                lambda_code: g.array("lambda_code", &shape)?,
+                lambda_code_flag: g.array("lambda_code_flag", &shape)?,
+                attached_fraction_roof: g.array("attached_fraction_roof", &shape)?,
+                attached_fraction_roof_flag: g.array("attached_fraction_roof_flag", &shape)?,
+                t_new_first_mode: g.array("T_new_first_mode", &shape)?,
+            })
+        }
     };
     let period_sd_s = g.vector("period_sd")?;
     let sd_mean_m = g.array("sd_mean", &[period_sd_s.len()])?;

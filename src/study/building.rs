@@ -150,7 +150,18 @@ impl Frame {
         if self.storeys() == 1 {
             return case.t_rigid_s();
         }
-        let alpha = case.alpha_total();
+        self.t1_attached_s(case, 1.0)
+    }
+
+    /// The first-mode period of the building carrying `fraction` of `case`'s stack rigidly
+    /// attached to each loaded floor, s: `T_1` at 0, `T_1,rigid` at 1 (the same arithmetic as
+    /// [`Self::t_rigid_s`], bit for bit), shorter than `T_1` below 0 (docs/model.md, "The
+    /// attached fraction").
+    pub fn t1_attached_s(&self, case: &Case, fraction: f64) -> f64 {
+        let alpha = fraction * case.alpha_total();
+        if self.storeys() == 1 {
+            return case.period_s * (1.0 + alpha).sqrt();
+        }
         let mut loaded = self.floor_masses.clone();
         for f in self.floors() {
             loaded[f - 1] *= 1.0 + alpha;
@@ -158,6 +169,17 @@ impl Frame {
         let bare = modes(&self.floor_masses, &self.storey_stiffnesses).0[0];
         let rigid = modes(&loaded, &self.storey_stiffnesses).0[0];
         case.period_s * (bare / rigid).sqrt()
+    }
+
+    /// The building's height, m.
+    pub fn height_m(&self) -> f64 {
+        self.storey_heights_m.iter().sum()
+    }
+
+    /// An overturning moment at the base (N·m) over the bare building's weight times its
+    /// height.
+    pub fn overturning_ratio(&self, m_n_m: f64) -> f64 {
+        self.base_shear_ratio(m_n_m) / self.height_m()
     }
 }
 

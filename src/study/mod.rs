@@ -1,6 +1,8 @@
 //! The parametric study's numerics and configuration (the stages that drive them are in
 //! [`crate::pipeline`]).
 //!
+//! * [`attached`]: attached fractions: `λ` of the base shear, of each storey's shear and of the
+//!   overturning moment, the code-format `λ`, a building's `T_new` (the roof's).
 //! * [`building`]: a study over buildings: the `building:` section, `grid.stack_floor`, a frame.
 //! * [`cases`]: the paper's named cases (Section 7.1, Table 2, Section 9).
 //! * [`config`]: the study file (YAML), validated before any work.
@@ -11,11 +13,11 @@
 //! * [`sweep`]: the skip rules, one work unit.
 //! * [`tnew`]: `T_new` from the mean displacement spectrum; the fit's samples.
 
+pub mod attached;
 pub mod building;
 pub mod cases;
 pub mod config;
 pub mod ida;
-pub mod lambda;
 pub mod motions;
 pub mod physics;
 pub mod storey_strength;

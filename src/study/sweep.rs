@@ -77,6 +77,15 @@ struct Peaks {
     /// In a building: peak base shear over the bare building's weight `g·Σm_j` (NaN on one
     /// storey, whose integrator does not give it).
     base_shear: f64,
+    /// In a building: each storey's peak shear over the bare building's weight, storey 1 first
+    /// (NaN on one storey).
+    storey_shear: Vec<f64>,
+    /// In a building: the peak overturning moment at the base over the bare building's weight
+    /// times its height (NaN on one storey).
+    overturning: f64,
+    /// In a building: the stacks' stuck mass share (NaN on one storey, and for a system
+    /// without stacks).
+    stuck_share: f64,
 }
 
 impl Peaks {
@@ -90,6 +99,9 @@ impl Peaks {
             floor_a_g: Vec::new(),
             drift_ratio: Vec::new(),
             base_shear: f64::NAN,
+            storey_shear: Vec::new(),
+            overturning: f64::NAN,
+            stuck_share: f64::NAN,
         }
     }
 
@@ -118,6 +130,11 @@ impl Peaks {
                 .map(|(d, h)| d / h)
                 .collect(),
             base_shear: frame.base_shear_ratio(r.peak_base_shear_n),
+            storey_shear: (r.storey_peak_shear_n.iter())
+                .map(|&v| frame.base_shear_ratio(v))
+                .collect(),
+            overturning: frame.overturning_ratio(r.peak_overturning_n_m),
+            stuck_share: r.stuck_mass_share,
         }
     }
 }
@@ -152,19 +169,44 @@ pub struct UnitResult {
     /// a building of one storey).
     pub base_shear_stack: Vec<f64>,
     pub base_shear_rigid: Vec<f64>,
+    /// In a building: each storey's peak shear over the bare building's weight, `[case][storey]`,
+    /// idem (NaN in a building of one storey).
+    pub storey_shear_stack: Vec<f64>,
+    pub storey_shear_rigid: Vec<f64>,
+    /// In a building: the peak overturning moment at the base over the bare building's weight
+    /// times its height, per case, idem (NaN in a building of one storey).
+    pub overturning_stack: Vec<f64>,
+    pub overturning_rigid: Vec<f64>,
+    /// In a building: the stack's stuck mass share (the time average of its mass moving with
+    /// its floor over its mass), per case: exactly 1 where a skip rule shows it never slides
+    /// (NaN in a building of one storey).
+    pub stuck_share_stack: Vec<f64>,
 }
 
 impl UnitResult {
     /// Appends a building's per-floor and per-storey peaks of the stack system `s` and the rigid
-    /// system `r` (nothing on one storey, where both are empty).
-    fn push_profiles(&mut self, s: &Peaks, r: &Peaks) {
+    /// system `r` (nothing on one storey, where both are empty); `held`: a skip rule showed
+    /// that the stack never slides (its stuck share is then 1: the rule's state is the one the
+    /// integrator keeps).
+    fn push_profiles(&mut self, s: &Peaks, r: &Peaks, held: bool) {
         self.floor_accel_stack.extend_from_slice(&s.floor_a_g);
         self.floor_accel_rigid.extend_from_slice(&r.floor_a_g);
         self.drift_ratio_stack.extend_from_slice(&s.drift_ratio);
         self.drift_ratio_rigid.extend_from_slice(&r.drift_ratio);
+        self.storey_shear_stack.extend_from_slice(&s.storey_shear);
+        self.storey_shear_rigid.extend_from_slice(&r.storey_shear);
         if frame_of(s) {
             self.base_shear_stack.push(s.base_shear);
             self.base_shear_rigid.push(r.base_shear);
+            self.overturning_stack.push(s.overturning);
+            self.overturning_rigid.push(r.overturning);
+            // One storey's integrator gives no share (NaN, as its base shear).
+            let one_storey = r.base_shear.is_nan();
+            self.stuck_share_stack.push(if held && !one_storey {
+                1.0
+            } else {
+                s.stuck_share
+            });
         }
     }
 }
@@ -265,13 +307,13 @@ pub fn run_unit(
         out.single_rule.push(u8::from(single_holds));
         out.skip_rule.push(rule as u8);
         // The stack's profiles come from the same system as its other peaks.
-        let profile = match (rule, &resp) {
-            (_, Some(s)) => s,
-            (SkipRule::NoSlip, None) => r,
-            (_, None) if single_holds => r,
-            (_, None) => &single[&skey],
+        let (profile, held) = match (rule, &resp) {
+            (_, Some(s)) => (s, false),
+            (SkipRule::NoSlip, None) => (r, true),
+            (_, None) if single_holds => (r, true),
+            (_, None) => (&single[&skey], false),
         };
-        out.push_profiles(profile, r);
+        out.push_profiles(profile, r, held);
         match (rule, &resp) {
             (_, Some(s)) => {
                 out.u_stack.push(s.u_m);

@@ -14,6 +14,7 @@
 
 use crate::fit::{BuildingFeatures, Sample, features};
 use crate::grid::Grid;
+use crate::study::attached::FractionFlag;
 use crate::study::building::Frame;
 
 /// The fit's samples: every case of `grid` (flat over `[T_p][case]`) with a finite `T_new`,
@@ -80,9 +81,24 @@ pub enum TnewFlag {
 }
 
 /// Meaning of the `T_new_flag` codes, for the file attribute.
-pub const TNEW_FLAG_CODES: &str = "0 one crossing of the mean displacement spectrum; 1 several \
-     crossings, the one nearest T_rigid (log period) taken; 2 the mean displacement lies outside \
-     the spectrum's range (T_new NaN); 3 nothing slid, T_new = T_rigid";
+pub const TNEW_FLAG_CODES: &str = "0 one crossing (one storey: of the mean displacement \
+     spectrum; a building of several storeys: of the mean peak roof displacement of the building \
+     carrying a fraction of the stack attached); 1 several crossings, the one nearest T_rigid (log \
+     period) taken (a building: the fraction nearest the stuck mass share); 2 the mean \
+     displacement lies outside the spectrum's (the attached family's) range, T_new NaN; 3 \
+     nothing slid, T_new = T_rigid";
+
+/// A building's `T_new` from the first-mode period `t1_s` of the building carrying the attached
+/// fraction of its roof's mean peak displacement, found as `how`
+/// ([`crate::study::attached`]): NaN when no fraction gives it.
+pub fn of_attached(t1_s: f64, how: FractionFlag) -> (f64, TnewFlag) {
+    match how {
+        FractionFlag::Root => (t1_s, TnewFlag::Unique),
+        FractionFlag::Several | FractionFlag::Near => (t1_s, TnewFlag::Several),
+        FractionFlag::Below | FractionFlag::Above => (f64::NAN, TnewFlag::OutsideRange),
+        FractionFlag::NoSlide => (t1_s, TnewFlag::NoSlip),
+    }
+}
 
 /// Where a case's `T_new` lies against its physical band `[T_p, T_rigid]` (paper Section 10:
 /// generally `T_p < T_new < T_rigid`; docs/model.md, "Derived quantities").

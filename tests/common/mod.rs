@@ -293,3 +293,18 @@ impl Held {
         std::fs::remove_file(&self.file).unwrap();
     }
 }
+
+/// Runs the `slidestack` binary with `args` on `threads` threads.
+pub fn slidestack(args: &[&str], threads: &str) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .args(args)
+        .env("RAYON_NUM_THREADS", threads)
+        .output()
+        .unwrap()
+}
+
+/// `o`, having checked that its process succeeded (its stderr otherwise).
+pub fn ok(o: std::process::Output) -> std::process::Output {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}

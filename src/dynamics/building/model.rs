@@ -265,8 +265,8 @@ impl Building {
                 expected: n,
             });
         }
-        if let Some((index, &value)) = (spec.storey_heights_m.iter().enumerate())
-            .find(|(_, h)| !(h.is_finite() && **h > 0.0))
+        if let Some((index, &value)) =
+            (spec.storey_heights_m.iter().enumerate()).find(|(_, h)| !(h.is_finite() && **h > 0.0))
         {
             return Err(BuildingError::Height { index, value });
         }

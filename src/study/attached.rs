@@ -1,0 +1,786 @@
+//! Attached fractions (docs/model.md, "The attached fraction"): the fraction `f` of a case's
+//! stack which, rigidly attached to its floor with the rest of its mass absent from the
+//! dynamics, gives the same mean peak over a zone's motions as the sliding stack, for one peak
+//! quantity at a time. Applied to the base shear it is the effective live-load fraction `λ`
+//! (the paper's references \[12\] and \[14\]: the portion of the live load a code counts as
+//! seismic weight); to each storey's shear and to the overturning moment at the base, the same
+//! question for what a code user checks above the base; to the roof displacement, the fraction
+//! whose first-mode period is a building's `T_new` (`pipeline::tnew`).
+//!
+//! **The family.** `B(f)` is the building carrying `f` of every stack rigidly attached
+//! ([`crate::dynamics::building::Building::with_stacks_attached_fraction`]: the same `K` and the
+//! same damping matrix `C` of the study's basis). `B(1)` is the rigid system, bit for bit
+//! (`1·m = m`); `B(0)` is the bare building with the loaded `C`, which is exactly what a
+//! frictionless stack leaves: so both limits are exact by construction under both damping
+//! bases, a stack that never slides giving `f = 1` and a frictionless one `f → 0`. Below 0 the
+//! family takes mass off the loaded floors (a stack that lowers a peak below the bare building's
+//! does so as much as removing `|f|` of its mass would), down to [`lowest_fraction`]: half the
+//! floor's mass kept, at most the whole stack removed.
+//!
+//! **Which fraction.** A mean peak is not monotone in `f` (attaching mass raises the inertia but
+//! lengthens the periods), so several fractions may give it; and where it is stationary in `f`
+//! a root can vanish under a change of the target far below what the motions resolve (a nearly
+//! frictionless stack lowers a mean peak by 1e-5 of it; at a minimum of the family's no
+//! fraction near 0 lowers it that much). So a fraction *matches* when its mean peak lies within
+//! [`MATCH_TOL`] of the target, and of the matching fractions the one nearest the case's *stuck
+//! mass share* `s̄` is taken (the time average of the stack's mass moving with its floor,
+//! [`crate::dynamics::building::BuildingResponse::stuck_mass_share`], averaged over the
+//! motions): the fraction of the stack that, in the simulation itself, moved as an attached
+//! load. It is exactly 1 for a stack that never slides and near 0 for a frictionless one, so
+//! the rule keeps both limits. The family is scanned at `f = k/10` ([`SCAN_STEP`]); the
+//! matching stretches' ends are roots of `value = target ± tolerance`, found by Brent's method
+//! (argmin's `BrentRoot`) to [`FRACTION_TOL`]. With nothing matching on `[lowest, 1]` the scan
+//! is extended above 1 up to [`MAX_FRACTION`]; with nothing there either the flag says on which
+//! side the target lies and the scan point nearest it is taken.
+
+use super::building::Frame;
+use super::physics::{CaseError, Physics, SystemKind};
+use crate::case::Case;
+use crate::dynamics::building::{Building, BuildingResponse, simulate_building};
+use crate::dynamics::{ExactOptions, G, Ground};
+use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
+use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
+use argmin::solver::brent::BrentRoot;
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+
+/// A root's tolerance in `f` (absolute): far below any physical meaning, well above the
+/// round-off of a mean peak.
+pub const FRACTION_TOL: f64 = 1e-9;
+
+/// Steps of the scan per unit of `f`: the scan's fractions are `k/10`.
+pub const SCAN_STEPS_PER_UNIT: i64 = 10;
+
+/// Step of the scan that brackets the roots.
+pub const SCAN_STEP: f64 = 1.0 / SCAN_STEPS_PER_UNIT as f64;
+
+/// A fraction matches a mean peak when its value lies within this of it (relative): far below
+/// what a zone's few motions resolve (their means differ by percents), far above the round-off
+/// of a mean peak. Where a mean peak is flat in `f` (a stationary stretch), every fraction of
+/// the stretch matches, and the stuck mass share decides among them.
+pub const MATCH_TOL: f64 = 1e-4;
+
+/// Largest fraction the scan is extended to when no root lies on `[lowest, 1]`.
+pub const MAX_FRACTION: f64 = 2.0;
+
+/// How a fraction was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum FractionFlag {
+    /// One crossing on the scan: its root.
+    Root = 0,
+    /// The target below every scanned value: the scan point of the smallest.
+    Below = 1,
+    /// The target above every scanned value: the scan point of the largest.
+    Above = 2,
+    /// Nothing slid under any motion (the value is computed all the same: 1).
+    NoSlide = 3,
+    /// Several crossings: the matching fraction nearest the stuck mass share.
+    Several = 4,
+    /// No crossing, but a stretch where the value stays within [`MATCH_TOL`] of the target (a
+    /// stationary point): the matching fraction nearest the stuck mass share.
+    Near = 5,
+}
+
+/// `(code, word)` of each [`FractionFlag`], for the CF `flag_values`/`flag_meanings`.
+pub const FRACTION_FLAGS: [(u8, &str); 6] = [
+    (FractionFlag::Root as u8, "root"),
+    (FractionFlag::Below as u8, "below_range_clamped"),
+    (FractionFlag::Above as u8, "above_range_clamped"),
+    (FractionFlag::NoSlide as u8, "no_slide"),
+    (
+        FractionFlag::Several as u8,
+        "several_roots_nearest_stuck_share",
+    ),
+    (FractionFlag::Near as u8, "stationary_within_tolerance"),
+];
+
+/// Mean peaks over a zone's motions (each summed in motion order, then divided), each over the
+/// bare building: the roof's displacement (m), every storey's shear over the bare building's
+/// weight (storey 1 the base), the overturning moment at the base over that weight times the
+/// height.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Means {
+    pub roof_m: f64,
+    pub storey_shear: Vec<f64>,
+    pub overturning: f64,
+}
+
+/// One of the mean peaks of [`Means`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quantity {
+    Roof,
+    /// Storey `i`'s shear, 0 the base.
+    StoreyShear(usize),
+    Overturning,
+}
+
+impl Means {
+    pub fn get(&self, q: Quantity) -> f64 {
+        match q {
+            Quantity::Roof => self.roof_m,
+            Quantity::StoreyShear(i) => self.storey_shear[i],
+            Quantity::Overturning => self.overturning,
+        }
+    }
+
+    /// The means of the responses (one per motion, in order) of `frame`.
+    fn of(responses: &[BuildingResponse], frame: &Frame) -> Self {
+        let m = responses.len() as f64;
+        let n = frame.storeys();
+        let mean =
+            |get: &dyn Fn(&BuildingResponse) -> f64| responses.iter().map(get).sum::<f64>() / m;
+        Self {
+            roof_m: mean(&|r| r.floor_peak_displacement_m[n - 1]),
+            storey_shear: (0..n)
+                .map(|i| mean(&|r| frame.base_shear_ratio(r.storey_peak_shear_n[i])))
+                .collect(),
+            overturning: mean(&|r| frame.overturning_ratio(r.peak_overturning_n_m)),
+        }
+    }
+}
+
+/// The lowest fraction of the family for `case`: every loaded floor keeps at least half its
+/// mass, and at most the whole stack is removed.
+pub fn lowest_fraction(case: &Case) -> f64 {
+    (-0.5 / case.alpha_total()).max(-1.0)
+}
+
+/// The scan's fractions for `case`: `k/10` from the first at or above [`lowest_fraction`] to 1.
+pub fn scan_fractions(case: &Case) -> Vec<f64> {
+    let per = SCAN_STEPS_PER_UNIT;
+    let lo = (lowest_fraction(case) * per as f64).ceil() as i64;
+    (lo..=per).map(|k| k as f64 / per as f64).collect()
+}
+
+/// The scan's next fraction after `f` (one of its fractions).
+fn next_fraction(f: f64) -> f64 {
+    let per = SCAN_STEPS_PER_UNIT as f64;
+    ((f * per).round() + 1.0) / per
+}
+
+fn options() -> ExactOptions {
+    ExactOptions {
+        energy_balance: false,
+        ..ExactOptions::default()
+    }
+}
+
+fn run_all(
+    b: &Building,
+    grounds: &[Ground],
+    fail: impl Fn(crate::dynamics::SimError) -> CaseError,
+) -> Result<Vec<BuildingResponse>, CaseError> {
+    grounds
+        .iter()
+        .map(|g| simulate_building(b, g, &options()).map_err(&fail))
+        .collect()
+}
+
+/// [`Means`] of `B(fraction)` for `case` in `frame` ([`Physics::building`]'s single block, its
+/// stacks then attached by `fraction`), by the building's integrator.
+pub fn family_means(
+    physics: &Physics,
+    case: &Case,
+    frame: &Frame,
+    fraction: f64,
+    grounds: &[Ground],
+) -> Result<Means, CaseError> {
+    let in_building = |e| CaseError::InBuilding {
+        frame: frame.to_string(),
+        source: Box::new(e),
+    };
+    let b = physics
+        .building(SystemKind::SingleBlock, case, frame)
+        .map(|b| b.with_stacks_attached_fraction(fraction))
+        .map_err(|source| {
+            in_building(CaseError::BuildingModel {
+                case: case.clone(),
+                kind: SystemKind::Rigid,
+                source: Box::new(source),
+            })
+        })?;
+    let responses = run_all(&b, grounds, |source| {
+        in_building(CaseError::Simulation {
+            case: case.clone(),
+            kind: SystemKind::Rigid,
+            source,
+        })
+    })?;
+    Ok(Means::of(&responses, frame))
+}
+
+/// [`Means`] of system `kind` of `case` in `frame` and its stuck mass share's mean over the
+/// motions (NaN for the rigid system), by the building's integrator even on one storey (whose
+/// sweep runs the one-storey integrator, which gives neither the shears nor the share).
+pub fn system_means(
+    physics: &Physics,
+    kind: SystemKind,
+    case: &Case,
+    frame: &Frame,
+    grounds: &[Ground],
+) -> Result<(Means, f64), CaseError> {
+    let in_building = |e| CaseError::InBuilding {
+        frame: frame.to_string(),
+        source: Box::new(e),
+    };
+    let b = physics.building(kind, case, frame).map_err(|source| {
+        in_building(CaseError::BuildingModel {
+            case: case.clone(),
+            kind,
+            source: Box::new(source),
+        })
+    })?;
+    let responses = run_all(&b, grounds, |source| {
+        in_building(CaseError::Simulation {
+            case: case.clone(),
+            kind,
+            source,
+        })
+    })?;
+    let share = responses.iter().map(|r| r.stuck_mass_share).sum::<f64>() / grounds.len() as f64;
+    Ok((Means::of(&responses, frame), share))
+}
+
+/// The peak absolute acceleration, m/s², of the floors carrying `case`'s stack in the rigid
+/// system, the largest over `grounds`: what the sweep's no-slip rule compares with `μ_s·g`.
+pub fn holds_everywhere(
+    physics: &Physics,
+    case: &Case,
+    frame: &Frame,
+    grounds: &[Ground],
+) -> Result<bool, CaseError> {
+    let b = physics
+        .building(SystemKind::Rigid, case, frame)
+        .map_err(|source| CaseError::BuildingModel {
+            case: case.clone(),
+            kind: SystemKind::Rigid,
+            source: Box::new(source),
+        })?;
+    let min_mu_s = (case.mu.iter())
+        .map(|m| m * physics.mu_static_ratio)
+        .fold(f64::INFINITY, f64::min);
+    for g in grounds {
+        let r = simulate_building(&b, g, &options()).map_err(|source| CaseError::Simulation {
+            case: case.clone(),
+            kind: SystemKind::Rigid,
+            source,
+        })?;
+        let a = (frame.floors().iter())
+            .map(|&f| r.floor_peak_abs_accel_mps2[f - 1])
+            .fold(0.0, f64::max);
+        if a >= min_mu_s * G * (1.0 - 1e-9) {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
+/// The fraction whose value matches `target` (module doc): `scan` holds `(f, value)` at the
+/// scan's fractions (ascending), `prior` is the stuck mass share, `value` gives the value at any
+/// other fraction (errors returned as they are). The fractions that match are those whose value
+/// lies within [`MATCH_TOL`] of the target; of them the one nearest the prior is taken: the prior
+/// itself when it matches, else the nearest end of a matching stretch (a root of `value = target
+/// ± tolerance`, found by Brent's method).
+pub fn solve<E>(
+    target: f64,
+    prior: f64,
+    scan: &[(f64, f64)],
+    mut value: impl FnMut(f64) -> Result<f64, E>,
+) -> Result<(f64, FractionFlag), E> {
+    let tol = MATCH_TOL * target.abs();
+    let (lo, hi) = (scan[0].0, scan[scan.len() - 1].0);
+    let prior = if prior.is_finite() {
+        prior.clamp(lo, hi)
+    } else {
+        hi
+    };
+    let known = scan.iter().find(|p| p.0 == prior).map(|p| p.1);
+    let at_prior = match known {
+        Some(v) => v,
+        None => value(prior)?,
+    };
+    let mut points = scan.to_vec();
+    let mut exact = crossings(target, &points);
+    let mut levels = [target - tol, target + tol].map(|l| (l, crossings(l, &points)));
+    // Above 1 only when nothing matches below: the scan grows a step at a time.
+    while exact.is_empty() && levels.iter().all(|(_, c)| c.is_empty()) {
+        let next = next_fraction(points[points.len() - 1].0);
+        if next > MAX_FRACTION + 1e-12 {
+            break;
+        }
+        points.push((next, value(next)?));
+        let from = points.len() - 2;
+        exact = crossings_from(target, &points, from);
+        for (l, c) in &mut levels {
+            *c = crossings_from(*l, &points, from);
+        }
+    }
+    let flag = match exact.len() {
+        0 => FractionFlag::Near,
+        1 => FractionFlag::Root,
+        _ => FractionFlag::Several,
+    };
+    if (at_prior - target).abs() <= tol {
+        return Ok((prior, flag));
+    }
+    if levels.iter().all(|(_, c)| c.is_empty()) {
+        let pick = |better: fn(f64, f64) -> bool| {
+            (points[..scan.len()].iter().copied())
+                .reduce(|a, b| if better(b.1, a.1) { b } else { a })
+                .expect("the scan has points")
+        };
+        // No interval meets the band: every value lies on one side of it.
+        return Ok(if target < points[0].1 {
+            (pick(|b, a| b < a).0, FractionFlag::Below)
+        } else {
+            (pick(|b, a| b > a).0, FractionFlag::Above)
+        });
+    }
+    // The intervals that may hold the matching fraction nearest the prior: within a scan step
+    // of the nearest one (a root lies anywhere in its interval).
+    let distance = |k: usize| {
+        let (a, b) = (points[k].0, points[k + 1].0);
+        if prior < a {
+            a - prior
+        } else if prior > b {
+            prior - b
+        } else {
+            0.0
+        }
+    };
+    let nearest = (levels.iter())
+        .flat_map(|(_, c)| c.iter().map(|&k| distance(k)))
+        .fold(f64::INFINITY, f64::min);
+    let mut best: Option<f64> = None;
+    for (level, c) in &levels {
+        for &k in c.iter().filter(|&&k| distance(k) <= nearest + SCAN_STEP) {
+            let root = root_in(*level, points[k], points[k + 1], &mut value)?;
+            let closer = best.is_none_or(|b| {
+                let (d, db) = ((root - prior).abs(), (b - prior).abs());
+                d < db || (d == db && root > b)
+            });
+            if closer {
+                best = Some(root);
+            }
+        }
+    }
+    Ok((best.expect("a level was crossed"), flag))
+}
+
+/// The scan intervals whose ends straddle `target` (a point on it counts once, in the interval
+/// it ends, or the first interval it starts).
+fn crossings(target: f64, points: &[(f64, f64)]) -> Vec<usize> {
+    crossings_from(target, points, 0)
+}
+
+fn crossings_from(target: f64, points: &[(f64, f64)], from: usize) -> Vec<usize> {
+    (from..points.len().saturating_sub(1))
+        .filter(|&k| {
+            let (a, b) = (points[k].1 - target, points[k + 1].1 - target);
+            a * b < 0.0 || b == 0.0 || (k == 0 && a == 0.0)
+        })
+        .collect()
+}
+
+/// The root of `value(f) = target` between the bracket's ends `(f, value)`.
+fn root_in<E>(
+    target: f64,
+    a: (f64, f64),
+    b: (f64, f64),
+    value: &mut impl FnMut(f64) -> Result<f64, E>,
+) -> Result<f64, E> {
+    if b.1 == target {
+        return Ok(b.0);
+    }
+    if a.1 == target {
+        return Ok(a.0);
+    }
+    let problem = Crossing {
+        target,
+        ends: [a, b],
+        value: RefCell::new(value),
+        error: RefCell::new(None),
+    };
+    let best = Executor::new(&problem, BrentRoot::new(a.0, b.0, FRACTION_TOL))
+        .configure(|s| s.max_iters(200))
+        .run()
+        .map(|r| r.state().get_best_param().copied());
+    if let Some(e) = problem.error.into_inner() {
+        return Err(e);
+    }
+    Ok(best
+        .expect("the ends bracket the root and every value is finite")
+        .expect("Brent keeps its best"))
+}
+
+/// `value(f) − target`, remembering the first error of `value`.
+struct Crossing<'v, F, E> {
+    target: f64,
+    /// The bracket's ends, `(f, value)`, already known.
+    ends: [(f64, f64); 2],
+    value: RefCell<&'v mut F>,
+    error: RefCell<Option<E>>,
+}
+
+impl<F: FnMut(f64) -> Result<f64, E>, E> CostFunction for &Crossing<'_, F, E> {
+    type Param = f64;
+    type Output = f64;
+
+    fn cost(&self, f: &f64) -> Result<f64, ArgminError> {
+        let known = self.ends.iter().find(|e| e.0 == *f);
+        let v = match known {
+            Some(&(_, v)) => Ok(v),
+            None => (self.value.borrow_mut())(*f),
+        };
+        match v {
+            Ok(v) => Ok(v - self.target),
+            Err(e) => {
+                self.error.borrow_mut().get_or_insert(e);
+                Err(ArgminError::msg("the mean peak could not be computed"))
+            }
+        }
+    }
+}
+
+/// [`family_means`] remembered by fraction, seeded with a scan: every quantity of a case is
+/// solved on one memo, so a fraction is simulated once.
+pub struct Memo<'a> {
+    known: BTreeMap<u64, Means>,
+    compute: Box<dyn FnMut(f64) -> Result<Means, CaseError> + 'a>,
+}
+
+impl<'a> Memo<'a> {
+    pub fn new(
+        scan: &[(f64, Means)],
+        compute: impl FnMut(f64) -> Result<Means, CaseError> + 'a,
+    ) -> Self {
+        Self {
+            known: scan.iter().map(|(f, m)| (f.to_bits(), m.clone())).collect(),
+            compute: Box::new(compute),
+        }
+    }
+
+    pub fn get(&mut self, fraction: f64) -> Result<&Means, CaseError> {
+        let key = fraction.to_bits();
+        if !self.known.contains_key(&key) {
+            let m = (self.compute)(fraction)?;
+            self.known.insert(key, m);
+        }
+        Ok(&self.known[&key])
+    }
+}
+
+/// The code-format fraction's ingredients for `case` in `frame` (docs/model.md, "The
+/// code-format fraction"): the stack's weight over the bare building's, `W_L/W`, and the first
+/// mode's period of `B(f)`.
+pub fn load_ratio(case: &Case, frame: &Frame) -> f64 {
+    let loaded: f64 = frame
+        .floors()
+        .iter()
+        .map(|&f| frame.floor_masses[f - 1])
+        .sum();
+    case.alpha_total() * loaded / frame.floor_masses.iter().sum::<f64>()
+}
+
+/// The mean over the motions of their 5 %-damped pseudo-spectral acceleration at `period_s`
+/// exactly (each summed in motion order, then divided), g.
+pub fn mean_psa_g(grounds: &[Ground], period_s: f64) -> Result<f64, SpectrumError> {
+    let mut sum = 0.0;
+    for g in grounds {
+        let s = response_spectrum(g.accel_mps2, g.dt_s, &[period_s], TARGET_DAMPING)?;
+        sum += s.psa_g()[0];
+    }
+    Ok(sum / grounds.len() as f64)
+}
+
+/// The code-format base shear of `B(f)` over the rigid system's, as a design code would estimate
+/// it from the zone's mean spectrum: `(W + f·W_L)·S̄a(T_1(f)) / ((W + W_L)·S̄a(T_1,rigid))`;
+/// exactly 1 at `f = 1`.
+pub fn code_shear_ratio(
+    case: &Case,
+    frame: &Frame,
+    grounds: &[Ground],
+    fraction: f64,
+    psa_rigid_g: f64,
+) -> Result<f64, SpectrumError> {
+    let r = load_ratio(case, frame);
+    let psa = mean_psa_g(grounds, frame.t1_attached_s(case, fraction))?;
+    Ok((1.0 + fraction * r) * psa / ((1.0 + r) * psa_rigid_g))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_matching_fraction_nearest_the_prior_clamps_and_ends() {
+        let scan = |f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
+            (0..=10)
+                .map(|k| (k as f64 / 10.0, f(k as f64 / 10.0)))
+                .collect()
+        };
+        // Within MATCH_TOL of the target: f² ≈ 0.49 ± 1.5e-4 gives f = 0.7 ± 1.1e-4.
+        let near = |l: f64, want: f64| (l - want).abs() < 2e-4;
+        // V = 1 + f²: the root of 1.49 is 0.7; from a prior below it, the band's lower end.
+        let sq = |l: f64| 1.0 + l * l;
+        let (l, flag) = solve(1.49, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        assert_eq!(flag, FractionFlag::Root);
+        assert!(near(l, 0.7) && l < 0.7, "{l}");
+        assert!((sq(l) / 1.49 - 1.0).abs() <= MATCH_TOL * (1.0 + 1e-9));
+        // A prior inside the band is taken itself.
+        let (l, _) = solve(1.49, 0.70001, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        assert_eq!(l, 0.70001);
+        // Below and above the range: the scan point of the smallest (largest) value.
+        assert_eq!(
+            solve(0.5, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap(),
+            (0.0, FractionFlag::Below)
+        );
+        // Above 1 the scan grows: 1 + f² = 3.25 at f = 1.5.
+        let (l, flag) = solve(3.25, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        assert_eq!(flag, FractionFlag::Root);
+        assert!(near(l, 1.5), "{l}");
+        assert_eq!(
+            solve(9.0, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap(),
+            (1.0, FractionFlag::Above)
+        );
+        // The end itself with a prior of 1 (a stack that never slid): exactly 1.
+        assert_eq!(
+            solve(2.0, 1.0, &scan(&sq), |_| Ok::<_, ()>(f64::NAN)).unwrap(),
+            (1.0, FractionFlag::Root)
+        );
+        // A stationary point: V = 1 + f² has its minimum 1 at 0; a target 1e-5 below it has no
+        // root, but f = 0 matches within the tolerance: the prior 0.001 is taken.
+        let (l, flag) = solve(1.0 - 1e-5, 0.001, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        assert_eq!((l, flag), (0.001, FractionFlag::Near));
+        // A hump: 1 + sin(πf) crosses 1.5 at 1/6 and 5/6; the one nearest the prior is taken.
+        let hump = |l: f64| 1.0 + (std::f64::consts::PI * l).sin();
+        for (prior, want) in [
+            (0.0, 1.0 / 6.0),
+            (0.3, 1.0 / 6.0),
+            (0.6, 5.0 / 6.0),
+            (1.0, 5.0 / 6.0),
+        ] {
+            let (l, flag) = solve(1.5, prior, &scan(&hump), |l| Ok::<_, ()>(hump(l))).unwrap();
+            assert_eq!(flag, FractionFlag::Several);
+            assert!(near(l, want), "prior {prior}: {l}");
+        }
+        // An error of the value comes back as it is.
+        assert_eq!(
+            solve(1.49, 0.55, &scan(&sq)[..5], |_| Err::<f64, _>(7)),
+            Err(7)
+        );
+    }
+
+    #[test]
+    fn the_scan_reaches_below_zero_keeping_half_the_floor() {
+        let case = |a: f64| Case {
+            period_s: 1.0,
+            alpha: vec![a],
+            mu: vec![0.2],
+        };
+        let s = scan_fractions(&case(0.25));
+        assert_eq!((s[0], s.len()), (-1.0, 21));
+        let s = scan_fractions(&case(2.0));
+        assert!((s[0] + 0.2).abs() < 1e-12 && s.len() == 13, "{s:?}");
+        assert!(s.iter().any(|&f| f == 0.0) && s[s.len() - 1] == 1.0);
+    }
+}
+
+/// What a case's attached fractions come from and what they are (docs/model.md, "The attached
+/// fraction").
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaseFractions {
+    /// Mean peaks with the sliding stack, with it rigidly attached (`f = 1`) and without its
+    /// mass (`f = 0`).
+    pub stack: Means,
+    pub rigid: Means,
+    pub bare: Means,
+    /// The stuck mass share's mean over the motions (the prior of the roots).
+    pub share: f64,
+    /// The fraction of the roof's mean peak displacement (a building's `T_new` is `T_1` of it).
+    pub roof: (f64, FractionFlag),
+    /// Each storey's shear's, storey 1 (the base: `λ`) first.
+    pub storey: Vec<(f64, FractionFlag)>,
+    /// The overturning moment's at the base.
+    pub overturning: (f64, FractionFlag),
+    /// The code-format fraction ([`code_shear_ratio`] equal to the base shear's
+    /// `V̄_stack/V̄_rigid`).
+    pub code: (f64, FractionFlag),
+}
+
+/// What the sweep stored of a case in a building of several storeys: its mean peaks with the
+/// sliding stack and with it attached, and its mean stuck mass share (one storey: `None`, its
+/// integrator gives neither the shears nor the share, and they are simulated here).
+pub type Swept = Option<(Means, Means, f64)>;
+
+/// Why a zone's fractions could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum AttachedError {
+    #[error(transparent)]
+    Case(#[from] CaseError),
+    #[error("the mean spectrum at T_1 = {period_s} s: {source}")]
+    Spectrum {
+        period_s: f64,
+        source: SpectrumError,
+    },
+    /// `keep_going` said stop.
+    #[error("stopped")]
+    Stopped,
+}
+
+/// The attached fractions of every case of a zone, flat over `[frame][case]` (`grid`'s cases in
+/// each of `frames`): `swept` per case, `slides` whether any interface slipped under any motion.
+/// The scans depend on the frame, `T_p` and `α` (through the damping matrix) but not on `μ`:
+/// each is made once for the first case of its key; frames that are one building
+/// ([`super::building::first_of_building`]) are computed once. Keys and cases run in
+/// parallel, each on its own, so the numbers do not depend on the threads. `keep_going` is
+/// asked before each case (Ctrl-C).
+pub fn zone_fractions(
+    physics: &Physics,
+    grid: &crate::grid::Grid,
+    frames: &[Frame],
+    grounds: &[Ground],
+    swept: &[Swept],
+    slides: &[bool],
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<CaseFractions>, AttachedError> {
+    use rayon::prelude::*;
+    let per_frame = grid.cases();
+    let cases = frames.len() * per_frame;
+    let first = super::building::first_of_building(frames);
+    let own: Vec<usize> = (0..cases)
+        .filter(|&c| first[c / per_frame] == c / per_frame)
+        .collect();
+    let case_of = |c: usize| grid.case(c % per_frame);
+    let key = |c: usize| {
+        let case = case_of(c);
+        (
+            c / per_frame,
+            case.period_s.to_bits(),
+            case.alpha_total().to_bits(),
+        )
+    };
+    // The stack's and the rigid system's means and the share of every own case: the sweep's,
+    // or on one storey simulated here (the rigid system once per key; the sweep's no-slip rule
+    // for the stack, whose argument holds whatever the integrator).
+    let mut firsts = BTreeMap::new();
+    for &c in &own {
+        firsts.entry(key(c)).or_insert(c);
+    }
+    let firsts: Vec<((usize, u64, u64), usize)> = firsts.into_iter().collect();
+    type Scan = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64);
+    let scans: BTreeMap<(usize, u64, u64), Scan> = firsts
+        .par_iter()
+        .map(|&(k, c)| -> Result<_, AttachedError> {
+            if !keep_going() {
+                return Err(AttachedError::Stopped);
+            }
+            let (case, frame) = (case_of(c), &frames[c / per_frame]);
+            let rigid = match &swept[c] {
+                Some((_, rigid, _)) => rigid.clone(),
+                None => system_means(physics, SystemKind::Rigid, &case, frame, grounds)?.0,
+            };
+            let mut scan = Vec::new();
+            for f in scan_fractions(&case) {
+                let m = if f == 1.0 {
+                    rigid.clone()
+                } else {
+                    family_means(physics, &case, frame, f, grounds)?
+                };
+                scan.push((f, m));
+            }
+            let t_rigid = frame.t1_attached_s(&case, 1.0);
+            let psa_rigid =
+                mean_psa_g(grounds, t_rigid).map_err(|source| AttachedError::Spectrum {
+                    period_s: t_rigid,
+                    source,
+                })?;
+            let code = (scan.iter().map(|(f, _)| *f))
+                .map(|f| {
+                    code_shear_ratio(&case, frame, grounds, f, psa_rigid)
+                        .map(|g| (f, g))
+                        .map_err(|source| AttachedError::Spectrum {
+                            period_s: frame.t1_attached_s(&case, f),
+                            source,
+                        })
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok((k, (scan, code, psa_rigid)))
+        })
+        .collect::<Result<_, _>>()?;
+    let computed: Vec<CaseFractions> = own
+        .par_iter()
+        .map(|&c| -> Result<CaseFractions, AttachedError> {
+            if !keep_going() {
+                return Err(AttachedError::Stopped);
+            }
+            let (case, frame) = (case_of(c), &frames[c / per_frame]);
+            let (scan, code_scan, psa_rigid) = &scans[&key(c)];
+            let rigid = scan[scan.len() - 1].1.clone();
+            let bare = (scan.iter().find(|(f, _)| *f == 0.0))
+                .expect("the scan holds 0")
+                .1
+                .clone();
+            let (stack, share) = match &swept[c] {
+                Some((stack, _, share)) => (stack.clone(), *share),
+                None if holds_everywhere(physics, &case, frame, grounds)? => (rigid.clone(), 1.0),
+                None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
+            };
+            let mut memo = Memo::new(scan, |f| family_means(physics, &case, frame, f, grounds));
+            let mut solve_for = |q: Quantity| -> Result<(f64, FractionFlag), CaseError> {
+                let points: Vec<(f64, f64)> = scan.iter().map(|(f, m)| (*f, m.get(q))).collect();
+                let (f, flag) = solve(stack.get(q), share, &points, |f| {
+                    memo.get(f).map(|m| m.get(q))
+                })?;
+                Ok((
+                    f,
+                    if slides[c] {
+                        flag
+                    } else {
+                        FractionFlag::NoSlide
+                    },
+                ))
+            };
+            let roof = solve_for(Quantity::Roof)?;
+            let storey = (0..frame.storeys())
+                .map(|i| solve_for(Quantity::StoreyShear(i)))
+                .collect::<Result<Vec<_>, _>>()?;
+            let overturning = solve_for(Quantity::Overturning)?;
+            let target = stack.storey_shear[0] / rigid.storey_shear[0];
+            let mut spectrum_error = None;
+            let code = solve(target, share, code_scan, |f| {
+                code_shear_ratio(&case, frame, grounds, f, *psa_rigid).map_err(|source| {
+                    spectrum_error = Some(frame.t1_attached_s(&case, f));
+                    source
+                })
+            })
+            .map_err(|source| AttachedError::Spectrum {
+                period_s: spectrum_error.unwrap_or(f64::NAN),
+                source,
+            })?;
+            let code = (
+                code.0,
+                if slides[c] {
+                    code.1
+                } else {
+                    FractionFlag::NoSlide
+                },
+            );
+            Ok(CaseFractions {
+                stack,
+                rigid,
+                bare,
+                share,
+                roof,
+                storey,
+                overturning,
+                code,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let at: BTreeMap<usize, usize> = own.iter().enumerate().map(|(i, &c)| (c, i)).collect();
+    Ok((0..cases)
+        .map(|c| computed[at[&(first[c / per_frame] * per_frame + c % per_frame)]].clone())
+        .collect())
+}
