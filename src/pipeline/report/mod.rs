@@ -63,7 +63,7 @@ use text::{fixed, joined, num, nums};
 use thiserror::Error;
 
 /// Changes when the report's contents change.
-const REPORT_VERSION: &str = "report-5";
+const REPORT_VERSION: &str = "report-6";
 
 #[derive(Debug, Error)]
 pub enum ReportError {
