@@ -2,8 +2,10 @@
 //!
 //! For a zone, a structure period `T_p` and a stack (`α_i`, `μ_i`): `T_rigid = T_p·sqrt(1+α)`;
 //! `T_new` by multilinear interpolation in the study's stored grid (`tnew.h5`; outside the grid
-//! only with `extrapolate`, and then from the fit); `T_new` from the zone's recommended fitted
-//! form (`fit.yaml`); `T_new` from the paper's Eqs. 16–17 (zones III and V, two blocks); and
+//! only with `extrapolate`, and then from the fit, on the box beyond the grid where the fit stage
+//! checked it, [`ZoneDesign::extrapolation_margin`]); `T_new` from the zone's recommended fitted
+//! form (`fit.yaml`); `T_new` from the paper's Eqs. 16–17 (zones III and V, two blocks; a fitted
+//! or paper `T_new` that is no period is left out with a note); and
 //! the zone's design spectral acceleration (its target spectrum, `Z·Sa/g` for IS 1893) at `T_p`
 //! and at `T_new`, from the target spectrum stored in `motions.h5` (never from a table file,
 //! which may have changed since). Reads only verified files of the study directory, and only a
@@ -17,8 +19,10 @@
 //! counts or floors nothing is interpolated: a frame the study does not hold is refused.
 
 use crate::case::Case;
+use crate::fit::extrapolation::{LOWER_T_P, UPPER_T_RIGID};
 use crate::fit::{BuildingFeatures, Fitted, PaperEquation, Sample, features};
 use crate::grid::{BuildingAxes, Grid, OutsideGrid, StackFloor};
+use crate::limits::STRUCTURE_PERIOD_RANGE_S;
 use crate::spectrum::target::TargetSpectrum;
 use crate::store::StoreError;
 use crate::store::fit::{FitReport, FormFit, FrameSpec, ZoneFit, read_fit};
@@ -47,8 +51,38 @@ pub enum DesignError {
     },
     #[error("{what} = {value} must be finite and > 0")]
     Value { what: String, value: f64 },
+    /// A period no structure `simulate` runs has ([`STRUCTURE_PERIOD_RANGE_S`]).
+    #[error(
+        "{what} = {value:?} must be within {} … {} s, the periods of a structure `simulate` runs",
+        STRUCTURE_PERIOD_RANGE_S.0,
+        STRUCTURE_PERIOD_RANGE_S.1
+    )]
+    Period { what: String, value: f64 },
     #[error("{0}; with `extrapolate` the fitted form answers there")]
     Outside(OutsideGrid),
+    /// Outside the grid with `extrapolate`, where the fitted form was not checked
+    /// ([`ZoneDesign::extrapolation_margin`]).
+    #[error(
+        "{dim} = {value:?} lies outside {} … {}, the study's grid ({} … {}) and {:.0} % beyond, \
+         the only range where the fitted form was checked to stay a period of the structure \
+         (finite, T_new within {LOWER_T_P}·T_p … {UPPER_T_RIGID}·T_rigid): nothing answers there",
+        shown(*lo), shown(*hi), shown(*grid_lo), shown(*grid_hi), 100.0 * margin
+    )]
+    BeyondFit {
+        dim: String,
+        value: f64,
+        lo: f64,
+        hi: f64,
+        grid_lo: f64,
+        grid_hi: f64,
+        margin: f64,
+    },
+    /// Outside the grid with `extrapolate`, and no fitted form passed its check beyond the grid.
+    #[error(
+        "{0}; no fitted form was found to stay a period of the structure beyond the grid \
+         (fit.yaml's box check), so nothing answers there"
+    )]
+    Unchecked(OutsideGrid),
     #[error("{}: belongs to another tnew.h5 than the study's: rerun `slidestack fit`", file.display())]
     Mismatch { file: PathBuf },
     /// `motions.h5` is not the one `tnew.h5` was made from (or `tnew.h5` does not say which).
@@ -164,6 +198,11 @@ pub struct ZoneDesign {
     /// A building study's code-format `λ_code` per case of the frame (grid's flat order).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lambda_code: Option<Vec<f64>>,
+    /// How far beyond the grid the fitted form answers (`extrapolate`): the margin, a fraction
+    /// of each axis's extreme values, of the box on which the recommended form was checked to
+    /// stay finite and inside `[½·T_p, 1.5·T_rigid]` (`fit.yaml`'s `box_check`). `None` when
+    /// it failed that check or there is none: then nothing answers outside the grid.
+    pub extrapolation_margin: Option<f64>,
 }
 
 impl ZoneDesign {
@@ -176,16 +215,20 @@ impl ZoneDesign {
         fit: Option<&ZoneFit>,
     ) -> Self {
         let paper = PaperEquation::of_zone(zone).filter(|_| grid.blocks() == 2);
+        let recommended = fit.and_then(|z| z.recommended_fit());
         Self {
             zone: zone.to_string(),
             target,
-            fit: fit.and_then(|z| z.recommended_fit()).map(FormFit::fitted),
+            fit: recommended.map(FormFit::fitted),
             grid,
             t_new_s,
             paper,
             building: None,
             lambda: None,
             lambda_code: None,
+            extrapolation_margin: (recommended.map(|f| &f.box_check))
+                .filter(|b| b.passed)
+                .map(|b| b.margin),
         }
     }
 
@@ -239,9 +282,16 @@ fn positive(what: String, value: f64) -> Result<(), DesignError> {
     }
 }
 
-/// The question's numbers are finite and positive.
+/// The question's numbers are finite and positive, the period one a structure may have.
 fn check_values(q: &Query) -> Result<(), DesignError> {
     positive("`period_s`".into(), q.period_s)?;
+    let (lo, hi) = STRUCTURE_PERIOD_RANGE_S;
+    if !(lo..=hi).contains(&q.period_s) {
+        return Err(DesignError::Period {
+            what: "`period_s`".into(),
+            value: q.period_s,
+        });
+    }
     for (i, &a) in q.alpha.iter().enumerate() {
         positive(format!("alpha_{}", i + 1), a)?;
     }
@@ -421,6 +471,57 @@ fn check_counts(q: &Query, blocks: usize) -> Result<(), DesignError> {
     Ok(())
 }
 
+/// `v` rounded to 7 significant digits, as a message shows a bound computed from the grid.
+fn shown(v: f64) -> String {
+    format!("{:?}", format!("{v:.6e}").parse::<f64>().unwrap_or(v))
+}
+
+/// `Err` unless the fitted form may answer at `point` (`[T_p, α…, μ…]`, outside the grid by
+/// `outside`): inside the box beyond the grid on which it was checked
+/// ([`ZoneDesign::extrapolation_margin`], the box of the fit stage's check, `fit::DesignBox`).
+fn check_extrapolation(
+    z: &ZoneDesign,
+    point: &[f64],
+    outside: OutsideGrid,
+) -> Result<(), DesignError> {
+    let Some(margin) = z.extrapolation_margin else {
+        return Err(DesignError::Unchecked(outside));
+    };
+    let g = &z.grid;
+    let axes = std::iter::once(&g.periods_s).chain(&g.alpha).chain(&g.mu);
+    for ((axis, &value), dim) in axes.zip(point).zip(g.dim_names()) {
+        let grid_lo = axis.iter().copied().fold(f64::INFINITY, f64::min);
+        let grid_hi = axis.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let (lo, hi) = ((1.0 - margin) * grid_lo, (1.0 + margin) * grid_hi);
+        if !(lo..=hi).contains(&value) {
+            return Err(DesignError::BeyondFit {
+                dim,
+                value,
+                lo,
+                hi,
+                grid_lo,
+                grid_hi,
+                margin,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `t`, a `T_new` (s) from `what`, if it is a period (finite and > 0); else `None`, with a
+/// note saying so.
+fn a_period(t: Option<f64>, what: &str, notes: &mut Vec<String>) -> Option<f64> {
+    match t {
+        Some(t) if !(t.is_finite() && t > 0.0) => {
+            notes.push(format!(
+                "{what} gives T_new = {t:?} s here, which is no period: left out"
+            ));
+            None
+        }
+        t => t,
+    }
+}
+
 /// Answers `q` (whose zone is `z`'s) from `z`, files aside.
 pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
     check_values(q)?;
@@ -459,6 +560,7 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
             None
         }
         Err(outside) if q.extrapolate => {
+            check_extrapolation(z, &point, outside.clone())?;
             notes.push(format!("{outside}: T_new from the fitted form"));
             None
         }
@@ -483,6 +585,7 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
             t_new_s: f64::NAN,
         })
     });
+    let t_new_fit_s = a_period(t_new_fit_s, "the fitted form", &mut notes);
     let (lambda_grid, lambda_fit) = match &z.lambda {
         Some((values, fitted)) => (
             z.grid.interpolate(values, &point).ok().flatten(),
@@ -498,7 +601,11 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
     };
     let lambda_code_grid = (z.lambda_code.as_ref())
         .and_then(|values| z.grid.interpolate(values, &point).ok().flatten());
-    let t_new_paper_s = z.paper.and_then(|p| p.evaluate(&x));
+    let t_new_paper_s = a_period(
+        z.paper.and_then(|p| p.evaluate(&x)),
+        "the paper's equation",
+        &mut notes,
+    );
     let target = &z.target;
     let sa = |t: Option<f64>| t.filter(|t| t.is_finite()).map(|t| target.sa_g(t));
     Ok(Answer {
@@ -526,4 +633,121 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
         lambda_code_grid,
         notes,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::paper_equation;
+
+    /// Zone V on a grid of `periods_s`, every `T_new` 1 s, no fit unless `margin` (a fit that
+    /// passed its box check on that margin: the paper form with every parameter 0, whose
+    /// `T_new` is 0 everywhere).
+    fn zone_v(periods_s: Vec<f64>, margin: Option<f64>) -> ZoneDesign {
+        let grid = Grid {
+            periods_s,
+            alpha: vec![vec![0.5, 1.0], vec![0.5, 1.0]],
+            mu: vec![vec![0.05, 0.3], vec![0.05, 0.1]],
+        };
+        let mut z = ZoneDesign::new(
+            "V",
+            "is1893:zone=V,soil=I".parse().unwrap(),
+            grid.clone(),
+            vec![1.0; grid.cases()],
+            None,
+        );
+        z.extrapolation_margin = margin;
+        z.fit = margin.map(|_| Fitted {
+            form: crate::fit::Form::Paper,
+            params: vec![0.0; 12],
+        });
+        z
+    }
+
+    fn query(period_s: f64, alpha: [f64; 2], extrapolate: bool) -> Query {
+        Query {
+            zone: "V".into(),
+            period_s,
+            alpha: alpha.to_vec(),
+            mu: vec![0.05, 0.05],
+            extrapolate,
+            building: None,
+        }
+    }
+
+    #[test]
+    fn a_paper_or_fitted_t_new_that_is_no_period_is_left_out_with_a_note() {
+        // Eq. 17 at T_p = 0.01 s, α 1/1, μ 0.05/0.05 is −0.04 s; the fit here gives 0 s.
+        let z = zone_v(vec![0.01, 0.5], Some(0.25));
+        let a = answer(&z, &query(0.01, [1.0, 1.0], false)).unwrap();
+        let paper = paper_equation("V", &[0.01, 0.05, 0.05, 1.0, 1.0]).unwrap();
+        assert!(paper < 0.0, "{paper}");
+        assert_eq!((a.t_new_paper_s, a.sa_new_paper_g), (None, None));
+        assert_eq!((a.t_new_fit_s, a.sa_new_fit_g), (None, None));
+        assert_eq!(a.t_new_grid_s, Some(1.0));
+        assert_eq!(
+            a.notes,
+            [
+                "the fitted form gives T_new = 0.0 s here, which is no period: left out"
+                    .to_string(),
+                format!(
+                    "the paper's equation gives T_new = {paper:?} s here, which is no period: left out"
+                ),
+            ]
+        );
+    }
+
+    #[test]
+    fn extrapolation_answers_only_where_the_fit_was_checked() {
+        // Grid T_p 0.3 … 2 s: checked 25 % beyond, 0.225 … 2.5 s.
+        let z = zone_v(vec![0.3, 2.0], Some(0.25));
+        assert!(answer(&z, &query(2.5, [1.0, 1.0], true)).is_ok());
+        let e = answer(&z, &query(2.6, [1.0, 1.0], true)).unwrap_err();
+        assert_eq!(
+            crate::fault::classify(&e).kind,
+            crate::fault::FaultKind::BadInput
+        );
+        assert_eq!(
+            e.to_string(),
+            "T_p = 2.6 lies outside 0.225 … 2.5, the study's grid (0.3 … 2.0) and 25 % beyond, \
+             the only range where the fitted form was checked to stay a period of the structure \
+             (finite, T_new within 0.5·T_p … 1.5·T_rigid): nothing answers there"
+        );
+        let e = answer(&z, &query(1.0, [1.0, 1.3], true)).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("alpha_2 = 1.3 lies outside 0.375 … 1.25"),
+            "{e}"
+        );
+        // Without a checked fit, nothing answers outside the grid.
+        let e = answer(&zone_v(vec![0.3, 2.0], None), &query(2.4, [1.0, 1.0], true)).unwrap_err();
+        assert!(
+            e.to_string().starts_with(
+                "T_p = 2.4 lies outside the grid's 0.3 … 2; no fitted form was found to stay a \
+                 period"
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_period_no_structure_has_is_refused_before_the_grid() {
+        let z = zone_v(vec![0.3, 2.0], Some(0.25));
+        for (period, shown) in [(1e-300, "1e-300"), (1e9, "1000000000.0"), (2e4, "20000.0")] {
+            for extrapolate in [false, true] {
+                let e = answer(&z, &query(period, [1.0, 1.0], extrapolate)).unwrap_err();
+                assert_eq!(
+                    crate::fault::classify(&e).kind,
+                    crate::fault::FaultKind::BadInput
+                );
+                assert_eq!(
+                    e.to_string(),
+                    format!(
+                        "`period_s` = {shown} must be within 0.000001 … 10000 s, the periods of \
+                         a structure `simulate` runs"
+                    )
+                );
+            }
+        }
+    }
 }

@@ -19,6 +19,7 @@ use crate::spectrum::PeriodsError;
 use crate::spectrum::batch::BatchError;
 use crate::spectrum::ductility::DuctilityError;
 use crate::store::StoreError;
+use crate::store::atomic::OutputPathError;
 use crate::study::config::ConfigError;
 use crate::study::motions::SeedError;
 use std::error::Error;
@@ -140,6 +141,7 @@ fn known(e: &(dyn Error + 'static)) -> Option<Fault> {
         BatchError,
         ConfigError,
         StoreError,
+        OutputPathError,
         LockError,
         RecordError,
         SeedError,
@@ -269,7 +271,9 @@ impl Classify for RecordError {
     fn fault(&self) -> Fault {
         let mut f = match self {
             RecordError::Io { file, source } => Fault::io(source).file(file),
-            RecordError::TooLarge { file, .. } => Fault::of(FaultKind::BadInput).file(file),
+            RecordError::TooLarge { file, .. } | RecordError::Empty { file } => {
+                Fault::of(FaultKind::BadInput).file(file)
+            }
             RecordError::Located { file, .. } => Fault::of(FaultKind::BadInput).file(file),
             RecordError::Samples { name, .. } => Fault::of(FaultKind::BadInput).file(name),
             RecordError::Setting { setting, .. } => Fault::of(FaultKind::BadInput).key(*setting),
@@ -278,6 +282,18 @@ impl Classify for RecordError {
             f.line = Some(*line);
         }
         f
+    }
+}
+
+impl Classify for OutputPathError {
+    fn fault(&self) -> Fault {
+        let path = match self {
+            OutputPathError::NoDirectory { path, .. }
+            | OutputPathError::NotADirectory { path, .. }
+            | OutputPathError::IsADirectory { path }
+            | OutputPathError::Extension { path, .. } => path,
+        };
+        Fault::of(FaultKind::BadInput).file(path.display())
     }
 }
 
@@ -299,6 +315,7 @@ impl Classify for SimulationError {
                 Fault::of(FaultKind::BadInput).file(file)
             }
             SimulationError::Invalid(_) => Fault::of(FaultKind::BadInput),
+            SimulationError::Output(e) => e.fault(),
             SimulationError::Simulation { record, source } => source.fault().file(record),
         }
     }

@@ -52,7 +52,8 @@ fn main() -> std::process::ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let matches = Cli::command().get_matches();
+    let args = cmd::join_negative_values(std::env::args_os().collect(), &Cli::command());
+    let matches = Cli::command().get_matches_from(args);
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     // The study's stages check for Ctrl-C between work units; the other commands end at once.
     let checked = !matches!(

@@ -8,9 +8,8 @@ use crate::ground_motion::{Record, RecordError, checked_at2};
 use crate::spectrum::{TargetError, TargetSpectrum};
 use crate::store::StoreError;
 use crate::store::atomic::write_bytes;
-use crate::study::config::{ConfigError, read_yaml_text};
+use crate::study::config::{ConfigError, read_yaml_text, yaml_problem};
 use rayon::prelude::*;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -54,8 +53,9 @@ pub fn read_settings(path: &Path) -> Result<MatchSettings, MatchFilesError> {
         file: path.to_path_buf(),
         why,
     };
+    let text = read_yaml_text(path)?;
     let s: MatchSettings =
-        serde_yaml::from_str(&read_yaml_text(path)?).map_err(|e| bad(e.to_string()))?;
+        serde_yaml::from_str(&text).map_err(|e| bad(yaml_problem(&text, &e).to_string()))?;
     s.validate().map_err(|e| bad(e.to_string()))?;
     Ok(s)
 }
@@ -135,32 +135,43 @@ pub fn match_files(
     Ok(files)
 }
 
-/// `summary.csv`: one row per record.
+/// `summary.csv`: one row per record (the `csv` crate quotes a record's name where it holds a
+/// comma, a quote or a line break).
 fn summary(files: &[MatchedFile]) -> String {
-    let mut text = String::from(
-        "record,converged,iterations,worst_misfit,scale,pga_before_g,pga_after_g,\
-         final_velocity_mps,final_displacement_m,arias_ratio,output\n",
-    );
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let header = [
+        "record",
+        "converged",
+        "iterations",
+        "worst_misfit",
+        "scale",
+        "pga_before_g",
+        "pga_after_g",
+        "final_velocity_mps",
+        "final_displacement_m",
+        "arias_ratio",
+        "output",
+    ];
+    w.write_record(header).expect("writing to memory");
     for f in files {
         let r = &f.report;
-        writeln!(
-            text,
-            "{},{},{},{},{},{},{},{},{},{},{}",
-            f.record,
-            r.converged,
-            r.iterations,
-            r.worst_misfit,
-            r.scale,
-            r.pga_before_g,
-            r.pga_after_g,
-            r.final_velocity_mps,
-            r.final_displacement_m,
-            r.arias_ratio,
-            f.written.as_deref().unwrap_or("")
-        )
-        .expect("writing to a String");
+        w.write_record([
+            f.record.clone(),
+            r.converged.to_string(),
+            r.iterations.to_string(),
+            r.worst_misfit.to_string(),
+            r.scale.to_string(),
+            r.pga_before_g.to_string(),
+            r.pga_after_g.to_string(),
+            r.final_velocity_mps.to_string(),
+            r.final_displacement_m.to_string(),
+            r.arias_ratio.to_string(),
+            f.written.clone().unwrap_or_default(),
+        ])
+        .expect("writing to memory");
     }
-    text
+    let bytes = w.into_inner().expect("writing to memory");
+    String::from_utf8(bytes).expect("UTF-8 fields")
 }
 
 /// Refuses a run in which some record did not meet the acceptance, naming them.

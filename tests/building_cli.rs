@@ -343,13 +343,13 @@ fn bad_building_input_is_refused_naming_the_file_and_key() {
         (good_stack.to_string(), "`stacks` needs `building`"),
         (
             format!("{good_building}  floors: 3\n"),
-            "unknown field `floors`",
+            "unknown key `floors`",
         ),
         (
             format!(
                 "{good_building}stacks:\n  - floor: 1\n    alpha: [0.5]\n    mu: [0.2]\n    friction: 1\n"
             ),
-            "unknown field `friction`",
+            "unknown key `friction`",
         ),
     ];
     for (i, (yaml, needle)) in cases.iter().enumerate() {

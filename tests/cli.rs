@@ -66,7 +66,7 @@ fn bad_input_is_refused_with_a_clear_message() {
     let out = run(&["simulate", "--config", case.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        !out.status.success() && err.contains("unknown field `mass_ratio`"),
+        !out.status.success() && err.contains("line 2: unknown key `mass_ratio`"),
         "{err}"
     );
     let out = run(&["simulate", "--history", "out.txt"]);

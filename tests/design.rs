@@ -95,10 +95,39 @@ fn worked_example_grid_points_and_refusals() {
         &base("III", "3", "1,1"),
         "T_p = 3 lies outside the grid's 0.3 … 2",
     );
-    let mut ex = base("III", "3", "1,1");
-    ex.extend(["--extrapolate", "--json"]);
+    let extrapolate = |zone, period, alpha| {
+        let mut ex = base(zone, period, alpha);
+        ex.push("--extrapolate");
+        ex
+    };
+    let mut ex = extrapolate("III", "2.4", "1,1");
+    ex.push("--json");
     let a = json(&ex);
     assert!(a["t_new_grid_s"].is_null() && a["t_new_fit_s"].as_f64().is_some());
+    // Only on the box 25 % beyond the grid where the fit was checked (T_p 0.225 … 2.5 s,
+    // α_1 0.075 … 1.25); beyond it nothing answers, never a negative or NaN period (Eq. 17
+    // gives −0.04 s at T_p = 0.01 s, μ 0.05/0.05).
+    let checked = "the only range where the fitted form was checked to stay a period of the \
+                   structure (finite, T_new within 0.5·T_p … 1.5·T_rigid): nothing answers there";
+    for (zone, period, alpha, outside) in [
+        ("III", "3", "1,1", "T_p = 3.0 lies outside 0.225 … 2.5"),
+        ("V", "0.01", "1,1", "T_p = 0.01 lies outside 0.225 … 2.5"),
+        ("V", "0.7", "2,1", "alpha_1 = 2.0 lies outside 0.075 … 1.25"),
+    ] {
+        refuse(
+            &extrapolate(zone, period, alpha),
+            &format!("{outside}, the study's grid ("),
+        );
+        refuse(&extrapolate(zone, period, alpha), checked);
+    }
+    refuse(
+        &extrapolate("III", "1e-300", "1,1"),
+        "--period = 1e-300 must be within 0.000001 … 10000 s",
+    );
+    refuse(
+        &extrapolate("III", "1e9", "1,1"),
+        "--period = 1000000000.0 must be within 0.000001 … 10000 s",
+    );
     refuse(
         &base("IV", "0.7", "1,1"),
         "zone `IV` is not in the study; it has III, V",

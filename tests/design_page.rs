@@ -236,7 +236,7 @@ fn design_page_answers_as_the_command_does() {
     let study = run_study(dir.path());
     let report = study.join("report");
     let design = file_url(&report.join("design.html"));
-    let questions: [Question; 14] = [
+    let questions: [Question; 18] = [
         // Section 9's worked example, both zones of the paper.
         ("III", "0.7", "1,1", "0.3,0.1", false),
         ("V", "0.7", "1,1", "0.3,0.1", false),
@@ -251,13 +251,18 @@ fn design_page_answers_as_the_command_does() {
         // SD1/T) and the table.
         ("US", "0.45", "0.2,0.8", "0.15,0.1", false),
         ("TB", "1.7", "1,0.6", "0.25,0.07", false),
-        // Outside: refused, then extrapolated (one and several dimensions out).
+        // Outside: refused, then extrapolated (one and several dimensions out) inside the box
+        // 25 % beyond the grid where the fit was checked, refused beyond it.
         ("III", "3", "1,1", "0.3,0.1", false),
+        ("III", "2.4", "1,1", "0.3,0.1", true),
+        ("V", "0.25", "1.2,1", "0.08,0.22", true),
         ("III", "3", "1,1", "0.3,0.1", true),
         ("V", "0.2", "2,1", "0.05,0.3", true),
         ("TB", "0.7", "1,1", "0.5,0.1", false),
         // Bad input: refused by both.
         ("III", "-1", "1,1", "0.3,0.1", false),
+        ("V", "1e-300", "1,1", "0.3,0.1", true),
+        ("III", "1e9", "1,1", "0.3,0.1", true),
     ];
     let mut ids: Vec<&str> = OUTPUTS.to_vec();
     ids.extend([
@@ -293,6 +298,22 @@ fn design_page_answers_as_the_command_does() {
                    change('x-mu', e => { for (const o of e.options) o.selected = true; }); })()",
     }));
     pages.push(json!({"url": file_url(&report.join("index.html")), "ids": ["design-link"]}));
+    // A grid down to T_p = 0.01 s and μ_1 = 0.05 (the page's data edited), where the paper's
+    // Eq. 17 gives a negative T_new: left out with a note, as `design::answer` does (its unit
+    // tests).
+    let edited = report.join("design-edited.html");
+    let html = std::fs::read_to_string(report.join("design.html")).unwrap();
+    let open = "<script type='application/json' id='study-data'>";
+    let (head, rest) = html.split_once(open).unwrap();
+    let (data, tail) = rest.split_once("</script>").unwrap();
+    let mut data: Value = serde_json::from_str(data).unwrap();
+    for z in data["zones"].as_array_mut().unwrap() {
+        z["grid"]["periods_s"][0] = json!(0.01);
+        z["grid"]["mu"][0][0] = json!(0.05);
+    }
+    std::fs::write(&edited, format!("{head}{open}{data}</script>{tail}")).unwrap();
+    let low: Question = ("V", "0.01", "1,1", "0.05,0.05", false);
+    pages.push(json!({"url": format!("{}{}", file_url(&edited), query(&low)), "ids": ids}));
     // Negative controls: what the probe must see.
     let bad = dir.path().join("bad.html");
     std::fs::write(
@@ -304,11 +325,16 @@ fn design_page_answers_as_the_command_does() {
     pages.push(json!({"url": file_url(&bad), "ids": []}));
     let answer = probe(&json!({ "pages": pages }));
     let seen = answer["pages"].as_array().unwrap();
-    assert_eq!(seen.len(), questions.len() + 4);
+    assert_eq!(seen.len(), questions.len() + 5);
 
     for (q, page) in questions.iter().zip(seen) {
         check_page(q, page, &command(&study, q));
         check_quiet(page);
+    }
+    // The command extrapolates inside the box and refuses beyond it (the page as it does).
+    for q in questions.iter().filter(|q| q.4) {
+        let inside = ["2.4", "0.25"].contains(&q.1);
+        assert_eq!(command(&study, q).is_ok(), inside, "{q:?}");
     }
     let typed_page = &seen[questions.len()];
     check_page(&typed, typed_page, &command(&study, &typed));
@@ -363,7 +389,27 @@ fn design_page_answers_as_the_command_does() {
         }
     }
 
-    let control = &seen[questions.len() + 3];
+    let low_page = &seen[questions.len() + 3];
+    check_quiet(low_page);
+    let el = &low_page["elements"];
+    assert_eq!(el["error"]["text"], "", "{low:?}");
+    assert_eq!(el["t_new_paper_s"]["text"], "–");
+    assert!(el["t_new_paper_s"]["value"].is_null());
+    let paper = slidestack::fit::paper_equation("V", &[0.01, 0.05, 0.05, 1.0, 1.0]).unwrap();
+    assert!(paper < 0.0, "{paper}");
+    let notes = el["notes"]["text"].as_str().unwrap();
+    let shown = notes
+        .split_once("the paper's equation gives T_new = ")
+        .and_then(|(_, r)| r.split_once(" s here, which is no period: left out"))
+        .unwrap_or_else(|| panic!("no note on the paper's equation: {notes}"))
+        .0;
+    let shown: f64 = shown.parse().unwrap();
+    assert!(
+        (shown - paper).abs() <= 1e-12 * paper.abs(),
+        "{shown} vs {paper}"
+    );
+
+    let control = &seen[questions.len() + 4];
     let requests = control["requests"].to_string();
     assert!(requests.contains("http://127.0.0.1:9/x.png"), "{requests}");
     let errors = control["errors"].to_string();
@@ -466,7 +512,7 @@ fn a_building_studys_design_page_answers_as_the_command_does() {
     let design = file_url(&report.join("design.html"));
     // The grid: T_1 0.3, 0.6, 1 s; α_1 0.25, 0.5; α_2 0.5; μ_1 0.1, 0.3; μ_2 0.05, 0.2; one
     // and three storeys; the stack on floor 1, the roof, every floor.
-    let questions: [FrameQuestion; 16] = [
+    let questions: [FrameQuestion; 17] = [
         // A grid point of each kind of frame of three storeys.
         ("III", "0.6", "0.25,0.5", "0.1,0.05", false, "3", "roof"),
         ("V", "0.6", "0.5,0.5", "0.3,0.2", false, "3", "1"),
@@ -480,8 +526,10 @@ fn a_building_studys_design_page_answers_as_the_command_does() {
         ("V", "0.45", "0.3,0.5", "0.2,0.1", false, "1", "1"),
         ("V", "0.45", "0.3,0.5", "0.2,0.1", false, "1", "roof"),
         ("III", "0.3", "0.25,0.5", "0.1,0.05", false, "1", "all"),
-        // Outside the grid: refused, then extrapolated.
-        ("III", "1.5", "0.25,0.5", "0.1,0.05", false, "3", "roof"),
+        // Outside the grid: refused, then extrapolated inside the box 25 % beyond it, refused
+        // beyond.
+        ("III", "1.2", "0.25,0.5", "0.1,0.05", false, "3", "roof"),
+        ("III", "1.2", "0.25,0.5", "0.1,0.05", true, "3", "roof"),
         ("III", "1.5", "0.25,0.5", "0.1,0.05", true, "3", "roof"),
         // Frames the study lacks: a floor of three storeys, a storey count, a floor above the
         // roof; and a floor that is none.
@@ -542,8 +590,9 @@ fn a_building_studys_design_page_answers_as_the_command_does() {
         check_frame_page(q, page, &cli);
         check_quiet(page);
     }
-    // The refusals: outside the grid, three frames the study lacks, a floor that is none.
-    assert_eq!(refused, 5);
+    // The refusals: outside the grid, beyond the box the fit was checked on, three frames the
+    // study lacks, a floor that is none.
+    assert_eq!(refused, 6);
 
     let typed_page = &seen[questions.len()];
     check_frame_page(&typed, typed_page, &frame_command(&study, &typed));

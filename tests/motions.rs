@@ -172,7 +172,7 @@ fn match_command_writes_accepted_motions_and_a_summary() {
     ]);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("unknown field `tolerence`"),
+        stderr(&out).contains("unknown key `tolerence`"),
         "{}",
         stderr(&out)
     );
@@ -269,7 +269,7 @@ fn motions_stage_writes_skips_and_rebuilds() {
 fn motions_stage_refuses_bad_configs_naming_the_key() {
     let dir = tempfile::tempdir().unwrap();
     for (extra, want) in [
-        ("  colour: red\n", "unknown field `colour`"),
+        ("  colour: red\n", "unknown key `colour`"),
         (
             "  set_mean_min: -1\n",
             "`motions.set_mean_min`: -1 must be in (0, matching.upper]",

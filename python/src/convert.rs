@@ -62,6 +62,31 @@ pub fn to_yaml_value(obj: &Bound<'_, PyAny>, key: &str) -> PyResult<serde_yaml::
     )))
 }
 
+/// A whole-number keyword argument `key` (a Python or numpy integer, not a bool) of at least
+/// `min`; anything else a `ValueError` naming `key` (pyo3's own conversion raises
+/// `OverflowError` for a negative number and `TypeError` for a float).
+pub fn whole(obj: &Bound<'_, PyAny>, key: &str, min: usize) -> PyResult<usize> {
+    let bad = || {
+        PyValueError::new_err(format!(
+            "`{key}` must be a whole number ≥ {min}, got {}",
+            obj.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+        ))
+    };
+    if obj.is_instance_of::<PyBool>() {
+        return Err(bad());
+    }
+    let index = obj
+        .py()
+        .import("operator")?
+        .call_method1("index", (obj,))
+        .map_err(|_| bad())?;
+    index
+        .extract::<usize>()
+        .ok()
+        .filter(|&n| n >= min)
+        .ok_or_else(bad)
+}
+
 /// A 1-D float64 sequence (a number list, tuple or numpy array).
 pub fn float_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     let np = obj.py().import("numpy")?;

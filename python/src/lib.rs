@@ -111,6 +111,9 @@ fn simulate<'py>(
         ("building", building),
         ("stacks", stacks),
     ];
+    if let Some(n) = rk4_substeps.filter(|n| !n.is_none()) {
+        convert::whole(n, "rk4_substeps", 1)?;
+    }
     let mut mapping = serde_yaml::Mapping::new();
     for (key, value) in keys {
         if let Some(v) = value.filter(|v| !v.is_none()) {
@@ -352,10 +355,13 @@ fn design<'py>(
     alpha: &Bound<'py, PyAny>,
     mu: &Bound<'py, PyAny>,
     extrapolate: bool,
-    storeys: Option<usize>,
+    storeys: Option<&Bound<'py, PyAny>>,
     floor: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let floor = match floor {
+    let storeys = (storeys.filter(|s| !s.is_none()))
+        .map(|s| convert::whole(s, "storeys", 1))
+        .transpose()?;
+    let floor = match floor.filter(|f| !f.is_none()) {
         None => None,
         Some(f) => {
             let text = f.str()?.to_string();

@@ -16,7 +16,7 @@ use slidestack::pipeline::{
     Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, StageState, Study,
     execute, run_all, status as study_status, sweep, terminal_progress,
 };
-use slidestack::study::config::StudyConfig;
+use slidestack::study::config::{ConfigError, StudyConfig};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -57,7 +57,9 @@ impl ConfigArg {
             ConfigArg::Path(p) => Study::load(p, out),
             ConfigArg::Yaml(text) => {
                 let name = Path::new(DICT_CONFIG);
-                let cfg = StudyConfig::parse(text.as_bytes(), name, Path::new("."))?;
+                // The lines are of the YAML made from the dict: not the caller's.
+                let cfg = StudyConfig::parse(text.as_bytes(), name, Path::new("."))
+                    .map_err(ConfigError::without_line)?;
                 Study::with_config(cfg, name, out)
             }
         }
@@ -290,11 +292,18 @@ fn sweep_<'py>(
     out: Option<PathBuf>,
     force: bool,
     wait: bool,
-    shard: Option<(usize, usize)>,
+    shard: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let Some((k, n)) = shard else {
+    let Some(shard) = shard.filter(|s| !s.is_none()) else {
         return one_stage(py, StageId::Sweep, config, out, force, wait);
     };
+    let pair: Vec<Bound<'py, PyAny>> = (shard.extract().ok())
+        .filter(|p: &Vec<Bound<'py, PyAny>>| p.len() == 2)
+        .ok_or_else(|| PyValueError::new_err("`shard` must be a pair (k, n) of whole numbers"))?;
+    let (k, n) = (
+        crate::convert::whole(&pair[0], "shard", 1)?,
+        crate::convert::whole(&pair[1], "shard", 1)?,
+    );
     if k == 0 || k > n {
         return Err(PyValueError::new_err(format!(
             "`shard` ({k}, {n}): needs 1 ≤ k ≤ n"

@@ -174,3 +174,27 @@ def test_every_kind_of_fault_has_its_class_and_names_its_place(tmp_path):
         slidestack.tnew(cfg, force=True)
     assert e.value.kind == "damaged_file"  # type: ignore[attr-defined]
     # Interrupted: KeyboardInterrupt (test_study.py, the Ctrl-C tests).
+
+
+def test_a_whole_number_keyword_is_a_value_error_naming_it(tmp_path):
+    """Negative, fractional, boolean or huge integers raise ValueError naming the keyword (pyo3's
+    own conversion raised OverflowError or TypeError), before any file is read."""
+    question = (tmp_path, "III", 0.7, [1, 1], [0.3, 0.1])
+    for storeys in (-3, 0, 1.5, True, 2**70, "3"):
+        with pytest.raises(ValueError, match="^`storeys` must be a whole number ≥ 1, got "):
+            slidestack.design(*question, storeys=storeys, floor="roof")
+    for floor in (-1, 0, 1.5, "top"):
+        with pytest.raises(ValueError, match="a floor number, `roof` or `all`"):
+            slidestack.design(*question, storeys=3, floor=floor)
+    for shard in ((-1, 2), (1, 2**70), (1.5, 2)):
+        with pytest.raises(ValueError, match="^`shard` must be a whole number ≥ 1, got "):
+            slidestack.sweep(tmp_path / "none.yaml", shard=shard)
+    for shard in ((1,), "12", 3):
+        with pytest.raises(ValueError, match=r"^`shard` must be a pair \(k, n\)"):
+            slidestack.sweep(tmp_path / "none.yaml", shard=shard)
+    for n in (-1, 0, 2.5):
+        with pytest.raises(ValueError, match="^`rk4_substeps` must be a whole number ≥ 1, got "):
+            slidestack.simulate(integrator="rk4", rk4_substeps=n)
+    # numpy's integers are whole numbers too.
+    with pytest.raises(FileNotFoundError):
+        slidestack.design(*question, storeys=np.int64(3), floor="roof")

@@ -18,6 +18,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(path) = &args.figure {
+        super::check_figure(path)?;
+    }
     let study = args.study.study()?;
     // Without an `ida` section: refused before the output directory is touched.
     study.fingerprint(StageId::Ida)?;

@@ -15,6 +15,7 @@ use slidestack::spectrum::TargetSpectrum;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     #[command(flatten)]
     records: RecordArgs,

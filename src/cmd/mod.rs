@@ -19,6 +19,7 @@ use slidestack::pipeline::lock::{LockError, LockMode};
 use slidestack::pipeline::{
     Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, Study,
 };
+use std::ffi::OsString;
 use std::path::PathBuf;
 
 /// What every study stage takes.
@@ -94,13 +95,24 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
     slidestack::fault::classify(e.as_ref()).kind.exit_code()
 }
 
+/// `Err` unless an SVG figure (`--figure`) can be written at `path`, checked before any work.
+pub fn check_figure(path: &std::path::Path) -> Result<(), BadInput> {
+    slidestack::store::atomic::check_output_extension(path, "a figure (SVG)", &["svg"])
+        .map_err(|e| BadInput(e.to_string()))
+}
+
 /// The message of an error and its causes, each cause once (a cause whose text the message
 /// already holds, from error types that repeat their source, is not printed again), with the
-/// settings it names as `command`'s flags ([`with_flags`]).
+/// settings it names as `command`'s flags ([`with_flags`]), but for a YAML file's message,
+/// which names the file's keys.
 pub fn message(e: &anyhow::Error, command: &clap::Command) -> String {
     let mut text = String::new();
     for cause in e.chain() {
-        let c = cause.to_string();
+        let c = if names_file_keys(cause) {
+            cause.to_string()
+        } else {
+            with_flags(&cause.to_string(), command)
+        };
         if !text.contains(&c) {
             if !text.is_empty() {
                 text += ": ";
@@ -113,7 +125,66 @@ pub fn message(e: &anyhow::Error, command: &clap::Command) -> String {
     {
         text += " (or run without --no-wait to wait)";
     }
-    with_flags(&text, command)
+    text
+}
+
+/// Whether `cause` is a YAML file's parser error, whose backticked names are the file's keys.
+fn names_file_keys(cause: &(dyn std::error::Error + 'static)) -> bool {
+    matches!(
+        cause.downcast_ref::<slidestack::simulation::SimulationError>(),
+        Some(slidestack::simulation::SimulationError::Yaml { .. })
+    ) || matches!(
+        cause.downcast_ref::<slidestack::study::config::ConfigError>(),
+        Some(slidestack::study::config::ConfigError::Yaml { .. })
+    )
+}
+
+/// The command line `args` (the program's name first) with the values of a flag given each as
+/// `--flag=VALUE` where one of them is a negative number or list: `--mu -0.1,0.05` becomes
+/// `--mu=-0.1,0.05`, `--alpha -0.5 0.5` becomes `--alpha=-0.5 --alpha=0.5`. Clap takes a
+/// token that starts with `-` for short flags (`-0`) unless it is a lone number of the form
+/// it knows (`allow_negative_numbers`): not a list, `-.5`, `-1e-3` or `-inf`; so a negative
+/// value then reaches the library, which says what is wrong with it.
+pub fn join_negative_values(args: Vec<OsString>, root: &clap::Command) -> Vec<OsString> {
+    let mut root = root.clone();
+    root.build();
+    let sub = (args.iter().skip(1))
+        .find_map(|a| a.to_str().filter(|a| !a.starts_with('-')))
+        .and_then(|name| root.find_subcommand(name));
+    let Some(sub) = sub else { return args };
+    // The most values `--long` takes at once; `None` for a flag taking none.
+    let most_values = |long: &str| {
+        (sub.get_arguments())
+            .find(|a| a.get_long() == Some(long) && a.get_action().takes_values())
+            .map(|a| a.get_num_args().map_or(1, |n| n.max_values()))
+    };
+    let negative = |v: &str| {
+        v.starts_with('-')
+            && v.split(',')
+                .next()
+                .is_some_and(|x| x.parse::<f64>().is_ok())
+    };
+    let mut out = Vec::with_capacity(args.len());
+    let mut i = 0;
+    while i < args.len() {
+        let flag = (args[i].to_str())
+            .and_then(|s| s.strip_prefix("--"))
+            .filter(|f| !f.contains('='));
+        if let Some((flag, most)) = flag.and_then(|f| Some((f, most_values(f)?))) {
+            let values: Vec<&str> = (args[i + 1..].iter())
+                .take(most)
+                .map_while(|v| v.to_str().filter(|v| !v.starts_with('-') || negative(v)))
+                .collect();
+            if values.iter().any(|v| negative(v)) {
+                out.extend(values.iter().map(|v| format!("--{flag}={v}").into()));
+                i += 1 + values.len();
+                continue;
+            }
+        }
+        out.push(args[i].clone());
+        i += 1;
+    }
+    out
 }
 
 /// The library names a setting in backticks, with its value where that matters

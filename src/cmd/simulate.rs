@@ -34,6 +34,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(path) = &args.figure {
+        super::check_figure(path)?;
+    }
     let file = match &args.config {
         Some(path) => Settings::read(path)?,
         None => Settings::default(),

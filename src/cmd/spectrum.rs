@@ -16,10 +16,12 @@ use super::RecordArgs;
 use anyhow::Result;
 use slidestack::spectrum::batch::{ductility_spectra, response_spectra};
 use slidestack::spectrum::parse_periods;
+use slidestack::store::atomic::check_output_file;
 use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     #[command(flatten)]
     records: RecordArgs,
@@ -49,99 +51,142 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(path) = &args.out {
+        check_output_file(path).map_err(|e| super::BadInput(e.to_string()))?;
+    }
     let periods = parse_periods(&args.periods)?;
     if !args.ductility.is_empty() {
         return run_ductility(&args, &periods);
     }
     let records = args.records.read()?;
     let spectra = response_spectra(&records, &periods, &args.damping)?;
-    let mut text = String::new();
-    if args.json {
-        text = serde_json::to_string_pretty(&spectra)? + "\n";
-    } else {
-        let csv = args.csv;
-        text += if csv {
-            "record,damping,period_s,sd_m,psv_mps,psa_g,peak_time_s\n"
-        } else {
-            "record                          damping  period_s         sd_m      psv_mps        psa_g  peak_time_s\n"
-        };
+    let text = if args.json {
+        serde_json::to_string_pretty(&spectra)? + "\n"
+    } else if args.csv {
+        let mut w = csv_writer();
+        w.write_record([
+            "record",
+            "damping",
+            "period_s",
+            "sd_m",
+            "psv_mps",
+            "psa_g",
+            "peak_time_s",
+        ])?;
         for s in &spectra {
             for i in 0..s.periods_s.len() {
-                let row = (
+                w.write_record([
+                    s.record.clone(),
+                    s.damping.to_string(),
+                    s.periods_s[i].to_string(),
+                    s.sd_m[i].to_string(),
+                    s.psv_mps[i].to_string(),
+                    s.psa_g[i].to_string(),
+                    s.peak_time_s[i].to_string(),
+                ])?;
+            }
+        }
+        csv_text(w)?
+    } else {
+        let mut text = String::from(
+            "record                          damping  period_s         sd_m      psv_mps        psa_g  peak_time_s\n",
+        );
+        for s in &spectra {
+            for i in 0..s.periods_s.len() {
+                text += &format!(
+                    "{:<30} {:>8.4} {:>9.4} {:>12.6e} {:>12.6e} {:>12.6} {:>12.4}\n",
+                    s.record,
+                    s.damping,
                     s.periods_s[i],
                     s.sd_m[i],
                     s.psv_mps[i],
                     s.psa_g[i],
-                    s.peak_time_s[i],
+                    s.peak_time_s[i]
                 );
-                text += &if csv {
-                    format!(
-                        "{},{},{},{},{},{},{}\n",
-                        s.record, s.damping, row.0, row.1, row.2, row.3, row.4
-                    )
-                } else {
-                    format!(
-                        "{:<30} {:>8.4} {:>9.4} {:>12.6e} {:>12.6e} {:>12.6} {:>12.4}\n",
-                        s.record, s.damping, row.0, row.1, row.2, row.3, row.4
-                    )
-                };
             }
         }
-    }
+        text
+    };
     write_out(args.out.as_deref(), &text)
+}
+
+/// A CSV writer into memory (the `csv` crate: a field is quoted where it holds a comma, a quote
+/// or a line break, as a record's name may).
+fn csv_writer() -> csv::Writer<Vec<u8>> {
+    csv::Writer::from_writer(Vec::new())
+}
+
+/// The text `w` wrote.
+fn csv_text(w: csv::Writer<Vec<u8>>) -> Result<String> {
+    let bytes = w
+        .into_inner()
+        .map_err(|e| anyhow::anyhow!("{}", e.error()))?;
+    Ok(String::from_utf8(bytes)?)
 }
 
 fn run_ductility(args: &Args, periods: &[f64]) -> Result<()> {
     let r = args.post_yield_ratio.unwrap_or(0.0);
     let records = args.records.read()?;
     let spectra = ductility_spectra(&records, periods, &args.damping, &args.ductility, r)?;
-    let mut text = String::new();
-    if args.json {
-        text = serde_json::to_string_pretty(&spectra)? + "\n";
-    } else {
-        text += if args.csv {
-            "record,damping,ductility,post_yield_ratio,period_s,strength_ratio,\
-             yield_displacement_m,peak_displacement_m,ductility_reached,elastic_strength_ratio,\
-             reduction_factor\n"
-        } else {
-            "record                          damping  ductility  period_s    C_y (g)   D_y (m)      \
-             u_m (m)      C_e (g)    R_y\n"
-        };
+    let text = if args.json {
+        serde_json::to_string_pretty(&spectra)? + "\n"
+    } else if args.csv {
+        let mut w = csv_writer();
+        w.write_record([
+            "record",
+            "damping",
+            "ductility",
+            "post_yield_ratio",
+            "period_s",
+            "strength_ratio",
+            "yield_displacement_m",
+            "peak_displacement_m",
+            "ductility_reached",
+            "elastic_strength_ratio",
+            "reduction_factor",
+        ])?;
         for s in &spectra {
             for i in 0..s.periods_s.len() {
-                text += &if args.csv {
-                    format!(
-                        "{},{},{},{},{},{},{},{},{},{},{}\n",
-                        s.record,
-                        s.damping,
-                        s.ductility,
-                        s.post_yield_ratio,
-                        s.periods_s[i],
-                        s.strength_ratio[i],
-                        s.yield_displacement_m[i],
-                        s.peak_displacement_m[i],
-                        s.ductility_reached[i],
-                        s.elastic_strength_ratio[i],
-                        s.reduction_factor[i]
-                    )
-                } else {
-                    format!(
-                        "{:<30} {:>8.4} {:>10.3} {:>9.4} {:>10.5} {:>12.5e} {:>12.5e} {:>10.5} \
-                         {:>6.3}\n",
-                        s.record,
-                        s.damping,
-                        s.ductility,
-                        s.periods_s[i],
-                        s.strength_ratio[i],
-                        s.yield_displacement_m[i],
-                        s.peak_displacement_m[i],
-                        s.elastic_strength_ratio[i],
-                        s.reduction_factor[i]
-                    )
-                };
+                w.write_record([
+                    s.record.clone(),
+                    s.damping.to_string(),
+                    s.ductility.to_string(),
+                    s.post_yield_ratio.to_string(),
+                    s.periods_s[i].to_string(),
+                    s.strength_ratio[i].to_string(),
+                    s.yield_displacement_m[i].to_string(),
+                    s.peak_displacement_m[i].to_string(),
+                    s.ductility_reached[i].to_string(),
+                    s.elastic_strength_ratio[i].to_string(),
+                    s.reduction_factor[i].to_string(),
+                ])?;
             }
         }
-    }
+        csv_text(w)?
+    } else {
+        let mut text = String::from(
+            "record                          damping  ductility  period_s    C_y (g)   D_y (m)      \
+             u_m (m)      C_e (g)    R_y\n",
+        );
+        for s in &spectra {
+            for i in 0..s.periods_s.len() {
+                text += &format!(
+                    "{:<30} {:>8.4} {:>10.3} {:>9.4} {:>10.5} {:>12.5e} {:>12.5e} {:>10.5} \
+                     {:>6.3}\n",
+                    s.record,
+                    s.damping,
+                    s.ductility,
+                    s.periods_s[i],
+                    s.strength_ratio[i],
+                    s.yield_displacement_m[i],
+                    s.peak_displacement_m[i],
+                    s.elastic_strength_ratio[i],
+                    s.reduction_factor[i]
+                );
+            }
+        }
+        text
+    };
     write_out(args.out.as_deref(), &text)
 }
 

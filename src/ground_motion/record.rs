@@ -175,6 +175,9 @@ pub enum RecordError {
     },
     #[error("{file}: {bytes} bytes: a record file may have at most {MAX_FILE_BYTES}")]
     TooLarge { file: String, bytes: u64 },
+    /// No bytes, or only white space.
+    #[error("{file}: empty file")]
+    Empty { file: String },
     #[error("{file}:{line}: {problem}")]
     Located {
         file: String,
@@ -312,6 +315,16 @@ pub fn parse_record(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Rec
     }
 }
 
+/// `Err` for a file of no text but white space.
+fn not_empty(text: &str, file: &str) -> Result<(), RecordError> {
+    if text.trim().is_empty() {
+        return Err(RecordError::Empty {
+            file: file.to_string(),
+        });
+    }
+    Ok(())
+}
+
 fn number(tok: &str, file: &str, line: usize) -> Result<f64, RecordError> {
     let v: f64 = tok.parse().map_err(|_| {
         let token = excerpt(tok);
@@ -434,6 +447,7 @@ pub fn parse_at2(text: &str, file: &str) -> Result<Record, RecordError> {
 /// Parses the text of a PEER `.AT2` file: four header lines (the third may name the units, the
 /// fourth gives NPTS and DT), then the values, any number per line, converted to g.
 pub fn parse_at2_with(text: &str, file: &str, opts: &ReadOptions) -> Result<Record, RecordError> {
+    not_empty(text, file)?;
     let mut lines = text.lines().enumerate();
     let mut header = None;
     let mut units_line = None;
@@ -546,6 +560,7 @@ fn declare<T: PartialEq>(
 /// The record's step is the declared `# dt:` if any, else `opts.dt_s`, else (two columns) the first
 /// time difference; any two of these must agree within `1e-6` relative.
 pub fn parse_text(text: &str, file: &str, opts: &ReadOptions) -> Result<Record, RecordError> {
+    not_empty(text, file)?;
     let mut units: Option<Declared<Units>> = None;
     let mut dt_decl: Option<Declared<f64>> = None;
     // Columns per data line (1 or 2), fixed by the first data line, and that line.

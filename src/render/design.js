@@ -25,6 +25,22 @@ function rustNum(x) {
   return x.toFixed(Math.min(100, digits)).replace(/0+$/, "").replace(/\.$/, "");
 }
 
+// Rust's `{:?}` of an f64: a decimal with a fraction digit from 1e-4 to 1e16, else the shortest
+// digits with an exponent.
+function rustDebug(x) {
+  if (!Number.isFinite(x)) return rustNum(x);
+  const a = Math.abs(x);
+  if (a === 0 || (a >= 1e-4 && a < 1e16)) {
+    const s = rustNum(x);
+    return (Object.is(x, -0) ? "-" : "") + (s.includes(".") ? s : s + ".0");
+  }
+  const [m, e] = x.toExponential().split("e");
+  return m + "e" + (e.startsWith("+") ? e.slice(1) : e);
+}
+
+// design.rs, shown: a bound rounded to 7 significant digits.
+const shown = (v) => rustDebug(Number(v.toExponential(6)));
+
 // grid.rs, Grid::interpolate: multilinear in [T_p, α_1 … α_n, μ_1 … μ_n]; `outside` names the
 // first dimension out of range, `value` is null where a corner with weight has no T_new.
 function interpolate(grid, values, point) {
@@ -262,6 +278,44 @@ function tRigidOf(z, period, alphaTotal) {
     : period * Math.sqrt(1.0 + alphaTotal);
 }
 
+// design.rs, check_extrapolation: null where the fitted form may answer at `point` (outside the
+// grid, `text` saying where), else the command's refusal.
+function checkExtrapolation(z, point, text) {
+  const m = z.extrapolation_margin;
+  if (m === null || m === undefined) {
+    return text + "; no fitted form was found to stay a period of the structure beyond the grid " +
+      "(fit.yaml's box check), so nothing answers there";
+  }
+  const g = z.grid;
+  const axes = [g.periods_s, ...g.alpha, ...g.mu];
+  const names = ["T_p"];
+  for (let i = 1; i <= g.alpha.length; i++) names.push("alpha_" + i);
+  for (let i = 1; i <= g.alpha.length; i++) names.push("mu_" + i);
+  for (let d = 0; d < axes.length; d++) {
+    const gridLo = Math.min(...axes[d]);
+    const gridHi = Math.max(...axes[d]);
+    const lo = (1.0 - m) * gridLo;
+    const hi = (1.0 + m) * gridHi;
+    if (!(point[d] >= lo && point[d] <= hi)) {
+      return names[d] + " = " + rustDebug(point[d]) + " lies outside " + shown(lo) + " … " +
+        shown(hi) + ", the study's grid (" + shown(gridLo) + " … " + shown(gridHi) + ") and " +
+        (100.0 * m).toFixed(0) + " % beyond, the only range where the fitted form was checked " +
+        "to stay a period of the structure (finite, T_new within " + rustNum(DATA.band[0]) +
+        "·T_p … " + rustNum(DATA.band[1]) + "·T_rigid): nothing answers there";
+    }
+  }
+  return null;
+}
+
+// design.rs, a_period: `t` if it is a period, else null with a note.
+function aPeriod(t, what, notes) {
+  if (t !== null && !(Number.isFinite(t) && t > 0.0)) {
+    notes.push(what + " gives T_new = " + rustDebug(t) + " s here, which is no period: left out");
+    return null;
+  }
+  return t;
+}
+
 // design.rs, answer: {answer} or {error}.
 function answer(q) {
   let z = ZONES.find((z) => z.zone === q.zone);
@@ -271,6 +325,11 @@ function answer(q) {
   }
   const bad = (what, v) => ({ error: what + " = " + rustNum(v) + " must be finite and > 0" });
   if (!(Number.isFinite(q.period) && q.period > 0)) return bad("T_p", q.period);
+  const [pLo, pHi] = DATA.period_range_s;
+  if (!(q.period >= pLo && q.period <= pHi)) {
+    return { error: "T_p = " + rustDebug(q.period) + " must be within " + rustNum(pLo) + " … " +
+      rustNum(pHi) + " s, the periods of a structure `simulate` runs" };
+  }
   for (const [name, list] of [["alpha", q.alpha], ["mu", q.mu]]) {
     for (let i = 0; i < list.length; i++) {
       if (!(Number.isFinite(list[i]) && list[i] > 0)) return bad(name + "_" + (i + 1), list[i]);
@@ -305,6 +364,8 @@ function answer(q) {
     if (!q.extrapolate) {
       return { error: text + "; with `extrapolate` the fitted form answers there", outside: true };
     }
+    const beyond = checkExtrapolation(z, [q.period, ...q.alpha, ...q.mu], text);
+    if (beyond) return { error: beyond, outside: true };
     notes.push(text + ": T_new from the fitted form");
   } else if (r.value === null) {
     notes.push("a grid point next to this structure has no T_new (no crossing of the mean " +
@@ -314,7 +375,8 @@ function answer(q) {
   }
   const x = [q.period, ...q.mu, ...q.alpha];
   const fitX = fitFeatures(z, q.period, q.alpha, q.mu);
-  const tFit = z.fit ? predict(z.fit, fitX, q.period, tRigid) : null;
+  const tFit = aPeriod(z.fit ? predict(z.fit, fitX, q.period, tRigid) : null, "the fitted form",
+    notes);
   let lambdaGrid = null;
   let lambdaFit = null;
   let lambdaCode = null;
@@ -328,7 +390,7 @@ function answer(q) {
     lambdaFit = fitted ? predict(fitted, fitX, q.period, tRigid) : null;
   }
   if (z.lambda_code) lambdaCode = onGrid(z.lambda_code);
-  const tPaper = paperEquation(z.paper, x);
+  const tPaper = aPeriod(paperEquation(z.paper, x), "the paper's equation", notes);
   const sa = (t) => (fin(t) === null ? null : saG(z.target, t));
   return {
     answer: {

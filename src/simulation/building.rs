@@ -22,6 +22,7 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct BuildingSettings {
     /// Storeys `N`.
+    #[serde(deserialize_with = "crate::study::building::one_storey_count")]
     pub storeys: usize,
     /// First-mode period of the bare building, s.
     pub period: f64,
@@ -42,7 +43,11 @@ pub struct BuildingSettings {
     pub post_yield_ratio: Option<f64>,
     /// Storey heights, m: one value for every storey or a list, storey 1 first [default:
     /// [`DEFAULT_STOREY_HEIGHT_M`]]; they give the drift ratios.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "crate::study::building::storey_heights",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub storey_heights_m: Option<OneOrList<f64>>,
 }
 
@@ -73,11 +78,34 @@ impl BuildingSettings {
 }
 
 /// The floor a stack stands on: `1 … N`, or `roof` (floor `N`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Floor {
     Index(usize),
     Name(String),
+}
+
+impl<'de> Deserialize<'de> for Floor {
+    /// A whole number or a word; anything else refused in words
+    /// ([`crate::study::config::checked_value`]). A number or word that is no floor of the
+    /// building is refused with the building.
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use crate::study::config::{checked_value, shown};
+        checked_value(d, |v| {
+            match &v {
+                serde_yaml::Value::String(s) => Some(Floor::Name(s.clone())),
+                _ => (v.as_u64())
+                    .and_then(|j| usize::try_from(j).ok())
+                    .map(Floor::Index),
+            }
+            .ok_or_else(|| {
+                format!(
+                    "expected a floor number (1 the lowest) or `roof`, got {}",
+                    shown(&v)
+                )
+            })
+        })
+    }
 }
 
 /// One entry of the `stacks:` key.

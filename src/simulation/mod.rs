@@ -13,7 +13,7 @@ use crate::dynamics::{
     simulate_exact, simulate_rk4,
 };
 use crate::ground_motion::{self, Record, RecordError};
-use crate::study::config::{ConfigError, read_yaml_text};
+use crate::study::config::{ConfigError, read_yaml_text, yaml_problem};
 use crate::study::physics::{DampingBasis, Physics};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -126,8 +126,14 @@ pub struct Settings {
 pub enum SimulationError {
     #[error(transparent)]
     Config(#[from] ConfigError),
-    #[error("{file}: {message}")]
-    Yaml { file: String, message: String },
+    /// A case file that is not valid YAML or has keys of the wrong kind
+    /// ([`crate::study::config::yaml_problem`]): the message names the file's keys as it
+    /// writes them, not a command's flags.
+    #[error("{file}: {problem}")]
+    Yaml {
+        file: String,
+        problem: crate::study::config::YamlProblem,
+    },
     #[error("invalid case: {0}")]
     Invalid(String),
     /// A key of a case file, named with the file.
@@ -135,6 +141,9 @@ pub enum SimulationError {
     Key { file: String, message: String },
     #[error(transparent)]
     Record(#[from] RecordError),
+    /// A file to write (`history`) that cannot be made where it is asked for.
+    #[error(transparent)]
+    Output(#[from] crate::store::atomic::OutputPathError),
     #[error("simulation of {record} failed")]
     Simulation {
         record: String,
@@ -150,7 +159,7 @@ impl Settings {
         let mut settings: Settings =
             serde_yaml::from_str(&text).map_err(|e| SimulationError::Yaml {
                 file: path.display().to_string(),
-                message: crate::limits::excerpt_message(&e.to_string()),
+                problem: yaml_problem(&text, &e),
             })?;
         settings.file = Some(path.to_path_buf());
         Ok(settings)
@@ -197,6 +206,7 @@ impl Settings {
         }
         if let Some(p) = &self.history {
             crate::store::HistoryFormat::from_path(p).map_err(|e| self.key_error(e.to_string()))?;
+            crate::store::atomic::check_output_file(p)?;
         }
         let record = match &self.record {
             Some(path) => ground_motion::read_record(path)?,

@@ -35,6 +35,76 @@ pub fn is_temp_name(name: &str) -> bool {
             .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
 }
 
+/// Why a file cannot be written at the path a user gave, known before any work.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputPathError {
+    #[error("{}: directory {} does not exist", path.display(), dir.display())]
+    NoDirectory { path: PathBuf, dir: PathBuf },
+    #[error("{}: {} is not a directory", path.display(), dir.display())]
+    NotADirectory { path: PathBuf, dir: PathBuf },
+    #[error("{}: is a directory, not a file", path.display())]
+    IsADirectory { path: PathBuf },
+    /// The file's format is given by its extension: one of `extensions`.
+    #[error(
+        "{}: {what} must end in {}",
+        path.display(),
+        (extensions.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or "))
+    )]
+    Extension {
+        path: PathBuf,
+        what: &'static str,
+        extensions: &'static [&'static str],
+    },
+}
+
+/// `Err` unless a file can be made at `path`: its directory exists (the working directory for a
+/// bare name) and `path` is not a directory. Checked before any work, so that a run is not lost
+/// to a typing mistake in where its output goes.
+pub fn check_output_file(path: &Path) -> Result<(), OutputPathError> {
+    if path.is_dir() {
+        return Err(OutputPathError::IsADirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => return Ok(()),
+    };
+    let (path, dir) = (path.to_path_buf(), dir.to_path_buf());
+    match std::fs::metadata(&dir) {
+        Ok(m) if m.is_dir() => Ok(()),
+        Ok(_) => Err(OutputPathError::NotADirectory { path, dir }),
+        Err(e)
+            if matches!(
+                e.kind(),
+                std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+            ) =>
+        {
+            Err(OutputPathError::NoDirectory { path, dir })
+        }
+        // Anything else (a directory it may not read) is for the write to report.
+        Err(_) => Ok(()),
+    }
+}
+
+/// [`check_output_file`], and `path` ends in one of `extensions` (`svg`, no dot; any case),
+/// the format of `what` (`a figure (SVG)`).
+pub fn check_output_extension(
+    path: &Path,
+    what: &'static str,
+    extensions: &'static [&'static str],
+) -> Result<(), OutputPathError> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !extensions.iter().any(|e| e.eq_ignore_ascii_case(ext)) {
+        return Err(OutputPathError::Extension {
+            path: path.to_path_buf(),
+            what,
+            extensions,
+        });
+    }
+    check_output_file(path)
+}
+
 /// A temporary file, removed when dropped unless [`Temp::commit`]ted.
 #[derive(Debug)]
 pub struct Temp {

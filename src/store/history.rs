@@ -5,6 +5,7 @@ use super::atomic::Temp;
 use super::h5::attr_str as attr;
 use super::{H5Context, StoreError};
 use crate::dynamics::History;
+use std::fmt::Write as _;
 use std::io::Write;
 use std::path::Path;
 
@@ -89,28 +90,39 @@ pub fn write_history(
     tmp.commit(path)
 }
 
+/// One row per sample through the `csv` crate (the column names are ours and need no quoting;
+/// the numbers are Rust's shortest round-trip text).
 fn write_csv(path: &Path, h: &History, layout: &HistoryLayout) -> std::io::Result<()> {
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut w = csv::Writer::from_writer(std::io::BufWriter::new(std::fs::File::create(path)?));
     let (nb, ni) = (h.bodies, h.interfaces);
     let mut cols = vec!["time_s".to_string(), "ground_accel_mps2".to_string()];
     for (what, unit) in [("disp", "m"), ("vel", "mps"), ("abs_accel", "mps2")] {
         cols.extend(layout.bodies.iter().map(|b| format!("{b}_{what}_{unit}")));
     }
     cols.extend(layout.interfaces.iter().map(|i| format!("{i}_state")));
-    writeln!(w, "{}", cols.join(","))?;
+    w.write_record(&cols)?;
+    let mut field = String::new();
+    let mut put = |w: &mut csv::Writer<_>, v: &dyn std::fmt::Display| {
+        field.clear();
+        write!(field, "{v}").expect("writing to a String");
+        w.write_field(&field)
+    };
     for r in 0..h.rows() {
-        write!(w, "{},{}", h.time_s[r], h.ground_accel_mps2[r])?;
+        put(&mut w, &h.time_s[r])?;
+        put(&mut w, &h.ground_accel_mps2[r])?;
         for data in [&h.displacement_m, &h.velocity_mps, &h.abs_accel_mps2] {
             for v in &data[r * nb..(r + 1) * nb] {
-                write!(w, ",{v}")?;
+                put(&mut w, v)?;
             }
         }
         for c in &h.contact[r * ni..(r + 1) * ni] {
-            write!(w, ",{c}")?;
+            put(&mut w, c)?;
         }
-        writeln!(w)?;
+        w.write_record(None::<&[u8]>)?;
     }
-    w.flush()
+    w.into_inner()
+        .map_err(|e| std::io::Error::new(e.error().kind(), e.error().to_string()))?
+        .flush()
 }
 
 fn write_hdf5(path: &Path, h: &History, layout: &HistoryLayout) -> hdf5::Result<()> {

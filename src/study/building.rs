@@ -16,6 +16,7 @@
 //! The building's damping is the grid's (`damping`, `damping_basis`: modal, `ζ` in every mode
 //! of the basis); its period the grid's `period_s`; its storeys elastic.
 
+use super::config::{checked_value, shown};
 use crate::case::Case;
 use crate::dynamics::G;
 use crate::dynamics::building::model::modes;
@@ -25,12 +26,96 @@ use crate::limits::{MAX_AXIS_VALUES, MAX_STOREYS, excerpt};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
-/// One value or a list of them.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// One value or a list of them. Read by [`one_or_list`], which says what one value must be.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum OneOrList<T> {
     One(T),
     List(Vec<T>),
+}
+
+/// One value or a list of them, each read by `one`; anything else refused as not `what`, in
+/// words the parser places after the key and line.
+fn one_or_list<T>(
+    v: &serde_yaml::Value,
+    what: &str,
+    one: impl Fn(&serde_yaml::Value) -> Option<T>,
+) -> Result<OneOrList<T>, String> {
+    let bad = |x: &serde_yaml::Value| format!("expected {what}, got {}", shown(x));
+    match v {
+        serde_yaml::Value::Sequence(items) => (items.iter())
+            .map(|x| one(x).ok_or_else(|| bad(x)))
+            .collect::<Result<_, _>>()
+            .map(OneOrList::List),
+        x => one(x).map(OneOrList::One).ok_or_else(|| bad(x)),
+    }
+}
+
+/// A key read by [`one_or_list`]; `null` is no value.
+fn optional_one_or_list<'de, D, T>(
+    d: D,
+    what: &str,
+    one: impl Fn(&serde_yaml::Value) -> Option<T>,
+) -> Result<Option<OneOrList<T>>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    checked_value(d, |v| match v {
+        serde_yaml::Value::Null => Ok(None),
+        v => one_or_list(&v, what, one).map(Some),
+    })
+}
+
+/// A whole number of storeys (0 and too many are refused with the building's limits).
+fn storey_count(v: &serde_yaml::Value) -> Option<usize> {
+    v.as_u64().and_then(|n| usize::try_from(n).ok())
+}
+
+/// `building.storeys` of a study: a storey count or a list of them.
+fn storeys<'de, D: serde::Deserializer<'de>>(d: D) -> Result<OneOrList<usize>, D::Error> {
+    checked_value(d, |v| {
+        one_or_list(
+            &v,
+            "a whole number of storeys ≥ 1 or a list of them",
+            storey_count,
+        )
+    })
+}
+
+/// `building.storeys` of a case file: one storey count.
+pub fn one_storey_count<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
+    checked_value(d, |v| {
+        storey_count(&v)
+            .ok_or_else(|| format!("expected a whole number of storeys ≥ 1, got {}", shown(&v)))
+    })
+}
+
+/// `building.storey_heights_m`: a height, m, for every storey, or a list of them.
+pub fn storey_heights<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<OneOrList<f64>>, D::Error> {
+    optional_one_or_list(
+        d,
+        "a storey height in m or a list of them, storey 1 first",
+        serde_yaml::Value::as_f64,
+    )
+}
+
+/// `grid.stack_floor`: a floor or a list of them.
+pub fn stack_floors<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<OneOrList<FloorKey>>, D::Error> {
+    let floor = |v: &serde_yaml::Value| match v {
+        serde_yaml::Value::String(s) => Some(FloorKey::Name(s.clone())),
+        _ => (v.as_u64())
+            .and_then(|j| usize::try_from(j).ok())
+            .map(FloorKey::Index),
+    };
+    optional_one_or_list(
+        d,
+        "a floor number, `roof` or `all`, or a list of them",
+        floor,
+    )
 }
 
 impl<T: Clone> OneOrList<T> {
@@ -42,8 +127,8 @@ impl<T: Clone> OneOrList<T> {
     }
 }
 
-/// A floor as the config writes it: a number, `roof` or `all`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// A floor as the config writes it: a number, `roof` or `all` (read by [`stack_floors`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum FloorKey {
     Index(usize),
@@ -57,6 +142,7 @@ pub enum FloorKey {
 #[serde(deny_unknown_fields)]
 pub struct BuildingSection {
     /// Storey counts `N`: one, or a list (the `storeys` axis).
+    #[serde(deserialize_with = "storeys")]
     pub storeys: OneOrList<usize>,
     /// Relative floor masses, floor 1 first [default: all 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -66,7 +152,11 @@ pub struct BuildingSection {
     pub storey_stiffnesses: Option<Vec<f64>>,
     /// Storey heights, m: one value for every storey or a list, storey 1 first [default:
     /// [`DEFAULT_STOREY_HEIGHT_M`]]; they turn drifts into drift ratios.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "storey_heights",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub storey_heights_m: Option<OneOrList<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub period: Option<f64>,

@@ -27,7 +27,7 @@ use crate::ground_motion::stochastic::{StochasticError, StochasticModel};
 use crate::ground_motion::{ReadOptions, Units};
 use crate::limits::{
     InputFileError, MAX_ALPHA, MAX_AXIS_VALUES, MAX_BLOCKS, MAX_CASE_RESULTS, MAX_FILE_BYTES,
-    MAX_MOTIONS, MAX_MU, MAX_YAML_DEPTH, PERIOD_RANGE_S, excerpt_message, input_text,
+    MAX_MOTIONS, MAX_MU, MAX_YAML_DEPTH, PERIOD_RANGE_S, excerpt, excerpt_message, input_text,
     read_input_file, yaml_depth,
 };
 use crate::spectrum::target::read_table_bytes;
@@ -101,11 +101,34 @@ impl ZoneTarget {
 }
 
 /// A list of values, or an inclusive range `{ from, to, step }`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Values {
     List(Vec<f64>),
     Range(Range),
+}
+
+impl<'de> Deserialize<'de> for Values {
+    /// A list of numbers or a range; anything else refused in words ([`checked_value`]).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde_yaml::Value;
+        checked_value(d, |v| match v {
+            Value::Sequence(items) => (items.iter())
+                .map(|x| {
+                    (x.as_f64())
+                        .ok_or_else(|| format!("expected a number in the list, got {}", shown(x)))
+                })
+                .collect::<Result<_, _>>()
+                .map(Values::List),
+            Value::Mapping(_) => serde_yaml::from_value(v)
+                .map(Values::Range)
+                .map_err(|e| format!("a range {{ from, to, step }}: {e}")),
+            x => Err(format!(
+                "expected a list of numbers or a range {{ from, to, step }}, got {}",
+                shown(&x)
+            )),
+        })
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -158,7 +181,11 @@ pub struct GridConfig {
     pub damping_basis: DampingBasis,
     /// With a `building:` section: the floor the stack stands on, `roof` (the default), `all`
     /// (a stack on every floor), or a list of them (the `stack_floor` axis).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "super::building::stack_floors",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub stack_floor: Option<OneOrList<FloorKey>>,
 }
 
@@ -280,15 +307,33 @@ pub enum ConfigError {
         file: String,
         source: std::io::Error,
     },
-    /// Not valid YAML or not a study file; the parser's message, shortened.
-    #[error("{file}: {message}")]
-    Yaml { file: String, message: String },
+    /// Not valid YAML or not a study file ([`yaml_problem`]): the message names the file's
+    /// keys as it writes them, not a command's flags.
+    #[error("{file}: {problem}")]
+    Yaml { file: String, problem: YamlProblem },
     #[error("{file}: `{key}`: {why}")]
     Invalid {
         file: String,
         key: String,
         why: String,
     },
+}
+
+impl ConfigError {
+    /// The error without the line of a YAML problem: for YAML written by a program from other
+    /// data (the Python module's config dict), whose lines mean nothing to its reader.
+    pub fn without_line(self) -> Self {
+        match self {
+            ConfigError::Yaml { file, problem } => ConfigError::Yaml {
+                file,
+                problem: YamlProblem {
+                    line: None,
+                    ..problem
+                },
+            },
+            e => e,
+        }
+    }
 }
 
 /// The text of a YAML file, checked before any parser sees it: at most [`MAX_FILE_BYTES`],
@@ -329,6 +374,191 @@ fn yaml_text(bytes: &[u8], path: &Path) -> Result<String, ConfigError> {
     Ok(text.to_string())
 }
 
+/// What a YAML parser found wrong with a file, in the file's own words ([`yaml_problem`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct YamlProblem {
+    /// The line of the key or value at fault.
+    pub line: Option<usize>,
+    /// `` `key`: what ``: the key as the file writes it (`building.storeys`, `stacks[0].floor`;
+    /// never a command's flag) and what is wrong with it.
+    pub message: String,
+}
+
+impl std::fmt::Display for YamlProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "line {l}: {}", self.message),
+            None => f.write_str(&self.message),
+        }
+    }
+}
+
+/// A YAML parser's error about `text` in the file's own words: the line of the key or value at
+/// fault (for a key given twice, the second one), the key and what is wrong, an unknown key with
+/// the keys allowed there. The parser's own message, shortened, for what it does not recognise.
+pub fn yaml_problem(text: &str, e: &serde_yaml::Error) -> YamlProblem {
+    let full = e.to_string();
+    let location = e.location();
+    let mut body = full.as_str();
+    if let Some(l) = &location {
+        body = body
+            .strip_suffix(&format!(" at line {} column {}", l.line(), l.column()))
+            .unwrap_or(body);
+    }
+    let is_path = |p: &str| {
+        !p.is_empty()
+            && p.chars()
+                .all(|c| c.is_alphanumeric() || "_-.[]".contains(c))
+    };
+    let (path, body) = match body.split_once(": ") {
+        Some((p, rest)) if is_path(p) => (Some(p), rest),
+        _ => (None, body),
+    };
+    let mut line = location.as_ref().map(serde_yaml::Location::line);
+    let quoted = |rest: &str| {
+        rest.split_once('`')
+            .map(|(k, after)| (k.to_string(), after.to_string()))
+    };
+    let what = if let Some((key, _)) = body.strip_prefix("duplicate field `").and_then(quoted) {
+        if let Some(l) = &location {
+            line = second_key_line(text, l.line(), l.column(), &key).or(line);
+        }
+        format!("`{key}` is given twice")
+    } else if let Some((key, expected)) = body.strip_prefix("unknown field `").and_then(quoted) {
+        let keys: Vec<String> = (expected.split('`').skip(1).step_by(2))
+            .map(|k| format!("`{k}`"))
+            .collect();
+        let allowed = match (keys.is_empty(), path) {
+            (true, _) => "no key is allowed here".to_string(),
+            (false, Some(p)) => format!("the keys of `{p}` are {}", keys.join(", ")),
+            (false, None) => format!("the keys are {}", keys.join(", ")),
+        };
+        format!("unknown key `{}`; {allowed}", excerpt(&key))
+    } else if let Some((key, _)) = body.strip_prefix("missing field `").and_then(quoted) {
+        format!("missing key `{key}`")
+    } else {
+        excerpt_message(body)
+    };
+    let message = match path {
+        Some(p) => format!("`{p}`: {what}"),
+        None => what,
+    };
+    YamlProblem { line, message }
+}
+
+/// A YAML value as a message shows it: a number or word as written (at most
+/// [`crate::limits::ECHO_CHARS`] characters), else its kind.
+pub fn shown(v: &serde_yaml::Value) -> String {
+    use serde_yaml::Value;
+    match v {
+        Value::Null => "nothing".into(),
+        Value::Bool(b) => b.to_string(),
+        Value::Number(n) => n.to_string(),
+        Value::String(s) => format!("`{}`", excerpt(s)),
+        Value::Sequence(_) => "a list".into(),
+        Value::Mapping(_) => "a mapping".into(),
+        Value::Tagged(t) => format!("a value tagged {}", t.tag),
+    }
+}
+
+/// A value read whole and turned into a `T` by `check`, whose `Err` says in words what the
+/// value should have been: refused inside the parser's call for the key, so that the message
+/// carries the key's path and line ([`yaml_problem`]), as a derived type's would (an untagged
+/// enum's says only that no variant matched).
+pub fn checked_value<'de, D, T>(
+    d: D,
+    check: impl FnOnce(serde_yaml::Value) -> Result<T, String>,
+) -> Result<T, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    d.deserialize_any(Checked(check))
+}
+
+struct Checked<F>(F);
+
+impl<F> Checked<F> {
+    fn check<T, E: serde::de::Error>(self, v: serde_yaml::Value) -> Result<T, E>
+    where
+        F: FnOnce(serde_yaml::Value) -> Result<T, String>,
+    {
+        (self.0)(v).map_err(E::custom)
+    }
+}
+
+impl<'de, T, F: FnOnce(serde_yaml::Value) -> Result<T, String>> serde::de::Visitor<'de>
+    for Checked<F>
+{
+    type Value = T;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a YAML value")
+    }
+    fn visit_bool<E: serde::de::Error>(self, v: bool) -> Result<T, E> {
+        self.check(serde_yaml::Value::Bool(v))
+    }
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<T, E> {
+        self.check(serde_yaml::Value::Number(v.into()))
+    }
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<T, E> {
+        self.check(serde_yaml::Value::Number(v.into()))
+    }
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<T, E> {
+        self.check(serde_yaml::Value::Number(v.into()))
+    }
+    fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<T, E> {
+        self.check(serde_yaml::Value::String(v.to_string()))
+    }
+    fn visit_unit<E: serde::de::Error>(self) -> Result<T, E> {
+        self.check(serde_yaml::Value::Null)
+    }
+    fn visit_none<E: serde::de::Error>(self) -> Result<T, E> {
+        self.check(serde_yaml::Value::Null)
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<T, A::Error> {
+        let mut items = Vec::new();
+        while let Some(x) = seq.next_element()? {
+            items.push(x);
+        }
+        self.check(serde_yaml::Value::Sequence(items))
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<T, A::Error> {
+        let mut m = serde_yaml::Mapping::new();
+        while let Some((k, v)) = map.next_entry()? {
+            m.insert(k, v);
+        }
+        self.check(serde_yaml::Value::Mapping(m))
+    }
+}
+
+/// The line of the second `key` of the block mapping whose first key is on `line` at `column`
+/// (1-based, as the parser reports a mapping's start); `None` in a flow mapping or when not
+/// found.
+fn second_key_line(text: &str, line: usize, column: usize, key: &str) -> Option<usize> {
+    let indent = column.checked_sub(1)?;
+    let mut seen = 0;
+    for (i, l) in text.lines().enumerate().skip(line.checked_sub(1)?) {
+        let body = l.trim_start();
+        if body.is_empty() || body.starts_with('#') {
+            continue;
+        }
+        if i + 1 > line && l.len() - body.len() < indent {
+            return None;
+        }
+        let Some(at) = l.get(indent..) else { continue };
+        let name = [key.to_string(), format!("\"{key}\""), format!("'{key}'")]
+            .into_iter()
+            .find_map(|k| at.strip_prefix(&k));
+        if name.is_some_and(|rest| rest.trim_start().starts_with(':')) {
+            seen += 1;
+            if seen == 2 {
+                return Some(i + 1);
+            }
+        }
+    }
+    None
+}
+
 impl StudyConfig {
     /// Reads and validates a study file. Record files and target tables are found relative to
     /// its folder, like any file it names, and each file is read once ([`Loaded`]).
@@ -345,7 +575,7 @@ impl StudyConfig {
         let text = yaml_text(bytes, path)?;
         let mut cfg: StudyConfig = serde_yaml::from_str(&text).map_err(|e| ConfigError::Yaml {
             file: file.clone(),
-            message: excerpt_message(&e.to_string()),
+            problem: yaml_problem(&text, &e),
         })?;
         cfg.loaded.config_sha256 = sha256_hex(bytes);
         let invalid = |key: String, why: String| ConfigError::Invalid {

@@ -7,7 +7,9 @@
 use super::text::num;
 use super::{Files, Inputs, ReportError};
 use crate::design::{ZoneDesign, frame_cases, frame_designs, known_frames};
+use crate::fit::extrapolation::{LOWER_T_P, UPPER_T_RIGID};
 use crate::fit::forms::DAMPING_DEPTH;
+use crate::limits::STRUCTURE_PERIOD_RANGE_S;
 use crate::pipeline::PipelineError;
 use crate::render::design::{FrameInputs, design_page};
 use crate::render::page::escape;
@@ -39,6 +41,10 @@ struct Frames {
 struct PageData {
     /// [`DAMPING_DEPTH`] of the damped form.
     damping_depth: f64,
+    /// [`STRUCTURE_PERIOD_RANGE_S`]: the periods `design` takes, s.
+    period_range_s: (f64, f64),
+    /// The physical band of the fit's box check, `[LOWER_T_P·T_p, UPPER_T_RIGID·T_rigid]`.
+    band: (f64, f64),
     /// One per zone; in a building study one per zone and frame (zone by zone, the frames in
     /// stored order), as [`frame_designs`] gives them.
     zones: Vec<ZoneDesign>,
@@ -140,6 +146,8 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
     let names: Vec<String> = inp.zones.iter().map(|z| z.name.clone()).collect();
     let data = serde_json::to_string(&PageData {
         damping_depth: DAMPING_DEPTH,
+        period_range_s: STRUCTURE_PERIOD_RANGE_S,
+        band: (LOWER_T_P, UPPER_T_RIGID),
         zones,
         drr,
         frames,
