@@ -358,6 +358,17 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
 }
 
 /// The median of the finite values of `v` (the mean of the middle two of an even count).
+/// The `p`-th percentile of the finite values of `v`, linearly between order statistics (as
+/// NumPy's `nanpercentile`).
+fn pct(v: &[f64], p: f64) -> f64 {
+    let mut x: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    x.sort_by(f64::total_cmp);
+    let pos = p / 100.0 * (x.len() - 1) as f64;
+    let lo = pos.floor() as usize;
+    let hi = (lo + 1).min(x.len() - 1);
+    x[lo] + (pos - lo as f64) * (x[hi] - x[lo])
+}
+
 fn median(v: impl Iterator<Item = f64>) -> f64 {
     let mut x: Vec<f64> = v.filter(|x| x.is_finite()).collect();
     x.sort_by(f64::total_cmp);
@@ -511,6 +522,49 @@ fn a_building_studys_report_shows_the_files_numbers() {
                     let pct: &str = cell.split('(').nth(1).unwrap().split(' ').next().unwrap();
                     close(pct, share(v), 0.5 + 1e-9, &what("share below 1"));
                 }
+                // The 10–90 % band of the ratios motion by motion, pooled over cases and motions.
+                let each = |s: ArrayD<f64>, r: ArrayD<f64>| {
+                    (&s / &r).iter().copied().collect::<Vec<f64>>()
+                };
+                let bands = [
+                    (&row[3], each(frame(&sw.vars.u_stack), frame(&sw.vars.u_rigid))),
+                    (&row[4], each(peak(&b.drift_ratio_stack), peak(&b.drift_ratio_rigid))),
+                    (&row[5], each(peak(&b.floor_accel_stack), peak(&b.floor_accel_rigid))),
+                ];
+                for (cell, v) in bands {
+                    let inner = cell.split('[').nth(1).unwrap().trim_end_matches(']');
+                    let (lo, hi) = inner.split_once(", ").unwrap();
+                    close(lo, pct(&v, 10.0), 5e-3, &what("10th percentile"));
+                    close(hi, pct(&v, 90.0), 5e-3, &what("90th percentile"));
+                }
+                let bare: Vec<f64> = in_frame(&l.base_shear_ratio_bare).iter().copied().collect();
+                close_to(&row[9], median(bare.iter().copied()), 5e-4, &what("vs bare"));
+                let code: Vec<f64> = in_frame(&l.lambda_code).iter().copied().collect();
+                close_to(&row[10], median(code.iter().copied()), 5e-3, &what("λ_code"));
+                // The floor holding the largest floor acceleration most often.
+                let acc = frame(&b.floor_accel_stack);
+                let mut count = vec![0usize; n];
+                for lane in acc.lanes(Axis(acc.ndim() - 1)) {
+                    let top = (0..n).fold(0, |a, j| if lane[j] > lane[a] { j } else { a });
+                    count[top] += 1;
+                }
+                let (top, most) = (count.iter().enumerate()).fold((0, 0), |b, (j, &k)| {
+                    if k > b.1 { (j, k) } else { b }
+                });
+                let name = if top + 1 == n {
+                    "roof".to_string()
+                } else {
+                    format!("floor {}", top + 1)
+                };
+                assert!(row[11].starts_with(&format!("{name} (")), "{}", row[11]);
+                let shown = row[11].split('(').nth(1).unwrap().split(' ').next().unwrap();
+                let all: usize = count.iter().sum();
+                close(shown, 100.0 * most as f64 / all as f64, 0.5 + 1e-9, &what("floor"));
+                // Interface 1's peak slip: the median over the cases of the mean over motions.
+                let slip = frame(&sw.vars.slip_peak);
+                let first = slip.index_axis(Axis(slip.ndim() - 1), 0).to_owned();
+                let slip: Vec<f64> = over_motions(first).iter().copied().collect();
+                close(&row[12], median(slip.iter().copied()), 5e-5, &what("slip"));
                 checked += 1;
             }
         }

@@ -71,6 +71,20 @@ struct FrameCases {
     drift: Pair,
     accel: Pair,
     shear: Pair,
+    /// Per case and motion (pooled), stack over rigid: the spread the means hide.
+    roof_each: Vec<f64>,
+    drift_each: Vec<f64>,
+    accel_each: Vec<f64>,
+    /// Empty on one storey (its sweep gives no base shear per motion).
+    shear_each: Vec<f64>,
+    /// Per floor (1 the lowest), how often (cases × motions) it held the largest floor
+    /// acceleration with the sliding stack.
+    accel_floor_count: Vec<usize>,
+    /// Per case, the mean over the motions of the peak slip of interface 1, m.
+    slip: Vec<f64>,
+    /// Per case: `V̄_stack/V̄(0)`, `λ_code`.
+    ratio_bare: Vec<f64>,
+    lambda_code: Vec<f64>,
     lambda: Vec<f64>,
     /// `T_new / T_1`.
     t_ratio: Vec<f64>,
@@ -123,6 +137,13 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
             flat(&lambda.base_shear_rigid_mean),
         );
         let (lam, t_new) = (flat(&lambda.lambda), flat(&z.tnew.vars.t_new));
+        let (ratio_bare, lam_code) = (
+            flat(&lambda.base_shear_ratio_bare),
+            flat(&lambda.lambda_code),
+        );
+        let (vm_stack, vm_rigid) = (flat(&b.base_shear_stack), flat(&b.base_shear_rigid));
+        let slip_peak = flat(&sweep.vars.slip_peak);
+        let blocks = grid.blocks();
         let mut zone_frames = Vec::new();
         for &(f, ref frame) in &frames {
             let n = frame.storeys();
@@ -146,7 +167,36 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
                     .collect()
             };
             let in_frame = |v: &[f64]| v[f * per..(f + 1) * per].to_vec();
+            // Per case and motion (pooled), `value(m, c)`.
+            let each = |value: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
+                (0..per)
+                    .flat_map(|c| (0..motions).map(move |m| (m, c)))
+                    .map(|(m, c)| value(m, c))
+                    .collect()
+            };
+            let mut accel_floor_count = vec![0; n];
+            for c in 0..per {
+                for m in 0..motions {
+                    let i = at(m, c) * n_max;
+                    let top = (0..n)
+                        .reduce(|a, j| if a_stack[i + j] > a_stack[i + a] { j } else { a })
+                        .unwrap_or(0);
+                    accel_floor_count[top] += 1;
+                }
+            }
             zone_frames.push(FrameCases {
+                roof_each: each(&|m, c| u_stack[at(m, c)] / u_rigid[at(m, c)]),
+                drift_each: each(&|m, c| peak_over(&d_stack, m, c) / peak_over(&d_rigid, m, c)),
+                accel_each: each(&|m, c| peak_over(&a_stack, m, c) / peak_over(&a_rigid, m, c)),
+                shear_each: if n > 1 {
+                    each(&|m, c| vm_stack[at(m, c)] / vm_rigid[at(m, c)])
+                } else {
+                    Vec::new()
+                },
+                accel_floor_count,
+                slip: over_motions(&|m, c| slip_peak[at(m, c) * blocks]),
+                ratio_bare: in_frame(&ratio_bare),
+                lambda_code: in_frame(&lam_code),
                 frame: frame.clone(),
                 roof: Pair {
                     stack: over_motions(&|m, c| u_stack[at(m, c)]),
@@ -181,16 +231,20 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
 }
 
 /// The answer table's header.
-const ANSWER_HEADER: [&str; 9] = [
+const ANSWER_HEADER: [&str; 13] = [
     "zone",
     "building, stack on",
     "cases",
-    "roof displacement (DRR_1)",
-    "peak interstorey drift ratio",
-    "peak floor acceleration",
-    "peak base shear",
-    "λ [25th, 75th percentile]",
+    "roof displacement (DRR_1) [10–90 % per motion]",
+    "peak interstorey drift ratio (share below 1) [10–90 % per motion]",
+    "peak floor acceleration (share below 1) [10–90 % per motion]",
+    "peak base shear [10–90 % per motion]",
+    "λ [25th, 75th percentile] (share below 0)",
     "T_new/T_1",
+    "base shear over the bare building's (share below 1)",
+    "λ_code [25th, 75th percentile]",
+    "floor holding the peak floor acceleration (share of cases × motions)",
+    "peak slip of interface 1, m",
 ];
 
 /// `3 storeys, roof` (`1 storey` alone).
@@ -213,32 +267,53 @@ fn floor_name(s: StackFloor) -> String {
 
 fn answer_rows(zones: &[BuildingZone]) -> Vec<Vec<String>> {
     let med = |v: &[f64]| fixed(percentile(v, 50.0), 3);
-    let with_share = |v: &[f64]| {
+    let band = |v: &[f64]| {
+        if v.iter().any(|x| x.is_finite()) {
+            format!(
+                " [{}, {}]",
+                fixed(percentile(v, 10.0), 2),
+                fixed(percentile(v, 90.0), 2)
+            )
+        } else {
+            String::new()
+        }
+    };
+    let share = |v: &[f64]| format!(" ({:.0} %)", 100.0 * share_below_1(v));
+    let quartiles = |v: &[f64]| {
         format!(
-            "{} ({:.0} %)",
-            fixed(percentile(v, 50.0), 3),
-            100.0 * share_below_1(v)
+            "{} [{}, {}]",
+            fixed(percentile(v, 50.0), 2),
+            fixed(percentile(v, 25.0), 2),
+            fixed(percentile(v, 75.0), 2)
         )
     };
     let mut rows = Vec::new();
     for z in zones {
         for f in &z.frames {
             let l = &f.lambda;
+            let below_0 = l.iter().filter(|&&x| x < 0.0).count() as f64 / l.len() as f64;
+            let total: usize = f.accel_floor_count.iter().sum();
+            let (top, count) = (f.accel_floor_count.iter().enumerate())
+                .fold((0, 0), |b, (j, &k)| if k > b.1 { (j, k) } else { b });
+            let top_name = if top + 1 == f.frame.storeys() {
+                "roof".to_string()
+            } else {
+                format!("floor {}", top + 1)
+            };
             rows.push(vec![
                 z.name.clone(),
                 frame_name(&f.frame),
                 f.roof.stack.len().to_string(),
-                med(&f.roof.ratio()),
-                with_share(&f.drift.ratio()),
-                with_share(&f.accel.ratio()),
-                med(&f.shear.ratio()),
-                format!(
-                    "{} [{}, {}]",
-                    fixed(percentile(l, 50.0), 2),
-                    fixed(percentile(l, 25.0), 2),
-                    fixed(percentile(l, 75.0), 2)
-                ),
+                med(&f.roof.ratio()) + &band(&f.roof_each),
+                med(&f.drift.ratio()) + &share(&f.drift.ratio()) + &band(&f.drift_each),
+                med(&f.accel.ratio()) + &share(&f.accel.ratio()) + &band(&f.accel_each),
+                med(&f.shear.ratio()) + &band(&f.shear_each),
+                format!("{} ({:.0} %)", quartiles(l), 100.0 * below_0),
                 med(&f.t_ratio),
+                med(&f.ratio_bare) + &share(&f.ratio_bare),
+                quartiles(&f.lambda_code),
+                format!("{top_name} ({:.0} %)", 100.0 * count as f64 / total as f64),
+                fixed(percentile(&f.slip, 50.0), 4),
             ]);
         }
     }
@@ -463,10 +538,18 @@ pub(super) fn building_section(inp: &Inputs, files: &mut Files) -> Result<Sectio
          (the grid's T_1, α and μ) and, for the drift and the floor acceleration, the share of \
          cases below 1. The peak drift ratio is the largest storey's, the peak floor \
          acceleration the largest floor's; the peak base shear is the mean over the motions \
-         (tnew.h5). λ is the effective live-load fraction (the part of the stack's mass that, \
-         rigidly attached, gives the sliding stack's mean peak base shear; clamped to [0, 1], \
-         docs/model.md). A frame that is an earlier one's building (on one storey every stack \
-         floor) is shown once.",
+         (tnew.h5). In brackets, the 10th and 90th percentiles of the same ratio motion by motion \
+         (each case's peak under one motion over its rigid peak under that motion; pooled over \
+         the cases and motions): the spread the means over few motions hide. λ is the effective \
+         live-load fraction (the part of the stack's mass that, rigidly attached, gives the \
+         sliding stack's mean peak base shear; below 0 where the stack lowers the base shear \
+         below the bare building's, as removing that part of its mass would; docs/model.md, \
+         \"The attached fraction\"), λ_code the fraction a code's equivalent lateral force with \
+         the zone's mean spectrum needs to give the same base shear. The floor column says \
+         which floor holds the largest floor acceleration with the sliding stack, and how often; \
+         the slip is the median over the cases of the mean over the motions of interface 1's \
+         peak slip (with a stack on every floor, the largest over them). A frame that is an \
+         earlier one's building (on one storey every stack floor) is shown once.",
         axes.storeys
             .iter()
             .map(|n| n.to_string())
