@@ -527,9 +527,18 @@ fn a_building_studys_report_shows_the_files_numbers() {
                     (&s / &r).iter().copied().collect::<Vec<f64>>()
                 };
                 let bands = [
-                    (&row[3], each(frame(&sw.vars.u_stack), frame(&sw.vars.u_rigid))),
-                    (&row[4], each(peak(&b.drift_ratio_stack), peak(&b.drift_ratio_rigid))),
-                    (&row[5], each(peak(&b.floor_accel_stack), peak(&b.floor_accel_rigid))),
+                    (
+                        &row[3],
+                        each(frame(&sw.vars.u_stack), frame(&sw.vars.u_rigid)),
+                    ),
+                    (
+                        &row[4],
+                        each(peak(&b.drift_ratio_stack), peak(&b.drift_ratio_rigid)),
+                    ),
+                    (
+                        &row[5],
+                        each(peak(&b.floor_accel_stack), peak(&b.floor_accel_rigid)),
+                    ),
                 ];
                 for (cell, v) in bands {
                     let inner = cell.split('[').nth(1).unwrap().trim_end_matches(']');
@@ -538,9 +547,19 @@ fn a_building_studys_report_shows_the_files_numbers() {
                     close(hi, pct(&v, 90.0), 5e-3, &what("90th percentile"));
                 }
                 let bare: Vec<f64> = in_frame(&l.base_shear_ratio_bare).iter().copied().collect();
-                close_to(&row[9], median(bare.iter().copied()), 5e-4, &what("vs bare"));
+                close_to(
+                    &row[9],
+                    median(bare.iter().copied()),
+                    5e-4,
+                    &what("vs bare"),
+                );
                 let code: Vec<f64> = in_frame(&l.lambda_code).iter().copied().collect();
-                close_to(&row[10], median(code.iter().copied()), 5e-3, &what("λ_code"));
+                close_to(
+                    &row[10],
+                    median(code.iter().copied()),
+                    5e-3,
+                    &what("λ_code"),
+                );
                 // The floor holding the largest floor acceleration most often.
                 let acc = frame(&b.floor_accel_stack);
                 let mut count = vec![0usize; n];
@@ -548,18 +567,28 @@ fn a_building_studys_report_shows_the_files_numbers() {
                     let top = (0..n).fold(0, |a, j| if lane[j] > lane[a] { j } else { a });
                     count[top] += 1;
                 }
-                let (top, most) = (count.iter().enumerate()).fold((0, 0), |b, (j, &k)| {
-                    if k > b.1 { (j, k) } else { b }
-                });
+                let (top, most) = (count.iter().enumerate())
+                    .fold((0, 0), |b, (j, &k)| if k > b.1 { (j, k) } else { b });
                 let name = if top + 1 == n {
                     "roof".to_string()
                 } else {
                     format!("floor {}", top + 1)
                 };
                 assert!(row[11].starts_with(&format!("{name} (")), "{}", row[11]);
-                let shown = row[11].split('(').nth(1).unwrap().split(' ').next().unwrap();
+                let shown = row[11]
+                    .split('(')
+                    .nth(1)
+                    .unwrap()
+                    .split(' ')
+                    .next()
+                    .unwrap();
                 let all: usize = count.iter().sum();
-                close(shown, 100.0 * most as f64 / all as f64, 0.5 + 1e-9, &what("floor"));
+                close(
+                    shown,
+                    100.0 * most as f64 / all as f64,
+                    0.5 + 1e-9,
+                    &what("floor"),
+                );
                 // Interface 1's peak slip: the median over the cases of the mean over motions.
                 let slip = frame(&sw.vars.slip_peak);
                 let first = slip.index_axis(Axis(slip.ndim() - 1), 0).to_owned();

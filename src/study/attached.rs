@@ -36,7 +36,9 @@
 use super::building::Frame;
 use super::physics::{CaseError, Physics, SystemKind};
 use crate::case::Case;
-use crate::dynamics::building::{Building, BuildingResponse, simulate_building};
+use crate::dynamics::building::{
+    Building, BuildingResponse, LinearBuilding, LinearPeaks, simulate_building,
+};
 use crate::dynamics::{ExactOptions, G, Ground};
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
 use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
@@ -126,19 +128,47 @@ impl Means {
 
     /// The means of the responses (one per motion, in order) of `frame`.
     fn of(responses: &[BuildingResponse], frame: &Frame) -> Self {
-        let m = responses.len() as f64;
+        let peaks: Vec<Peaks> = (responses.iter())
+            .map(|r| {
+                let roof = &r.floor_peak_displacement_m[..];
+                (roof, &r.storey_peak_shear_n[..], r.peak_overturning_n_m)
+            })
+            .collect();
+        Self::of_peaks(&peaks, frame)
+    }
+
+    /// The means of the linear kernel's peaks (one per motion, in order) of `frame`.
+    fn of_linear(peaks: &[LinearPeaks], frame: &Frame) -> Self {
+        let peaks: Vec<Peaks> = (peaks.iter())
+            .map(|p| {
+                let roof = &p.floor_peak_displacement_m[..];
+                (
+                    roof,
+                    &p.storey_peak_shear_n[..],
+                    p.peak_overturning_moment_nm,
+                )
+            })
+            .collect();
+        Self::of_peaks(&peaks, frame)
+    }
+
+    fn of_peaks(peaks: &[Peaks], frame: &Frame) -> Self {
+        let m = peaks.len() as f64;
         let n = frame.storeys();
-        let mean =
-            |get: &dyn Fn(&BuildingResponse) -> f64| responses.iter().map(get).sum::<f64>() / m;
+        let mean = |get: &dyn Fn(&Peaks) -> f64| peaks.iter().map(get).sum::<f64>() / m;
         Self {
-            roof_m: mean(&|r| r.floor_peak_displacement_m[n - 1]),
+            roof_m: mean(&|p| p.0[n - 1]),
             storey_shear: (0..n)
-                .map(|i| mean(&|r| frame.base_shear_ratio(r.storey_peak_shear_n[i])))
+                .map(|i| mean(&|p| frame.base_shear_ratio(p.1[i])))
                 .collect(),
-            overturning: mean(&|r| frame.overturning_ratio(r.peak_overturning_n_m)),
+            overturning: mean(&|p| frame.overturning_ratio(p.2)),
         }
     }
 }
+
+/// One motion's peaks: each floor's displacement (m), each storey's shear (N), the overturning
+/// moment (N·m).
+type Peaks<'a> = (&'a [f64], &'a [f64], f64);
 
 /// The lowest fraction of the family for `case`: every loaded floor keeps at least half its
 /// mass, and at most the whole stack is removed.
@@ -178,7 +208,9 @@ fn run_all(
 }
 
 /// [`Means`] of `B(fraction)` for `case` in `frame` ([`Physics::building`]'s single block, its
-/// stacks then attached by `fraction`), by the building's integrator.
+/// stacks then attached by `fraction`), by the linear building's kernel
+/// ([`crate::dynamics::building::LinearBuilding`]: the modal basis once, every motion after it;
+/// it agrees with the building's integrator to 2e-13, docs/model.md).
 pub fn family_means(
     physics: &Physics,
     case: &Case,
@@ -200,14 +232,19 @@ pub fn family_means(
                 source: Box::new(source),
             })
         })?;
-    let responses = run_all(&b, grounds, |source| {
-        in_building(CaseError::Simulation {
+    let linear = |source| {
+        in_building(CaseError::Linear {
             case: case.clone(),
-            kind: SystemKind::Rigid,
+            fraction,
             source,
         })
-    })?;
-    Ok(Means::of(&responses, frame))
+    };
+    let kernel = LinearBuilding::new(&b).map_err(linear)?;
+    let peaks = (grounds.iter())
+        .map(|g| kernel.run(g))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(linear)?;
+    Ok(Means::of_linear(&peaks, frame))
 }
 
 /// [`Means`] of system `kind` of `case` in `frame` and its stuck mass share's mean over the

@@ -9,8 +9,8 @@
 use super::building::Frame;
 use crate::case::Case;
 use crate::dynamics::building::{
-    Building, BuildingError, BuildingResponse, BuildingSpec, StackSpec, StoreyYielding,
-    simulate_building,
+    Building, BuildingError, BuildingResponse, BuildingSpec, LinearBuildingError, StackSpec,
+    StoreyYielding, simulate_building,
 };
 use crate::dynamics::{
     ExactOptions, Ground, ModelError, Response, SimError, System, SystemSpec, Yielding,
@@ -78,6 +78,13 @@ pub enum CaseError {
         case: Case,
         kind: SystemKind,
         source: Box<BuildingError>,
+    },
+    /// A linear building (a fraction of the stack attached) the linear kernel could not run.
+    #[error("case {case}, {} of the stack attached: {source}", fraction)]
+    Linear {
+        case: Case,
+        fraction: f64,
+        source: LinearBuildingError,
     },
     /// A system of a case in a building: the building (`3 storeys, stack on the roof`) and the
     /// error.

@@ -191,6 +191,12 @@ impl StateModes {
         &self.v[i * m..(i + 1) * m]
     }
 
+    /// `V⁻¹` applied to a unit load on every floor, per kept mode: under `p(τ) = −a(τ)·1` (the
+    /// ground's acceleration alone, no force offsets) the modal loads are `β = −a·load_row()`.
+    pub fn load_row(&self) -> &[Cx] {
+        &self.up_ones
+    }
+
     /// The largest `|λ|`, rad/s.
     pub fn fastest(&self) -> f64 {
         self.abs_lambda.iter().copied().fold(0.0, f64::max)

@@ -179,7 +179,13 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
                 for m in 0..motions {
                     let i = at(m, c) * n_max;
                     let top = (0..n)
-                        .reduce(|a, j| if a_stack[i + j] > a_stack[i + a] { j } else { a })
+                        .reduce(|a, j| {
+                            if a_stack[i + j] > a_stack[i + a] {
+                                j
+                            } else {
+                                a
+                            }
+                        })
                         .unwrap_or(0);
                     accel_floor_count[top] += 1;
                 }

@@ -1,0 +1,73 @@
+//! Criterion bench of the linear building kernel (`LinearBuilding`) against the event-driven
+//! integrator (`simulate_building`) on the same linear building: 3, 6 and 20 storeys with 0.3 of
+//! two stacks attached (the building of a `λ` evaluation: `C` not classical for its masses),
+//! one thread, one real record (RSN960, 1999 samples at 0.01 s). Criterion's throughput is
+//! record samples, so `1e9 / (elements per second)` is the time per sample; the ratio of the
+//! `exact/N` and `kernel/N` rows of one run is the kernel's speed-up (every output: floor
+//! displacements and accelerations, drifts, storey shears, overturning moment);
+//! `base_shear/N` is the base shear alone (what a `λ` evaluation needs); `new/N` is the
+//! kernel's set-up (modal basis and output rows), paid once per building.
+//!
+//! `cargo bench --bench linear`.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use slidestack::dynamics::building::{
+    Building, BuildingSpec, LinearBuilding, StackSpec, simulate_building,
+};
+use slidestack::dynamics::{ExactOptions, Ground};
+use slidestack::ground_motion::read_record;
+use std::hint::black_box;
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+fn stack(floor: usize, alpha: &[f64], mu: &[f64]) -> StackSpec {
+    StackSpec {
+        floor,
+        alpha: alpha.to_vec(),
+        mu: mu.to_vec(),
+        mu_static: None,
+    }
+}
+
+fn linear(c: &mut Criterion) {
+    let rec = read_record(&common::fixture("RSN960_NORTHR_LOS270.AT2")).unwrap();
+    let accel = rec.accel_mps2(1.0);
+    let ground = Ground {
+        dt_s: rec.dt_s,
+        accel_mps2: &accel,
+    };
+    let opts = ExactOptions {
+        energy_balance: false,
+        ..ExactOptions::default()
+    };
+    let mut g = c.benchmark_group("linear");
+    g.throughput(Throughput::Elements(accel.len() as u64));
+    for (n, period_s) in [(3, 0.6), (6, 0.8), (20, 2.0)] {
+        let mut spec = BuildingSpec::uniform(n, period_s);
+        spec.stacks = vec![
+            stack(n, &[0.5, 0.5], &[0.2, 0.1]),
+            stack(n.div_ceil(2), &[1.0], &[0.15]),
+        ];
+        let b = Building::new(&spec)
+            .unwrap()
+            .with_stacks_attached_fraction(0.3);
+        let lin = LinearBuilding::new(&b).unwrap();
+        g.bench_function(format!("kernel/{n}"), |bn| {
+            bn.iter(|| black_box(lin.run(&ground).unwrap()))
+        });
+        g.bench_function(format!("base_shear/{n}"), |bn| {
+            bn.iter(|| black_box(lin.peak_base_shear_n(&ground).unwrap()))
+        });
+        g.bench_function(format!("exact/{n}"), |bn| {
+            bn.iter(|| black_box(simulate_building(&b, &ground, &opts).unwrap()))
+        });
+        g.bench_function(format!("new/{n}"), |bn| {
+            bn.iter(|| black_box(LinearBuilding::new(&b).unwrap()))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, linear);
+criterion_main!(benches);

@@ -1,0 +1,691 @@
+//! The linear building (docs/model.md, "The linear building kernel"): a shear building without
+//! stacks and with elastic storeys, whose peak responses to a record are computed from one
+//! complex modal basis, without the event-driven machinery of [`super::exact`].
+//!
+//! Such a building is one linear system `M·ü + C·u̇ + K·u = −M·1·a_g(t)` for the whole record
+//! (the rigidly loaded and bare systems of a study, the building of `λ`; `C` need not be
+//! classical for `M`). In the eigenvectors of its state matrix (`StateModes`, computed once)
+//! every mode obeys `ẏ_r = λ_r·y_r + β₀ + β₁·τ` over a sample interval, with `β = −g_r·a_g`
+//! (`g_r` the modal share of a unit load on every floor), so the exact step from sample to sample
+//! is the complex Nigam–Jennings recurrence
+//!
+//! `y_r(k+1) = e^{λh}·y_r(k) + F_r·a_g,k + G_r·a_g,k+1`,
+//! `F_r = −g_r·(hφ₁(λh) − hφ₂(λh))`, `G_r = −g_r·hφ₂(λh)`,
+//!
+//! its coefficients computed once per record step `h`. Every output is a fixed real linear
+//! function of the modal state, `f(t) = Σ_r w_r·Re(c_r·y_r(t))` (per floor the displacement and
+//! the absolute acceleration, per storey the drift and the storey shear, the overturning moment at
+//! the base), so one pass over the samples costs `O(modes × outputs)` multiply-adds per sample,
+//! with no allocation, division or square root: a matrix–vector product over outputs grouped by
+//! eight (compiled for AVX2 where the processor has it, the same bits either way).
+//!
+//! Peaks are exact between samples. The first pass takes every output's largest sampled `|f|`
+//! and keeps, per block of `BLOCK` (32) intervals, the modal state at its start, each output's
+//! largest sampled `|f|` in it and per mode the largest `|y_r''|` bound over its intervals
+//! (`y_r''(τ) = e^{λτ}·q_r`, `q_r = λ²y₀ + λβ₀ + β₁`, bounded by `|Re q_r| + |Im q_r|`). Over an
+//! interval `max|f| ≤ max(|f(0)|, |f(h)|) + max|f''|·h²/8`, with `|f''| ≤ Σ_r w_r·|c_r|·|q_r|`
+//! (times `e^{Re λ·h}` where round-off leaves a mode growing): the second pass revisits only the
+//! blocks where this bound reaches an output's sampled peak, repeats their recurrence from the
+//! stored state (the same bits), tests each interval the same way, and searches the survivors by
+//! the certified peak search of `dynamics::search` on the closed form (the searches of
+//! the building's integrator, on the same functions).
+
+use super::super::search::{self, Node};
+use super::super::{Ground, SimError};
+use super::modal::{ModalError, ModalFn, Piece, StateModes, mode_terms};
+use super::model::Building;
+use crate::numeric::Cx;
+use thiserror::Error;
+
+/// Sample intervals per block of the first pass: the second pass repeats a block's recurrence
+/// when one of its outputs may hold a peak above the sampled one; the blocks' stored states and
+/// maxima take `(3·modes + outputs)/BLOCK` numbers per sample.
+const BLOCK: usize = 32;
+
+/// Relative slack on the derivative bounds against the rounding of their sums (as
+/// `ModalFn::bound`).
+const BOUND_SLACK: f64 = 1.0 + 1e-12;
+
+/// A building the kernel cannot take, or a record it cannot run.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum LinearBuildingError {
+    #[error(
+        "the linear building kernel takes a building without stacks (attach them first, \
+         Building::with_stacks_attached_fraction); this one carries {0} block(s)"
+    )]
+    Stacks(usize),
+    #[error(
+        "the linear building kernel takes elastic storeys; this building's storeys yield (run \
+         simulate_building)"
+    )]
+    Yielding,
+    #[error(transparent)]
+    Modal(#[from] ModalError),
+    #[error(transparent)]
+    Ground(#[from] SimError),
+    #[error("the linear building's response is not finite")]
+    NotFinite,
+}
+
+/// The peaks over a whole record of a linear building's responses, exact between samples
+/// (docs/model.md, "The linear building kernel").
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearPeaks {
+    /// Peak `|u_j|` of each floor relative to the ground, m, floor 1 first.
+    pub floor_peak_displacement_m: Vec<f64>,
+    /// Peak `|ü_j + a_g|`, each floor's absolute acceleration, m/s².
+    pub floor_peak_abs_accel_mps2: Vec<f64>,
+    /// Peak `|δ_i|`, `δ_i = u_i − u_{i−1}`, m, storey 1 first.
+    pub storey_peak_drift_m: Vec<f64>,
+    /// Peak `|V_i|`, N, of the storey shear `V_i = k_i·δ_i + Σ_{j≥i} (C·u̇)_j`
+    /// `= −Σ_{j≥i} m_j·a_abs,j`; storey 1's is the base shear
+    /// (`BuildingResponse::peak_base_shear_n`).
+    pub storey_peak_shear_n: Vec<f64>,
+    /// Peak `|M|`, N·m, of the overturning moment at the base `M = Σ_i h_i·V_i`
+    /// `= −Σ_j z_j·m_j·a_abs,j` (`h_i` storey `i`'s height, `z_j` floor `j`'s elevation).
+    pub peak_overturning_moment_nm: f64,
+}
+
+impl LinearPeaks {
+    /// Peak `|V|` of the base shear `V = k_1·u_1 + 1ᵀ·C·u̇`, N (storey 1's shear).
+    pub fn peak_base_shear_n(&self) -> f64 {
+        self.storey_peak_shear_n[0]
+    }
+}
+
+/// A linear building ready to run records: its modal basis and output rows, computed once.
+#[derive(Debug, Clone)]
+pub struct LinearBuilding {
+    n: usize,
+    modes: StateModes,
+    heights_m: Vec<f64>,
+    /// Every output: floor displacements, floor absolute accelerations, storey drifts, storey
+    /// shears, the overturning moment (`4N + 1`).
+    all: Outputs,
+    /// The base shear alone (storey 1's shear row of `all`).
+    base: Outputs,
+}
+
+/// A table of outputs, each a linear function of the modal state.
+#[derive(Debug, Clone)]
+struct Outputs {
+    count: usize,
+    /// Per output the coefficient `c_r` of every kept mode (`count × modes`).
+    rows: Vec<Cx>,
+    /// `w_r·|c_r|` (`outputs × modes`).
+    rows_abs: Vec<f64>,
+    /// The rows weighted by state component, `f_o = Σ_c wrows[o][c]·y_c` over the state
+    /// `y = (Re y_r, Im y_r)`: `wrows[o][r] = w_r·Re c_r`, `wrows[o][m + r] = −w_r·Im c_r`
+    /// (`outputs × 2·modes`).
+    wrows: Vec<f64>,
+    /// The same numbers for the samples' matrix–vector product, [`LANE`] outputs at a time:
+    /// `cols[g·2m + c][i] = wrows[g·LANE + i][c]` (zero past the last output), so that a group's
+    /// sums stay in registers. Each output is summed in the same order either way.
+    cols: Vec<[f64; LANE]>,
+}
+
+impl Outputs {
+    /// The table of `rows` (`count × modes`) in `modes`' basis.
+    fn new(modes: &StateModes, rows: Vec<Cx>) -> Self {
+        let m = modes.modes();
+        let count = rows.len() / m;
+        let rows_abs = rows
+            .iter()
+            .enumerate()
+            .map(|(i, c)| modes.weight[i % m] * c.abs())
+            .collect();
+        let mut wrows = vec![0.0; count * 2 * m];
+        for o in 0..count {
+            for r in 0..m {
+                let (cr, w) = (rows[o * m + r], modes.weight[r]);
+                wrows[o * 2 * m + r] = w * cr.0;
+                wrows[o * 2 * m + m + r] = -w * cr.1;
+            }
+        }
+        let mut cols = vec![[0.0; LANE]; count.div_ceil(LANE) * 2 * m];
+        for o in 0..count {
+            for c in 0..2 * m {
+                cols[(o / LANE) * 2 * m + c][o % LANE] = wrows[o * 2 * m + c];
+            }
+        }
+        Self {
+            count,
+            rows,
+            rows_abs,
+            wrows,
+            cols,
+        }
+    }
+
+    /// Every output at modal state `y`, [`LANE`] at a time.
+    #[inline(always)]
+    fn eval_all(&self, y: &[f64], f: &mut [[f64; LANE]]) {
+        for (out, group) in f.iter_mut().zip(self.cols.chunks_exact(y.len())) {
+            let mut acc = [0.0; LANE];
+            for (col, &s) in group.iter().zip(y) {
+                for i in 0..LANE {
+                    acc[i] += col[i] * s;
+                }
+            }
+            *out = acc;
+        }
+    }
+
+    /// Output `o` at modal state `y`: the same sum as [`Self::eval_all`]'s, the same bits.
+    fn eval_one(&self, o: usize, y: &[f64]) -> f64 {
+        let row = &self.wrows[o * y.len()..(o + 1) * y.len()];
+        row.iter().zip(y).fold(0.0, |acc, (c, s)| acc + c * s)
+    }
+}
+
+/// Outputs summed together in the samples' matrix–vector product (two AVX2 registers).
+const LANE: usize = 8;
+
+/// What the first pass keeps: per block its start state (`2·modes`), each output's largest
+/// sampled `|f|` (grouped by [`LANE`]) and per mode the largest `|y''|` bound; each output's
+/// largest sampled `|f|`.
+struct FirstPass {
+    starts: Vec<f64>,
+    block_max: Vec<[f64; LANE]>,
+    block_q: Vec<f64>,
+    best: Vec<[f64; LANE]>,
+}
+
+/// One mode's coefficients over a sample interval of `h`.
+#[derive(Debug, Clone, Copy)]
+struct ModeStep {
+    /// `e^{λh}`.
+    e: Cx,
+    /// `F_r`, `G_r` (module doc): the end state's coefficients on `a_g,k` and `a_g,k+1`, s.
+    fa0: Cx,
+    fa1: Cx,
+    /// `λ²`, `−λ·g`, `−g`: `q = λ²·y₀ + (−λg)·a_g,k + (−g)·ȧ_g`.
+    l2: Cx,
+    lg: Cx,
+    ng: Cx,
+}
+
+impl LinearBuilding {
+    /// The kernel of `building` (no stacks, elastic storeys; its storey heights enter only the
+    /// overturning moment). Computes the modal basis of `(M, C, K)` and the output rows once.
+    pub fn new(building: &Building) -> Result<Self, LinearBuildingError> {
+        if building.blocks() > 0 {
+            return Err(LinearBuildingError::Stacks(building.blocks()));
+        }
+        if building.springs().is_some() {
+            return Err(LinearBuildingError::Yielding);
+        }
+        let n = building.storeys();
+        let storey_heights_m = building.storey_heights_m();
+        let masses = &building.masses()[..n];
+        let (k, c) = (building.stiffness(), building.damping());
+        let modes = StateModes::new(masses, k, c)?;
+        let m = modes.modes();
+        let outputs = 4 * n + 1;
+
+        // Storey i's shear, V_i = k_i·(u_i − u_{i−1}) + Σ_{j≥i} Σ_l C_jl·u̇_l, as coefficients on
+        // the floors' displacements (N/m) and velocities (N·s/m); the moment Σ_i h_i·V_i the
+        // same way.
+        let shear = |i: usize| {
+            let mut su = vec![0.0; n];
+            su[i] = k[i];
+            if i > 0 {
+                su[i - 1] = -k[i];
+            }
+            let sv: Vec<f64> = (0..n).map(|l| (i..n).map(|j| c[j * n + l]).sum()).collect();
+            (su, sv)
+        };
+        let (mut mu, mut mv) = (vec![0.0; n], vec![0.0; n]);
+        for (i, &h) in storey_heights_m.iter().enumerate() {
+            let (su, sv) = shear(i);
+            for j in 0..n {
+                mu[j] += h * su[j];
+                mv[j] += h * sv[j];
+            }
+        }
+        // A real combination of displacement and velocity rows, summed floor by floor (for
+        // storey 1 the same operations as the integrator's `Row::Shear`).
+        let combine = |su: &[f64], sv: &[f64], r: usize| {
+            (0..n).fold(Cx(0.0, 0.0), |s, j| {
+                s.add(modes.row(j)[r].scale(su[j]))
+                    .add(modes.row(n + j)[r].scale(sv[j]))
+            })
+        };
+        let mut rows = vec![Cx(0.0, 0.0); outputs * m];
+        for j in 0..n {
+            let (su, sv) = shear(j);
+            for r in 0..m {
+                let u = modes.row(j)[r];
+                let u_prev = if j > 0 {
+                    modes.row(j - 1)[r]
+                } else {
+                    Cx(0.0, 0.0)
+                };
+                rows[Self::disp(j) * m + r] = u;
+                rows[Self::accel(n, j) * m + r] = modes.lambda[r].mul(modes.row(n + j)[r]);
+                rows[Self::drift(n, j) * m + r] = u.sub(u_prev);
+                rows[Self::shear(n, j) * m + r] = combine(&su, &sv, r);
+            }
+        }
+        for r in 0..m {
+            rows[Self::moment(n) * m + r] = combine(&mu, &mv, r);
+        }
+        let base_row = rows[Self::shear(n, 0) * m..(Self::shear(n, 0) + 1) * m].to_vec();
+        let (all, base) = (Outputs::new(&modes, rows), Outputs::new(&modes, base_row));
+        Ok(Self {
+            n,
+            modes,
+            heights_m: storey_heights_m.to_vec(),
+            all,
+            base,
+        })
+    }
+
+    fn disp(j: usize) -> usize {
+        j
+    }
+    fn accel(n: usize, j: usize) -> usize {
+        n + j
+    }
+    fn drift(n: usize, i: usize) -> usize {
+        2 * n + i
+    }
+    fn shear(n: usize, i: usize) -> usize {
+        3 * n + i
+    }
+    fn moment(n: usize) -> usize {
+        4 * n
+    }
+
+    /// Storeys (and floors) `N`.
+    pub fn storeys(&self) -> usize {
+        self.n
+    }
+
+    /// Storey heights, m, storey 1 first.
+    pub fn storey_heights_m(&self) -> &[f64] {
+        &self.heights_m
+    }
+
+    /// Kept modes of the state matrix (one per complex pair, one per real eigenvalue).
+    pub fn modes(&self) -> usize {
+        self.modes.modes()
+    }
+
+    /// The modes' coefficients over a sample interval of `h` s.
+    fn mode_steps(&self, h: f64) -> Vec<ModeStep> {
+        let g = self.modes.load_row();
+        let inv_h = 1.0 / h;
+        self.modes
+            .lambda
+            .iter()
+            .zip(g)
+            .map(|(&l, &g)| {
+                let [e, p1, p2, _] = mode_terms(l, h);
+                let ng = Cx(-g.0, -g.1);
+                let p2h = p2.scale(inv_h);
+                ModeStep {
+                    e,
+                    fa0: ng.mul(p1.sub(p2h)),
+                    fa1: ng.mul(p2h),
+                    l2: l.mul(l),
+                    lg: l.mul(ng),
+                    ng,
+                }
+            })
+            .collect()
+    }
+
+    /// One sample interval: raises `q_max[r]` to the interval's bound of `|y_r''|`
+    /// (`|Re q| + |Im q| ≥ |q|`) and moves `y` (`Re y_r` then `Im y_r`) to its end.
+    #[inline(always)]
+    fn step(steps: &[ModeStep], y: &mut [f64], q_max: &mut [f64], a0: f64, a1: f64, inv_h: f64) {
+        let m = steps.len();
+        let (re, im) = y.split_at_mut(m);
+        let slope = (a1 - a0) * inv_h;
+        // Written out rather than through `Cx` so that it is compiled into the AVX2 copy of the
+        // first pass whatever the inliner decides (the same operations in the same order).
+        for (((s, yr), yi), q_max) in steps.iter().zip(re).zip(im).zip(q_max) {
+            let (y0r, y0i) = (*yr, *yi);
+            let qr = s.l2.0 * y0r - s.l2.1 * y0i + s.lg.0 * a0 + s.ng.0 * slope;
+            let qi = s.l2.0 * y0i + s.l2.1 * y0r + s.lg.1 * a0 + s.ng.1 * slope;
+            let qa = qr.abs() + qi.abs();
+            *q_max = if qa > *q_max { qa } else { *q_max };
+            *yr = s.e.0 * y0r - s.e.1 * y0i + s.fa0.0 * a0 + s.fa1.0 * a1;
+            *yi = s.e.0 * y0i + s.e.1 * y0r + s.fa0.1 * a0 + s.fa1.1 * a1;
+        }
+    }
+
+    /// The first pass over the samples (module doc), compiled twice: for AVX2 (chosen at run
+    /// time where the processor has it) and for the baseline. Neither contracts a multiply and
+    /// an add, so both give the same bits.
+    fn first_pass(out: &Outputs, steps: &[ModeStep], accel: &[f64], inv_h: f64) -> FirstPass {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor has AVX2 (checked just above).
+                return unsafe { Self::first_pass_avx2(out, steps, accel, inv_h) };
+            }
+        }
+        Self::first_pass_generic(out, steps, accel, inv_h)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn first_pass_avx2(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accel: &[f64],
+        inv_h: f64,
+    ) -> FirstPass {
+        Self::first_pass_generic(out, steps, accel, inv_h)
+    }
+
+    #[inline(always)]
+    fn first_pass_generic(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accel: &[f64],
+        inv_h: f64,
+    ) -> FirstPass {
+        let m = steps.len();
+        let groups = out.count.div_ceil(LANE);
+        let intervals = accel.len() - 1;
+        let blocks = intervals.div_ceil(BLOCK);
+        let mut starts = vec![0.0; blocks * 2 * m];
+        let mut block_max = vec![[0.0; LANE]; blocks * groups];
+        let mut block_q = vec![0.0; blocks * m];
+        let mut best = vec![[0.0; LANE]; groups];
+        let mut y = vec![0.0; 2 * m];
+        let mut f = vec![[0.0; LANE]; groups];
+        // |f| at the latest sample: the block's maxima start from its first sample's.
+        let mut f_abs = vec![[0.0; LANE]; groups];
+        for b in 0..blocks {
+            starts[b * 2 * m..(b + 1) * 2 * m].copy_from_slice(&y);
+            let bm = &mut block_max[b * groups..(b + 1) * groups];
+            bm.copy_from_slice(&f_abs);
+            let bq = &mut block_q[b * m..(b + 1) * m];
+            for k in b * BLOCK..((b + 1) * BLOCK).min(intervals) {
+                Self::step(steps, &mut y, bq, accel[k], accel[k + 1], inv_h);
+                out.eval_all(&y, &mut f);
+                for ((bm, fa), fo) in bm.iter_mut().zip(f_abs.iter_mut()).zip(&f) {
+                    for i in 0..LANE {
+                        let a = fo[i].abs();
+                        fa[i] = a;
+                        // `max` without its NaN case: one instruction.
+                        bm[i] = if a > bm[i] { a } else { bm[i] };
+                    }
+                }
+            }
+            for (best, bm) in best.iter_mut().zip(bm.iter()) {
+                for i in 0..LANE {
+                    best[i] = if bm[i] > best[i] { bm[i] } else { best[i] };
+                }
+            }
+        }
+        FirstPass {
+            starts,
+            block_max,
+            block_q,
+            best,
+        }
+    }
+
+    /// The peaks of every output over `ground` (from rest at its first sample, over its
+    /// duration), exact for a ground acceleration linear between samples.
+    pub fn run(&self, ground: &Ground) -> Result<LinearPeaks, LinearBuildingError> {
+        let best = self.peaks(&self.all, ground)?;
+        let n = self.n;
+        let take = |at: fn(usize, usize) -> usize| (0..n).map(|j| best[at(n, j)]).collect();
+        Ok(LinearPeaks {
+            floor_peak_displacement_m: take(|_, j| Self::disp(j)),
+            floor_peak_abs_accel_mps2: take(Self::accel),
+            storey_peak_drift_m: take(Self::drift),
+            storey_peak_shear_n: take(Self::shear),
+            peak_overturning_moment_nm: best[Self::moment(n)],
+        })
+    }
+
+    /// The peak `|V|` of the base shear over `ground`, N: [`Self::run`]'s
+    /// [`LinearPeaks::peak_base_shear_n`] to the bit (the same row, sums and searches), at the
+    /// cost of one output instead of `4N + 1` (what a `λ` evaluation needs).
+    pub fn peak_base_shear_n(&self, ground: &Ground) -> Result<f64, LinearBuildingError> {
+        Ok(self.peaks(&self.base, ground)?[0])
+    }
+
+    /// The peak `|f|` of every output of `out` over `ground` (module doc).
+    fn peaks(&self, out: &Outputs, ground: &Ground) -> Result<Vec<f64>, LinearBuildingError> {
+        ground.validate()?;
+        let accel = ground.accel_mps2;
+        let h = ground.dt_s;
+        let inv_h = 1.0 / h;
+        let steps = self.mode_steps(h);
+        let (m, outputs) = (self.modes(), out.count);
+        // Curvature rows: h²/8 · w_r·|c_r| · max(1, e^{Re λ·h}), with the slack.
+        let growth: Vec<f64> = (self.modes.lambda.iter())
+            .map(|l| (l.0 * h).exp().max(1.0) * h * h / 8.0 * BOUND_SLACK)
+            .collect();
+        let curv: Vec<f64> = (out.rows_abs.chunks_exact(m))
+            .flat_map(|row| row.iter().zip(&growth).map(|(a, g)| a * g))
+            .collect();
+
+        // First pass: sampled peaks, and per block its start state, sampled maxima and `|y''|`
+        // bounds.
+        let FirstPass {
+            starts,
+            block_max,
+            block_q,
+            best,
+        } = Self::first_pass(out, &steps, accel, inv_h);
+        let mut best: Vec<f64> = best.as_flattened()[..outputs].to_vec();
+        if !best.iter().all(|x| x.is_finite()) {
+            return Err(LinearBuildingError::NotFinite);
+        }
+        let block_max = block_max.as_flattened();
+        let stride = outputs.div_ceil(LANE) * LANE;
+
+        // Second pass: the blocks and intervals whose bound reaches an output's peak so far.
+        let intervals = accel.len() - 1;
+        let mut candidates = Vec::with_capacity(outputs);
+        // Each candidate's value at the interval's start and end.
+        let (mut f0, mut f1) = (Vec::with_capacity(outputs), Vec::with_capacity(outputs));
+        let mut q = vec![0.0; m];
+        let mut y = vec![0.0; 2 * m];
+        let mut y1 = vec![0.0; 2 * m];
+        let mut piece = Piece::default();
+        for b in 0..intervals.div_ceil(BLOCK) {
+            let bq = &block_q[b * m..(b + 1) * m];
+            candidates.clear();
+            for o in 0..outputs {
+                let slack: f64 = curv[o * m..(o + 1) * m]
+                    .iter()
+                    .zip(bq)
+                    .map(|(c, q)| c * q)
+                    .sum();
+                if block_max[b * stride + o] + slack > best[o] {
+                    candidates.push(o);
+                }
+            }
+            if candidates.is_empty() {
+                continue;
+            }
+            y.copy_from_slice(&starts[b * 2 * m..(b + 1) * 2 * m]);
+            f0.clear();
+            f0.extend(candidates.iter().map(|&o| out.eval_one(o, &y)));
+            for k in b * BLOCK..((b + 1) * BLOCK).min(intervals) {
+                let (a0, a1) = (accel[k], accel[k + 1]);
+                q.fill(0.0);
+                y1.copy_from_slice(&y);
+                Self::step(&steps, &mut y1, &mut q, a0, a1, inv_h);
+                f1.clear();
+                f1.extend(candidates.iter().map(|&o| out.eval_one(o, &y1)));
+                let mut built = false;
+                for (i, &o) in candidates.iter().enumerate() {
+                    let slack: f64 = curv[o * m..(o + 1) * m]
+                        .iter()
+                        .zip(&q)
+                        .map(|(c, q)| c * q)
+                        .sum();
+                    if f0[i].abs().max(f1[i].abs()) + slack <= best[o] {
+                        continue;
+                    }
+                    if !built {
+                        self.piece(&y, a0, (a1 - a0) * inv_h, &mut piece);
+                        built = true;
+                    }
+                    let ends = (f0[i], f1[i]);
+                    best[o] = self.search(out, o, &piece, (&y, &y1), ends, h, best[o]);
+                }
+                std::mem::swap(&mut y, &mut y1);
+                std::mem::swap(&mut f0, &mut f1);
+            }
+        }
+
+        Ok(best)
+    }
+
+    /// The modal coefficients of the interval starting at state `y` under
+    /// `a_g(τ) = a0 + slope·τ`: `y₀`, `β₀ = −g·a0`, `β₁ = −g·slope`, `q = λ²y₀ + λβ₀ + β₁` and
+    /// `|q|·|λ|^{k−2}` (as [`StateModes::piece`] from the physical state).
+    fn piece(&self, y: &[f64], a0: f64, slope: f64, out: &mut Piece) {
+        let m = self.modes();
+        let g = self.modes.load_row();
+        for v in [&mut out.y0, &mut out.b0, &mut out.b1, &mut out.q2] {
+            v.clear();
+        }
+        out.mag.clear();
+        for r in 0..m {
+            let l = self.modes.lambda[r];
+            let y0 = Cx(y[r], y[m + r]);
+            let b0 = g[r].scale(-a0);
+            let b1 = g[r].scale(-slope);
+            let q2 = l.mul(l).mul(y0).add(l.mul(b0)).add(b1);
+            let (a, al) = (q2.abs(), l.abs());
+            out.y0.push(y0);
+            out.b0.push(b0);
+            out.b1.push(b1);
+            out.q2.push(q2);
+            out.mag.push([a, al * a, al * al * a]);
+        }
+    }
+
+    /// The peak `|f_o|` over one interval (`y`, `f` at its ends) if above `best`, else `best`:
+    /// the certified search on the closed form.
+    #[allow(clippy::too_many_arguments)]
+    fn search(
+        &self,
+        out: &Outputs,
+        o: usize,
+        piece: &Piece,
+        (y0, y1): (&[f64], &[f64]),
+        (f0, f1): (f64, f64),
+        h: f64,
+        best: f64,
+    ) -> f64 {
+        let m = self.modes();
+        let c = &out.rows[o * m..(o + 1) * m];
+        let func = ModalFn {
+            modes: &self.modes,
+            piece,
+            c,
+            c_abs: &out.rows_abs[o * m..(o + 1) * m],
+            scale: 1.0,
+            poly: [0.0; 4],
+        };
+        // Slopes at the ends: y' = λ·y + β₀ + β₁·τ.
+        let (mut d0, mut d1) = (0.0, 0.0);
+        for r in 0..m {
+            let (l, w) = (self.modes.lambda[r], self.modes.weight[r]);
+            let (b0, b1) = (piece.b0[r], piece.b1[r]);
+            let s0 = l.mul(Cx(y0[r], y0[m + r])).add(b0);
+            let s1 = l.mul(Cx(y1[r], y1[m + r])).add(b0).add(b1.scale(h));
+            d0 += w * c[r].mul(s0).0;
+            d1 += w * c[r].mul(s1).0;
+        }
+        let n0 = Node {
+            at: 0.0,
+            f: f0,
+            df: d0,
+        };
+        let n1 = Node {
+            at: h,
+            f: f1,
+            df: d1,
+        };
+        search::peak_abs(&func, &n0, &n1, best, h).0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::model::{BuildingSpec, StackSpec, StoreyYielding};
+    use super::*;
+
+    fn spec() -> BuildingSpec {
+        let mut s = BuildingSpec::uniform(3, 0.6);
+        s.floor_masses = vec![1.2, 1.0, 0.7];
+        s.storey_stiffnesses = vec![3.0, 2.0, 1.0];
+        s
+    }
+
+    /// Stacks and yielding storeys are refused with the reason; the attached
+    /// building of the same stacks is taken.
+    #[test]
+    fn refuses_what_is_not_a_linear_building() {
+        let mut s = spec();
+        s.stacks = vec![StackSpec {
+            floor: 2,
+            alpha: vec![0.5, 0.5],
+            mu: vec![0.2, 0.1],
+            mu_static: None,
+        }];
+        let b = Building::new(&s).unwrap();
+        let e = LinearBuilding::new(&b).unwrap_err();
+        assert_eq!(e, LinearBuildingError::Stacks(2));
+        assert!(e.to_string().contains("without stacks"), "{e}");
+        assert!(LinearBuilding::new(&b.with_stacks_attached_fraction(0.3)).is_ok());
+        let mut y = spec();
+        y.yielding = Some(StoreyYielding {
+            strength_ratios: vec![0.2; 3],
+            post_yield_ratio: 0.05,
+        });
+        let b = Building::new(&y).unwrap();
+        assert_eq!(
+            LinearBuilding::new(&b).unwrap_err(),
+            LinearBuildingError::Yielding
+        );
+        let b = Building::new(&spec()).unwrap();
+        let lin = LinearBuilding::new(&b).unwrap();
+        let e = lin.run(&Ground::new(0.01, &[0.0])).unwrap_err();
+        assert_eq!(e, LinearBuildingError::Ground(SimError::TooShort(1)));
+    }
+
+    /// The recurrence's coefficients against the closed form of one interval: a state and a
+    /// linear load stepped by `ModeStep` equal `e^{λh}y₀ + hφ₁β₀ + h²φ₂β₁` (the piece's own
+    /// evaluation, `ModalPoint`) to a few ulps.
+    #[test]
+    fn the_recurrence_is_the_closed_form_of_an_interval() {
+        use super::super::modal::ModalPoint;
+        let b = Building::new(&spec()).unwrap();
+        let lin = LinearBuilding::new(&b).unwrap();
+        let m = lin.modes();
+        let h = 0.013;
+        let steps = lin.mode_steps(h);
+        let y0: Vec<f64> = (0..2 * m).map(|i| 0.01 * (i as f64 + 1.0).sin()).collect();
+        let (a0, a1) = (1.7, -0.4);
+        let mut y = y0.clone();
+        let mut q = vec![0.0; m];
+        LinearBuilding::step(&steps, &mut y, &mut q, a0, a1, 1.0 / h);
+        let mut piece = Piece::default();
+        lin.piece(&y0, a0, (a1 - a0) / h, &mut piece);
+        let mut p = ModalPoint::default();
+        p.at(&lin.modes, &piece, h);
+        for r in 0..m {
+            let want = p.y[r];
+            let err = Cx(y[r], y[m + r]).sub(want).abs();
+            assert!(err < 1e-14 * want.abs().max(1e-3), "mode {r}: {err:e}");
+            // The curvature bound covers the modulus of y''(0) = q.
+            assert!(q[r] >= piece.q2[r].abs() && q[r] <= 1.5 * piece.q2[r].abs());
+        }
+    }
+}
