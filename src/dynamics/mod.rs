@@ -53,6 +53,7 @@ pub use exact::{ExactOptions, simulate_exact};
 pub use model::{DampingBasis, G, Hysteresis, ModelError, System, SystemSpec, Yielding};
 pub use response::{Energy, History, Response};
 pub use rk4::simulate_rk4;
+pub use search::SearchError;
 
 use crate::limits::{DT_RANGE_S, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP};
 use thiserror::Error;
@@ -108,6 +109,13 @@ pub enum SimError {
     },
     #[error("the response is not finite (the integration diverged)")]
     Diverged,
+    /// A certified search for a switch or a peak that could not proceed.
+    #[error("in the sample interval starting at t = {time_s} s: {source}")]
+    Search {
+        time_s: f64,
+        #[source]
+        source: SearchError,
+    },
     /// A building's contact and yield state that the modal solution cannot represent.
     #[error("{0}")]
     Modal(String),
@@ -121,7 +129,10 @@ impl SimError {
     pub fn is_bad_input(&self) -> bool {
         !matches!(
             self,
-            SimError::Zeno { .. } | SimError::Contact(_) | SimError::Diverged
+            SimError::Zeno { .. }
+                | SimError::Contact(_)
+                | SimError::Diverged
+                | SimError::Search { .. }
         )
     }
 }

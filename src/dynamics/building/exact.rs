@@ -485,7 +485,9 @@ impl<'b> Integrator<'b> {
                     } else {
                         Node::of(&f, limit)
                     };
-                    if let Some(t) = search::first_violation(&f, &n0, &n1, self.dt)
+                    let found = search::first_violation(&f, &n0, &n1, self.dt)
+                        .map_err(|source| SimError::Search { time_s: t0, source })?;
+                    if let Some(t) = found
                         && first.is_none_or(|f| t < f.0)
                     {
                         first = Some((t, e));
@@ -495,7 +497,8 @@ impl<'b> Integrator<'b> {
                 if end != h {
                     self.p_end.at(&mode.modes, &self.piece, end);
                 }
-                self.advance(&mode, ga, slope, end);
+                self.advance(&mode, ga, slope, end)
+                    .map_err(|source| SimError::Search { time_s: t0, source })?;
                 let Some((_, e)) = first else {
                     break;
                 };
@@ -944,7 +947,13 @@ impl<'b> Integrator<'b> {
 
     /// Moves the state to the end of the current piece (`self.p_end`, at `end`), accumulating
     /// peaks and energy over it.
-    fn advance(&mut self, mode: &Mode, ga: f64, slope: f64, end: f64) {
+    fn advance(
+        &mut self,
+        mode: &Mode,
+        ga: f64,
+        slope: f64,
+        end: f64,
+    ) -> Result<(), search::SearchError> {
         let (n, nb) = (self.n, self.b.blocks());
         let dt = self.dt;
         // Peaks: floor displacements, storey drifts, floor accelerations (with the blocks that
@@ -972,7 +981,7 @@ impl<'b> Integrator<'b> {
             let f = self.func(mode, &g);
             let n0 = self.node0(mode, &g);
             let n1 = self.node_at(mode, &g, &self.p_end);
-            let (peak, _) = search::peak_abs(&f, &n0, &n1, best, dt);
+            let (peak, _) = search::peak_abs(&f, &n0, &n1, best, dt)?;
             if peak > best {
                 match kind {
                     0 => self.out.floor_peak_displacement_m[j] = peak,
@@ -1067,6 +1076,7 @@ impl<'b> Integrator<'b> {
             let p = &mut self.out.peak_slip_m[k];
             *p = p.max(slip.abs());
         }
+        Ok(())
     }
 
     /// `∫₀^end u̇ᵀ·C·u̇ dτ` of the floors over the piece, J.
