@@ -1194,10 +1194,8 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
                 self.spring.unload(self.x[0]);
                 self.out.yield_events += 1;
             }
-            EventKind::SlipStop(i) => {
-                self.out.switches += switch_contacts(self, Some(i), None, ga)?
-            }
-            EventKind::Break(i) => self.out.switches += switch_contacts(self, None, Some(i), ga)?,
+            EventKind::SlipStop(i) => self.out.switches += switch_contacts(self, Some(i), &[], ga)?,
+            EventKind::Break(i) => self.out.switches += switch_contacts(self, None, &[i], ga)?,
         }
         Ok(())
     }

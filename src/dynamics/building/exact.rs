@@ -210,12 +210,18 @@ struct Func {
 /// A floor's acceleration bound (m/s²) with the interface whose static limit sets it.
 type Bound = Option<(f64, usize)>;
 
+/// Bounds of a floor's acceleration equal to within this (relative) tie: equal `μ` up to
+/// round-off. The tightest bound's event goes to the first of them, and they break together
+/// ([`Integrator::broken_together`]).
+const BREAK_TIE: f64 = 0.1 * BREAK_TOLERANCE;
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum EventKind {
     /// Slipping interface whose relative velocity reaches zero.
     SlipStop(usize),
-    /// Stuck interface whose demand leaves its static limit.
-    Break(usize),
+    /// Stuck interface whose demand leaves its static limit: the floor's acceleration above
+    /// its upper bound (`+1`) or below its lower one (`−1`).
+    Break(usize, i8),
     /// Storey `i` reaches the end of its elastic range on side ±1.
     Yield(usize, i8),
     /// Storey `i`'s drift rate reverses on a bounding line.
@@ -762,34 +768,17 @@ impl<'b> Integrator<'b> {
         events.clear();
         peaks.clear();
         // Break bounds per floor: the tightest over its stacks' stuck interfaces.
-        let tie = 0.1 * BREAK_TOLERANCE;
         for f in 0..n {
             let (mut upper, mut lower): (Bound, Bound) = (None, None);
-            for (si, s) in b.stacks().iter().enumerate() {
-                if s.floor != f || self.stuck[si] == 0 {
-                    continue;
+            self.break_bounds(f, |_, k, hi, lo| {
+                if upper.is_none_or(|(h, _)| hi < h - BREAK_TIE * h.abs()) {
+                    upper = Some((hi, k));
                 }
-                let e = self.stuck[si];
-                let f_top = if e < s.blocks {
-                    self.force[s.first + e]
-                } else {
-                    0.0
-                };
-                let mut m_above: f64 = (0..e).map(|q| b.masses()[n + s.first + q]).sum();
-                for q in 0..e {
-                    let k = s.first + q;
-                    let room = b.static_limit(k) * (1.0 + BREAK_TOLERANCE);
-                    let (hi, lo) = ((room - f_top) / m_above, (-room - f_top) / m_above);
-                    if upper.is_none_or(|(h, _)| hi < h - tie * h.abs()) {
-                        upper = Some((hi, k));
-                    }
-                    if lower.is_none_or(|(l, _)| lo > l + tie * l.abs()) {
-                        lower = Some((lo, k));
-                    }
-                    m_above -= b.masses()[n + k];
+                if lower.is_none_or(|(l, _)| lo > l + BREAK_TIE * l.abs()) {
+                    lower = Some((lo, k));
                 }
-            }
-            for (bound, sign) in [(upper, -1.0), (lower, 1.0)] {
+            });
+            for (bound, sign, side) in [(upper, -1.0, 1), (lower, 1.0, -1)] {
                 if let Some((value, k)) = bound {
                     let mut g = Func {
                         row: Some((Row::Accel, f)),
@@ -800,7 +789,7 @@ impl<'b> Integrator<'b> {
                     };
                     g.f0 = Self::value_at(mode, &g, &self.p_start).0;
                     events.push(Event {
-                        kind: EventKind::Break(k),
+                        kind: EventKind::Break(k, side),
                         g,
                     });
                 }
@@ -922,6 +911,64 @@ impl<'b> Integrator<'b> {
         });
         self.events = events;
         self.peaks = peaks;
+    }
+
+    /// Calls `each(stack, interface, upper, lower)` for every interface stuck to floor `f`, in
+    /// order (stacks, then bottom up): the interval of the floor's absolute acceleration (m/s²)
+    /// within which its static limit carries the blocks above it, in the current mode.
+    fn break_bounds(&self, f: usize, mut each: impl FnMut(usize, usize, f64, f64)) {
+        let (n, b) = (self.n, self.b);
+        for (si, s) in b.stacks().iter().enumerate() {
+            if s.floor != f || self.stuck[si] == 0 {
+                continue;
+            }
+            let e = self.stuck[si];
+            let f_top = if e < s.blocks {
+                self.force[s.first + e]
+            } else {
+                0.0
+            };
+            let mut m_above: f64 = (0..e).map(|q| b.masses()[n + s.first + q]).sum();
+            for q in 0..e {
+                let k = s.first + q;
+                let room = b.static_limit(k) * (1.0 + BREAK_TOLERANCE);
+                each(si, k, (room - f_top) / m_above, (-room - f_top) / m_above);
+                m_above -= b.masses()[n + k];
+            }
+        }
+    }
+
+    /// The interfaces a break event of interface `k` on side `side` breaks loose: `k`, and in
+    /// every other stack on its floor the lowest stuck interface whose bound on that side ties
+    /// `k`'s (within [`BREAK_TIE`], the tolerance by which the event chose `k`): the floor's
+    /// acceleration reaches their limits at the same instant. Identical stacks, or single blocks
+    /// of one `μ` of any masses, tie; within one stack only the lowest breaks (the run above it
+    /// then moves with it).
+    fn broken_together(&self, k: usize, side: i8) -> Vec<usize> {
+        let b = self.b;
+        let Some(home) = b
+            .stacks()
+            .iter()
+            .position(|s| (s.first..s.first + s.blocks).contains(&k))
+        else {
+            return vec![k];
+        };
+        let mut value = f64::NAN;
+        self.break_bounds(b.stacks()[home].floor, |_, i, hi, lo| {
+            if i == k {
+                value = if side > 0 { hi } else { lo };
+            }
+        });
+        let mut out = vec![k];
+        let mut last = None;
+        self.break_bounds(b.stacks()[home].floor, |si, i, hi, lo| {
+            let v = if side > 0 { hi } else { lo };
+            if si != home && last != Some(si) && (v - value).abs() <= BREAK_TIE * value.abs() {
+                out.push(i);
+                last = Some(si);
+            }
+        });
+        out
     }
 
     /// Every floor's absolute acceleration at the current state in the current mode, m/s²:
@@ -1150,10 +1197,11 @@ impl<'b> Integrator<'b> {
                 self.out.yield_events += 1;
                 self.mode = None;
             }
-            EventKind::SlipStop(k) => {
-                self.out.switches += switch_contacts(self, Some(k), None, ga)?
+            EventKind::SlipStop(k) => self.out.switches += switch_contacts(self, Some(k), &[], ga)?,
+            EventKind::Break(k, side) => {
+                let broke = self.broken_together(k, side);
+                self.out.switches += switch_contacts(self, None, &broke, ga)?
             }
-            EventKind::Break(k) => self.out.switches += switch_contacts(self, None, Some(k), ga)?,
         }
         Ok(())
     }
