@@ -8,7 +8,8 @@
 //! * a slipping interface's relative velocity reaches zero;
 //! * a floor's absolute acceleration leaves the interval in which the static friction of every
 //!   interface stuck to it can carry the blocks above (the tightest bound over the floor's
-//!   stacks, ties to the first stack and the lowest interface);
+//!   stacks, ties to the first stack and the lowest interface; the stacks whose bound ties it
+//!   break loose together, [`Integrator::broken_together`]);
 //! * a storey's drift reaches the end of its elastic range (yield), or its drift rate reverses
 //!   on a bounding line (unloading).
 //!
