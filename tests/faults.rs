@@ -907,7 +907,7 @@ fn extreme_record_values_end_with_a_result_or_a_clean_refusal() {
             record(&format!("peak{peak:e}"), &|k| peak * wave(k)),
             Some(2),
         ));
-        let alternating = move |k: usize| if k % 2 == 0 { peak } else { -peak };
+        let alternating = move |k: usize| if k.is_multiple_of(2) { peak } else { -peak };
         records.push((
             record(&format!("alternating{peak:e}"), &alternating),
             Some(2),
@@ -918,7 +918,7 @@ fn extreme_record_values_end_with_a_result_or_a_clean_refusal() {
     records.push((record("subnormal", &|_| 1e-310), None));
     records.push((
         record("subnormal_alternating", &|k| {
-            if k % 2 == 0 { 1e-310 } else { -1e-310 }
+            if k.is_multiple_of(2) { 1e-310 } else { -1e-310 }
         }),
         None,
     ));
@@ -926,7 +926,7 @@ fn extreme_record_values_end_with_a_result_or_a_clean_refusal() {
     records.push((record("at_the_limit", &|k| 1e6 * wave(k)), None));
     records.push((
         record("alternating_at_the_limit", &|k| {
-            if k % 2 == 0 { 9e5 } else { -9e5 }
+            if k.is_multiple_of(2) { 9e5 } else { -9e5 }
         }),
         None,
     ));
