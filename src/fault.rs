@@ -324,7 +324,10 @@ impl Classify for SimulationError {
 impl Classify for SimError {
     fn fault(&self) -> Fault {
         Fault::of(match self {
-            SimError::Zeno { .. } | SimError::Contact(_) | SimError::Diverged => FaultKind::Failed,
+            SimError::Zeno { .. }
+            | SimError::Contact(_)
+            | SimError::Diverged
+            | SimError::Search { .. } => FaultKind::Failed,
             _ => FaultKind::BadInput,
         })
     }

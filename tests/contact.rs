@@ -458,3 +458,102 @@ fn the_tree_selector_on_a_chain_is_the_chain_selector() {
         assert_eq!(f1, f2);
     }
 }
+
+/// Identical stacks on a floor get the same choice, bit for bit, and it is the choice for one
+/// stack of their summed masses, forces and limits (each copy carrying its share of the force),
+/// beside other stacks, with and without static friction above kinetic. The problem is
+/// invariant under swapping identical stacks and strictly convex, so its minimiser treats them
+/// alike; solved one by one, round-off in the coupled solve used to tell them apart (the
+/// integrator then broke three copies of one block loose one at a time and stuck them again
+/// without end).
+#[test]
+fn identical_stacks_get_the_same_choice_as_one_stack_of_their_mass() {
+    let mut rng = Rng::new(37);
+    for round in 0..3000 {
+        let gap = round % 2 == 1;
+        // One random stack copied `n` times, then a random other stack (or none).
+        let base = random_state(&mut rng, gap);
+        let copies = [2, 3, 4, 6, 16][rng.below(5)];
+        let other = (rng.unit() < 0.5).then(|| random_state(&mut rng, gap));
+        let accel_floor = rng.normal();
+        let floor_mass = rng.log_range(0.5, 5.0);
+        let build = |w: &[f64]| {
+            let mut t = Tree {
+                st: State {
+                    masses: vec![floor_mass],
+                    external: vec![floor_mass * G * accel_floor],
+                    lim_s: vec![],
+                    lim_k: vec![],
+                    given: vec![],
+                },
+                below: vec![],
+            };
+            let stacks = w
+                .iter()
+                .map(|&w| (&base, w))
+                .chain(other.iter().map(|o| (o, 1.0)));
+            for (s, w) in stacks {
+                for i in 0..s.given.len() {
+                    let at = t.below.len();
+                    t.below.push(if i == 0 { 0 } else { at });
+                    t.st.masses.push(w * s.masses[i + 1]);
+                    t.st.external.push(w * s.external[i + 1]);
+                    t.st.lim_s.push(w * s.lim_s[i]);
+                    t.st.lim_k.push(w * s.lim_k[i]);
+                    t.st.given.push(s.given[i]);
+                }
+            }
+            t
+        };
+        let run = |t: &Tree| {
+            let n = t.st.given.len();
+            let (mut contacts, mut force) = (t.st.given.clone(), vec![0.0; n]);
+            ContactSelector::new(n)
+                .select_tree(
+                    &t.below,
+                    &t.st.masses,
+                    &t.st.external,
+                    &t.st.lim_s,
+                    &t.st.lim_k,
+                    &mut contacts,
+                    &mut force,
+                )
+                .unwrap();
+            (contacts, force)
+        };
+        let many = build(&vec![1.0; copies]);
+        let one = build(&[copies as f64]);
+        let (c_many, f_many) = run(&many);
+        let (c_one, f_one) = run(&one);
+        let p = base.given.len();
+        let scale = many
+            .st
+            .lim_s
+            .iter()
+            .chain(many.st.external.iter())
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        for c in 0..copies {
+            for i in 0..p {
+                let k = c * p + i;
+                assert_eq!(c_many[k], c_many[i], "copy {c}, interface {i}");
+                assert_eq!(
+                    f_many[k].to_bits(),
+                    f_many[i].to_bits(),
+                    "copy {c}, interface {i}"
+                );
+                assert_eq!(c_many[k], c_one[i], "copy {c}, interface {i}");
+                let share = f_one[i] / copies as f64;
+                assert!(
+                    (f_many[k] - share).abs() <= 1e-12 * scale,
+                    "{} vs {share}",
+                    f_many[k]
+                );
+            }
+        }
+        // The other stack's choice is the same beside the copies as beside the heavy stack.
+        assert_eq!(c_many[copies * p..], c_one[p..]);
+        if gap {
+            assert!(consistent_tree(&many.st, &many.below, &c_many, 1e-9));
+        }
+    }
+}

@@ -1017,3 +1017,106 @@ fn every_kind_of_fault_has_its_exit_code() {
     run(&["fit", s(&small)], PLAIN).fails(1, "no form could be fitted");
     // Interrupted: 130 (ctrl_c_ends_a_stage_with_130_at_any_point_and_a_rerun_resumes).
 }
+
+/// Records of extreme values, on one storey and on a building (three storeys, a stack on the
+/// roof), with the exact integrator and RK4: every run ends with a result, a refusal before
+/// any work (exit 2, a peak beyond `limits::MAX_PEAK_ACCEL_G` after scaling) or a clean error
+/// (exit 1). A record of 1e160 g used to hang `simulate` (a certified search halving stretches
+/// its overflowed bounds could not clear, 2^80 of them); the test ending is the proof, the guard
+/// only turns a hang into a failure. The times are printed, not judged.
+#[test]
+fn extreme_record_values_end_with_a_result_or_a_clean_refusal() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let record = |name: &str, values: &dyn Fn(usize) -> f64| -> PathBuf {
+        let p = d.join(format!("{name}.txt"));
+        let mut text = String::from("# dt: 0.01\n");
+        for k in 0..1000 {
+            text += &format!("{:e}\n", values(k));
+        }
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let wave = |k: usize| (0.05 * k as f64).sin() * (-0.002 * k as f64).exp();
+    let ordinary = |k: usize| 0.3 * wave(k);
+    // (record, what it must do: Some(2) refused, None a result or a clean error)
+    let mut records: Vec<(PathBuf, Option<i32>)> = Vec::new();
+    for peak in [1e100, 1e160, 1e200, 1e300, 1.7e308] {
+        records.push((
+            record(&format!("peak{peak:e}"), &|k| peak * wave(k)),
+            Some(2),
+        ));
+        let alternating = move |k: usize| if k.is_multiple_of(2) { peak } else { -peak };
+        records.push((
+            record(&format!("alternating{peak:e}"), &alternating),
+            Some(2),
+        ));
+        let one = move |k: usize| if k == 400 { peak } else { ordinary(k) };
+        records.push((record(&format!("one{peak:e}"), &one), Some(2)));
+    }
+    records.push((record("subnormal", &|_| 1e-310), None));
+    records.push((
+        record("subnormal_alternating", &|k| {
+            if k.is_multiple_of(2) { 1e-310 } else { -1e-310 }
+        }),
+        None,
+    ));
+    // Inside the limit: up to it, and an ordinary record at the largest scale.
+    records.push((record("at_the_limit", &|k| 1e6 * wave(k)), None));
+    records.push((
+        record("alternating_at_the_limit", &|k| {
+            if k.is_multiple_of(2) { 9e5 } else { -9e5 }
+        }),
+        None,
+    ));
+    let case = d.join("building.yaml");
+    std::fs::write(
+        &case,
+        "building: {storeys: 3, period: 0.6}\n\
+         stacks:\n  - {floor: 3, alpha: [0.5, 0.5], mu: [0.2, 0.1]}\n",
+    )
+    .unwrap();
+    let ord = record("ordinary", &ordinary);
+    let mut runs = 0;
+    for (rec, want) in &records {
+        for structure in [&[][..], &["--config", s(&case)][..]] {
+            for integrator in ["exact", "rk4"] {
+                let mut args = vec!["simulate", "--record", s(rec), "--integrator", integrator];
+                args.extend_from_slice(structure);
+                let start = Instant::now();
+                let r = run(&args, PLAIN);
+                eprintln!(
+                    "{:.3} s, exit {}: {}",
+                    start.elapsed().as_secs_f64(),
+                    r.code,
+                    args.join(" ")
+                );
+                match want {
+                    Some(code) => {
+                        r.fails(*code, "beyond the 1e6 g a simulation takes");
+                    }
+                    None => {
+                        assert!(
+                            r.code == 0 || r.code == 1 && r.stderr.starts_with("error: "),
+                            "{}: exit {}: {}",
+                            args.join(" "),
+                            r.code,
+                            r.stderr
+                        );
+                        assert!(!r.stderr.contains("panicked"), "{}", r.stderr);
+                    }
+                }
+                runs += 1;
+            }
+        }
+    }
+    // The largest scale on an ordinary record (0.28 g) runs; on a record of 2.8 g it is refused.
+    run(&["simulate", "--record", s(&ord), "--scale", "1e6"], PLAIN).ok();
+    let strong = record("strong", &|k| 10.0 * ordinary(k));
+    run(
+        &["simulate", "--record", s(&strong), "--scale", "1e6"],
+        PLAIN,
+    )
+    .fails(2, "times --scale 1000000 that is 2.8");
+    assert_eq!(runs, records.len() * 4);
+}

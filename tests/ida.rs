@@ -279,3 +279,53 @@ fn the_report_shows_the_ida_section_and_needs_ida_h5() {
         "{err}"
     );
 }
+
+/// An IDA hunt that scales a record beyond `limits::MAX_PEAK_ACCEL_G` (a million g) gets a
+/// typed error for that run, an input error, after the runs below the limit gave their
+/// demands; the stage reports it naming the zone, motion, case and system
+/// (`IdaStageError::Simulation`). Every cap of the repository's configs and tests is 5 g or
+/// less, some 10⁵ times below.
+#[test]
+fn a_run_scaled_beyond_the_peak_limit_is_a_clean_error_of_that_run() {
+    use slidestack::dynamics::SimError;
+    let rec = &common::real_records()[0];
+    let accel = rec.accel_mps2(1.0);
+    let pga_g = rec.pga_g();
+    let sys = System::new(&SystemSpec::new(0.8, &[0.5], &[0.2])).unwrap();
+    let opts = ExactOptions {
+        energy_balance: false,
+        ..ExactOptions::default()
+    };
+    // Intensities are scale factors here: a hunt in steps of 0.19 million g.
+    let step = 0.19e6 / pga_g;
+    let p = HuntFill {
+        first_sa_g: step,
+        step_increment_sa_g: 0.0,
+        bracket_runs: 0,
+        fill_runs: 0,
+        cap_sa_g: 10.0 * step,
+    };
+    let mut below = 0;
+    let err = hunt_fill(&p, |lambda| {
+        let a: Vec<f64> = accel.iter().map(|x| lambda * x).collect();
+        let ground = Ground {
+            dt_s: rec.dt_s,
+            accel_mps2: &a,
+        };
+        let r = simulate_exact(&sys, &ground, &opts)?;
+        below += 1;
+        Ok::<_, SimError>((r.peak_displacement_m, false))
+    })
+    .unwrap_err();
+    // Runs at 0.19, 0.38, …, 0.95 million g ran; the next (1.14) was refused.
+    assert_eq!(below, 5);
+    assert!(
+        matches!(err, SimError::PeakAccel { value_g, .. } if value_g.abs() > 1e6),
+        "{err}"
+    );
+    assert_eq!(
+        slidestack::fault::classify(&err).kind,
+        slidestack::fault::FaultKind::BadInput
+    );
+    assert!(err.to_string().contains("beyond the 1e6 g"), "{err}");
+}

@@ -71,15 +71,20 @@ pub(crate) trait Contacts {
 }
 
 /// The stick/slip switch of both exact integrators, at an event that stopped interface
-/// `stopped` or broke interface `broke` loose: every slipping interface whose relative velocity
-/// has reached or crossed zero sticks momentarily (its group merged), the new mode is selected,
-/// and a break that the selection left unchanged (the force pinned at its limit with a relative
-/// acceleration below round-off, where the event proved the demand exceeds it) slips against
-/// its force. Returns the number of interfaces whose state changed.
+/// `stopped` or broke the interfaces `broke` loose: every slipping interface whose relative
+/// velocity has reached or crossed zero sticks momentarily (its group merged), and so does every
+/// one no further from zero than the stopped interface (its root's residue: interfaces that stop
+/// together, such as identical stacks, stop at one event); the new mode is selected, and a break
+/// that the selection left unchanged (the forces pinned at their limits with a relative
+/// acceleration below round-off, where the event proved the demand exceeds them) slips each of
+/// `broke` against its force. `broke` holds the interface whose limit the event reached and
+/// those of other stacks whose limit it reached at the same instant (bounds tied within the
+/// integrator's tolerance): they break together. Returns the number of interfaces whose state
+/// changed.
 pub(crate) fn switch_contacts(
     c: &mut impl Contacts,
     stopped: Option<usize>,
-    broke: Option<usize>,
+    broke: &[usize],
     ga: f64,
 ) -> Result<u64, super::SimError> {
     let n = {
@@ -87,13 +92,19 @@ pub(crate) fn switch_contacts(
         before.copy_from_slice(now);
         now.len()
     };
+    // The stopped interface's relative velocity at its root, if it is still on the slipping
+    // side (a few ulps).
+    let residue = stopped.map_or(0.0, |k| match c.states().0[k] {
+        Contact::Slip(dir) => (f64::from(dir) * c.relative_velocity(k)).max(0.0),
+        _ => 0.0,
+    });
     let mut any = false;
     for k in 0..n {
         let Contact::Slip(dir) = c.states().0[k] else {
             continue;
         };
         let s = f64::from(dir) * c.relative_velocity(k);
-        if s <= 0.0 || stopped == Some(k) {
+        if s <= residue || stopped == Some(k) {
             c.states().0[k] = Contact::Stick;
             any = true;
         }
@@ -102,11 +113,13 @@ pub(crate) fn switch_contacts(
         c.merge_stopped();
     }
     c.select(ga)?;
-    if let Some(k) = broke {
+    if !broke.is_empty() {
         let (now, before) = c.states();
         if now == before {
-            let f = c.force(k);
-            c.states().0[k] = Contact::Slip(if f > 0.0 { -1 } else { 1 });
+            for &k in broke {
+                let f = c.force(k);
+                c.states().0[k] = Contact::Slip(if f > 0.0 { -1 } else { 1 });
+            }
             c.select(ga)?;
         }
     }
@@ -211,6 +224,15 @@ impl ContactSelector {
     /// [`ContactSelector::select`] for a tree: body 0 (a floor) carries several stacks.
     /// Interface `i` lies under body `i + 1` and above body `below[i]` (`< i + 1`); the rule is
     /// the same (the module doc), solved over every stack of the floor together.
+    ///
+    /// Stacks standing on the floor that are identical at this instant (the same masses,
+    /// forces, limits and contact states, bit for bit) get the same choice, bit for bit: the
+    /// problem is invariant under swapping them and strictly convex, so its minimiser gives
+    /// them the same forces, and they are solved as one stack of their summed masses, forces
+    /// and limits (the quotient of the problem by that symmetry), each taking its share. Solved
+    /// one by one, round-off in the coupled solve and the order in which the active-set and
+    /// release steps visit them would tell them apart, and the integrator would then break them
+    /// loose and stick them one at a time.
     #[allow(clippy::too_many_arguments)]
     pub fn select_tree(
         &mut self,
@@ -227,6 +249,16 @@ impl ContactSelector {
         } else {
             Shape::Tree(below)
         };
+        if let Shape::Tree(_) = shape {
+            let lim = Limits {
+                external,
+                limit_static,
+                limit_kinetic,
+            };
+            if let Some(classes) = identical_stacks(below, masses, &lim, contacts) {
+                return self.select_quotient(&classes, masses, &lim, contacts, force);
+            }
+        }
         self.select_shaped(
             shape,
             masses,
@@ -236,6 +268,63 @@ impl ContactSelector {
             contacts,
             force,
         )
+    }
+
+    /// [`ContactSelector::select_tree`] on the quotient of the floor's problem by its identical
+    /// stacks: each class of identical stacks (`classes`: per class its stacks, each a range of
+    /// interfaces, the first standing for all) becomes one stack whose masses, external forces
+    /// and limits are the class's sums; its forces are shared out equally, the states copied,
+    /// and a slipping interface takes its own kinetic force exactly.
+    fn select_quotient(
+        &mut self,
+        classes: &[Vec<std::ops::Range<usize>>],
+        masses: &[f64],
+        lim: &Limits,
+        contacts: &mut [Contact],
+        force: &mut [f64],
+    ) -> Result<(), ContactError> {
+        let mut below_q = Vec::new();
+        let mut masses_q = vec![masses[0]];
+        let mut external_q = vec![lim.external[0]];
+        let (mut ls_q, mut lk_q, mut contacts_q) = (Vec::new(), Vec::new(), Vec::new());
+        for class in classes {
+            let w = class.len() as f64;
+            for (o, i) in class[0].clone().enumerate() {
+                below_q.push(if o == 0 { 0 } else { below_q.len() });
+                masses_q.push(w * masses[i + 1]);
+                external_q.push(w * lim.external[i + 1]);
+                ls_q.push(w * lim.limit_static[i]);
+                lk_q.push(w * lim.limit_kinetic[i]);
+                contacts_q.push(contacts[i]);
+            }
+        }
+        let mut force_q = vec![0.0; contacts_q.len()];
+        self.select_tree(
+            &below_q,
+            &masses_q,
+            &external_q,
+            &ls_q,
+            &lk_q,
+            &mut contacts_q,
+            &mut force_q,
+        )?;
+        let mut q = 0;
+        for class in classes {
+            let w = class.len() as f64;
+            for o in 0..class[0].len() {
+                for stack in class {
+                    let i = stack.start + o;
+                    contacts[i] = contacts_q[q];
+                    force[i] = match contacts_q[q] {
+                        Contact::Slip(d) => -lim.limit_kinetic[i] * f64::from(d),
+                        Contact::Free => 0.0,
+                        Contact::Stick => force_q[q] / w,
+                    };
+                }
+                q += 1;
+            }
+        }
+        Ok(())
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -641,6 +730,51 @@ impl ContactSelector {
         }
         None
     }
+}
+
+/// The stacks of a floor (`below`: a tree whose interfaces each stand on the floor, body 0, or
+/// continue the chain below them) in classes of identical ones, in order of their first stacks,
+/// each stack a range of interfaces; `None` when no two are identical (or the tree has a body
+/// carrying two stacks).
+fn identical_stacks(
+    below: &[usize],
+    masses: &[f64],
+    lim: &Limits,
+    contacts: &[Contact],
+) -> Option<Vec<Vec<std::ops::Range<usize>>>> {
+    let n = below.len();
+    let mut stacks = Vec::new();
+    let mut i = 0;
+    while i < n {
+        if below[i] != 0 {
+            return None;
+        }
+        let start = i;
+        i += 1;
+        while i < n && below[i] == i {
+            i += 1;
+        }
+        stacks.push(start..i);
+    }
+    let same = |a: &std::ops::Range<usize>, b: &std::ops::Range<usize>| {
+        let bits = |x: f64, y: f64| x.to_bits() == y.to_bits();
+        a.len() == b.len()
+            && a.clone().zip(b.clone()).all(|(i, j)| {
+                bits(masses[i + 1], masses[j + 1])
+                    && bits(lim.external[i + 1], lim.external[j + 1])
+                    && bits(lim.limit_static[i], lim.limit_static[j])
+                    && bits(lim.limit_kinetic[i], lim.limit_kinetic[j])
+                    && contacts[i] == contacts[j]
+            })
+    };
+    let mut classes: Vec<Vec<std::ops::Range<usize>>> = Vec::new();
+    for stack in stacks {
+        match classes.iter_mut().find(|c| same(&c[0], &stack)) {
+            Some(c) => c.push(stack),
+            None => classes.push(vec![stack]),
+        }
+    }
+    (classes.len() < below.iter().filter(|&&b| b == 0).count()).then_some(classes)
 }
 
 /// The forces a selection is given.

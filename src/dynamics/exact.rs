@@ -562,8 +562,10 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
                         Basis::at(osc, limit)
                     };
                     let g = ev.g.over(osc);
-                    if let Some(t) =
+                    let found =
                         search::first_violation(&g, &ev.g.start(), &ev.g.node(osc, b_end), self.dt)
+                            .map_err(|source| SimError::Search { time_s: t0, source })?;
+                    if let Some(t) = found
                         && first.is_none_or(|f| t < f.0)
                     {
                         first = Some((t, e));
@@ -575,7 +577,8 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
                 } else {
                     Basis::at(osc, end)
                 };
-                self.advance(t0 + tau, ga, slope, &basis_end);
+                self.advance(t0 + tau, ga, slope, &basis_end)
+                    .map_err(|source| SimError::Search { time_s: t0, source })?;
                 if let Some((_, e)) = first {
                     tau += end;
                     let kind = self.events[e].kind;
@@ -1043,7 +1046,13 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
     }
 
     /// Moves the state to the end of the current piece, accumulating peaks and energy over it.
-    fn advance(&mut self, t_start: f64, ga: f64, slope: f64, b: &Basis) {
+    fn advance(
+        &mut self,
+        t_start: f64,
+        ga: f64,
+        slope: f64,
+        b: &Basis,
+    ) -> Result<(), search::SearchError> {
         let osc = self.osc();
         let top = self.top[0];
         let b0 = Basis::ZERO;
@@ -1058,7 +1067,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
                 &n1,
                 self.out.peak_displacement_m,
                 self.dt,
-            )
+            )?
         };
         if best > self.out.peak_displacement_m {
             self.out.peak_displacement_m = best;
@@ -1071,7 +1080,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             .copied()
             .fold(f64::INFINITY, f64::min);
         let (n0, n1) = (self.a0.node(osc, b0), self.a0.node(osc, *b));
-        let (best_acc, _) = search::peak_abs(&self.a0.over(osc), &n0, &n1, floor, self.dt);
+        let (best_acc, _) = search::peak_abs(&self.a0.over(osc), &n0, &n1, floor, self.dt)?;
         if best_acc > floor {
             for p in &mut self.out.peak_abs_accel_mps2[..=top] {
                 *p = p.max(best_acc);
@@ -1083,6 +1092,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             *p = p.max(a);
         }
         self.settle(ga, slope, b);
+        Ok(())
     }
 
     /// The energy terms over the piece ending at `b` and the new state of every body (the
@@ -1184,10 +1194,8 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
                 self.spring.unload(self.x[0]);
                 self.out.yield_events += 1;
             }
-            EventKind::SlipStop(i) => {
-                self.out.switches += switch_contacts(self, Some(i), None, ga)?
-            }
-            EventKind::Break(i) => self.out.switches += switch_contacts(self, None, Some(i), ga)?,
+            EventKind::SlipStop(i) => self.out.switches += switch_contacts(self, Some(i), &[], ga)?,
+            EventKind::Break(i) => self.out.switches += switch_contacts(self, None, &[i], ga)?,
         }
         Ok(())
     }

@@ -53,8 +53,11 @@ pub use exact::{ExactOptions, simulate_exact};
 pub use model::{DampingBasis, G, Hysteresis, ModelError, System, SystemSpec, Yielding};
 pub use response::{Energy, History, Response};
 pub use rk4::simulate_rk4;
+pub use search::SearchError;
 
-use crate::limits::{DT_RANGE_S, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP};
+use crate::limits::{
+    DT_RANGE_S, MAX_PEAK_ACCEL_G, MAX_RK4_SUBSTEPS, MAX_SAMPLES, RK4_MAX_OMEGA_STEP,
+};
 use thiserror::Error;
 
 /// A ground acceleration sampled at a constant step, linear between samples.
@@ -88,6 +91,11 @@ pub enum SimError {
     #[error("ground acceleration sample {index} is not finite ({value})")]
     NonFinite { index: usize, value: f64 },
     #[error(
+        "ground acceleration sample {index} is {value_g:.3e} g, beyond the {MAX_PEAK_ACCEL_G:e} g a \
+         simulation takes (its results would be round-off; a unit or scale mistake?)"
+    )]
+    PeakAccel { index: usize, value_g: f64 },
+    #[error(
         "switches accumulate (Zeno behaviour): more than {limit} stick/slip switches within the \
          sample interval starting at t = {time_s} s; the case is refused rather than run forever"
     )]
@@ -108,6 +116,13 @@ pub enum SimError {
     },
     #[error("the response is not finite (the integration diverged)")]
     Diverged,
+    /// A certified search for a switch or a peak that could not proceed.
+    #[error("in the sample interval starting at t = {time_s} s: {source}")]
+    Search {
+        time_s: f64,
+        #[source]
+        source: SearchError,
+    },
     /// A building's contact and yield state that the modal solution cannot represent.
     #[error("{0}")]
     Modal(String),
@@ -133,6 +148,18 @@ impl Ground<'_> {
             .find(|(_, a)| !a.is_finite())
         {
             return Err(SimError::NonFinite { index, value });
+        }
+        let most = MAX_PEAK_ACCEL_G * G;
+        if let Some((index, &value)) = self
+            .accel_mps2
+            .iter()
+            .enumerate()
+            .find(|(_, a)| a.abs() > most)
+        {
+            return Err(SimError::PeakAccel {
+                index,
+                value_g: value / G,
+            });
         }
         Ok(())
     }

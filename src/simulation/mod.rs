@@ -13,6 +13,7 @@ use crate::dynamics::{
     simulate_exact, simulate_rk4,
 };
 use crate::ground_motion::{self, Record, RecordError};
+use crate::limits::MAX_PEAK_ACCEL_G;
 use crate::study::config::{ConfigError, read_yaml_text, yaml_problem};
 use crate::study::physics::{DampingBasis, Physics};
 use serde::{Deserialize, Serialize};
@@ -212,6 +213,18 @@ impl Settings {
             Some(path) => ground_motion::read_record(path)?,
             None => ground_motion::builtin(),
         };
+        let peak_g = record.pga_g() * scale;
+        if peak_g > MAX_PEAK_ACCEL_G {
+            return Err(self.key_error(format!(
+                "`record` {} peaks at {:.3e} g, times `scale` {scale} that is {peak_g:.3e} g, beyond \
+                 the {MAX_PEAK_ACCEL_G:e} g a simulation takes (its results would be round-off; \
+                 a unit or scale mistake?)",
+                self.record
+                    .as_ref()
+                    .map_or(record.name.clone(), |p| p.display().to_string()),
+                record.pga_g(),
+            )));
+        }
         Ok(Simulation {
             record,
             scale,

@@ -8,7 +8,8 @@
 //! * a slipping interface's relative velocity reaches zero;
 //! * a floor's absolute acceleration leaves the interval in which the static friction of every
 //!   interface stuck to it can carry the blocks above (the tightest bound over the floor's
-//!   stacks, ties to the first stack and the lowest interface);
+//!   stacks, ties to the first stack and the lowest interface; the stacks whose bound ties it
+//!   break loose together, [`Integrator::broken_together`]);
 //! * a storey's drift reaches the end of its elastic range (yield), or its drift rate reverses
 //!   on a bounding line (unloading).
 //!
@@ -231,12 +232,18 @@ struct Func {
 /// A floor's acceleration bound (m/s²) with the interface whose static limit sets it.
 type Bound = Option<(f64, usize)>;
 
+/// Bounds of a floor's acceleration equal to within this (relative) tie: equal `μ` up to
+/// round-off. The tightest bound's event goes to the first of them, and they break together
+/// ([`Integrator::broken_together`]).
+const BREAK_TIE: f64 = 0.1 * BREAK_TOLERANCE;
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum EventKind {
     /// Slipping interface whose relative velocity reaches zero.
     SlipStop(usize),
-    /// Stuck interface whose demand leaves its static limit.
-    Break(usize),
+    /// Stuck interface whose demand leaves its static limit: the floor's acceleration above
+    /// its upper bound (`+1`) or below its lower one (`−1`).
+    Break(usize, i8),
     /// Storey `i` reaches the end of its elastic range on side ±1.
     Yield(usize, i8),
     /// Storey `i`'s drift rate reverses on a bounding line.
@@ -519,7 +526,9 @@ impl<'b> Integrator<'b> {
                     } else {
                         Node::of(&f, limit)
                     };
-                    if let Some(t) = search::first_violation(&f, &n0, &n1, self.dt)
+                    let found = search::first_violation(&f, &n0, &n1, self.dt)
+                        .map_err(|source| SimError::Search { time_s: t0, source })?;
+                    if let Some(t) = found
                         && first.is_none_or(|f| t < f.0)
                     {
                         first = Some((t, e));
@@ -529,7 +538,8 @@ impl<'b> Integrator<'b> {
                 if end != h {
                     self.p_end.at(&mode.modes, &self.piece, end);
                 }
-                self.advance(&mode, ga, slope, end);
+                self.advance(&mode, ga, slope, end)
+                    .map_err(|source| SimError::Search { time_s: t0, source })?;
                 let Some((_, e)) = first else {
                     break;
                 };
@@ -797,34 +807,17 @@ impl<'b> Integrator<'b> {
         events.clear();
         peaks.clear();
         // Break bounds per floor: the tightest over its stacks' stuck interfaces.
-        let tie = 0.1 * BREAK_TOLERANCE;
         for f in 0..n {
             let (mut upper, mut lower): (Bound, Bound) = (None, None);
-            for (si, s) in b.stacks().iter().enumerate() {
-                if s.floor != f || self.stuck[si] == 0 {
-                    continue;
+            self.break_bounds(f, |_, k, hi, lo| {
+                if upper.is_none_or(|(h, _)| hi < h - BREAK_TIE * h.abs()) {
+                    upper = Some((hi, k));
                 }
-                let e = self.stuck[si];
-                let f_top = if e < s.blocks {
-                    self.force[s.first + e]
-                } else {
-                    0.0
-                };
-                let mut m_above: f64 = (0..e).map(|q| b.masses()[n + s.first + q]).sum();
-                for q in 0..e {
-                    let k = s.first + q;
-                    let room = b.static_limit(k) * (1.0 + BREAK_TOLERANCE);
-                    let (hi, lo) = ((room - f_top) / m_above, (-room - f_top) / m_above);
-                    if upper.is_none_or(|(h, _)| hi < h - tie * h.abs()) {
-                        upper = Some((hi, k));
-                    }
-                    if lower.is_none_or(|(l, _)| lo > l + tie * l.abs()) {
-                        lower = Some((lo, k));
-                    }
-                    m_above -= b.masses()[n + k];
+                if lower.is_none_or(|(l, _)| lo > l + BREAK_TIE * l.abs()) {
+                    lower = Some((lo, k));
                 }
-            }
-            for (bound, sign) in [(upper, -1.0), (lower, 1.0)] {
+            });
+            for (bound, sign, side) in [(upper, -1.0, 1), (lower, 1.0, -1)] {
                 if let Some((value, k)) = bound {
                     let mut g = Func {
                         row: Some((Row::Accel, f)),
@@ -835,7 +828,7 @@ impl<'b> Integrator<'b> {
                     };
                     g.f0 = Self::value_at(mode, &g, &self.p_start).0;
                     events.push(Event {
-                        kind: EventKind::Break(k),
+                        kind: EventKind::Break(k, side),
                         g,
                     });
                 }
@@ -975,6 +968,64 @@ impl<'b> Integrator<'b> {
         self.peaks = peaks;
     }
 
+    /// Calls `each(stack, interface, upper, lower)` for every interface stuck to floor `f`, in
+    /// order (stacks, then bottom up): the interval of the floor's absolute acceleration (m/s²)
+    /// within which its static limit carries the blocks above it, in the current mode.
+    fn break_bounds(&self, f: usize, mut each: impl FnMut(usize, usize, f64, f64)) {
+        let (n, b) = (self.n, self.b);
+        for (si, s) in b.stacks().iter().enumerate() {
+            if s.floor != f || self.stuck[si] == 0 {
+                continue;
+            }
+            let e = self.stuck[si];
+            let f_top = if e < s.blocks {
+                self.force[s.first + e]
+            } else {
+                0.0
+            };
+            let mut m_above: f64 = (0..e).map(|q| b.masses()[n + s.first + q]).sum();
+            for q in 0..e {
+                let k = s.first + q;
+                let room = b.static_limit(k) * (1.0 + BREAK_TOLERANCE);
+                each(si, k, (room - f_top) / m_above, (-room - f_top) / m_above);
+                m_above -= b.masses()[n + k];
+            }
+        }
+    }
+
+    /// The interfaces a break event of interface `k` on side `side` breaks loose: `k`, and in
+    /// every other stack on its floor the lowest stuck interface whose bound on that side ties
+    /// `k`'s (within [`BREAK_TIE`], the tolerance by which the event chose `k`): the floor's
+    /// acceleration reaches their limits at the same instant. Identical stacks, or single blocks
+    /// of one `μ` of any masses, tie; within one stack only the lowest breaks (the run above it
+    /// then moves with it).
+    fn broken_together(&self, k: usize, side: i8) -> Vec<usize> {
+        let b = self.b;
+        let Some(home) = b
+            .stacks()
+            .iter()
+            .position(|s| (s.first..s.first + s.blocks).contains(&k))
+        else {
+            return vec![k];
+        };
+        let mut value = f64::NAN;
+        self.break_bounds(b.stacks()[home].floor, |_, i, hi, lo| {
+            if i == k {
+                value = if side > 0 { hi } else { lo };
+            }
+        });
+        let mut out = vec![k];
+        let mut last = None;
+        self.break_bounds(b.stacks()[home].floor, |si, i, hi, lo| {
+            let v = if side > 0 { hi } else { lo };
+            if si != home && last != Some(si) && (v - value).abs() <= BREAK_TIE * value.abs() {
+                out.push(i);
+                last = Some(si);
+            }
+        });
+        out
+    }
+
     /// Every floor's absolute acceleration at the current state in the current mode, m/s²:
     /// `(F_j + m_j·a_g − f_top,j)/M_j`, `F_j` the spring, damper and ground forces on the bare
     /// floor and `f_top,j` the friction from the slipping interfaces above its stuck blocks.
@@ -998,7 +1049,13 @@ impl<'b> Integrator<'b> {
 
     /// Moves the state to the end of the current piece (`self.p_end`, at `end`), accumulating
     /// peaks and energy over it.
-    fn advance(&mut self, mode: &Mode, ga: f64, slope: f64, end: f64) {
+    fn advance(
+        &mut self,
+        mode: &Mode,
+        ga: f64,
+        slope: f64,
+        end: f64,
+    ) -> Result<(), search::SearchError> {
         let (n, nb) = (self.n, self.b.blocks());
         let dt = self.dt;
         self.loose_mass_time += self.loose_mass_kg * end;
@@ -1028,7 +1085,7 @@ impl<'b> Integrator<'b> {
             let f = self.func(mode, &g);
             let n0 = self.node0(mode, &g);
             let n1 = self.node_at(mode, &g, &self.p_end);
-            let (peak, _) = search::peak_abs(&f, &n0, &n1, best, dt);
+            let (peak, _) = search::peak_abs(&f, &n0, &n1, best, dt)?;
             if peak > best {
                 match kind {
                     0 => self.out.floor_peak_displacement_m[j] = peak,
@@ -1124,6 +1181,7 @@ impl<'b> Integrator<'b> {
             let p = &mut self.out.peak_slip_m[k];
             *p = p.max(slip.abs());
         }
+        Ok(())
     }
 
     /// `∫₀^end u̇ᵀ·C·u̇ dτ` of the floors over the piece, J.
@@ -1197,10 +1255,11 @@ impl<'b> Integrator<'b> {
                 self.out.yield_events += 1;
                 self.mode = None;
             }
-            EventKind::SlipStop(k) => {
-                self.out.switches += switch_contacts(self, Some(k), None, ga)?
+            EventKind::SlipStop(k) => self.out.switches += switch_contacts(self, Some(k), &[], ga)?,
+            EventKind::Break(k, side) => {
+                let broke = self.broken_together(k, side);
+                self.out.switches += switch_contacts(self, None, &broke, ga)?
             }
-            EventKind::Break(k) => self.out.switches += switch_contacts(self, None, Some(k), ga)?,
         }
         Ok(())
     }

@@ -30,7 +30,7 @@
 //! the certified peak search of `dynamics::search` on the closed form (the searches of
 //! the building's integrator, on the same functions).
 
-use super::super::search::{self, Node};
+use super::super::search::{self, Node, SearchError};
 use super::super::{Ground, SimError};
 use super::modal::{ModalError, ModalFn, Piece, StateModes, mode_terms};
 use super::model::Building;
@@ -534,7 +534,14 @@ impl LinearBuilding {
                         built = true;
                     }
                     let ends = (f0[i], f1[i]);
-                    best[o] = self.search(out, o, &piece, (&y, &y1), ends, h, best[o]);
+                    best[o] = self
+                        .search(out, o, &piece, (&y, &y1), ends, h, best[o])
+                        .map_err(|source| {
+                            LinearBuildingError::Ground(SimError::Search {
+                                time_s: k as f64 * h,
+                                source,
+                            })
+                        })?;
                 }
                 std::mem::swap(&mut y, &mut y1);
                 std::mem::swap(&mut f0, &mut f1);
@@ -581,7 +588,7 @@ impl LinearBuilding {
         (f0, f1): (f64, f64),
         h: f64,
         best: f64,
-    ) -> f64 {
+    ) -> Result<f64, SearchError> {
         let m = self.modes();
         let c = &out.rows[o * m..(o + 1) * m];
         let func = ModalFn {
@@ -612,7 +619,7 @@ impl LinearBuilding {
             f: f1,
             df: d1,
         };
-        search::peak_abs(&func, &n0, &n1, best, h).0
+        Ok(search::peak_abs(&func, &n0, &n1, best, h)?.0)
     }
 }
 
