@@ -324,6 +324,7 @@ impl Classify for SimulationError {
 impl Classify for SimError {
     fn fault(&self) -> Fault {
         Fault::of(match self {
+            SimError::Stopped { .. } => FaultKind::Interrupted,
             SimError::Zeno { .. }
             | SimError::Contact(_)
             | SimError::Diverged

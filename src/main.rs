@@ -55,10 +55,11 @@ fn main() -> std::process::ExitCode {
     let args = cmd::join_negative_values(std::env::args_os().collect(), &Cli::command());
     let matches = Cli::command().get_matches_from(args);
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
-    // The study's stages check for Ctrl-C between work units; the other commands end at once.
+    // The study's stages check for Ctrl-C between work units, `simulate` every few samples;
+    // the other commands end at once.
     let checked = !matches!(
         cli.command,
-        Command::Simulate(_) | Command::Spectrum(_) | Command::Match(_) | Command::Design(_)
+        Command::Spectrum(_) | Command::Match(_) | Command::Design(_)
     );
     cmd::interrupt::install(checked);
     let result = match cli.command {

@@ -1120,3 +1120,60 @@ fn extreme_record_values_end_with_a_result_or_a_clean_refusal() {
     .fails(2, "times --scale 1000000 that is 2.8");
     assert_eq!(runs, records.len() * 4);
 }
+
+/// Ctrl-C during `simulate` (held by the test hook after 128 samples of a six-storey building
+/// with a stack on every floor; the watch is asked every 64 samples): exit 130, naming the
+/// sample it stopped at.
+#[test]
+fn ctrl_c_stops_a_simulation_within_a_few_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("case.yaml");
+    let stacks: String = (1..=6)
+        .map(|j| format!("  - {{ floor: {j}, alpha: [0.5, 0.5], mu: [0.2, 0.1] }}\n"))
+        .collect();
+    std::fs::write(
+        &case,
+        format!("building: {{ storeys: 6, period: 1.0 }}\nstacks:\n{stacks}"),
+    )
+    .unwrap();
+    let r = interrupted_at(
+        &["simulate", "--config", s(&case)],
+        "simulate.samples:3",
+        dir.path(),
+    );
+    assert_eq!(r.code, 130, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("stopped at sample 128 of"),
+        "{}",
+        r.stderr
+    );
+}
+
+/// A case within the limits that runs long says so before it runs (on standard error, with
+/// its estimate), draws no bar on a pipe, and stops on Ctrl-C: sixty storeys with a two-block
+/// stack on every floor, held by the test hook at its first watch.
+#[test]
+fn a_long_case_says_its_estimate_and_draws_no_bar_on_a_pipe() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("case.yaml");
+    let stacks: String = (1..=60)
+        .map(|j| format!("  - {{ floor: {j}, alpha: [0.1, 0.1], mu: [0.2, 0.1] }}\n"))
+        .collect();
+    std::fs::write(
+        &case,
+        format!("building: {{ storeys: 60, period: 2.0 }}\nstacks:\n{stacks}"),
+    )
+    .unwrap();
+    let r = interrupted_at(
+        &["simulate", "--config", s(&case), "--scale", "2"],
+        "simulate.samples:1",
+        dir.path(),
+    );
+    assert_eq!(r.code, 130, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("simulate: this case takes about"),
+        "{}",
+        r.stderr
+    );
+    assert!(!r.stderr.contains("samples, ETA"), "{}", r.stderr);
+}

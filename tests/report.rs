@@ -685,3 +685,84 @@ fn frame_tail(floor: &str) -> String {
         j => format!("stack on floor {j}"),
     }
 }
+
+/// `report.compare_with`: the building section sets another study's answer (the same cases
+/// under the structure basis) beside this one's, each cell the median of that study's own
+/// answer table; refused while the other study has not been run (naming it and the stage to
+/// run), and out of date when the other's inputs change.
+#[test]
+fn a_building_report_compares_the_other_damping_basis_frame_by_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = std::fs::read_to_string(root.join("configs/mdof-quick.yaml")).unwrap();
+    let (out_r, out_s) = (dir.path().join("r"), dir.path().join("s"));
+    let structure = dir.path().join("structure.yaml");
+    let mut cfg: serde_yaml::Value = serde_yaml::from_str(&base).unwrap();
+    cfg["output_dir"] = serde_yaml::Value::from(out_s.to_str().unwrap());
+    cfg["grid"]["damping_basis"] = serde_yaml::Value::from("structure");
+    std::fs::write(&structure, serde_yaml::to_string(&cfg).unwrap()).unwrap();
+    let rigid = dir.path().join("rigid.yaml");
+    std::fs::write(
+        &rigid,
+        format!("{base}report:\n  compare_with: structure.yaml\n"),
+    )
+    .unwrap();
+    let (r, s) = (rigid.to_str().unwrap(), structure.to_str().unwrap());
+    // The compared study not run: refused, naming it.
+    let o = Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .args(["run", r, "--out", out_r.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("structure.yaml") && err.contains("is missing"),
+        "{err}"
+    );
+    slidestack(&["run", s]);
+    slidestack(&["run", r, "--out", out_r.to_str().unwrap()]);
+    let doc_of = |out: &Path| std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    let (mine, theirs) = (doc_of(&out_r), doc_of(&out_s));
+    let (mine, theirs) = (html_document(&mine), html_document(&theirs));
+    let compare = table(&mine, "building-compare");
+    let (own, other) = (
+        table(&mine, "building-answer"),
+        table(&theirs, "building-answer"),
+    );
+    assert_eq!(compare.len(), own.len());
+    let h = header(&mine, "building-compare");
+    assert!(h[2].contains("rigid basis, 3 stochastic motions"), "{h:?}");
+    assert!(
+        h[3].contains("structure basis, 3 stochastic motions"),
+        "{h:?}"
+    );
+    let first = |cell: &str| cell.split_whitespace().next().unwrap().to_string();
+    for ((c, a), b) in compare.iter().zip(&own).zip(&other) {
+        assert_eq!((&c[0], &c[1]), (&a[0], &a[1]));
+        // Drift ratio (answer column 4), base shear (6), λ (7), λ_code (10), T_new/T_1 (8).
+        for (k, col) in [4, 6, 7, 10, 8].iter().enumerate() {
+            let (x, y) = (first(&a[*col]), first(&b[*col]));
+            let (x, y): (f64, f64) = (x.parse().unwrap(), y.parse().unwrap());
+            // The answer table prints λ and λ_code to two digits, the comparison to three:
+            // half a unit of the second and of the third.
+            close(&c[2 + 2 * k], x, 5.5e-3, "this study's median");
+            close(&c[3 + 2 * k], y, 5.5e-3, "the compared study's median");
+        }
+    }
+    // The compared study's inputs changed (its damping): this report is out of date.
+    cfg["grid"]["damping"] = serde_yaml::Value::from(0.04);
+    std::fs::write(&structure, serde_yaml::to_string(&cfg).unwrap()).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_slidestack"))
+        .args([
+            "status",
+            r,
+            "--out",
+            out_r.to_str().unwrap(),
+            "--format",
+            "env",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("REPORT=stale"), "{text}");
+}

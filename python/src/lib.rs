@@ -12,6 +12,7 @@
 
 mod convert;
 mod errors;
+mod interrupt;
 mod pipeline;
 
 use convert::{json_to_py, to_yaml_value};
@@ -22,6 +23,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 use slidestack::design::{Query, design as design_query};
 use slidestack::dynamics::History;
+use slidestack::dynamics::Watch;
 use slidestack::grid::StackFloor;
 use slidestack::ground_motion::matching::{MatchSettings, match_record};
 use slidestack::ground_motion::{ReadOptions, Record, Units, read_record_with};
@@ -31,6 +33,19 @@ use slidestack::spectrum::batch::{ductility_spectra, response_spectra};
 use slidestack::spectrum::{TargetSpectrum, parse_periods};
 use slidestack::store::HistoryLayout;
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// A simulation's watch: it goes on until Ctrl-C sets the flag.
+struct Cancel(Arc<AtomicBool>);
+
+impl Watch for Cancel {
+    fn going_on(&self, _: usize, _: usize) -> bool {
+        let cancelled = || self.0.load(Ordering::Relaxed);
+        slidestack::pipeline::pause::point("simulate.samples", &cancelled);
+        !cancelled()
+    }
+}
 
 /// The label of a record given as samples (its `record` in the results).
 const ARRAY_RECORD: &str = "array";
@@ -143,22 +158,38 @@ fn simulate<'py>(
     if let Some(r) = samples {
         sim.record = r;
     }
-    let (outcome, hist, warnings) = py
-        .detach(|| {
+    // The run on a thread of its own, so that Ctrl-C stops it within a few samples' work.
+    let cancel = Arc::new(AtomicBool::new(false));
+    let watch = Cancel(Arc::clone(&cancel));
+    let waited = interrupt::on_worker(
+        py,
+        cancel,
+        || true,
+        move || {
             let accel = sim.accel_mps2();
             let warnings = sim.warnings(&accel);
-            sim.run_keeping(&accel, history)
-                .map(|(o, h)| (o, h, warnings))
-        })
-        .map_err(input)?;
+            let layout = |h: &History| match &sim.model {
+                Model::OneStorey { .. } => HistoryLayout::one_storey(h.interfaces),
+                Model::Building { building, .. } => history_layout(building),
+            };
+            sim.run_watched(&accel, history, &watch).map(|(o, h)| {
+                let h = h.map(|h| (layout(&h), h));
+                (o, h, warnings)
+            })
+        },
+    )?;
+    let (outcome, hist, warnings) = match (waited.result, waited.interrupt) {
+        (Ok(Err(e)), Some(_)) if matches!(e, SimulationError::Simulation { .. }) => {
+            return Err(input(e));
+        }
+        (_, Some(interrupt)) => return Err(interrupt),
+        (Ok(r), None) => r.map_err(input)?,
+        (Err(why), None) => return Err(errors::internal(&why)),
+    };
     convert::warn(py, &warnings)?;
     let text = serde_json::to_string(&outcome).expect("a summary serialises");
     let dict = json_to_py(py, &text)?;
-    if let Some(h) = hist {
-        let layout = match &sim.model {
-            Model::OneStorey { .. } => HistoryLayout::one_storey(h.interfaces),
-            Model::Building { building, .. } => history_layout(building),
-        };
+    if let Some((layout, h)) = hist {
         dict.set_item("history", history_dict(py, h, &layout)?)?;
     }
     Ok(dict)

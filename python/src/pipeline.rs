@@ -8,6 +8,7 @@
 
 use crate::convert::{to_yaml_value, warn};
 use crate::errors::{internal, to_py_err};
+use crate::interrupt::on_worker;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
@@ -20,12 +21,7 @@ use slidestack::study::config::{ConfigError, StudyConfig};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{RecvTimeoutError, channel};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
-
-/// How often the waiting thread looks for Ctrl-C.
-const SIGNAL_POLL: Duration = Duration::from_millis(50);
 
 /// The name a config given as a mapping has in messages.
 const DICT_CONFIG: &str = "<config dict>";
@@ -70,7 +66,7 @@ impl ConfigArg {
 /// kept for Python's `warnings`; the Ctrl-C flag.
 struct PyReporter {
     terminal: bool,
-    cancel: AtomicBool,
+    cancel: Arc<AtomicBool>,
     /// The output directory is locked (the stage checks `cancel` from here on).
     opened: AtomicBool,
     warnings: Mutex<Vec<String>>,
@@ -106,54 +102,24 @@ fn in_session<T: Send + 'static>(
 ) -> PyResult<T> {
     let reporter = Arc::new(PyReporter {
         terminal: std::io::stderr().is_terminal(),
-        cancel: AtomicBool::new(false),
+        cancel: Arc::new(AtomicBool::new(false)),
         opened: AtomicBool::new(false),
         warnings: Mutex::new(Vec::new()),
     });
-    let (tx, rx) = channel();
-    let rx = Mutex::new(rx);
     let worker = Arc::clone(&reporter);
-    std::thread::spawn(move || {
-        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+    let waited = on_worker(
+        py,
+        Arc::clone(&reporter.cancel),
+        // Still waiting for another run's lock: the thread stops at its first check.
+        || reporter.opened.load(Ordering::Relaxed),
+        move || {
             let study = config.study(out)?;
             let session = Session::open(study, mode, wait, &*worker)?;
             worker.opened.store(true, Ordering::Relaxed);
             work(&session)
-        }));
-        let _ = tx.send(result);
-    });
-    let mut interrupt: Option<PyErr> = None;
-    let result = loop {
-        let next = py.detach(|| match rx.lock() {
-            Ok(rx) => rx.recv_timeout(SIGNAL_POLL),
-            Err(_) => Err(RecvTimeoutError::Disconnected),
-        });
-        match next {
-            Ok(r) => {
-                // A Ctrl-C of the last slice is reported even though the stage has finished.
-                if interrupt.is_none()
-                    && let Err(e) = py.check_signals()
-                {
-                    interrupt = Some(e);
-                }
-                break r;
-            }
-            Err(RecvTimeoutError::Disconnected) => {
-                return Err(internal("the stage's thread ended without a result"));
-            }
-            Err(RecvTimeoutError::Timeout) => {}
-        }
-        if interrupt.is_none()
-            && let Err(e) = py.check_signals()
-        {
-            reporter.cancel.store(true, Ordering::Relaxed);
-            if !reporter.opened.load(Ordering::Relaxed) {
-                // Still waiting for another run's lock: the thread stops at its first check.
-                return Err(e);
-            }
-            interrupt = Some(e);
-        }
-    };
+        },
+    )?;
+    let (result, interrupt) = (waited.result, waited.interrupt);
     let warnings = reporter
         .warnings
         .lock()
@@ -169,14 +135,7 @@ fn in_session<T: Send + 'static>(
     }
     match result {
         Ok(r) => r.map_err(|e| to_py_err(&e)),
-        Err(panic) => {
-            let why = panic
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_default();
-            Err(internal(&why))
-        }
+        Err(why) => Err(internal(&why)),
     }
 }
 

@@ -156,3 +156,47 @@ def test_warnings_become_python_warnings(cli):
         got = slidestack.simulate(period=1000)
     assert [str(x.message) for x in w] == [want]
     assert got == json.loads(p.stdout)
+
+
+SIMULATE_SCRIPT = """
+import signal, sys, slidestack
+signal.signal(signal.SIGINT, signal.default_int_handler)
+case = dict(building={"storeys": 6, "period": 1.0},
+            stacks=[{"floor": j, "alpha": [0.5, 0.5], "mu": [0.2, 0.1]} for j in range(1, 7)])
+try:
+    slidestack.simulate(**case)
+except KeyboardInterrupt as e:
+    print("KeyboardInterrupt:", e, file=sys.stderr)
+    # The interpreter goes on: the next call runs to its end.
+    print(slidestack.simulate()["switches"] > 0)
+    sys.exit(3)
+print("returned")
+"""
+
+
+def test_ctrl_c_stops_a_simulation_within_a_few_samples(tmp_path):
+    """Held by the test hook after 128 samples of a six-storey building (the watch is asked
+    every 64 samples), SIGINT: KeyboardInterrupt names the sample, and the interpreter goes on."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    held = tmp_path / "held"
+    env = dict(os.environ, SLIDESTACK_PAUSE_AT="simulate.samples:3", SLIDESTACK_PAUSE_FILE=str(held))
+    p = subprocess.Popen(
+        [sys.executable, "-c", SIMULATE_SCRIPT],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    while not held.exists():
+        assert p.poll() is None, p.communicate()
+        time.sleep(0.002)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate()
+    assert p.returncode == 3, (p.returncode, out, err)
+    assert "stopped at sample 128 of" in err, err
+    assert out.strip() == "True", out

@@ -1,6 +1,6 @@
 //! Ctrl-C on the command line. A command whose library work checks for cancellation (the
-//! study's stages) is asked to stop at its next check: it keeps what it stored, says so and the
-//! process exits 130. A second Ctrl-C, or the first during a command that does not check, ends
+//! study's stages between work units, `simulate` every few samples) is asked to stop at its next
+//! check: it keeps what it stored, says so and the process exits 130. A second Ctrl-C, or the first during a command that does not check, ends
 //! the process at once with 130, as the shell's default would (every file is written under a
 //! temporary name and renamed, so nothing half-written is ever taken as a result).
 

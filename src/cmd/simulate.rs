@@ -14,6 +14,74 @@ use slidestack::simulation::{Model, Outcome, Settings, Summary};
 use slidestack::store::{HistoryLayout, write_history};
 use std::path::PathBuf;
 
+/// A long case's estimated time, s, beyond which `simulate` says it before it runs.
+const SAY_ESTIMATE_S: f64 = 15.0;
+
+/// A case's estimated time, s, beyond which a terminal shows a bar.
+const BAR_ESTIMATE_S: f64 = 1.0;
+
+/// What watches a simulation on the command line: a bar on a terminal for a long case, Ctrl-C
+/// (which stops it within [`slidestack::dynamics::WATCH_EVERY`] samples: exit 130), and the
+/// test hook's point `simulate.samples` ([`slidestack::pipeline::pause`]).
+struct Watch {
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Watch {
+    /// For a case estimated at `estimate_s`: says the estimate on standard error when it is
+    /// long, and draws a bar when standard error is a terminal and the case is not short.
+    fn of(estimate_s: f64) -> Self {
+        use std::io::IsTerminal;
+        if estimate_s > SAY_ESTIMATE_S {
+            eprintln!(
+                "simulate: this case takes about {} on a 2-core machine like the project's \
+                 (an estimate from its size); Ctrl-C stops it",
+                duration(estimate_s)
+            );
+        }
+        let bar = (estimate_s > BAR_ESTIMATE_S && std::io::stderr().is_terminal()).then(|| {
+            let style =
+                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} samples, ETA {eta}")
+                    .expect("valid template");
+            indicatif::ProgressBar::new(0).with_style(style)
+        });
+        Self { bar }
+    }
+}
+
+impl slidestack::dynamics::Watch for Watch {
+    fn going_on(&self, sample: usize, samples: usize) -> bool {
+        if let Some(b) = &self.bar {
+            b.set_length(samples as u64);
+            b.set_position(sample as u64);
+        }
+        let stop = super::interrupt::interrupted;
+        slidestack::pipeline::pause::point("simulate.samples", &stop);
+        !stop()
+    }
+}
+
+impl Drop for Watch {
+    fn drop(&mut self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// `3 s`, `4 min`, `2.5 h`, `85 days`.
+fn duration(s: f64) -> String {
+    if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.0} min", s / 60.0)
+    } else if s < 172_800.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else {
+        format!("{:.0} days", s / 86_400.0)
+    }
+}
+
 #[derive(Debug, clap::Args)]
 #[command(allow_negative_numbers = true)]
 pub struct Args {
@@ -52,7 +120,8 @@ pub fn run(args: Args) -> Result<()> {
         )
         .into());
     }
-    let (outcome, history) = sim.run(&accel)?;
+    let watch = Watch::of(sim.cost_estimate_s());
+    let (outcome, history) = sim.run_watched(&accel, sim.history.is_some(), &watch)?;
     if let (Some(path), Some(h)) = (&sim.history, &history) {
         let layout = match &sim.model {
             Model::OneStorey { .. } => HistoryLayout::one_storey(h.interfaces),
@@ -61,7 +130,7 @@ pub fn run(args: Args) -> Result<()> {
         write_history(path, h, &layout)?;
     }
     if let Some(path) = &args.figure
-        && let Some(fig) = sim.building_figure(&accel)?
+        && let Some(fig) = sim.building_figure(&accel, &watch)?
     {
         let svg = slidestack::render::chart::render(&fig)?;
         slidestack::store::atomic::write_bytes(path, svg.as_bytes())?;

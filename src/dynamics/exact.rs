@@ -83,13 +83,23 @@ pub fn simulate_exact(
     ground: &Ground,
     opts: &ExactOptions,
 ) -> Result<Response, SimError> {
+    simulate_exact_watched(sys, ground, opts, &super::Unwatched)
+}
+
+/// [`simulate_exact`] under `watch` ([`super::Watch`]).
+pub fn simulate_exact_watched(
+    sys: &System,
+    ground: &Ground,
+    opts: &ExactOptions,
+    watch: &dyn super::Watch,
+) -> Result<Response, SimError> {
     ground.validate()?;
     let (dt, accel) = (ground.dt_s, ground.accel_mps2);
     let r = match (sys.hysteresis().is_some(), long_periods(sys, dt)) {
-        (true, true) => ExactRun::<true, true>::new(sys, dt, *opts).run(accel)?,
-        (true, false) => ExactRun::<true, false>::new(sys, dt, *opts).run(accel)?,
-        (false, true) => ExactRun::<false, true>::new(sys, dt, *opts).run(accel)?,
-        (false, false) => ExactRun::<false, false>::new(sys, dt, *opts).run(accel)?,
+        (true, true) => ExactRun::<true, true>::new(sys, dt, *opts).run(accel, watch)?,
+        (true, false) => ExactRun::<true, false>::new(sys, dt, *opts).run(accel, watch)?,
+        (false, true) => ExactRun::<false, true>::new(sys, dt, *opts).run(accel, watch)?,
+        (false, false) => ExactRun::<false, false>::new(sys, dt, *opts).run(accel, watch)?,
     };
     r.check_finite()?;
     Ok(r)
@@ -514,7 +524,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         }
     }
 
-    fn run(mut self, accel: &[f64]) -> Result<Response, SimError> {
+    fn run(mut self, accel: &[f64], watch: &dyn super::Watch) -> Result<Response, SimError> {
         let steps = accel.len() - 1;
         let mut history = self
             .opts
@@ -527,6 +537,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         }
         let mut input_peak = 0.0f64;
         for k in 0..steps {
+            super::watched(watch, k, steps)?;
             let t0 = k as f64 * self.dt;
             let slope = (accel[k + 1] - accel[k]) / self.dt;
             let mut tau = 0.0;

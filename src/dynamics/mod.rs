@@ -49,10 +49,10 @@ pub mod rk4;
 pub(crate) mod search;
 
 pub use contact::{Contact, ContactSelector};
-pub use exact::{ExactOptions, simulate_exact};
+pub use exact::{ExactOptions, simulate_exact, simulate_exact_watched};
 pub use model::{DampingBasis, G, Hysteresis, ModelError, System, SystemSpec, Yielding};
 pub use response::{Energy, History, Response};
-pub use rk4::simulate_rk4;
+pub use rk4::{simulate_rk4, simulate_rk4_watched};
 pub use search::SearchError;
 
 use crate::limits::{
@@ -116,6 +116,9 @@ pub enum SimError {
     },
     #[error("the response is not finite (the integration diverged)")]
     Diverged,
+    /// The run's [`Watch`] said stop (Ctrl-C).
+    #[error("stopped at sample {sample} of {samples}")]
+    Stopped { sample: usize, samples: usize },
     /// A certified search for a switch or a peak that could not proceed.
     #[error("in the sample interval starting at t = {time_s} s: {source}")]
     Search {
@@ -128,6 +131,38 @@ pub enum SimError {
     Modal(String),
     #[error(transparent)]
     Contact(#[from] contact::ContactError),
+}
+
+/// Someone watching a long run: told every [`WATCH_EVERY`] samples how far it is, and asked
+/// whether to go on (a progress bar, Ctrl-C). The integrators' `*_watched` entry points take
+/// one; the others run [`Unwatched`].
+pub trait Watch: Sync {
+    /// `sample` of `samples` done; `false` stops the run ([`SimError::Stopped`]).
+    fn going_on(&self, sample: usize, samples: usize) -> bool;
+}
+
+/// A run nobody watches.
+pub struct Unwatched;
+
+impl Watch for Unwatched {
+    fn going_on(&self, _: usize, _: usize) -> bool {
+        true
+    }
+}
+
+/// Samples between two calls of [`Watch::going_on`]: a small share of a sample interval's
+/// work for the largest building, often enough for a bar and for Ctrl-C.
+pub const WATCH_EVERY: usize = 64;
+
+/// Asks `watch` at sample `k` of `steps` whether to go on.
+pub(crate) fn watched(watch: &dyn Watch, k: usize, steps: usize) -> Result<(), SimError> {
+    if k.is_multiple_of(WATCH_EVERY) && !watch.going_on(k, steps) {
+        return Err(SimError::Stopped {
+            sample: k,
+            samples: steps,
+        });
+    }
+    Ok(())
 }
 
 impl Ground<'_> {

@@ -40,6 +40,17 @@ pub fn simulate_rk4(
     substeps: usize,
     history: bool,
 ) -> Result<Response, SimError> {
+    simulate_rk4_watched(sys, ground, substeps, history, &super::Unwatched)
+}
+
+/// [`simulate_rk4`] under `watch` ([`super::Watch`]).
+pub fn simulate_rk4_watched(
+    sys: &System,
+    ground: &Ground,
+    substeps: usize,
+    history: bool,
+    watch: &dyn super::Watch,
+) -> Result<Response, SimError> {
     ground.validate()?;
     if !(1..=MAX_RK4_SUBSTEPS).contains(&substeps) {
         return Err(SimError::Substeps(substeps));
@@ -56,7 +67,7 @@ pub fn simulate_rk4(
             needed: (omega * ground.dt_s / RK4_MAX_OMEGA_STEP).ceil() as usize,
         });
     }
-    let r = Rk4::new(sys).run(ground, substeps, history);
+    let r = Rk4::new(sys).run(ground, substeps, history, watch)?;
     r.check_finite()?;
     Ok(r)
 }
@@ -240,7 +251,13 @@ impl<'s> Rk4<'s> {
         }
     }
 
-    fn run(mut self, ground: &Ground, substeps: usize, want_history: bool) -> Response {
+    fn run(
+        mut self,
+        ground: &Ground,
+        substeps: usize,
+        want_history: bool,
+        watch: &dyn super::Watch,
+    ) -> Result<Response, SimError> {
         let n = self.n;
         let nb = n + 1;
         let acc_g = ground.accel_mps2;
@@ -266,6 +283,7 @@ impl<'s> Rk4<'s> {
         };
         let mut input_peak = 0.0f64;
         for k in 0..steps {
+            super::watched(watch, k, steps)?;
             for sub in 0..substeps {
                 let frac0 = sub as f64 / substeps as f64;
                 let t = k as f64 * dt + sub as f64 * h;
@@ -335,7 +353,7 @@ impl<'s> Rk4<'s> {
         out.switches = switches;
         out.energy = e;
         out.history = history;
-        out
+        Ok(out)
     }
 
     /// One classical RK4 step of length `h` over the current contact pattern, of the state and

@@ -35,7 +35,7 @@ pub enum SearchError {
     /// A value, slope or derivative bound is infinite or NaN: the arithmetic overflowed.
     #[error("a switching or peak function is not finite (the arithmetic overflowed)")]
     NonFinite,
-    /// [`MAX_SEARCH_NODES`] evaluations certified nothing.
+    /// `MAX_SEARCH_NODES` evaluations certified nothing.
     #[error(
         "the certified search made no progress within {MAX_SEARCH_NODES} evaluations (its \
          bounds certify nothing: values beyond what double precision resolves)"

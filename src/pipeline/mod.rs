@@ -286,6 +286,8 @@ pub struct Study {
     /// The building axes of a building study.
     building: Option<BuildingAxes>,
     fingerprints: Fingerprints,
+    /// The study `report.compare_with` names (its own `report:` section ignored: no chains).
+    pub compare: Option<Box<Study>>,
 }
 
 /// Refuses output directories that are surely mistakes: empty, the file-system root, an
@@ -340,6 +342,18 @@ impl Study {
         };
         let grid = cfg.grid.as_ref().map(|g| g.axes());
         let building = cfg.building_axes();
+        let compare = match cfg.report.as_ref().and_then(|r| r.compare_with.as_ref()) {
+            Some(path) => {
+                let mut other = StudyConfig::load(path)?;
+                other.report = None;
+                Some(Box::new(Study::with_config(other, path, None)?))
+            }
+            None => None,
+        };
+        // The compared study's results enter the report (its `T_new`, `λ` and fit).
+        let compared = (compare.as_deref())
+            .and_then(|c| c.fingerprints.rest.as_ref())
+            .map(|r| r[2].clone());
         let motions_fp = motions::fingerprint(&cfg);
         let ida = ida::fingerprint(&cfg, &motions_fp);
         let rest = match &cfg.grid {
@@ -347,7 +361,8 @@ impl Study {
                 let sweep = sweep::fingerprint(&cfg, &motions_fp);
                 let tnew = tnew::fingerprint(&sweep);
                 let fit = fit::fingerprint(&tnew, building.is_some());
-                let report = report::fingerprint(&fit, &motions_fp, ida.as_deref());
+                let report =
+                    report::fingerprint(&fit, &motions_fp, ida.as_deref(), compared.as_deref());
                 Some([sweep, tnew, fit, report])
             }
             None => None,
@@ -364,6 +379,7 @@ impl Study {
                 rest,
                 ida,
             },
+            compare,
         })
     }
 

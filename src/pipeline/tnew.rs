@@ -4,15 +4,16 @@
 //! `DRR_2` → `tnew.h5` (layout in [`crate::store::tnew`]).
 //!
 //! In a building study (docs/model.md, "A study over buildings") every frame (`storeys`,
-//! `stack_floor`) is done alike, with the first mode's `T_1,rigid` and the mean peak roof
-//! displacement divided by `Γ_1·φ_1,N` (the first mode's equivalent-SDOF displacement) before
-//! `T_new` is read off the spectrum; one storey is today's arithmetic, bit for bit. A building
-//! study's cases also get their effective live-load fraction `λ` ([`crate::study::lambda`]),
-//! which simulates the linear building with part of the stack attached (the stage's only
-//! simulations; on one storey also the stack and the rigid system, whose base shear the
-//! sweep's one-storey integrator does not give).
+//! `stack_floor`) is done alike: one storey keeps the paper's `T_new`, bit for bit; a building
+//! of several storeys reads it off the attached fraction of the roof's mean peak displacement,
+//! the first-mode period of the building carrying that fraction of its stack (and keeps the
+//! earlier first-mode definition as `T_new_first_mode`). Its cases also get their attached
+//! fractions ([`crate::study::attached`]: `λ` of the base shear, of each storey's shear and of
+//! the overturning moment, `λ_code`), which run the linear building with part of the stack
+//! attached (the stage's only simulations; on one storey also the stack and the rigid system,
+//! whose shears the sweep's one-storey integrator does not give).
 //!
-//! Fingerprint: the sweep's, and the step of the spectrum's period grid.
+//! Fingerprint: the sweep's, the step of the spectrum's period grid, the methods' versions.
 
 use super::{Outcome, PipelineError, Session, StageId, Study};
 use crate::dynamics::Ground;
@@ -265,19 +266,28 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             band.push(Band::of(case.period_s, tr, tn, f) as u8);
         }
         let lambda = fractions.map(|(l, nmax)| {
+            // Counted over the distinct buildings: a frame that repeats another is its copy.
+            let distinct = study.distinct_frames();
+            let counted: Vec<&attached::CaseFractions> = (distinct.iter())
+                .flat_map(|(f, _)| &l[f * per_frame..(f + 1) * per_frame])
+                .collect();
             let counts: Vec<String> = (FRACTION_FLAGS.iter())
                 .map(|(code, word)| {
-                    let k = l.iter().filter(|x| x.storey[0].1 as u8 == *code).count();
+                    let k = (counted.iter())
+                        .filter(|x| x.storey[0].1 as u8 == *code)
+                        .count();
                     format!("{word} {k}")
                 })
                 .collect();
-            let below = l.iter().filter(|x| x.storey[0].0 < 0.0).count();
+            let below = counted.iter().filter(|x| x.storey[0].0 < 0.0).count();
             s.reporter.info(
                 me,
                 &format!(
-                    "zone {}: effective live-load fraction λ: {}; {below} below 0 (the stack \
-                     lowers the base shear below the bare building's)",
+                    "zone {}: effective live-load fraction λ over the {} cases of the distinct \
+                     buildings: {}; {below} below 0 (the stack lowers the base shear below the \
+                     bare building's)",
                     zc.name,
+                    counted.len(),
                     counts.join(", ")
                 ),
             );

@@ -4,11 +4,12 @@
 //! modal one otherwise), and the [`BuildingSummary`] `--json` prints.
 
 use crate::dynamics::building::{
-    Building, BuildingResponse, BuildingSpec, StackSpec, StoreyYielding, simulate_building,
-    simulate_building_rk4,
+    Building, BuildingResponse, BuildingSpec, StackSpec, StoreyYielding,
+    simulate_building_rk4_watched, simulate_building_watched,
 };
 use crate::dynamics::{
-    DampingBasis, Energy, ExactOptions, G, Ground, History, simulate_exact, simulate_rk4,
+    DampingBasis, Energy, ExactOptions, G, Ground, History, Watch, simulate_exact_watched,
+    simulate_rk4_watched,
 };
 use crate::limits::MAX_STOREYS;
 use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
@@ -236,6 +237,7 @@ pub fn run_building(
     integrator: Integrator,
     rk4_substeps: usize,
     history: bool,
+    watch: &dyn Watch,
 ) -> Result<BuildingResponse, crate::dynamics::SimError> {
     let ground = Ground { dt_s, accel_mps2 };
     let opts = ExactOptions {
@@ -244,14 +246,14 @@ pub fn run_building(
     };
     if let Some(sys) = b.one_storey() {
         let r = match integrator {
-            Integrator::Exact => simulate_exact(&sys, &ground, &opts)?,
-            Integrator::Rk4 => simulate_rk4(&sys, &ground, rk4_substeps, history)?,
+            Integrator::Exact => simulate_exact_watched(&sys, &ground, &opts, watch)?,
+            Integrator::Rk4 => simulate_rk4_watched(&sys, &ground, rk4_substeps, history, watch)?,
         };
         return Ok(BuildingResponse::from_one_storey(r));
     }
     match integrator {
-        Integrator::Exact => simulate_building(b, &ground, &opts),
-        Integrator::Rk4 => simulate_building_rk4(b, &ground, rk4_substeps, history),
+        Integrator::Exact => simulate_building_watched(b, &ground, &opts, watch),
+        Integrator::Rk4 => simulate_building_rk4_watched(b, &ground, rk4_substeps, history, watch),
     }
 }
 

@@ -9,8 +9,8 @@ pub mod building;
 
 use crate::dynamics::building::Building;
 use crate::dynamics::{
-    Energy, ExactOptions, G, Ground, History, Response, SimError, System, SystemSpec, Yielding,
-    simulate_exact, simulate_rk4,
+    Energy, ExactOptions, G, Ground, History, Response, SimError, System, SystemSpec, Unwatched,
+    Watch, Yielding, simulate_exact_watched, simulate_rk4_watched,
 };
 use crate::ground_motion::{self, Record, RecordError};
 use crate::limits::MAX_PEAK_ACCEL_G;
@@ -18,6 +18,15 @@ use crate::study::config::{ConfigError, read_yaml_text, yaml_problem};
 use crate::study::physics::{DampingBasis, Physics};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// Seconds per record sample and body of the one-storey exact integrator; per sample of a
+/// building's, times `N^4.5` (with a two-block stack on every floor: 20, 30 and 60 storeys took
+/// 0.58, 3.6 and 83 ms per sample); per sub-step and body of RK4 (one storey at 1,000 sub-steps
+/// 9.5e-8 s, 20 storeys at 100 sub-steps 6.6e-8 s) ([`Simulation::cost_estimate_s`]; measured
+/// on this project's 2-core machine, docs/faults.md).
+const COST_ONE_STOREY_S: f64 = 1e-6;
+const COST_BUILDING_S: f64 = 8.3e-10;
+const COST_RK4_S: f64 = 1e-7;
 
 /// Largest factor on the record a case may ask for.
 pub const MAX_SCALE: f64 = 1e6;
@@ -385,6 +394,35 @@ impl Simulation {
         }
     }
 
+    /// About how long the run takes on a machine like the project's own (docs/faults.md,
+    /// "Costs a user can see"), s: the record's samples times a cost per sample fitted to runs
+    /// on this project's machine (RK4: per sub-step and body; the exact integrator of a
+    /// building: as `N^4.5` for a two-block stack on every floor, the contact states it meets
+    /// growing with the floors, each with its own modal basis). Measured, not bounded: how much
+    /// a case slides can make it several times shorter or longer.
+    pub fn cost_estimate_s(&self) -> f64 {
+        let samples = self.record.accel_g.len() as f64;
+        let substeps = self.rk4_substeps as f64;
+        let per_sample_s = match &self.model {
+            Model::OneStorey { system, .. } => {
+                let bodies = 1.0 + system.blocks() as f64;
+                match self.integrator {
+                    Integrator::Exact => COST_ONE_STOREY_S * bodies,
+                    Integrator::Rk4 => COST_RK4_S * substeps * bodies,
+                }
+            }
+            Model::Building { building, .. } => {
+                let n = building.storeys() as f64;
+                let bodies = n + building.blocks() as f64;
+                match self.integrator {
+                    Integrator::Exact => COST_BUILDING_S * n.powf(4.5) * bodies / (3.0 * n),
+                    Integrator::Rk4 => COST_RK4_S * substeps * bodies,
+                }
+            }
+        };
+        samples * per_sample_s
+    }
+
     /// The record scaled, in m/s².
     pub fn accel_mps2(&self) -> Vec<f64> {
         self.record.accel_mps2(self.scale)
@@ -421,6 +459,17 @@ impl Simulation {
         accel_mps2: &[f64],
         history: bool,
     ) -> Result<(Outcome, Option<History>), SimulationError> {
+        self.run_watched(accel_mps2, history, &Unwatched)
+    }
+
+    /// [`Simulation::run_keeping`] under `watch` (a progress bar, Ctrl-C:
+    /// [`crate::dynamics::Watch`]).
+    pub fn run_watched(
+        &self,
+        accel_mps2: &[f64],
+        history: bool,
+        watch: &dyn Watch,
+    ) -> Result<(Outcome, Option<History>), SimulationError> {
         let failed = |source| SimulationError::Simulation {
             record: self.record.name.clone(),
             source,
@@ -429,22 +478,25 @@ impl Simulation {
             Model::OneStorey { system, structure } => {
                 let ground = self.ground(accel_mps2);
                 let response = match self.integrator {
-                    Integrator::Exact => simulate_exact(
+                    Integrator::Exact => simulate_exact_watched(
                         system,
                         &ground,
                         &ExactOptions {
                             history,
                             ..ExactOptions::default()
                         },
+                        watch,
                     ),
-                    Integrator::Rk4 => simulate_rk4(system, &ground, self.rk4_substeps, history),
+                    Integrator::Rk4 => {
+                        simulate_rk4_watched(system, &ground, self.rk4_substeps, history, watch)
+                    }
                 }
                 .map_err(failed)?;
                 let summary = self.summary(system, *structure, &response);
                 Ok((Outcome::OneStorey(Box::new(summary)), response.history))
             }
             Model::Building { building, settings } => {
-                let mut r = self.run_building(building, accel_mps2, history)?;
+                let mut r = self.run_building(building, accel_mps2, history, watch)?;
                 let summary = building::building_summary(
                     building,
                     settings,
@@ -469,12 +521,13 @@ impl Simulation {
     pub fn building_figure(
         &self,
         accel_mps2: &[f64],
+        watch: &dyn Watch,
     ) -> Result<Option<crate::render::chart::Figure>, SimulationError> {
         let Model::Building { building: b, .. } = &self.model else {
             return Ok(None);
         };
-        let sliding = self.run_building(b, accel_mps2, true)?;
-        let attached = self.run_building(&b.with_stacks_attached(), accel_mps2, true)?;
+        let sliding = self.run_building(b, accel_mps2, true, watch)?;
+        let attached = self.run_building(&b.with_stacks_attached(), accel_mps2, true, watch)?;
         let title = format!(
             "{} storeys, T_1 = {} s, under {} × {}",
             b.storeys(),
@@ -494,6 +547,7 @@ impl Simulation {
         b: &Building,
         accel_mps2: &[f64],
         history: bool,
+        watch: &dyn Watch,
     ) -> Result<crate::dynamics::building::BuildingResponse, SimulationError> {
         building::run_building(
             b,
@@ -502,6 +556,7 @@ impl Simulation {
             self.integrator,
             self.rk4_substeps,
             history,
+            watch,
         )
         .map_err(|source| SimulationError::Simulation {
             record: self.record.name.clone(),
@@ -625,6 +680,7 @@ impl std::str::FromStr for StructureKind {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dynamics::simulate_exact;
 
     #[test]
     fn flags_override_the_file_and_defaults_fill_the_rest() {

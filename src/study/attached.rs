@@ -27,9 +27,11 @@
 //! [`crate::dynamics::building::BuildingResponse::stuck_mass_share`], averaged over the
 //! motions): the fraction of the stack that, in the simulation itself, moved as an attached
 //! load. It is exactly 1 for a stack that never slides and near 0 for a frictionless one, so
-//! the rule keeps both limits. The family is scanned at `f = k/10` ([`SCAN_STEP`]); the
-//! matching stretches' ends are roots of `value = target ± tolerance`, found by Brent's method
-//! (argmin's `BrentRoot`) to [`FRACTION_TOL`]. With nothing matching on `[lowest, 1]` the scan
+//! the rule keeps both limits: `s̄` itself when it matches, else the nearest end of a matching
+//! stretch (within `tol/|q̄'|` of a root, a few 1e-4 in `f` where `q̄` is not flat). The family is
+//! scanned at `f = k/10` ([`SCAN_STEP`]); a stretch's end is a root of `value = target ±
+//! tolerance`, on the side the stretch is entered from, found by Brent's method (argmin's
+//! `BrentRoot`) to [`FRACTION_TOL`]. With nothing matching on `[lowest, 1]` the scan
 //! is extended above 1 up to [`MAX_FRACTION`]; with nothing there either the flag says on which
 //! side the target lies and the scan point nearest it is taken.
 
@@ -315,10 +317,10 @@ pub fn holds_everywhere(
 
 /// The fraction whose value matches `target` (module doc): `scan` holds `(f, value)` at the
 /// scan's fractions (ascending), `prior` is the stuck mass share, `value` gives the value at any
-/// other fraction (errors returned as they are). The fractions that match are those whose value
-/// lies within [`MATCH_TOL`] of the target; of them the one nearest the prior is taken: the prior
-/// itself when it matches, else the nearest end of a matching stretch (a root of `value = target
-/// ± tolerance`, found by Brent's method).
+/// other fraction (errors returned as they are). Of the fractions whose value lies within
+/// [`MATCH_TOL`] of the target, the one nearest the prior: the prior itself when it matches,
+/// else the nearest end of a matching stretch, a root of `value = target ± tolerance` (Brent's
+/// method) on the side the stretch is entered from.
 pub fn solve<E>(
     target: f64,
     prior: f64,
@@ -332,38 +334,54 @@ pub fn solve<E>(
     } else {
         hi
     };
-    let known = scan.iter().find(|p| p.0 == prior).map(|p| p.1);
-    let at_prior = match known {
-        Some(v) => v,
-        None => value(prior)?,
-    };
     let mut points = scan.to_vec();
-    let mut exact = crossings(target, &points);
-    let mut levels = [target - tol, target + tol].map(|l| (l, crossings(l, &points)));
+    if !points.iter().any(|p| p.0 == prior) {
+        let at = points.partition_point(|p| p.0 < prior);
+        points.insert(at, (prior, value(prior)?));
+    }
+    let at_prior = points.iter().find(|p| p.0 == prior).expect("inserted").1;
+    let matches = |v: f64| (v - target).abs() <= tol;
+    // An interval enters the band from its end nearest the prior: (the level crossed, the
+    // interval) where it does.
+    let entered = |points: &[(f64, f64)], from: usize| -> Vec<(f64, usize)> {
+        (from..points.len().saturating_sub(1))
+            .filter_map(|k| {
+                let (a, b) = (points[k], points[k + 1]);
+                let (near, far) = if a.0 >= prior { (a, b) } else { (b, a) };
+                if matches(near.1) {
+                    return None;
+                }
+                let level = if near.1 > target {
+                    target + tol
+                } else {
+                    target - tol
+                };
+                let crosses = matches(far.1) || (near.1 - level) * (far.1 - level) < 0.0;
+                crosses.then_some((level, k))
+            })
+            .collect()
+    };
+    let mut found = entered(&points, 0);
     // Above 1 only when nothing matches below: the scan grows a step at a time.
-    while exact.is_empty() && levels.iter().all(|(_, c)| c.is_empty()) {
+    while found.is_empty() && !points.iter().any(|p| matches(p.1)) {
         let next = next_fraction(points[points.len() - 1].0);
         if next > MAX_FRACTION + 1e-12 {
             break;
         }
         points.push((next, value(next)?));
-        let from = points.len() - 2;
-        exact = crossings_from(target, &points, from);
-        for (l, c) in &mut levels {
-            *c = crossings_from(*l, &points, from);
-        }
+        found = entered(&points, points.len() - 2);
     }
-    let flag = match exact.len() {
+    let flag = match crossings(target, &points).len() {
         0 => FractionFlag::Near,
         1 => FractionFlag::Root,
         _ => FractionFlag::Several,
     };
-    if (at_prior - target).abs() <= tol {
+    if matches(at_prior) {
         return Ok((prior, flag));
     }
-    if levels.iter().all(|(_, c)| c.is_empty()) {
+    if found.is_empty() {
         let pick = |better: fn(f64, f64) -> bool| {
-            (points[..scan.len()].iter().copied())
+            (scan.iter().copied())
                 .reduce(|a, b| if better(b.1, a.1) { b } else { a })
                 .expect("the scan has points")
         };
@@ -375,7 +393,7 @@ pub fn solve<E>(
         });
     }
     // The intervals that may hold the matching fraction nearest the prior: within a scan step
-    // of the nearest one (a root lies anywhere in its interval).
+    // of the nearest one (a band's end lies anywhere in its interval).
     let distance = |k: usize| {
         let (a, b) = (points[k].0, points[k + 1].0);
         if prior < a {
@@ -386,23 +404,33 @@ pub fn solve<E>(
             0.0
         }
     };
-    let nearest = (levels.iter())
-        .flat_map(|(_, c)| c.iter().map(|&k| distance(k)))
+    let nearest = found
+        .iter()
+        .map(|&(_, k)| distance(k))
         .fold(f64::INFINITY, f64::min);
     let mut best: Option<f64> = None;
-    for (level, c) in &levels {
-        for &k in c.iter().filter(|&&k| distance(k) <= nearest + SCAN_STEP) {
-            let root = root_in(*level, points[k], points[k + 1], &mut value)?;
-            let closer = best.is_none_or(|b| {
-                let (d, db) = ((root - prior).abs(), (b - prior).abs());
-                d < db || (d == db && root > b)
-            });
-            if closer {
-                best = Some(root);
-            }
+    for &(level, k) in found
+        .iter()
+        .filter(|(_, k)| distance(*k) <= nearest + SCAN_STEP)
+    {
+        let (a, b) = (points[k], points[k + 1]);
+        let (near, far) = if a.0 >= prior { (a, b) } else { (b, a) };
+        // A far end inside the band with no crossing of the level: the band's end is where the
+        // level is met, or the far end itself when the band is entered there exactly.
+        let end = if (near.1 - level) * (far.1 - level) < 0.0 || far.1 == level {
+            root_in(level, a, b, &mut value)?
+        } else {
+            far.0
+        };
+        let closer = best.is_none_or(|b| {
+            let (d, db) = ((end - prior).abs(), (b - prior).abs());
+            d < db || (d == db && end > b)
+        });
+        if closer {
+            best = Some(end);
         }
     }
-    Ok((best.expect("a level was crossed"), flag))
+    Ok((best.expect("a band was entered"), flag))
 }
 
 /// The scan intervals whose ends straddle `target` (a point on it counts once, in the interval
@@ -557,15 +585,18 @@ mod tests {
                 .map(|k| (k as f64 / 10.0, f(k as f64 / 10.0)))
                 .collect()
         };
-        // Within MATCH_TOL of the target: f² ≈ 0.49 ± 1.5e-4 gives f = 0.7 ± 1.1e-4.
-        let near = |l: f64, want: f64| (l - want).abs() < 2e-4;
-        // V = 1 + f²: the root of 1.49 is 0.7; from a prior below it, the band's lower end.
+        let near = |l: f64, want: f64| (l - want).abs() < FRACTION_TOL;
+        let (lo, hi) = (1.0 - MATCH_TOL, 1.0 + MATCH_TOL);
+        // V = 1 + f²: 1.49 is met at 0.7; from a prior below, the matching stretch is entered at
+        // its lower end, where 1 + f² = 1.49·(1 − tol).
         let sq = |l: f64| 1.0 + l * l;
         let (l, flag) = solve(1.49, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
         assert_eq!(flag, FractionFlag::Root);
-        assert!(near(l, 0.7) && l < 0.7, "{l}");
-        assert!((sq(l) / 1.49 - 1.0).abs() <= MATCH_TOL * (1.0 + 1e-9));
-        // A prior inside the band is taken itself.
+        assert!(near(l, (1.49 * lo - 1.0f64).sqrt()), "{l}");
+        // From a prior above, at its upper end.
+        let (l, _) = solve(1.49, 0.95, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        assert!(near(l, (1.49 * hi - 1.0f64).sqrt()), "{l}");
+        // A prior whose value matches is taken itself (f² = 0.49 ± 1.5e-4: 0.7 ± 1.1e-4).
         let (l, _) = solve(1.49, 0.70001, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
         assert_eq!(l, 0.70001);
         // Below and above the range: the scan point of the smallest (largest) value.
@@ -573,10 +604,10 @@ mod tests {
             solve(0.5, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap(),
             (0.0, FractionFlag::Below)
         );
-        // Above 1 the scan grows: 1 + f² = 3.25 at f = 1.5.
+        // Above 1 the scan grows: 1 + f² = 3.25 near 1.5.
         let (l, flag) = solve(3.25, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
         assert_eq!(flag, FractionFlag::Root);
-        assert!(near(l, 1.5), "{l}");
+        assert!(near(l, (3.25 * lo - 1.0f64).sqrt()), "{l}");
         assert_eq!(
             solve(9.0, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap(),
             (1.0, FractionFlag::Above)
@@ -587,20 +618,28 @@ mod tests {
             (1.0, FractionFlag::Root)
         );
         // A stationary point: V = 1 + f² has its minimum 1 at 0; a target 1e-5 below it has no
-        // root, but f = 0 matches within the tolerance: the prior 0.001 is taken.
-        let (l, flag) = solve(1.0 - 1e-5, 0.001, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        // root, but f = 0 matches within the tolerance: the prior 0.001 is taken, and from a
+        // prior of 0.5 the stretch's end, where 1 + f² = target·(1 + tol).
+        let t = 1.0 - 1e-5;
+        let (l, flag) = solve(t, 0.001, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
         assert_eq!((l, flag), (0.001, FractionFlag::Near));
-        // A hump: 1 + sin(πf) crosses 1.5 at 1/6 and 5/6; the one nearest the prior is taken.
+        let (l, flag) = solve(t, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        assert_eq!(flag, FractionFlag::Near);
+        assert!(near(l, (t * hi - 1.0f64).sqrt()), "{l}");
+        // A hump: 1 + sin(πf) meets 1.5 at 1/6 and 5/6; the stretch nearest the prior is taken,
+        // entered from the prior's side (below the band outside the hump, above inside it).
         let hump = |l: f64| 1.0 + (std::f64::consts::PI * l).sin();
+        let edge = |s: f64| (s).asin() / std::f64::consts::PI;
+        let (below, above) = (edge(1.5 * lo - 1.0), edge(1.5 * hi - 1.0));
         for (prior, want) in [
-            (0.0, 1.0 / 6.0),
-            (0.3, 1.0 / 6.0),
-            (0.6, 5.0 / 6.0),
-            (1.0, 5.0 / 6.0),
+            (0.0, below),
+            (0.3, above),
+            (0.6, 1.0 - above),
+            (1.0, 1.0 - below),
         ] {
             let (l, flag) = solve(1.5, prior, &scan(&hump), |l| Ok::<_, ()>(hump(l))).unwrap();
             assert_eq!(flag, FractionFlag::Several);
-            assert!(near(l, want), "prior {prior}: {l}");
+            assert!(near(l, want), "prior {prior}: {l} vs {want}");
         }
         // An error of the value comes back as it is.
         assert_eq!(
@@ -620,7 +659,7 @@ mod tests {
         assert_eq!((s[0], s.len()), (-1.0, 21));
         let s = scan_fractions(&case(2.0));
         assert!((s[0] + 0.2).abs() < 1e-12 && s.len() == 13, "{s:?}");
-        assert!(s.iter().any(|&f| f == 0.0) && s[s.len() - 1] == 1.0);
+        assert!(s.contains(&0.0) && s[s.len() - 1] == 1.0);
     }
 }
 
@@ -785,16 +824,13 @@ pub fn zone_fractions(
                 .collect::<Result<Vec<_>, _>>()?;
             let overturning = solve_for(Quantity::Overturning)?;
             let target = stack.storey_shear[0] / rigid.storey_shear[0];
-            let mut spectrum_error = None;
             let code = solve(target, share, code_scan, |f| {
                 code_shear_ratio(&case, frame, grounds, f, *psa_rigid).map_err(|source| {
-                    spectrum_error = Some(frame.t1_attached_s(&case, f));
-                    source
+                    AttachedError::Spectrum {
+                        period_s: frame.t1_attached_s(&case, f),
+                        source,
+                    }
                 })
-            })
-            .map_err(|source| AttachedError::Spectrum {
-                period_s: spectrum_error.unwrap_or(f64::NAN),
-                source,
             })?;
             let code = (
                 code.0,

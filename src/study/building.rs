@@ -26,7 +26,7 @@ use crate::limits::{MAX_AXIS_VALUES, MAX_STOREYS, excerpt};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
-/// One value or a list of them. Read by [`one_or_list`], which says what one value must be.
+/// One value or a list of them. Read by `one_or_list`, which says what one value must be.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum OneOrList<T> {

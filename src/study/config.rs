@@ -53,9 +53,23 @@ pub struct StudyConfig {
     /// buildings").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub building: Option<BuildingSection>,
+    /// What the report sets beside this study's own numbers.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub report: Option<ReportConfig>,
     /// The config file and the files it names, as [`StudyConfig::load`] read them.
     #[serde(skip)]
     pub loaded: Loaded,
+}
+
+/// The `report:` section.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReportConfig {
+    /// Another building study's config (relative to this one's folder) whose answer the
+    /// report's building section sets beside this one's, frame by frame: the same buildings and
+    /// grid under the other damping basis, or other motions. Its stages must be run first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compare_with: Option<PathBuf>,
 }
 
 /// What [`StudyConfig::load`] read besides the YAML keys, each file once: what the study uses
@@ -595,6 +609,11 @@ impl StudyConfig {
                 .map_err(|e| invalid(format!("zones[{i}].target"), e.to_string()))?;
             cfg.loaded.targets.push(target);
         }
+        if let Some(other) = cfg.report.as_mut().and_then(|r| r.compare_with.as_mut())
+            && other.is_relative()
+        {
+            *other = base.join(&*other);
+        }
         cfg.validate().map_err(|(key, why)| invalid(key, why))?;
         if let Some(r) = &cfg.motions.seeds.records {
             for f in &r.files {
@@ -619,6 +638,18 @@ impl StudyConfig {
         let err = |k: &str, w: String| Err((k.to_string(), w));
         if self.zones.is_empty() {
             return err("zones", "needs at least one zone".into());
+        }
+        if let Some(other) = self.report.as_ref().and_then(|r| r.compare_with.as_ref()) {
+            let key = "report.compare_with";
+            if self.building.is_none() {
+                return err(
+                    key,
+                    "compares building studies: the config needs `building`".into(),
+                );
+            }
+            if !other.is_file() {
+                return err(key, format!("{}: no such config file", other.display()));
+            }
         }
         for (i, z) in self.zones.iter().enumerate() {
             let key = format!("zones[{i}]");

@@ -9,7 +9,7 @@
 //! * a floor's absolute acceleration leaves the interval in which the static friction of every
 //!   interface stuck to it can carry the blocks above (the tightest bound over the floor's
 //!   stacks, ties to the first stack and the lowest interface; the stacks whose bound ties it
-//!   break loose together, [`Integrator::broken_together`]);
+//!   break loose together, `Integrator::broken_together`);
 //! * a storey's drift reaches the end of its elastic range (yield), or its drift rate reverses
 //!   on a bounding line (unloading).
 //!
@@ -28,7 +28,7 @@ use super::super::contact::{Contact, ContactSelector, Contacts, switch_contacts}
 use super::super::exact::{BREAK_TOLERANCE, ExactOptions};
 use super::super::response::{Energy, History};
 use super::super::search::{self, Node};
-use super::super::{Ground, SimError};
+use super::super::{Ground, SimError, Unwatched, Watch, watched};
 use super::modal::{ModalError, ModalFn, ModalPoint, Piece, StateModes, mode_terms};
 use super::model::{Building, StoreySpring};
 use super::response::BuildingResponse;
@@ -48,8 +48,18 @@ pub fn simulate_building(
     ground: &Ground,
     opts: &ExactOptions,
 ) -> Result<BuildingResponse, SimError> {
+    simulate_building_watched(building, ground, opts, &Unwatched)
+}
+
+/// [`simulate_building`] under `watch` ([`Watch`]).
+pub fn simulate_building_watched(
+    building: &Building,
+    ground: &Ground,
+    opts: &ExactOptions,
+    watch: &dyn Watch,
+) -> Result<BuildingResponse, SimError> {
     ground.validate()?;
-    let r = Integrator::new(building, ground.dt_s, *opts).run(ground.accel_mps2)?;
+    let r = Integrator::new(building, ground.dt_s, *opts).run(ground.accel_mps2, watch)?;
     r.check_finite()?;
     Ok(r)
 }
@@ -483,7 +493,7 @@ impl<'b> Integrator<'b> {
         }
     }
 
-    fn run(mut self, accel: &[f64]) -> Result<BuildingResponse, SimError> {
+    fn run(mut self, accel: &[f64], watch: &dyn Watch) -> Result<BuildingResponse, SimError> {
         let steps = accel.len() - 1;
         self.steps = steps;
         let mut history = self
@@ -497,6 +507,7 @@ impl<'b> Integrator<'b> {
         }
         let mut input_peak = 0.0f64;
         for k in 0..steps {
+            watched(watch, k, steps)?;
             let t0 = k as f64 * self.dt;
             let slope = (accel[k + 1] - accel[k]) / self.dt;
             let mut tau = 0.0;

@@ -16,9 +16,9 @@ pub mod model;
 pub mod response;
 pub mod rk4;
 
-pub use exact::simulate_building;
+pub use exact::{simulate_building, simulate_building_watched};
 pub use linear::{LinearBuilding, LinearBuildingError, LinearPeaks};
 pub use modal::ModalError;
 pub use model::{Building, BuildingError, BuildingSpec, DampingBasis, StackSpec, StoreyYielding};
 pub use response::BuildingResponse;
-pub use rk4::simulate_building_rk4;
+pub use rk4::{simulate_building_rk4, simulate_building_rk4_watched};

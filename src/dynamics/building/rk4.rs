@@ -43,7 +43,7 @@
 use super::super::contact::Contact;
 use super::super::model::Hysteresis;
 use super::super::response::{Energy, History};
-use super::super::{Ground, SimError};
+use super::super::{Ground, SimError, Unwatched, Watch, watched};
 use super::model::Building;
 use super::response::BuildingResponse;
 use crate::limits::{MAX_RK4_SUBSTEPS, RK4_MAX_OMEGA_STEP};
@@ -58,6 +58,17 @@ pub fn simulate_building_rk4(
     ground: &Ground,
     substeps: usize,
     history: bool,
+) -> Result<BuildingResponse, SimError> {
+    simulate_building_rk4_watched(building, ground, substeps, history, &Unwatched)
+}
+
+/// [`simulate_building_rk4`] under `watch` ([`Watch`]).
+pub fn simulate_building_rk4_watched(
+    building: &Building,
+    ground: &Ground,
+    substeps: usize,
+    history: bool,
+    watch: &dyn Watch,
 ) -> Result<BuildingResponse, SimError> {
     ground.validate()?;
     if !(1..=MAX_RK4_SUBSTEPS).contains(&substeps) {
@@ -79,7 +90,7 @@ pub fn simulate_building_rk4(
             needed: (omega * ground.dt_s / RK4_MAX_OMEGA_STEP).ceil() as usize,
         });
     }
-    let r = Rk4::new(building).run(ground, substeps, history);
+    let r = Rk4::new(building).run(ground, substeps, history, watch)?;
     r.check_finite()?;
     Ok(r)
 }
@@ -435,7 +446,13 @@ impl<'b> Rk4<'b> {
         (kinetic, strain)
     }
 
-    fn run(mut self, ground: &Ground, substeps: usize, want_history: bool) -> BuildingResponse {
+    fn run(
+        mut self,
+        ground: &Ground,
+        substeps: usize,
+        want_history: bool,
+        watch: &dyn Watch,
+    ) -> Result<BuildingResponse, SimError> {
         let (n, b) = (self.n, self.b);
         let blocks = b.blocks();
         let nb = self.bodies;
@@ -482,6 +499,7 @@ impl<'b> Rk4<'b> {
         // ∫ (mass of the blocks not stuck to their floor) dt, kg·s, by sub-step.
         let mut loose_mass_time = 0.0;
         for k in 0..steps {
+            watched(watch, k, steps)?;
             for sub in 0..substeps {
                 let frac0 = sub as f64 / substeps as f64;
                 self.choose_pattern();
@@ -616,7 +634,7 @@ impl<'b> Rk4<'b> {
         } else {
             f64::NAN
         };
-        self.finish(out, switches, history)
+        Ok(self.finish(out, switches, history))
     }
 
     /// Appends the current state as a history row: bodies floors first, then blocks; one

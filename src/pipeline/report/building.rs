@@ -326,6 +326,89 @@ fn answer_rows(zones: &[BuildingZone]) -> Vec<Vec<String>> {
     rows
 }
 
+/// What a study's answer rests on: `rigid basis, 7 stochastic motions`.
+fn basis_and_motions(inp: &Inputs) -> String {
+    let motions = inp.zones.first().map_or(0, |z| z.motions.len());
+    let kind = match inp.study.cfg.motions.seeds.kind() {
+        crate::study::config::Seeds::Stochastic(_) => "stochastic motions",
+        crate::study::config::Seeds::Records(_) => "matched records",
+    };
+    format!("{} basis, {motions} {kind}", inp.physics.basis.name())
+}
+
+/// The compared quantities of [`comparison`]: header, the frame's median of it.
+const COMPARED: [&str; 5] = [
+    "peak drift ratio",
+    "peak base shear",
+    "λ",
+    "λ_code",
+    "T_new/T_1",
+];
+
+/// A frame's medians of the [`COMPARED`] quantities.
+fn compared_medians(f: &FrameCases) -> [f64; 5] {
+    [
+        percentile(&f.drift.ratio(), 50.0),
+        percentile(&f.shear.ratio(), 50.0),
+        percentile(&f.lambda, 50.0),
+        percentile(&f.lambda_code, 50.0),
+        percentile(&f.t_ratio, 50.0),
+    ]
+}
+
+/// Differences below this (in the medians of the ratios and fractions) are not called
+/// differences: the table's third digit, well within what a few motions' means resolve.
+const SAME_WITHIN: f64 = 0.01;
+
+/// The answer beside the compared study's (`report.compare_with`), frame by frame: the median
+/// ratios and fractions of both, and where they differ by more than [`SAME_WITHIN`].
+fn comparison(
+    inp: &Inputs,
+    zones: &[BuildingZone],
+    other: &Inputs,
+    theirs: &[BuildingZone],
+) -> String {
+    let (mine, their_label) = (basis_and_motions(inp), basis_and_motions(other));
+    let mut header = vec!["zone".to_string(), "building, stack on".to_string()];
+    for q in COMPARED {
+        header.push(format!("{q}: {mine}"));
+        header.push(format!("{q}: {their_label}"));
+    }
+    header.push("differs by more than 0.01 in".to_string());
+    let mut rows = Vec::new();
+    let mut differing = 0;
+    for (z, t) in zones.iter().zip(theirs) {
+        for (f, g) in z.frames.iter().zip(&t.frames) {
+            let (a, b) = (compared_medians(f), compared_medians(g));
+            let mut row = vec![z.name.clone(), frame_name(&f.frame)];
+            let mut which = Vec::new();
+            for (k, q) in COMPARED.iter().enumerate() {
+                row.push(fixed(a[k], 3));
+                row.push(fixed(b[k], 3));
+                if (a[k] - b[k]).abs() > SAME_WITHIN {
+                    which.push(*q);
+                }
+            }
+            differing += usize::from(!which.is_empty());
+            row.push(if which.is_empty() {
+                "–".into()
+            } else {
+                which.join(", ")
+            });
+            rows.push(row);
+        }
+    }
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
+    let frames = rows.len();
+    para(&format!(
+        "The same buildings and cases under {their_label} ({}, report.compare_with): the medians \
+         over each frame's cases of the ratios and fractions above, side by side; {differing} of \
+         {frames} frames differ by more than {SAME_WITHIN} in at least one of them (the last \
+         column says in which).",
+        other.study.config_path.display()
+    )) + &table_with_id("building-compare", &header, &rows)
+}
+
 /// The storey counts of a zone's frames, increasing, and each one's frames.
 fn by_storeys(z: &BuildingZone) -> Vec<(usize, Vec<&FrameCases>)> {
     let mut out: Vec<(usize, Vec<&FrameCases>)> = Vec::new();
@@ -532,7 +615,11 @@ fn profiles(z: &BuildingZone, files: &mut Files) -> Result<Option<String>, Repor
 }
 
 /// The building section.
-pub(super) fn building_section(inp: &Inputs, files: &mut Files) -> Result<Section, PipelineError> {
+pub(super) fn building_section(
+    inp: &Inputs,
+    compared: Option<&Inputs>,
+    files: &mut Files,
+) -> Result<Section, PipelineError> {
     let zones = load(inp)?;
     let axes: &BuildingAxes = inp.study.building().expect("a building study");
     let mut body = para(&format!(
@@ -569,6 +656,9 @@ pub(super) fn building_section(inp: &Inputs, files: &mut Files) -> Result<Sectio
         inp.grid.cases()
     ));
     body += &table_with_id("building-answer", &ANSWER_HEADER, &answer_rows(&zones));
+    if let Some(other) = compared {
+        body += &comparison(inp, &zones, other, &load(other)?);
+    }
     for z in &zones {
         body += &against_period(z, inp, files)?;
         if let Some(p) = profiles(z, files)? {

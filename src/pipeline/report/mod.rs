@@ -78,17 +78,20 @@ pub enum ReportError {
 }
 
 /// The fingerprint the report must carry; with an `ida:` section, `ida.h5`'s too (the report
-/// then shows it).
+/// then shows it), and with `report.compare_with` the compared study's fit's (its `T_new`, `λ`
+/// and fit enter the building section).
 pub fn fingerprint(
     fit_fingerprint: &str,
     motions_fingerprint: &str,
     ida_fingerprint: Option<&str>,
+    compared_fit_fingerprint: Option<&str>,
 ) -> String {
-    let hash = match ida_fingerprint {
-        None => hash_parts(&[fit_fingerprint, motions_fingerprint]),
-        Some(ida) => hash_parts(&[fit_fingerprint, motions_fingerprint, ida]),
-    };
-    StageId::Report.fingerprint(&hash)
+    let mut parts = vec![fit_fingerprint, motions_fingerprint];
+    parts.extend(ida_fingerprint);
+    if let Some(c) = compared_fit_fingerprint {
+        parts.extend(["compare_with", c]);
+    }
+    StageId::Report.fingerprint(&hash_parts(&parts))
 }
 
 /// One zone's inputs.
@@ -454,7 +457,31 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let building = study.building().is_some();
     let mut sections = vec![motions_section(&inp, &mut files)?];
     if building {
-        sections.push(building::building_section(&inp, &mut files)?);
+        // The compared study (`report.compare_with`), its files checked as an upstream stage's.
+        let compared = match &study.compare {
+            Some(other) => {
+                other.require(StageId::Tnew)?;
+                other.require(StageId::Fit)?;
+                if other.grid(StageId::Report)? != inp.grid || other.building() != study.building()
+                {
+                    return Err(PipelineError::BadInput {
+                        file: study.config_path.clone(),
+                        why: format!(
+                            "`report.compare_with`: {} has other buildings or another grid than \
+                             this study: compare the same cases",
+                            other.config_path.display()
+                        ),
+                    });
+                }
+                Some(Inputs::load(other)?)
+            }
+            None => None,
+        };
+        sections.push(building::building_section(
+            &inp,
+            compared.as_ref(),
+            &mut files,
+        )?);
     } else {
         sections.extend([
             section71_section(&inp, &mut files)?,
