@@ -149,9 +149,11 @@ fn first_period(masses: &[f64], loaded: &[f64], t1_bare: f64) -> f64 {
 /// The code-format `λ` satisfies its definition, `(W + λ·W_L)·S̄a(T_1(λ)) / ((W + W_L)·S̄a(T_1,
 /// rigid)) = V̄_stack / V̄_rigid`, recomputed from `sweep.h5` and `motions.h5` alone: the means of
 /// the stored peak base shears, `T_1(λ)` from the test's eigensolver, `S̄a` the mean of the
-/// motions' exact 5 %-damped spectra at that period. To `MATCH_TOL` (1e-4) relative, the
-/// tolerance within which a fraction matches by definition, plus 1e-9 for the two eigensolvers'
-/// round-off.
+/// motions' exact 5 %-damped spectra at that period. The stored value is then pinned to 1e-6 by
+/// the rule that chose it (docs/model.md, "Which fraction"): either it is the stuck mass share
+/// recomputed from `sweep.h5` (bit for bit) and meets the definition within `MATCH_TOL` (1e-4),
+/// or it is the end of a matching stretch, where the ratio misses the target by `MATCH_TOL`
+/// itself; 1e-6 covers the root's tolerance in `f` (1e-9) and the two eigensolvers' round-off.
 #[test]
 fn the_code_format_lambda_meets_its_definition_from_the_files() {
     let dir = tempfile::tempdir().unwrap();
@@ -182,7 +184,7 @@ fn the_code_format_lambda_meets_its_definition_from_the_files() {
     };
     let code = l.lambda_code.as_slice().unwrap();
     let slides = t.vars.slides.as_slice().unwrap();
-    let mut checked = 0;
+    let (mut checked, mut at_share) = (0, 0);
     for s in 0..2 {
         let n = [3, 6][s];
         for f in 0..3 {
@@ -212,15 +214,28 @@ fn the_code_format_lambda_meets_its_definition_from_the_files() {
                 let got = (w + lam * wl) * sa(first_period(&masses, &loaded_by(lam), t1))
                     / ((w + wl) * sa(first_period(&masses, &loaded_by(1.0), t1)));
                 let want = mean(&bv.base_shear_stack, c) / mean(&bv.base_shear_rigid, c);
-                assert!(
-                    (got / want - 1.0).abs() <= MATCH_TOL * (1.0 + 1e-6) + 1e-9,
-                    "{n} storeys, floor {f}, T_1 {t1}: λ_code {lam}: {got} vs {want}"
-                );
+                let miss = (got / want - 1.0).abs();
+                let share = mean(&bv.stuck_share_stack, c);
+                if lam == share {
+                    assert!(
+                        miss <= MATCH_TOL + 1e-6,
+                        "{n} storeys, floor {f}, T_1 {t1}: λ_code {lam} (the stuck share): \
+                         {got} vs {want}"
+                    );
+                    at_share += 1;
+                } else {
+                    assert!(
+                        (miss - MATCH_TOL).abs() <= 1e-6,
+                        "{n} storeys, floor {f}, T_1 {t1}: λ_code {lam} (a stretch's end, the \
+                         stuck share {share}): {got} vs {want}, missing by {miss}"
+                    );
+                }
                 checked += 1;
             }
         }
     }
     assert!(checked >= 6, "{checked}");
+    println!("λ_code checked on {checked} sliding cases, {at_share} of them at the stuck share");
 }
 
 /// A `tnew.h5` whose fingerprint names earlier method versions (the `T_new` and `λ` of the
