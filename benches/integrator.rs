@@ -23,15 +23,6 @@ use std::hint::black_box;
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-fn stack(floor: usize, alpha: &[f64], mu: &[f64]) -> StackSpec {
-    StackSpec {
-        floor,
-        alpha: alpha.to_vec(),
-        mu: mu.to_vec(),
-        mu_static: None,
-    }
-}
-
 fn integrators(c: &mut Criterion) {
     let rec = read_record(&common::fixture("RSN960_NORTHR_LOS270.AT2")).unwrap();
     let accel = rec.accel_mps2(1.0);
@@ -70,11 +61,14 @@ fn integrators(c: &mut Criterion) {
     }
 
     let mut one = BuildingSpec::uniform(1, 1.0);
-    one.stacks = vec![stack(1, &[0.5, 0.5], &[0.2, 0.1])];
+    one.stacks = vec![StackSpec::new(1, &[0.5, 0.5], &[0.2, 0.1])];
     let mut three = BuildingSpec::uniform(3, 0.6);
     three.storey_stiffnesses = vec![3.0, 2.0, 1.0];
     three.damping_basis = DampingBasis::Rigid;
-    three.stacks = vec![stack(3, &[0.5, 0.5], &[0.2, 0.1]), stack(1, &[1.0], &[0.3])];
+    three.stacks = vec![
+        StackSpec::new(3, &[0.5, 0.5], &[0.2, 0.1]),
+        StackSpec::new(1, &[1.0], &[0.3]),
+    ];
     let mut three_yielding = three.clone();
     three_yielding.yielding = Some(StoreyYielding {
         strength_ratios: vec![0.15, 0.12, 0.1],
@@ -83,15 +77,15 @@ fn integrators(c: &mut Criterion) {
     let storeys = |n: usize, period_s: f64| {
         let mut b = BuildingSpec::uniform(n, period_s);
         b.stacks = vec![
-            stack(n, &[0.5, 0.5], &[0.2, 0.1]),
-            stack(n.div_ceil(2), &[1.0], &[0.15]),
+            StackSpec::new(n, &[0.5, 0.5], &[0.2, 0.1]),
+            StackSpec::new(n.div_ceil(2), &[1.0], &[0.15]),
         ];
         b
     };
     let mut twenty = BuildingSpec::uniform(20, 2.0);
     twenty.stacks = vec![
-        stack(20, &[0.5, 0.5], &[0.2, 0.1]),
-        stack(10, &[1.0], &[0.15]),
+        StackSpec::new(20, &[0.5, 0.5], &[0.2, 0.1]),
+        StackSpec::new(10, &[1.0], &[0.15]),
     ];
     for (name, spec) in [
         ("building/1_storey_sliding", one),

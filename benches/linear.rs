@@ -21,15 +21,6 @@ use std::hint::black_box;
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-fn stack(floor: usize, alpha: &[f64], mu: &[f64]) -> StackSpec {
-    StackSpec {
-        floor,
-        alpha: alpha.to_vec(),
-        mu: mu.to_vec(),
-        mu_static: None,
-    }
-}
-
 fn linear(c: &mut Criterion) {
     let rec = read_record(&common::fixture("RSN960_NORTHR_LOS270.AT2")).unwrap();
     let accel = rec.accel_mps2(1.0);
@@ -46,8 +37,8 @@ fn linear(c: &mut Criterion) {
     for (n, period_s) in [(3, 0.6), (6, 0.8), (20, 2.0)] {
         let mut spec = BuildingSpec::uniform(n, period_s);
         spec.stacks = vec![
-            stack(n, &[0.5, 0.5], &[0.2, 0.1]),
-            stack(n.div_ceil(2), &[1.0], &[0.15]),
+            StackSpec::new(n, &[0.5, 0.5], &[0.2, 0.1]),
+            StackSpec::new(n.div_ceil(2), &[1.0], &[0.15]),
         ];
         let b = Building::new(&spec)
             .unwrap()

@@ -12,15 +12,6 @@ use slidestack::dynamics::building::{
 };
 use slidestack::dynamics::{ExactOptions, Ground, simulate_exact};
 
-fn stack(floor: usize, alpha: &[f64], mu: &[f64]) -> StackSpec {
-    StackSpec {
-        floor,
-        alpha: alpha.to_vec(),
-        mu: mu.to_vec(),
-        mu_static: None,
-    }
-}
-
 /// A building of `n` storeys with non-uniform masses and stiffnesses, a two-block stack half-way
 /// up and a one-block stack on the roof (one stack on one storey).
 fn loaded(n: usize, basis: DampingBasis) -> BuildingSpec {
@@ -32,11 +23,11 @@ fn loaded(n: usize, basis: DampingBasis) -> BuildingSpec {
     s.damping_basis = basis;
     s.storey_heights_m = heights(n);
     s.stacks = if n == 1 {
-        vec![stack(1, &[0.5, 0.7], &[0.2, 0.1])]
+        vec![StackSpec::new(1, &[0.5, 0.7], &[0.2, 0.1])]
     } else {
         vec![
-            stack(n.div_ceil(2), &[0.5, 0.7], &[0.2, 0.1]),
-            stack(n, &[0.8], &[0.3]),
+            StackSpec::new(n.div_ceil(2), &[0.5, 0.7], &[0.2, 0.1]),
+            StackSpec::new(n, &[0.8], &[0.3]),
         ]
     };
     s

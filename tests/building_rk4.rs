@@ -21,21 +21,15 @@ const HIST: ExactOptions = ExactOptions {
     energy_balance: true,
 };
 
-fn stack(floor: usize, alpha: &[f64], mu: &[f64]) -> StackSpec {
-    StackSpec {
-        floor,
-        alpha: alpha.to_vec(),
-        mu: mu.to_vec(),
-        mu_static: None,
-    }
-}
-
 /// Three storeys (stiffnesses 3:2:1, first period 0.6 s), a two-block stack on floor 3 and one
 /// block on floor 1.
 fn two_stacks() -> BuildingSpec {
     let mut s = BuildingSpec::uniform(3, 0.6);
     s.storey_stiffnesses = vec![3.0, 2.0, 1.0];
-    s.stacks = vec![stack(3, &[0.5, 0.5], &[0.2, 0.1]), stack(1, &[1.0], &[0.3])];
+    s.stacks = vec![
+        StackSpec::new(3, &[0.5, 0.5], &[0.2, 0.1]),
+        StackSpec::new(1, &[1.0], &[0.3]),
+    ];
     s
 }
 
@@ -362,7 +356,7 @@ fn one_storey_equals_the_one_storey_rk4() {
     for yielding in [None, Some((0.15, 0.05))] {
         let mut spec = BuildingSpec::uniform(1, 1.0);
         spec.damping_basis = DampingBasis::Structure;
-        spec.stacks = vec![stack(1, &[0.5, 0.5], &[0.2, 0.1])];
+        spec.stacks = vec![StackSpec::new(1, &[0.5, 0.5], &[0.2, 0.1])];
         let mut sys = System::new(&SystemSpec::new(1.0, &[0.5, 0.5], &[0.2, 0.1])).unwrap();
         if let Some((c, r)) = yielding {
             spec.yielding = Some(StoreyYielding {

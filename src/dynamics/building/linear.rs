@@ -640,12 +640,7 @@ mod tests {
     #[test]
     fn refuses_what_is_not_a_linear_building() {
         let mut s = spec();
-        s.stacks = vec![StackSpec {
-            floor: 2,
-            alpha: vec![0.5, 0.5],
-            mu: vec![0.2, 0.1],
-            mu_static: None,
-        }];
+        s.stacks = vec![StackSpec::new(2, &[0.5, 0.5], &[0.2, 0.1])];
         let b = Building::new(&s).unwrap();
         let e = LinearBuilding::new(&b).unwrap_err();
         assert_eq!(e, LinearBuildingError::Stacks(2));

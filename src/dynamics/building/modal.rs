@@ -600,12 +600,7 @@ mod tests {
     fn building() -> Building {
         let mut s = BuildingSpec::uniform(3, 0.6);
         s.storey_stiffnesses = vec![3.0, 2.0, 1.0];
-        s.stacks = vec![StackSpec {
-            floor: 2,
-            alpha: vec![2.0],
-            mu: vec![0.2],
-            mu_static: None,
-        }];
+        s.stacks = vec![StackSpec::new(2, &[2.0], &[0.2])];
         Building::new(&s).unwrap()
     }
 

@@ -37,6 +37,18 @@ pub struct StackSpec {
     pub mu_static: Option<Vec<f64>>,
 }
 
+impl StackSpec {
+    /// A stack on `floor` whose static friction equals its kinetic friction.
+    pub fn new(floor: usize, alpha: &[f64], mu: &[f64]) -> Self {
+        StackSpec {
+            floor,
+            alpha: alpha.to_vec(),
+            mu: mu.to_vec(),
+            mu_static: None,
+        }
+    }
+}
+
 /// Storeys that yield: bilinear with kinematic hardening per storey.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StoreyYielding {
@@ -667,12 +679,7 @@ mod tests {
                 mu: vec![0.2, 0.1],
                 mu_static: Some(vec![0.25, 0.1]),
             },
-            StackSpec {
-                floor: 1,
-                alpha: vec![1.0],
-                mu: vec![0.3],
-                mu_static: None,
-            },
+            StackSpec::new(1, &[1.0], &[0.3]),
         ];
         s
     }
@@ -701,12 +708,7 @@ mod tests {
     fn one_storey_damping_is_the_sdof_damper_in_both_bases() {
         // Structure basis: c = 2ζ·sqrt(k·m); rigid: 2ζ·sqrt(k·m(1+α)).
         let mut s = BuildingSpec::uniform(1, 1.0);
-        s.stacks = vec![StackSpec {
-            floor: 1,
-            alpha: vec![0.5, 0.5],
-            mu: vec![0.2, 0.1],
-            mu_static: None,
-        }];
+        s.stacks = vec![StackSpec::new(1, &[0.5, 0.5], &[0.2, 0.1])];
         let k = (std::f64::consts::TAU).powi(2);
         for (basis, mass) in [(DampingBasis::Structure, 1.0), (DampingBasis::Rigid, 2.0)] {
             s.damping_basis = basis;
@@ -743,12 +745,7 @@ mod tests {
     #[test]
     fn one_storey_attached_is_the_rigid_system() {
         let mut s = BuildingSpec::uniform(1, 1.0);
-        s.stacks = vec![StackSpec {
-            floor: 1,
-            alpha: vec![0.5, 0.5],
-            mu: vec![0.2, 0.1],
-            mu_static: None,
-        }];
+        s.stacks = vec![StackSpec::new(1, &[0.5, 0.5], &[0.2, 0.1])];
         s.yielding = Some(StoreyYielding {
             strength_ratios: vec![0.3],
             post_yield_ratio: 0.05,
