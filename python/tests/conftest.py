@@ -1,8 +1,13 @@
 """Shared fixtures: the repository, the command-line binary the module is compared with."""
 
+from __future__ import annotations
+
 import json
 import os
+import signal
 import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -33,3 +38,21 @@ def run_cli(cli: Path, *args: str, ok: bool = True) -> subprocess.CompletedProce
 
 def cli_json(cli: Path, *args: str):
     return json.loads(run_cli(cli, *args, "--json").stdout)
+
+
+def interrupt_when_held(script: str, args: list[str], point: str, held: Path,
+                        env: dict[str, str] | None = None) -> tuple[str, str]:
+    """Runs `python -c script *args` held by the test hook at `point` (`SLIDESTACK_PAUSE_AT`,
+    src/pipeline/pause.rs), sends SIGINT while it holds there (the hook has written `held`), and
+    returns its (stdout, stderr); the child must end by its KeyboardInterrupt handler (exit 3)."""
+    env = dict(os.environ, **(env or {}), SLIDESTACK_PAUSE_AT=point,
+               SLIDESTACK_PAUSE_FILE=str(held))
+    p = subprocess.Popen([sys.executable, "-c", script, *args], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=env)
+    while not held.exists():
+        assert p.poll() is None, p.communicate()
+        time.sleep(0.002)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate()
+    assert p.returncode == 3, (p.returncode, out, err)
+    return out, err

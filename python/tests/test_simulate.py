@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import slidestack
-from conftest import ROOT, cli_json, run_cli
+from conftest import ROOT, cli_json, interrupt_when_held, run_cli
 
 KOBE = ROOT / "tests/fixtures/records/RSN1111_KOBE_NIS000.AT2"
 
@@ -177,26 +177,6 @@ print("returned")
 def test_ctrl_c_stops_a_simulation_within_a_few_samples(tmp_path):
     """Held by the test hook after 128 samples of a six-storey building (the watch is asked
     every 64 samples), SIGINT: KeyboardInterrupt names the sample, and the interpreter goes on."""
-    import os
-    import signal
-    import subprocess
-    import sys
-    import time
-
-    held = tmp_path / "held"
-    env = dict(os.environ, SLIDESTACK_PAUSE_AT="simulate.samples:3", SLIDESTACK_PAUSE_FILE=str(held))
-    p = subprocess.Popen(
-        [sys.executable, "-c", SIMULATE_SCRIPT],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
-    )
-    while not held.exists():
-        assert p.poll() is None, p.communicate()
-        time.sleep(0.002)
-    p.send_signal(signal.SIGINT)
-    out, err = p.communicate()
-    assert p.returncode == 3, (p.returncode, out, err)
+    out, err = interrupt_when_held(SIMULATE_SCRIPT, [], "simulate.samples:3", tmp_path / "held")
     assert "stopped at sample 128 of" in err, err
     assert out.strip() == "True", out

@@ -1,16 +1,14 @@
 """The study's stages from Python: the CLI's files, open_study, h5py beside the module, Ctrl-C."""
 
 import os
-import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
 
 import slidestack
-from conftest import ROOT, run_cli
+from conftest import ROOT, interrupt_when_held, run_cli
 
 QUICK = ROOT / "configs/quick.yaml"
 STAGE_FILES = ("motions.h5", "sweep.h5", "tnew.h5", "fit.h5", "fit.yaml")
@@ -165,22 +163,8 @@ def interrupted(cfg, stage: str, point: str, tmp_path: Path) -> str:
     """Runs `stage` of `cfg` in a child interpreter held at `point` of the test hook
     (slidestack.pipeline.pause), sends SIGINT while it holds there, and returns its stderr; the
     stage must end in KeyboardInterrupt (exit 3), however late the signal came."""
-    held = tmp_path / f"held-{stage}"
-    env = dict(os.environ, SLIDESTACK_PAUSE_AT=point, SLIDESTACK_PAUSE_FILE=str(held))
-    env["RAYON_NUM_THREADS"] = "1"
-    p = subprocess.Popen(
-        [sys.executable, "-c", INTERRUPT_SCRIPT, repr(cfg), stage],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
-    )
-    while not held.exists():
-        assert p.poll() is None, p.communicate()
-        time.sleep(0.002)
-    p.send_signal(signal.SIGINT)
-    out, err = p.communicate()
-    assert p.returncode == 3, (p.returncode, out, err)
+    out, err = interrupt_when_held(INTERRUPT_SCRIPT, [repr(cfg), stage], point,
+                                   tmp_path / f"held-{stage}", {"RAYON_NUM_THREADS": "1"})
     assert "returned" not in out
     return err
 
