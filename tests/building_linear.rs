@@ -8,9 +8,28 @@ mod common;
 
 use common::{real_records, sdof_oracle};
 use slidestack::dynamics::building::{
-    Building, BuildingSpec, DampingBasis, LinearBuilding, StackSpec, simulate_building,
+    Building, BuildingResponse, BuildingSpec, DampingBasis, LinearBuilding, LinearPeaks, StackSpec,
+    simulate_building,
 };
 use slidestack::dynamics::{ExactOptions, Ground, simulate_exact};
+
+/// The peaks both paths give, `(linear kernel, integrator)`: the base shear, then per floor the
+/// peak displacement, the peak absolute acceleration and the storey's peak drift.
+fn peak_pairs(l: &LinearPeaks, e: &BuildingResponse) -> Vec<(f64, f64)> {
+    let mut pairs = vec![(l.peak_base_shear_n(), e.peak_base_shear_n)];
+    for j in 0..e.floor_peak_displacement_m.len() {
+        pairs.push((
+            l.floor_peak_displacement_m[j],
+            e.floor_peak_displacement_m[j],
+        ));
+        pairs.push((
+            l.floor_peak_abs_accel_mps2[j],
+            e.floor_peak_abs_accel_mps2[j],
+        ));
+        pairs.push((l.storey_peak_drift_m[j], e.storey_peak_drift_m[j]));
+    }
+    pairs
+}
 
 /// A building of `n` storeys with non-uniform masses and stiffnesses, a two-block stack half-way
 /// up and a one-block stack on the roof (one stack on one storey).
@@ -89,19 +108,7 @@ fn agrees_with_the_event_driven_integrator() {
                         l.peak_base_shear_n().to_bits(),
                         "{what}"
                     );
-                    let mut pairs = vec![(l.peak_base_shear_n(), e.peak_base_shear_n)];
-                    for j in 0..n {
-                        pairs.push((
-                            l.floor_peak_displacement_m[j],
-                            e.floor_peak_displacement_m[j],
-                        ));
-                        pairs.push((
-                            l.floor_peak_abs_accel_mps2[j],
-                            e.floor_peak_abs_accel_mps2[j],
-                        ));
-                        pairs.push((l.storey_peak_drift_m[j], e.storey_peak_drift_m[j]));
-                    }
-                    for (i, (got, want)) in pairs.into_iter().enumerate() {
+                    for (i, (got, want)) in peak_pairs(&l, &e).into_iter().enumerate() {
                         assert!(want > 0.0, "{what}: peak {i} is zero");
                         let r = rel(got, want);
                         if r > worst.0 {
@@ -373,19 +380,7 @@ fn an_undamped_building_agrees_too() {
     for (name, b) in systems(&spec) {
         let l = LinearBuilding::new(&b).unwrap().run(&ground).unwrap();
         let e = simulate_building(&b, &ground, &opts).unwrap();
-        let mut pairs = vec![(l.peak_base_shear_n(), e.peak_base_shear_n)];
-        for j in 0..3 {
-            pairs.push((
-                l.floor_peak_displacement_m[j],
-                e.floor_peak_displacement_m[j],
-            ));
-            pairs.push((
-                l.floor_peak_abs_accel_mps2[j],
-                e.floor_peak_abs_accel_mps2[j],
-            ));
-            pairs.push((l.storey_peak_drift_m[j], e.storey_peak_drift_m[j]));
-        }
-        for (got, want) in pairs {
+        for (got, want) in peak_pairs(&l, &e) {
             assert!(rel(got, want) < 5e-12, "{name}: {got} vs {want}");
             worst = worst.max(rel(got, want));
         }
