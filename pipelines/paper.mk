@@ -2,8 +2,15 @@
 #
 #   make -f pipelines/paper.mk                          # configs/paper.yaml -> out/paper/report
 #   make -f pipelines/paper.mk CONFIG=configs/quick.yaml OUT=out/quick
+#   make -f pipelines/paper.mk CONFIG=configs/ida-quick.yaml OUT=out/ida-quick   # motions, ida, report
 #   make -f pipelines/paper.mk sweep                    # up to one stage
 #   make -f pipelines/paper.mk -B FORCE=1               # recompute every stage
+#
+# make runs exactly the stages the config configures, as `slidestack run` does: motions and the
+# report always, sweep and tnew with a `grid` section, fit when that grid has enough cases to fit
+# a design equation, ida with an `ida:` section. It asks the binary which
+# (`slidestack status --format make` into OUT/make/stages.mk, remade when the config or the
+# binary changes) before it decides anything else.
 #
 # Works from any directory (CONFIG and OUT are taken from the current one, as slidestack does).
 #
@@ -36,8 +43,24 @@ motions: $(OUT)/motions.h5
 sweep: $(OUT)/sweep.h5
 tnew: $(OUT)/tnew.h5
 fit: $(OUT)/fit.h5
+ida: $(OUT)/ida.h5
 report: $(OUT)/report/index.html
-.PHONY: all motions sweep tnew fit report always
+.PHONY: all motions sweep tnew fit ida report always
+
+# STAGES: the stages the config configures, in order (written by the binary).
+STAGES_MK := $(OUT)/make/stages.mk
+$(STAGES_MK): $(CONFIG) $(SLIDESTACK)
+	@mkdir -p '$(@D)'
+	@'$(SLIDESTACK)' status '$(CONFIG)' --out '$(OUT)' --format make >'$@.tmp'
+	@mv -f '$@.tmp' '$@'
+include $(STAGES_MK)
+# Each stage's file; the report depends on every other configured stage's.
+file_motions := $(OUT)/motions.h5
+file_sweep := $(OUT)/sweep.h5
+file_tnew := $(OUT)/tnew.h5
+file_fit := $(OUT)/fit.h5
+file_ida := $(OUT)/ida.h5
+REPORT_INPUTS := $(foreach s,$(filter-out report,$(STAGES)),$(file_$(s)))
 
 # Built only when missing, also under make -B (which remakes every target, this one included).
 $(SLIDESTACK):
@@ -63,7 +86,10 @@ $(OUT)/fit.h5: $(OUT)/tnew.h5 $(CONFIG) $(SLIDESTACK)
 	'$(SLIDESTACK)' fit '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
 	@touch -c '$@'
 
-$(OUT)/report/index.html: $(OUT)/fit.h5 $(OUT)/tnew.h5 $(OUT)/sweep.h5 $(OUT)/motions.h5 \
-		$(CONFIG) $(SLIDESTACK)
+$(OUT)/ida.h5: $(OUT)/motions.h5 $(CONFIG) $(SLIDESTACK)
+	'$(SLIDESTACK)' ida '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
+	@touch -c '$@'
+
+$(OUT)/report/index.html: $(REPORT_INPUTS) $(CONFIG) $(SLIDESTACK)
 	'$(SLIDESTACK)' report '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
 	@touch -c '$@'

@@ -3,7 +3,8 @@
 #   1. `motions` as one job (only when motions.h5 is not up to date),
 #   2. the sweep as a job array, task K computing shard K of N (`sweep --shard K/N`),
 #   3. one finishing job, started when every task has ended (`afterany`), that checks every work
-#      unit is there, merges them and runs tnew, fit and report.
+#      unit is there, merges them and runs the later stages the config configures (tnew, fit,
+#      ida with an `ida:` section, report).
 # Each part is left out when its file is already up to date (`slidestack status`), so submitting
 # a finished study submits nothing. Run with --help for the options; pipelines/README.md has the
 # walk-through.
@@ -148,27 +149,35 @@ esac
 sources (see pipelines/README.md, \"Building\")"
 status=$("$SLIDESTACK" status "$CONFIG" --out "$OUT" --format env) ||
   die "slidestack status failed on $CONFIG (message above); nothing was submitted"
-MOTIONS="" SWEEP="" TNEW="" FIT="" REPORT="" SWEEP_UNITS="" SWEEP_UNITS_DONE=""
-SWEEP_CASES_PER_UNIT="" SWEEP_SAMPLES_PER_MOTION="" SWEEP_SAMPLES_PER_UNIT=""
-# KEY=VALUE lines; the keys used here are checked below, others are left alone.
+MOTIONS="" SWEEP="" TNEW="" FIT="" IDA="" REPORT="" SWEEP_UNITS="" SWEEP_UNITS_DONE=""
+SWEEP_CASES_PER_UNIT="" SWEEP_SAMPLES_PER_MOTION="" SWEEP_SAMPLES_PER_UNIT="" STAGES=""
+# KEY=VALUE lines; the keys used here are checked below, others are left alone. A stage the
+# config does not configure has no line (STAGES lists the configured ones).
 while IFS= read -r line; do
   [[ $line =~ ^([A-Z_]+)=(.*)$ ]] || continue
   case ${BASH_REMATCH[1]} in
-  MOTIONS | SWEEP | TNEW | FIT | REPORT | SWEEP_UNITS | SWEEP_UNITS_DONE | SWEEP_CASES_PER_UNIT | \
-    SWEEP_SAMPLES_PER_MOTION | SWEEP_SAMPLES_PER_UNIT)
+  MOTIONS | SWEEP | TNEW | FIT | IDA | REPORT | SWEEP_UNITS | SWEEP_UNITS_DONE | \
+    SWEEP_CASES_PER_UNIT | SWEEP_SAMPLES_PER_MOTION | SWEEP_SAMPLES_PER_UNIT | STAGES)
     printf -v "${BASH_REMATCH[1]}" '%s' "${BASH_REMATCH[2]}" ;;
   esac
 done <<<"$status"
-[ -n "$SWEEP" ] || die "$CONFIG has no grid, so there is no sweep to run on a cluster; its only stage
-runs on one machine: $SLIDESTACK motions $CONFIG --out $OUT"
-for v in MOTIONS SWEEP TNEW FIT REPORT; do
+[ -n "$STAGES" ] || die "slidestack status gave no STAGES line: $SLIDESTACK is older than these
+scripts; build the current sources (see pipelines/README.md, \"Building\")"
+[ -n "$SWEEP" ] || die "$CONFIG has no grid, so there is no sweep to run on a cluster; its stages
+($STAGES) run on one machine: $SLIDESTACK run $CONFIG --out $OUT"
+IFS=, read -ra stages <<<"$STAGES"
+all_done=1 states=""
+for stage in "${stages[@]}"; do
+  v=${stage^^}
   case ${!v} in up_to_date | stale | missing | damaged) ;; *) die "slidestack status gave $v='${!v}'" ;; esac
+  [ "${!v}" = up_to_date ] || all_done=0
+  states="$states${states:+, }$stage ${!v}"
 done
 for v in SWEEP_UNITS SWEEP_UNITS_DONE SWEEP_CASES_PER_UNIT SWEEP_SAMPLES_PER_MOTION SWEEP_SAMPLES_PER_UNIT; do
   is_uint "${!v}" || die "slidestack status gave $v='${!v}'"
 done
-note "status: motions $MOTIONS, sweep $SWEEP ($SWEEP_UNITS_DONE of $SWEEP_UNITS units stored), tnew $TNEW, fit $FIT, report $REPORT"
-if [ $FORCE = 0 ] && [ "$MOTIONS$SWEEP$TNEW$FIT$REPORT" = "up_to_dateup_to_dateup_to_dateup_to_dateup_to_date" ]; then
+note "status: $states ($SWEEP_UNITS_DONE of $SWEEP_UNITS sweep units stored)"
+if [ $FORCE = 0 ] && [ $all_done = 1 ]; then
   note "the study in $OUT is up to date: nothing to submit ($OUT/report/index.html; --force recomputes it)"
   exit 0
 fi

@@ -9,7 +9,7 @@
 # (scripts/export-fema-p695.py), and into which it installs the Python module (python/) that
 # tests/python.rs tests with pytest; and a headless Chromium from the system's packages (Debian's
 # chromium-headless-shell), in which tests/design_page.rs opens the report's pages
-# (scripts/browser_probe.py).
+# (scripts/browser_probe.py); and GNU make, with which tests/stages.rs runs pipelines/paper.mk.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
@@ -44,6 +44,17 @@ if [ "${1:-}" = "--test" ]; then
   # only what changed since the last install.
   PATH="$PWD/.venv-test/bin:$PATH" .venv-test/bin/pip install -q --disable-pip-version-check \
     --no-build-isolation ./python
+fi
+if [ "${1:-}" = "--test" ] && ! command -v make >/dev/null 2>&1; then
+  if command -v apt-get >/dev/null 2>&1; then
+    SUDO=""
+    [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq make >/dev/null
+  else
+    echo "the tests need GNU make (pipelines/paper.mk is tested): install it" >&2
+    exit 1
+  fi
 fi
 if [ "${1:-}" = "--test" ] && [ -z "${SLIDESTACK_CHROMIUM:-}" ] \
   && ! command -v chromium-headless-shell >/dev/null 2>&1 && ! command -v chromium >/dev/null 2>&1; then

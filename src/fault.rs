@@ -186,7 +186,7 @@ impl Classify for PipelineError {
             PipelineError::Config(e) => e.fault(),
             PipelineError::BadInput { file, .. } => Fault::of(BadInput).file(file.display()),
             PipelineError::Setting { setting, .. } => Fault::of(BadInput).key(*setting),
-            PipelineError::NoGrid { config, .. } => {
+            PipelineError::NoGrid { config, .. } | PipelineError::TooFewToFit { config, .. } => {
                 Fault::of(BadInput).file(config.display()).key("grid")
             }
             PipelineError::Lock(e) => e.fault(),

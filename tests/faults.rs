@@ -1001,7 +1001,7 @@ fn every_kind_of_fault_has_its_exit_code() {
     let blocker = d.join("a-file");
     std::fs::write(&blocker, "").unwrap();
     run(&["motions", s(&cfg), "--out", s(&blocker.join("o"))], QUICK).fails(1, "cannot create it");
-    // A run that cannot produce its result: 1 (one case cannot be fitted).
+    // A grid too small to fit a design equation: 2, before any work (`fit` is not configured).
     let one = d.join("one");
     std::fs::create_dir(&one).unwrap();
     let small = study(&one, "");
@@ -1011,10 +1011,23 @@ fn every_kind_of_fault_has_its_exit_code() {
         .replace("[[0.5, 1.0], [0.5]]", "[[0.5], [0.5]]")
         .replace("[[0.1, 0.3, 0.5], [0.05, 0.2]]", "[[0.1], [0.05]]");
     std::fs::write(&small, text).unwrap();
-    for stage in ["motions", "sweep", "tnew"] {
-        run(&[stage, s(&small)], PLAIN).ok();
-    }
-    run(&["fit", s(&small)], PLAIN).fails(1, "no form could be fitted");
+    run(&["fit", s(&small)], PLAIN).fails(2, "the grid gives 1");
+    // A run that cannot produce its result: 1 (a record file changed while the stage ran).
+    let changing = d.join("changing");
+    std::fs::create_dir(&changing).unwrap();
+    let record = changing.join("RSN829_CAPEMEND_RIO360.AT2");
+    std::fs::copy(fixture("RSN829_CAPEMEND_RIO360.AT2"), &record).unwrap();
+    let text = std::fs::read_to_string(study(&changing, ""))
+        .unwrap()
+        .replace(s(&fixture("RSN829_CAPEMEND_RIO360.AT2")), s(&record));
+    let cfg_changing = changing.join("study.yaml");
+    std::fs::write(&cfg_changing, text).unwrap();
+    let (child, held) = spawn_held(&["motions", s(&cfg_changing)], "session.locked", &changing);
+    let mut bytes = std::fs::read(&record).unwrap();
+    bytes.extend_from_slice(b"\n");
+    std::fs::write(&record, bytes).unwrap();
+    held.release();
+    finish(child, PLAIN.guard, "motions").fails(1, "changed after the study was loaded");
     // Interrupted: 130 (ctrl_c_ends_a_stage_with_130_at_any_point_and_a_rerun_resumes).
 }
 

@@ -1,6 +1,8 @@
-//! `slidestack status CONFIG [--out DIR] [--format text|env]`: what is on disk for every stage
-//! and the sweep's work units, without changing anything (no lock is taken). `--format env`
-//! prints `KEY=value` lines for shell scripts (`eval "$(slidestack status … --format env)"`).
+//! `slidestack status CONFIG [--out DIR] [--format text|env|make]`: what is on disk for every
+//! stage the config configures and the sweep's work units, without changing anything (no lock
+//! is taken). `--format env` prints `KEY=value` lines for shell scripts (`eval "$(slidestack
+//! status … --format env)"`), `STAGES=motions,sweep,…` among them; `--format make` only the
+//! configured stages, as the make variable `STAGES` (pipelines/paper.mk includes it).
 
 use super::StudyArgs;
 use anyhow::Result;
@@ -11,6 +13,7 @@ use slidestack::pipeline::{StageState, status};
 pub enum Format {
     Text,
     Env,
+    Make,
 }
 
 #[derive(Debug, clap::Args)]
@@ -24,9 +27,17 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let study = args.study.study()?;
+    let stages: Vec<&str> = study.stages().iter().map(|s| s.name()).collect();
+    if args.format == Format::Make {
+        println!("# The stages {} configures.", args.study.config.display());
+        println!("STAGES := {}", stages.join(" "));
+        return Ok(());
+    }
     let st = status(&study)?;
     match args.format {
+        Format::Make => unreachable!("printed above"),
         Format::Env => {
+            println!("STAGES={}", stages.join(","));
             for (stage, state) in &st.stages {
                 println!("{}={}", stage.name().to_uppercase(), state.word());
             }

@@ -80,6 +80,31 @@ pub fn fingerprint(tnew_fingerprint: &str, building: bool) -> String {
     StageId::Fit.fingerprint(&hash_parts(&parts))
 }
 
+/// The least number of cases any form can be fitted to and [`FOLDS`]-fold cross-validated
+/// on, with `features` features: the whole fit and every fold's training cases need three
+/// per parameter ([`crate::fit`]).
+pub fn cases_needed(features: usize) -> usize {
+    let least = |m: usize| {
+        (1..)
+            .find(|&n: &usize| n - n.div_ceil(FOLDS) >= 3 * m)
+            .expect("the training cases grow with n")
+    };
+    (Form::ALL.iter())
+        .map(|f| least(f.parameter_count(features)))
+        .min()
+        .expect("there are forms")
+}
+
+/// The cases a fit of a study of `grid` over `frames` (empty on one storey) has at most (the
+/// distinct frames' cases; those whose `T_new` is not finite are left out later) and the least
+/// it needs ([`cases_needed`]), from the config alone.
+pub fn case_count(grid: &Grid, frames: &[Frame]) -> (usize, usize) {
+    let n = grid.blocks();
+    let features = fit_features(n, frames).map_or_else(|| feature_names(n), |b| b.names());
+    let distinct = repeats(frames).iter().filter(|r| !**r).count().max(1);
+    (grid.cases() * distinct, cases_needed(features.len()))
+}
+
 /// Names of a form's parameters, in [`crate::fit::Fitted::params`] order.
 pub fn parameter_names(form: Form, features: &[String]) -> Vec<String> {
     form.parameter_names(features)

@@ -159,6 +159,17 @@ pub enum PipelineError {
     },
     #[error("{}: the `{stage}` stage needs a `grid` section", config.display())]
     NoGrid { config: PathBuf, stage: StageId },
+    /// The grid has fewer cases than any design equation needs ([`fit::case_count`]).
+    #[error(
+        "{}: the `fit` stage needs at least {needed} cases (over the distinct frames) to fit \
+         and cross-validate a design equation; the grid gives {cases}",
+        config.display()
+    )]
+    TooFewToFit {
+        config: PathBuf,
+        cases: usize,
+        needed: usize,
+    },
     #[error(transparent)]
     Motions(#[from] motions::MotionsError),
     #[error(transparent)]
@@ -263,14 +274,20 @@ impl Reporter for Quiet {
     fn warn(&self, _: StageId, _: &str) {}
 }
 
-/// The expected fingerprint of every stage's output, from the config (and record files) alone.
+/// The expected fingerprint of every stage's output, from the config (and record files) alone;
+/// a stage the config does not configure has none ([`Study::configured`]).
 #[derive(Debug, Clone)]
 struct Fingerprints {
     motions: String,
     /// `None` without a `grid` section.
-    rest: Option<[String; 4]>,
+    sweep: Option<String>,
+    tnew: Option<String>,
+    /// `None` without a grid, or with one too small to fit a design equation to
+    /// ([`fit::case_count`]).
+    fit: Option<String>,
     /// `None` without an `ida` section.
     ida: Option<String>,
+    report: String,
 }
 
 /// A loaded, validated study: its config, output directory, grid and expected fingerprints.
@@ -285,6 +302,9 @@ pub struct Study {
     grid: Option<Grid>,
     /// The building axes of a building study.
     building: Option<BuildingAxes>,
+    /// The cases a fit would have and the least it needs ([`fit::case_count`]); `None`
+    /// without a grid.
+    fit_cases: Option<(usize, usize)>,
     fingerprints: Fingerprints,
     /// The study `report.compare_with` names (its own `report:` section ignored: no chains).
     pub compare: Option<Box<Study>>,
@@ -308,6 +328,13 @@ pub fn check_output_dir(out: &Path) -> Result<(), String> {
         None
     };
     why.map_or(Ok(()), Err)
+}
+
+/// The frames of a building study in stored order; empty on one storey.
+fn frames_of(cfg: &StudyConfig, building: Option<&BuildingAxes>) -> Vec<Frame> {
+    building.map_or_else(Vec::new, |b| {
+        (0..b.frames()).filter_map(|f| cfg.frame(b, f)).collect()
+    })
 }
 
 impl Study {
@@ -351,22 +378,27 @@ impl Study {
             None => None,
         };
         // The compared study's results enter the report (its `T_new`, `λ` and fit).
-        let compared = (compare.as_deref())
-            .and_then(|c| c.fingerprints.rest.as_ref())
-            .map(|r| r[2].clone());
+        let compared = (compare.as_deref()).and_then(|c| c.fingerprints.fit.clone());
         let motions_fp = motions::fingerprint(&cfg);
         let ida = ida::fingerprint(&cfg, &motions_fp);
-        let rest = match &cfg.grid {
-            Some(_) => {
-                let sweep = sweep::fingerprint(&cfg, &motions_fp);
-                let tnew = tnew::fingerprint(&sweep);
-                let fit = fit::fingerprint(&tnew, building.is_some());
-                let report =
-                    report::fingerprint(&fit, &motions_fp, ida.as_deref(), compared.as_deref());
-                Some([sweep, tnew, fit, report])
+        let sweep = grid.as_ref().map(|_| sweep::fingerprint(&cfg, &motions_fp));
+        let tnew = sweep.as_deref().map(tnew::fingerprint);
+        let fit_cases = grid
+            .as_ref()
+            .map(|g| fit::case_count(g, &frames_of(&cfg, building.as_ref())));
+        let fit = match (&tnew, fit_cases) {
+            (Some(t), Some((cases, needed))) if cases >= needed => {
+                Some(fit::fingerprint(t, building.is_some()))
             }
-            None => None,
+            _ => None,
         };
+        // The report reads the fit's results, else the `T_new` of a grid too small to fit.
+        let report = report::fingerprint(
+            fit.as_deref().or(tnew.as_deref()),
+            &motions_fp,
+            ida.as_deref(),
+            compared.as_deref(),
+        );
         Ok(Self {
             config_path: config.to_path_buf(),
             config_sha256: cfg.loaded.config_sha256.clone(),
@@ -374,22 +406,55 @@ impl Study {
             out,
             grid,
             building,
+            fit_cases,
             fingerprints: Fingerprints {
                 motions: motions_fp,
-                rest,
+                sweep,
+                tnew,
+                fit,
                 ida,
+                report,
             },
             compare,
         })
     }
 
-    /// Whether the config gives `stage` what it needs (`grid`, `ida` sections).
+    /// Whether the config configures `stage`: motions and the report always; sweep and `tnew`
+    /// with a `grid` section; the fit with a grid of enough cases to fit a design equation to
+    /// ([`fit::case_count`]); the IDA with an `ida:` section. `run`, make and Slurm run exactly
+    /// these stages.
     pub fn configured(&self, stage: StageId) -> bool {
+        let f = &self.fingerprints;
         match stage {
-            StageId::Motions => true,
-            StageId::Ida => self.cfg.ida.is_some(),
-            _ => self.grid.is_some(),
+            StageId::Motions | StageId::Report => true,
+            StageId::Sweep => f.sweep.is_some(),
+            StageId::Tnew => f.tnew.is_some(),
+            StageId::Fit => f.fit.is_some(),
+            StageId::Ida => f.ida.is_some(),
         }
+    }
+
+    /// The configured stages, in the order they run.
+    pub fn stages(&self) -> Vec<StageId> {
+        (StageId::ALL.into_iter())
+            .filter(|&s| self.configured(s))
+            .collect()
+    }
+
+    /// Why `stage` is not configured, in a sentence; `None` when it is.
+    pub fn not_configured_why(&self, stage: StageId) -> Option<String> {
+        self.fingerprint(stage).err().map(|e| e.to_string())
+    }
+
+    /// The configured stages whose files `stage` reads.
+    pub fn upstream(&self, stage: StageId) -> Vec<StageId> {
+        let mut up: Vec<StageId> = (stage.upstream().iter().copied())
+            .filter(|&s| self.configured(s))
+            .collect();
+        if stage == StageId::Report && self.configured(StageId::Ida) {
+            up.push(StageId::Ida);
+        }
+        up
     }
 
     /// The grid, or an error naming the stage that needs it.
@@ -410,7 +475,10 @@ impl Study {
     pub fn frames(&self) -> Vec<Option<Frame>> {
         match &self.building {
             None => vec![None],
-            Some(b) => (0..b.frames()).map(|f| self.cfg.frame(b, f)).collect(),
+            Some(_) => frames_of(&self.cfg, self.building.as_ref())
+                .into_iter()
+                .map(Some)
+                .collect(),
         }
     }
 
@@ -435,34 +503,34 @@ impl Study {
         self.out.join(name)
     }
 
-    /// The fingerprint the stage's output must carry.
+    /// The fingerprint the stage's output must carry; an error saying what the config lacks
+    /// for a stage it does not configure.
     pub fn fingerprint(&self, stage: StageId) -> Result<&str, PipelineError> {
-        if stage == StageId::Motions {
-            return Ok(&self.fingerprints.motions);
-        }
-        if stage == StageId::Ida {
-            return self.fingerprints.ida.as_deref().ok_or_else(|| {
+        let f = &self.fingerprints;
+        let no_grid = || PipelineError::NoGrid {
+            config: self.config_path.clone(),
+            stage,
+        };
+        match stage {
+            StageId::Motions => Ok(&f.motions),
+            StageId::Report => Ok(&f.report),
+            StageId::Sweep => f.sweep.as_deref().ok_or_else(no_grid),
+            StageId::Tnew => f.tnew.as_deref().ok_or_else(no_grid),
+            StageId::Fit => f.fit.as_deref().ok_or_else(|| match self.fit_cases {
+                Some((cases, needed)) => PipelineError::TooFewToFit {
+                    config: self.config_path.clone(),
+                    cases,
+                    needed,
+                },
+                None => no_grid(),
+            }),
+            StageId::Ida => f.ida.as_deref().ok_or_else(|| {
                 ida::IdaStageError::NoSection {
                     config: self.config_path.clone(),
                 }
                 .into()
-            });
+            }),
         }
-        let rest = self
-            .fingerprints
-            .rest
-            .as_ref()
-            .ok_or_else(|| PipelineError::NoGrid {
-                config: self.config_path.clone(),
-                stage,
-            })?;
-        Ok(match stage {
-            StageId::Sweep => &rest[0],
-            StageId::Tnew => &rest[1],
-            StageId::Fit => &rest[2],
-            StageId::Report => &rest[3],
-            StageId::Motions | StageId::Ida => unreachable!("handled above"),
-        })
     }
 
     /// The verified fingerprint stored in the stage's output, `None` when it is missing.
@@ -620,11 +688,8 @@ pub enum Outcome {
 pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
     s.check_cancelled(stage)?;
     s.study.fingerprint(stage)?;
-    for &up in stage.upstream() {
+    for up in s.study.upstream(stage) {
         s.study.require(up)?;
-    }
-    if stage == StageId::Report && s.study.configured(StageId::Ida) {
-        s.study.require(StageId::Ida)?;
     }
     let path = s.study.path(stage.output());
     if !opts.force {
@@ -652,17 +717,14 @@ pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcom
     Ok(outcome)
 }
 
-/// Every stage in order (`ida` only with an `ida:` section), each skipped when up to date,
+/// Every configured stage in order ([`Study::configured`]), each skipped when up to date,
 /// telling `done` what each did and how long it took, s.
 pub fn run_all(
     s: &Session,
     opts: StageOptions,
     mut done: impl FnMut(StageId, &Outcome, f64),
 ) -> Result<(), PipelineError> {
-    for stage in StageId::ALL {
-        if stage == StageId::Ida && !s.study.configured(stage) {
-            continue;
-        }
+    for stage in s.study.stages() {
         let start = std::time::Instant::now();
         let outcome = execute(s, stage, opts)?;
         done(stage, &outcome, start.elapsed().as_secs_f64());

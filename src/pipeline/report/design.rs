@@ -101,7 +101,7 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
                     target,
                     grid.clone(),
                     v.t_new.iter().copied().collect(),
-                    Some(&z.fit),
+                    Some(z.fit()),
                 ));
                 drr.push(Ratios {
                     zone: z.name.clone(),
@@ -112,7 +112,7 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
             Some(axes) => {
                 let fit_yaml = inp.study.path("fit.yaml");
                 let frames =
-                    frame_designs(&z.name, &target, grid, axes, &z.tnew, &inp.fit, &fit_yaml)
+                    frame_designs(&z.name, &target, grid, axes, &z.tnew, inp.fit(), &fit_yaml)
                         .map_err(ReportError::from)?;
                 for (f, d) in frames {
                     let cases = frame_cases(grid, f);
@@ -130,7 +130,7 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
     let example = building_example(inp);
     let frames = example.as_ref().map(|example| Frames {
         labels: labels.clone(),
-        known: known_frames(&inp.fit),
+        known: known_frames(inp.fit()),
         example: example.clone(),
     });
     let frame_inputs = inp.study.building().map(|axes| {

@@ -22,7 +22,7 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
              over buildings\"): the paper's Eqs. 16–17 as printed with T_p = T_1, and each form \
              fitted here (5-fold cross-validated columns from fits that did not see the \
              predicted cases).",
-            inp.fit.features.join(", ")
+            inp.fit().features.join(", ")
         )
     } else {
         format!(
@@ -30,7 +30,7 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
              equations as printed evaluated on our T_new, and each form fitted here (features \
              {}; 5-fold cross-validated columns from fits that did not see the predicted \
              cases).",
-            inp.fit.features.join(", ")
+            inp.fit().features.join(", ")
         )
     });
     let table3: Vec<Vec<String>> = (inp.zones.iter())
@@ -52,14 +52,14 @@ pub(super) fn fit_section(inp: &Inputs, files: &mut Files) -> Result<Section, Re
         &table3,
     );
     for z in &inp.zones {
-        if let Some(ff) = z.fit.recommended_fit() {
+        if let Some(ff) = z.fit().recommended_fit() {
             body += &coefficients(z, ff, "T_new's recommended");
         }
     }
     if building {
         body += &frames_table(inp);
         for z in &inp.zones {
-            if let Some(ff) = &z.fit.lambda {
+            if let Some(ff) = &z.fit().lambda {
                 body += &coefficients(z, ff, "λ's");
             }
         }
@@ -97,7 +97,12 @@ fn frames_table(inp: &Inputs) -> String {
         .collect();
     let mut rows = Vec::new();
     for z in &inp.zones {
-        for f in z.fit.frames.iter().filter(|f| distinct.contains(&f.frame)) {
+        for f in z
+            .fit()
+            .frames
+            .iter()
+            .filter(|f| distinct.contains(&f.frame))
+        {
             rows.push(vec![
                 z.name.clone(),
                 f.frame.clone(),
@@ -144,7 +149,7 @@ fn frames_table(inp: &Inputs) -> String {
 /// `T_new`, each fitted form.
 fn table3_rows(z: &Zone, paper: bool) -> Vec<Vec<String>> {
     let f3 = |v: f64| fixed(v, 3);
-    let zf = &z.fit;
+    let zf = z.fit();
     let mut rows = Vec::new();
     if let Some((_, p)) = (PAPER_TABLE_3.iter())
         .find(|p| p.0 == z.name)
@@ -269,8 +274,8 @@ fn residuals(z: &Zone, inp: &Inputs, files: &mut Files) -> Result<String, Report
     let grid = inp.grid;
     let building = inp.study.building().is_some();
     let (data, bands) = fitted_samples(z, inp);
-    let mut forms: Vec<_> = z.fit.forms.iter().collect();
-    forms.sort_by_key(|f| f.form != z.fit.recommended);
+    let mut forms: Vec<_> = z.fit().forms.iter().collect();
+    forms.sort_by_key(|f| f.form != z.fit().recommended);
     let panels: Vec<Panel> = forms
         .into_iter()
         .map(|ff| residual_panel(z, ff, grid, &data, &bands, building))
@@ -293,7 +298,7 @@ fn residuals(z: &Zone, inp: &Inputs, files: &mut Files) -> Result<String, Report
             "Zone {}: computed − predicted T_new against T_p for every fitted form, the \
              recommended ({}) first.",
             z.name,
-            z.fit.recommended.name()
+            z.fit().recommended.name()
         ),
     )
 }
@@ -381,7 +386,7 @@ fn residual_panel(
         format!(
             "{} form{}: RMSE {:.3} s, R² {:.3}",
             ff.form.name(),
-            if ff.form == z.fit.recommended {
+            if ff.form == z.fit().recommended {
                 " (recommended)"
             } else {
                 ""

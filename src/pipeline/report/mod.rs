@@ -25,8 +25,12 @@
 //! ([`crate::study::physics::Physics`]). The directory is replaced as a whole
 //! ([`crate::store::report`]).
 //!
-//! Fingerprint: the fit's and the motions' (which carry everything upstream), `ida.h5`'s with an
-//! `ida:` section, and the report's own version.
+//! A config that does not configure the fit (a grid too small to fit a design equation to) gets
+//! the same without the design equations and the design page; one without a grid gets the
+//! matched motions and the IDA.
+//!
+//! Fingerprint: the fit's (else `tnew`'s, else none) and the motions' (which carry everything
+//! upstream), `ida.h5`'s with an `ida:` section, and the report's own version.
 
 mod building;
 mod cases;
@@ -77,16 +81,18 @@ pub enum ReportError {
     Design(#[from] crate::design::DesignError),
 }
 
-/// The fingerprint the report must carry; with an `ida:` section, `ida.h5`'s too (the report
-/// then shows it), and with `report.compare_with` the compared study's fit's (its `T_new`, `λ`
+/// The fingerprint the report must carry: `grid_fingerprint` is the fit's, or `tnew`'s when the
+/// grid is too small to fit, or `None` without a grid; with an `ida:` section, `ida.h5`'s too
+/// (the report then shows it), and with `report.compare_with` the compared study's fit's (its `T_new`, `λ`
 /// and fit enter the building section).
 pub fn fingerprint(
-    fit_fingerprint: &str,
+    grid_fingerprint: Option<&str>,
     motions_fingerprint: &str,
     ida_fingerprint: Option<&str>,
     compared_fit_fingerprint: Option<&str>,
 ) -> String {
-    let mut parts = vec![fit_fingerprint, motions_fingerprint];
+    let mut parts: Vec<&str> = grid_fingerprint.into_iter().collect();
+    parts.push(motions_fingerprint);
     parts.extend(ida_fingerprint);
     if let Some(c) = compared_fit_fingerprint {
         parts.extend(["compare_with", c]);
@@ -101,7 +107,8 @@ struct Zone {
     spectra: ZoneSpectra,
     tnew: ZoneTnew,
     band_flags: Vec<(u8, String)>,
-    fit: ZoneFit,
+    /// `None` when the config does not configure the fit (a grid too small to fit).
+    fit: Option<ZoneFit>,
     /// The paper's named one-storey cases run on the zone's motions (`None` in a building
     /// study, whose report has the building section instead).
     paper: Option<PaperCases>,
@@ -121,6 +128,14 @@ impl Zone {
             .expect("the paper's cases are run for a one-storey study")
     }
 
+    /// The zone's fit: only the fit's sections and the design page ask, and they are made only
+    /// when the study has one.
+    fn fit(&self) -> &ZoneFit {
+        self.fit
+            .as_ref()
+            .expect("the fit's sections are made with a fit")
+    }
+
     /// Column `case` of a `[T_p, case…]` variable: one value per `T_p`.
     fn column(&self, v: &ndarray::ArrayD<f64>, per: usize, case: usize) -> Vec<f64> {
         v.iter().skip(case).step_by(per).copied().collect()
@@ -132,7 +147,8 @@ struct Inputs<'a> {
     study: &'a Study,
     grid: &'a Grid,
     physics: Physics,
-    fit: FitReport,
+    /// `None` when the config does not configure the fit ([`Study::configured`]).
+    fit: Option<FitReport>,
     zones: Vec<Zone>,
 }
 
@@ -146,9 +162,16 @@ impl<'a> Inputs<'a> {
             study.path("tnew.h5"),
             study.path("fit.yaml"),
         );
-        let fit = read_fit(&fyaml)?.ok_or_else(|| StoreError::corrupt(&fyaml, "is missing"))?;
         let n = grid.blocks();
-        fit.check_blocks(&fyaml, n)?;
+        let fit = match study.configured(StageId::Fit) {
+            true => {
+                let fit =
+                    read_fit(&fyaml)?.ok_or_else(|| StoreError::corrupt(&fyaml, "is missing"))?;
+                fit.check_blocks(&fyaml, n)?;
+                Some(fit)
+            }
+            false => None,
+        };
         let mut zones = Vec::new();
         for (zc, motions) in study.cfg.zones.iter().zip(motions) {
             if motions.is_empty() {
@@ -174,12 +197,17 @@ impl<'a> Inputs<'a> {
                 let why = format!("zone_{}: {why}", zc.name);
                 return Err(StoreError::corrupt(file, why).into());
             }
-            let zf = fit
-                .zones
-                .iter()
-                .find(|f| f.zone == zc.name)
-                .cloned()
-                .ok_or_else(|| StoreError::corrupt(&fyaml, format!("has no zone {}", zc.name)))?;
+            let zf = match &fit {
+                Some(fit) => Some(
+                    (fit.zones.iter())
+                        .find(|f| f.zone == zc.name)
+                        .cloned()
+                        .ok_or_else(|| {
+                            StoreError::corrupt(&fyaml, format!("has no zone {}", zc.name))
+                        })?,
+                ),
+                None => None,
+            };
             zones.push(Zone {
                 name: zc.name.clone(),
                 spectra,
@@ -204,6 +232,35 @@ impl<'a> Inputs<'a> {
             zones,
         })
     }
+
+    /// The study's fit: only the fit's sections and the design page ask, and they are made
+    /// only when the study has one.
+    fn fit(&self) -> &FitReport {
+        self.fit
+            .as_ref()
+            .expect("the fit's sections are made with a fit")
+    }
+
+    /// Every zone's matched motions, as the motions section shows them.
+    fn motions(&self) -> Vec<ZoneMotions<'_>> {
+        (self.zones.iter())
+            .map(|z| ZoneMotions {
+                name: &z.name,
+                target: &z.tnew.target,
+                count: z.motions.len(),
+                spectra: &z.spectra,
+            })
+            .collect()
+    }
+}
+
+/// One zone's matched motions and their stored spectra: what every report shows.
+struct ZoneMotions<'a> {
+    name: &'a str,
+    /// The target spectrum as the config names it.
+    target: &'a str,
+    count: usize,
+    spectra: &'a ZoneSpectra,
 }
 
 /// Whether stored `(code, word)` flags are `want`.
@@ -330,7 +387,7 @@ fn summary(inp: &Inputs) -> String {
             format!("{red:.1}"),
         ]);
         let p3 = PAPER_TABLE_3.iter().find(|p| p.0 == z.name);
-        if let Some(ff) = z.fit.recommended_fit() {
+        if let Some(ff) = z.fit.as_ref().and_then(ZoneFit::recommended_fit) {
             rows.push(vec![
                 format!("design equation R² (ours: {} form)", ff.form.name()),
                 z.name.clone(),
@@ -348,11 +405,16 @@ fn summary(inp: &Inputs) -> String {
     } else {
         String::new()
     };
-    format!(
-        "<p id='design-link'><a href='design.html'>The design page</a>: T_new and the design \
-         spectral acceleration of your structure from this study, in the browser{example}; and \
-         an explorer of the grid's figures.</p>"
-    ) + &list(&facts)
+    let design = match inp.fit {
+        Some(_) => format!(
+            "<p id='design-link'><a href='design.html'>The design page</a>: T_new and the design \
+             spectral acceleration of your structure from this study, in the browser{example}; \
+             and an explorer of the grid's figures.</p>"
+        ),
+        None => no_fit(inp.study),
+    };
+    design
+        + &list(&facts)
         + &para("The paper's numbers next to ours (details in the sections below):")
         + &table_with_id("summary", &["quantity", "zone", "paper", "ours"], &rows)
 }
@@ -362,7 +424,7 @@ fn summary(inp: &Inputs) -> String {
 fn building_summary(inp: &Inputs) -> String {
     let mut rows = Vec::new();
     for z in &inp.zones {
-        let zf = &z.fit;
+        let Some(zf) = &z.fit else { continue };
         if let Some(ff) = zf.recommended_fit() {
             rows.push(vec![
                 format!(
@@ -402,6 +464,9 @@ fn building_summary(inp: &Inputs) -> String {
             }
         }
     }
+    if inp.fit.is_none() {
+        return no_fit(inp.study) + &list(&facts(inp));
+    }
     let q = escape(&design::building_example(inp).unwrap_or_default());
     let design = format!(
         "<p id='design-link'><a href='design.html'>The design page</a>: T_new, T_1,rigid, λ \
@@ -417,6 +482,16 @@ fn building_summary(inp: &Inputs) -> String {
              section):",
         )
         + &table_with_id("summary", &["quantity", "zone", "ours"], &rows)
+}
+
+/// The paragraph of a study whose config does not configure the fit: why, and so no design
+/// equations and no design page.
+fn no_fit(study: &Study) -> String {
+    let why = study.not_configured_why(StageId::Fit).unwrap_or_default();
+    para(&format!(
+        "No design equations and no design page: {why}. The sections below show the grid's \
+         cases as computed."
+    ))
 }
 
 /// What the report leaves out (`building`: of a building study).
@@ -451,11 +526,14 @@ fn not_shown(building: bool) -> Section {
 /// Builds the report.
 pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let study = &s.study;
+    if !study.configured(StageId::Sweep) {
+        return build_without_grid(s);
+    }
     let inp = Inputs::load(study)?;
     let sel = Selection::new(inp.grid);
     let mut files = Files::default();
     let building = study.building().is_some();
-    let mut sections = vec![motions_section(&inp, &mut files)?];
+    let mut sections = vec![motions_section(study, &inp.motions(), &mut files)?];
     if building {
         // The compared study (`report.compare_with`), its files checked as an upstream stage's.
         let compared = match &study.compare {
@@ -490,17 +568,83 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
             tnew_section(&inp, &sel, &mut files)?,
         ]);
     }
-    sections.push(fit_section(&inp, &mut files)?);
+    if inp.fit.is_some() {
+        sections.push(fit_section(&inp, &mut files)?);
+    }
     if study.configured(StageId::Ida) {
         sections.push(ida::ida_section(study, &mut files)?);
     }
     sections.push(not_shown(building));
-    design::design_file(&inp, &mut files)?;
+    if inp.fit.is_some() {
+        design::design_file(&inp, &mut files)?;
+    }
     let summary = if building {
         building_summary(&inp)
     } else {
         summary(&inp)
     };
+    write(study, &summary, &sections, files)
+}
+
+/// The report of a config without a grid: the matched motions and, with an `ida:` section, the
+/// IDA.
+fn build_without_grid(s: &Session) -> Result<Outcome, PipelineError> {
+    let study = &s.study;
+    let motions = super::sweep::load_motions(study)?;
+    let mh5 = study.path("motions.h5");
+    let mut spectra = Vec::new();
+    for (zc, motions) in study.cfg.zones.iter().zip(&motions) {
+        if motions.is_empty() {
+            return Err(ReportError::NoMotions {
+                zone: zc.name.clone(),
+            }
+            .into());
+        }
+        let s = read_zone_spectra(&mh5, &zc.name)?;
+        if s.periods_s != study.cfg.motions.matching.check_grid_s() {
+            let why = format!("zone_{}: its check periods are not the config's", zc.name);
+            return Err(StoreError::corrupt(&mh5, why).into());
+        }
+        spectra.push(s);
+    }
+    let zones: Vec<ZoneMotions> = (study.cfg.zones.iter())
+        .zip(&motions)
+        .zip(&spectra)
+        .map(|((zc, m), s)| ZoneMotions {
+            name: &zc.name,
+            target: &zc.target,
+            count: m.len(),
+            spectra: s,
+        })
+        .collect();
+    let mut files = Files::default();
+    let mut sections = vec![motions_section(study, &zones, &mut files)?];
+    let ida = study.configured(StageId::Ida);
+    if ida {
+        sections.push(ida::ida_section(study, &mut files)?);
+    }
+    let counts: Vec<String> = (zones.iter())
+        .map(|z| format!("{} in Zone {}", z.count, z.name))
+        .collect();
+    let facts = vec![
+        format!("Config {}.", study.config_path.display()),
+        format!("Matched motions: {}.", counts.join(", ")),
+        format!(
+            "No grid: this config runs the motions{}; a `grid` section adds the sweep, T_new and \
+             the design equations.",
+            if ida { " and the IDA" } else { "" }
+        ),
+    ];
+    write(study, &list(&facts), &sections, files)
+}
+
+/// Writes the report's directory: `index.html` of `summary` and `sections`, and `files`.
+fn write(
+    study: &Study,
+    summary: &str,
+    sections: &[Section],
+    files: Files,
+) -> Result<Outcome, PipelineError> {
     let html = document(
         &format!(
             "slidestack report: {}",
@@ -509,8 +653,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
                 |f| { f.to_string_lossy().into_owned() }
             )
         ),
-        &summary,
-        &sections,
+        summary,
+        sections,
     );
     let mut out = files.files;
     out.push(("index.html".into(), html.into_bytes()));

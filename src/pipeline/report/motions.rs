@@ -1,12 +1,17 @@
 //! The matched motions against their target (paper Figs 4–5).
 
-use super::{Files, Inputs, ReportError};
+use super::{Files, ReportError, ZoneMotions};
+use crate::pipeline::Study;
 use crate::render::chart::{Axis, FAINT, Figure, PALETTE, Panel, Series, Stroke};
 use crate::render::page::{Section, para};
 use plotters::style::RGBColor;
 
-pub(super) fn motions_section(inp: &Inputs, files: &mut Files) -> Result<Section, ReportError> {
-    let m = &inp.study.cfg.motions.matching;
+pub(super) fn motions_section(
+    study: &Study,
+    zones: &[ZoneMotions],
+    files: &mut Files,
+) -> Result<Section, ReportError> {
+    let m = &study.cfg.motions.matching;
     let (lo, hi) = (m.lower, m.upper);
     let damping = format!("{} %", 100.0 * m.damping);
     let mut body = para(&format!(
@@ -15,7 +20,7 @@ pub(super) fn motions_section(inp: &Inputs, files: &mut Files) -> Result<Section
          the matching band {lo}–{hi} × target; every motion in grey. The right panel shows mean \
          / target: ASCE 7-16 asks that it not fall below 0.9."
     ));
-    for z in &inp.zones {
+    for z in zones {
         let s = &z.spectra;
         let t = &s.periods_s;
         let scaled = |f: f64| s.target_psa_g.iter().map(|v| v * f).collect::<Vec<_>>();
@@ -97,9 +102,7 @@ pub(super) fn motions_section(inp: &Inputs, files: &mut Files) -> Result<Section
             &format!(
                 "Zone {}: target ({}), mean of the {} matched motions and the matching band \
                  (paper Figs 4–5).",
-                z.name,
-                z.tnew.target,
-                z.motions.len()
+                z.name, z.target, z.count
             ),
         )?;
     }

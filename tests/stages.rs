@@ -1,0 +1,245 @@
+//! `run`, make and `status` run exactly the stages a config configures (`Study::configured`):
+//! the IDA-only `configs/ida-quick.yaml` (no grid: motions, ida, report) and
+//! `configs/mdof-ida-quick.yaml` (a one-case grid that names the IDA's frames, too small to fit:
+//! no fit) both end in a report; make gives the same bytes as `run`; the least case count the
+//! fit asks of a grid is the one at which the fit and its cross-validation stop refusing.
+
+mod common;
+
+use common::{ok, slidestack};
+use slidestack::fit::{FitError, Form, Sample, cross_validate, fit};
+use slidestack::pipeline::fit::{FOLDS, cases_needed};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+fn config(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("configs")
+        .join(name)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn stdout(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Every file under `dir` but the lock and make's own `make/`, by relative path: its bytes and
+/// inode (a rewrite is a new inode: every file is written under a temporary name and renamed).
+fn files(dir: &Path) -> BTreeMap<PathBuf, (Vec<u8>, u64)> {
+    use std::os::unix::fs::MetadataExt;
+    let mut out = BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let rel = p.strip_prefix(dir).unwrap().to_path_buf();
+            if rel == Path::new("make") || rel == Path::new(".slidestack.lock") {
+                continue;
+            }
+            if p.is_dir() {
+                todo.push(p);
+            } else {
+                let ino = std::fs::metadata(&p).unwrap().ino();
+                out.insert(rel, (std::fs::read(&p).unwrap(), ino));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn an_ida_only_config_runs_motions_ida_and_report_and_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config("ida-quick.yaml");
+    let out = dir.path().join("out");
+    let o = ok(slidestack(&["run", s(&cfg), "--out", s(&out)], "2"));
+    let text = stdout(&o);
+    assert!(
+        text.contains("run: stages motions, ida, report\n"),
+        "{text}"
+    );
+    assert_eq!(text.lines().last(), Some(s(&out.join("report/index.html"))));
+    for absent in [
+        "sweep.h5",
+        "tnew.h5",
+        "fit.h5",
+        "fit.yaml",
+        "report/design.html",
+    ] {
+        assert!(!out.join(absent).exists(), "{absent}");
+    }
+    let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    for part in [
+        "spectra_III.svg",
+        "spectra_V.svg",
+        "ida.svg",
+        "ida-fragility",
+    ] {
+        assert!(html.contains(part), "{part}");
+    }
+    // The report is up to date on a second run; `status` lists the same stages.
+    let o = ok(slidestack(&["run", s(&cfg), "--out", s(&out)], "1"));
+    assert!(stdout(&o).contains("report: ") && stdout(&o).contains("is up to date"));
+    let o = ok(slidestack(
+        &["status", s(&cfg), "--out", s(&out), "--format", "env"],
+        "1",
+    ));
+    let env = stdout(&o);
+    assert!(env.contains("STAGES=motions,ida,report\n"), "{env}");
+    assert!(
+        env.contains("REPORT=up_to_date\n") && !env.contains("SWEEP="),
+        "{env}"
+    );
+    // A stage it does not configure is refused naming the file and the key, before any work.
+    let o = slidestack(&["sweep", s(&cfg), "--out", s(&out)], "1");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("ida-quick.yaml") && err.contains("`grid`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_grid_too_small_to_fit_runs_every_stage_but_the_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config("mdof-ida-quick.yaml");
+    let out = dir.path().join("out");
+    let o = ok(slidestack(&["run", s(&cfg), "--out", s(&out)], "2"));
+    let text = stdout(&o);
+    assert!(
+        text.contains("run: stages motions, sweep, tnew, ida, report\n"),
+        "{text}"
+    );
+    // One case × two frames of six features (T_1, μ_1, μ_2, α_1, α_2, z_stack); the count
+    // `cases_needed` gives is checked against the fit itself below.
+    let needed = format!("at least {} cases", cases_needed(6));
+    assert!(
+        text.contains("run: no fit: ") && text.contains(&needed),
+        "{text}"
+    );
+    assert!(!out.join("fit.h5").exists() && !out.join("report/design.html").exists());
+    let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    for part in [
+        "No design equations and no design page",
+        "building_period_III.svg",
+        "ida.svg",
+    ] {
+        assert!(html.contains(part), "{part}");
+    }
+    let o = slidestack(&["fit", s(&cfg), "--out", s(&out)], "1");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("mdof-ida-quick.yaml") && err.contains(&needed) && err.contains("gives 2"),
+        "{err}"
+    );
+}
+
+#[test]
+fn status_tells_make_the_configured_stages() {
+    for (name, stages) in [
+        ("quick.yaml", "motions sweep tnew fit report"),
+        ("ida-quick.yaml", "motions ida report"),
+        ("mdof-ida-quick.yaml", "motions sweep tnew ida report"),
+        ("mdof-quick.yaml", "motions sweep tnew fit report"),
+    ] {
+        let o = ok(slidestack(
+            &["status", s(&config(name)), "--format", "make"],
+            "1",
+        ));
+        let want = format!("\nSTAGES := {stages}\n");
+        assert!(stdout(&o).contains(&want), "{name}: {}", stdout(&o));
+    }
+}
+
+/// make (pipelines/paper.mk) on the IDA-only config: the configured stages only, the same bytes
+/// as `run`, and a second make rewrites nothing.
+#[test]
+fn make_runs_the_configured_stages_with_the_bytes_of_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config("ida-quick.yaml");
+    let by_run = dir.path().join("run");
+    ok(slidestack(&["run", s(&cfg), "--out", s(&by_run)], "2"));
+    let mk = Path::new(env!("CARGO_MANIFEST_DIR")).join("pipelines/paper.mk");
+    let make = || {
+        let o = std::process::Command::new("make")
+            .args(["-f", s(&mk)])
+            .arg(format!("CONFIG={}", s(&cfg)))
+            .arg("OUT=out")
+            .arg(format!("SLIDESTACK={}", env!("CARGO_BIN_EXE_slidestack")))
+            .current_dir(dir.path())
+            .env("RAYON_NUM_THREADS", "2")
+            .output()
+            .expect("make (scripts/install-deps.sh --test installs it)");
+        ok(o)
+    };
+    let o = make();
+    let text = stdout(&o);
+    assert!(
+        !text.contains(" sweep ") && text.contains(" ida "),
+        "{text}"
+    );
+    let by_make = dir.path().join("out");
+    let stages = std::fs::read_to_string(by_make.join("make/stages.mk")).unwrap();
+    assert!(
+        stages.contains("STAGES := motions ida report\n"),
+        "{stages}"
+    );
+    let (a, b) = (files(&by_run), files(&by_make));
+    assert_eq!(
+        a.keys().collect::<Vec<_>>(),
+        b.keys().collect::<Vec<_>>(),
+        "the same files"
+    );
+    for (path, (bytes, _)) in &a {
+        assert!(bytes == &b[path].0, "{} differs", path.display());
+    }
+    make();
+    let again = files(&by_make);
+    for (path, (_, ino)) in &b {
+        assert_eq!(*ino, again[path].1, "{} was rewritten", path.display());
+    }
+}
+
+/// `cases_needed(k)` against the fit itself: with one case fewer every form refuses (in the
+/// whole fit or a fold of its cross-validation) for too few cases; with that many, some form
+/// does not.
+#[test]
+fn the_least_case_count_is_where_the_fit_stops_refusing() {
+    let mut rng = common::Rng::new(35);
+    for k in [3, 5, 6, 7] {
+        let needed = cases_needed(k);
+        let data = |n: usize, rng: &mut common::Rng| -> Vec<Sample> {
+            (0..n)
+                .map(|_| {
+                    let x: Vec<f64> = (0..k).map(|_| rng.range(0.05, 2.0)).collect();
+                    let t_rigid_s = x[0];
+                    Sample {
+                        t_new_s: t_rigid_s * rng.range(1.0, 1.3),
+                        t_rigid_s,
+                        x,
+                    }
+                })
+                .collect()
+        };
+        let too_few = |form: Form, d: &[Sample]| {
+            let whole = matches!(fit(form, d), Err(FitError::TooFew { .. }));
+            whole || matches!(cross_validate(form, d, FOLDS), Err(FitError::TooFew { .. }))
+        };
+        let below = data(needed - 1, &mut rng);
+        assert!(
+            Form::ALL.iter().all(|&f| too_few(f, &below)),
+            "k {k}: {} cases",
+            needed - 1
+        );
+        let at = data(needed, &mut rng);
+        assert!(
+            Form::ALL.iter().any(|&f| !too_few(f, &at)),
+            "k {k}: {needed} cases"
+        );
+    }
+}
