@@ -15,7 +15,7 @@ ROOT=$(dirname "$HERE")
 PROG=pipelines/slurm-submit.sh
 
 # A sweep unit's cost: 188 ns per simulated record sample per thread, measured by the paper
-# study on 2 threads (docs/evidence/study.md, README "The paper's study"); the time limit
+# study on 2 threads (docs/evidence/study.md, docs/performance.md "The paper's study"); the time limit
 # adds a factor 2 and 5 minutes on top of the bound this gives.
 NS_PER_SAMPLE=${SLIDESTACK_NS_PER_SAMPLE:-188}
 # Before the motions job has run, `slidestack status` cannot know the motions' length: the sizing

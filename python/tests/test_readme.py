@@ -1,16 +1,22 @@
-"""The README's notebook-style example runs and draws its figure."""
+"""The Python chapter's notebook-style example (docs/python.md) runs and draws its figure, and the
+three prompt lines of the chapter and of the README's tour print what they show."""
 
 import os
 import re
 import subprocess
 import sys
 
+import pytest
+
 from conftest import ROOT
+
+# The chapter that holds the module's documentation and its full example (moved out of the
+# README's "## Python" section; the README keeps the three prompt lines in its tour).
+CHAPTER = "docs/python.md"
 
 
 def test_the_readme_example_runs(tmp_path):
-    readme = (ROOT / "README.md").read_text()
-    section = readme[readme.index("## Python\n"):]
+    section = (ROOT / CHAPTER).read_text()
     blocks = re.findall(r"```python\n(.*?)```", section, re.S)
     example = next(b for b in blocks if "savefig" in b)
     out = tmp_path / "quick"
@@ -25,9 +31,9 @@ def test_the_readme_example_runs(tmp_path):
     assert (out / "tnew.h5").exists()
 
 
-def test_the_three_lines(tmp_path):
-    readme = (ROOT / "README.md").read_text()
-    section = readme[readme.index("## Python\n"):]
+@pytest.mark.parametrize("document", [CHAPTER, "README.md"])
+def test_the_three_lines(document):
+    section = (ROOT / document).read_text()
     prompt = re.search(r"```python\n(>>> .*?)```", section, re.S).group(1)
     lines = prompt.strip().splitlines()
     code = "\n".join(line[4:] for line in lines if line.startswith(">>> "))
