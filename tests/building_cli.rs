@@ -29,7 +29,7 @@ fn case_file(dir: &Path, name: &str, yaml: &str) -> String {
     p.to_str().unwrap().to_string()
 }
 
-/// The worked example of the README (configs/building.yaml): every key of the contract, with
+/// The worked example of docs/building.md (configs/building.yaml): every key of the contract, with
 /// the lengths the building gives them, and a closed energy balance.
 #[test]
 fn the_worked_example_prints_the_building_contract() {

@@ -297,7 +297,7 @@ pub struct StackSummary {
 }
 
 /// What one building simulation gives: the `simulate --json` contract for a case with
-/// `building` (README, "A multi-storey building").
+/// `building` (docs/building.md, "A multi-storey building").
 #[derive(Debug, Clone, Serialize)]
 pub struct BuildingSummary {
     pub record: String,

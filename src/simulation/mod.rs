@@ -606,7 +606,7 @@ impl Simulation {
     }
 }
 
-/// What one simulation gives: the `simulate --json` contract (README); field names are relied
+/// What one simulation gives: the `simulate --json` contract (docs/simulate.md); field names are relied
 /// on by users and checks.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
