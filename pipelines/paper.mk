@@ -47,12 +47,13 @@ ida: $(OUT)/ida.h5
 report: $(OUT)/report/index.html
 .PHONY: all motions sweep tnew fit ida report always
 
-# STAGES: the stages the config configures, in order (written by the binary).
+# STAGES: the stages the config configures, in order (written by the binary; under a name of
+# its own per make, then renamed, so two makes into one OUT at once both read a whole file).
 STAGES_MK := $(OUT)/make/stages.mk
 $(STAGES_MK): $(CONFIG) $(SLIDESTACK)
 	@mkdir -p '$(@D)'
-	@'$(SLIDESTACK)' status '$(CONFIG)' --out '$(OUT)' --format make >'$@.tmp'
-	@mv -f '$@.tmp' '$@'
+	@tmp='$@.'$$$$.tmp; '$(SLIDESTACK)' status '$(CONFIG)' --out '$(OUT)' --format make >"$$tmp" && \
+	  mv -f "$$tmp" '$@'
 include $(STAGES_MK)
 # Each stage's file; the report depends on every other configured stage's.
 file_motions := $(OUT)/motions.h5

@@ -149,6 +149,7 @@ esac
 sources (see pipelines/README.md, \"Building\")"
 status=$("$SLIDESTACK" status "$CONFIG" --out "$OUT" --format env) ||
   die "slidestack status failed on $CONFIG (message above); nothing was submitted"
+# shellcheck disable=SC2034 # TNEW, FIT, IDA and REPORT are read through ${!v} below
 MOTIONS="" SWEEP="" TNEW="" FIT="" IDA="" REPORT="" SWEEP_UNITS="" SWEEP_UNITS_DONE=""
 SWEEP_CASES_PER_UNIT="" SWEEP_SAMPLES_PER_MOTION="" SWEEP_SAMPLES_PER_UNIT="" STAGES=""
 # KEY=VALUE lines; the keys used here are checked below, others are left alone. A stage the

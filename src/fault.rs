@@ -4,11 +4,11 @@
 //! ([`FaultKind::exit_code`]) and the Python module to its exception class, both from
 //! [`classify`]: neither keeps a list of its own.
 
-use crate::design::DesignError;
 use crate::dynamics::building::BuildingError;
 use crate::dynamics::{ModelError, SimError};
 use crate::ground_motion::RecordError;
 use crate::ground_motion::matching::MatchError;
+use crate::ground_motion::spectra::SpectraError;
 use crate::match_files::MatchFilesError;
 use crate::pipeline::lock::LockError;
 use crate::pipeline::motions::MotionsError;
@@ -16,11 +16,11 @@ use crate::pipeline::sweep::SweepStageError;
 use crate::pipeline::{PipelineError, StageState};
 use crate::simulation::SimulationError;
 use crate::spectrum::PeriodsError;
-use crate::spectrum::batch::BatchError;
 use crate::spectrum::ductility::DuctilityError;
 use crate::store::StoreError;
 use crate::store::atomic::OutputPathError;
 use crate::study::config::ConfigError;
+use crate::study::design::DesignError;
 use crate::study::motions::SeedError;
 use std::error::Error;
 use std::io::ErrorKind;
@@ -138,7 +138,7 @@ fn known(e: &(dyn Error + 'static)) -> Option<Fault> {
         SimulationError,
         DesignError,
         MatchFilesError,
-        BatchError,
+        SpectraError,
         ConfigError,
         StoreError,
         OutputPathError,
@@ -409,12 +409,12 @@ impl Classify for DuctilityError {
     }
 }
 
-impl Classify for BatchError {
+impl Classify for SpectraError {
     fn fault(&self) -> Fault {
         match self {
-            BatchError::Damping(_) => Fault::of(FaultKind::BadInput).key("damping"),
-            BatchError::Spectrum { record, .. } => Fault::of(FaultKind::BadInput).file(record),
-            BatchError::Ductility { record, source } => source.fault().file(record),
+            SpectraError::Damping(_) => Fault::of(FaultKind::BadInput).key("damping"),
+            SpectraError::Spectrum { record, .. } => Fault::of(FaultKind::BadInput).file(record),
+            SpectraError::Ductility { record, source } => source.fault().file(record),
         }
     }
 }

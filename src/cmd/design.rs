@@ -3,8 +3,9 @@
 //! ([`slidestack::design`]); in a building study also `--storeys 3 --floor roof`.
 
 use anyhow::Result;
-use slidestack::design::{Answer, Query, design};
+use slidestack::design::design;
 use slidestack::grid::StackFloor;
+use slidestack::study::design::{Answer, Query};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]

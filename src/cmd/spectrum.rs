@@ -10,11 +10,11 @@
 //! ([`slidestack::spectrum::ductility`]): per period the yield strength ratio `C_y` of an
 //! elastic–perfectly-plastic (or, with `--post-yield-ratio`, bilinear) oscillator whose peak
 //! displacement is `μ` times its yield displacement, with `D_y`, `u_m`, the elastic `C_e` and
-//! `R_y = C_e/C_y`. The spectra themselves: [`slidestack::spectrum::batch`].
+//! `R_y = C_e/C_y`. The spectra themselves: [`slidestack::ground_motion::spectra`].
 
 use super::RecordArgs;
 use anyhow::Result;
-use slidestack::spectrum::batch::{ductility_spectra, response_spectra};
+use slidestack::ground_motion::spectra::{ductility_spectra, response_spectra};
 use slidestack::spectrum::parse_periods;
 use slidestack::store::atomic::check_output_file;
 use std::io::Write;

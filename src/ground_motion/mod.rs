@@ -1,11 +1,13 @@
 //! Ground-motion records: readers and writer ([`record`]), processing ([`process`]), spectral
-//! matching ([`matching`]) and the matched set ([`set`]), built-in stochastic motions
-//! ([`stochastic`]) and the built-in default motion.
+//! matching ([`matching`]) and the matched set ([`set`]), the spectra of several records in
+//! parallel ([`spectra`]), built-in stochastic motions ([`stochastic`]) and the built-in
+//! default motion.
 
 pub mod matching;
 pub mod process;
 pub mod record;
 pub mod set;
+pub mod spectra;
 pub mod stochastic;
 
 pub use process::{BaselineCorrection, ProcessError};

@@ -31,7 +31,7 @@ use crate::fit::{
 };
 use crate::grid::Grid;
 use crate::store::fingerprint::fingerprint as hash_parts;
-use crate::store::fit::{FitReport, FormFit, FrameFit, FrameSpec, NotFitted, ZoneFit, write_fit};
+use crate::store::fit::{FitReport, FormFit, FrameFit, NotFitted, ZoneFit, write_fit};
 use crate::study::building::{Frame, fit_features, repeats};
 use crate::study::tnew::{building_samples, samples};
 use rayon::prelude::*;
@@ -596,7 +596,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         features,
         folds: FOLDS,
         building: (frames.len() == 1).then(|| frames[0].to_string()),
-        frames: frames.iter().map(FrameSpec::of).collect(),
+        frames: frames.iter().map(Frame::spec).collect(),
         zones,
     };
     let (h5, yaml) = (study.path(me.output()), study.path("fit.yaml"));

@@ -1,13 +1,11 @@
 //! Response spectra of records and the target (design) spectra they are compared with.
 //!
 //! * [`response`]: exact linear response spectra (Nigam–Jennings, peaks between samples included).
-//! * [`batch`]: spectra of several records and damping ratios in parallel (`slidestack spectrum`).
 //! * [`ductility`]: constant-ductility spectra of yielding oscillators (Chopra, Section 7.5).
 //! * [`periods`]: period lists as users write them (`0.05:4:0.01`, `log:…`, lists).
 //! * [`target`]: target spectra: IS 1893 (Part 1):2016, ASCE 7-16 and tabulated spectra, parsed
 //!   from SPEC strings such as `is1893:zone=III,soil=I`.
 
-pub mod batch;
 pub mod ductility;
 pub mod periods;
 pub mod response;

@@ -35,7 +35,6 @@ use crate::fit::{
     BoxCheck, BuildingFeatures, Fitted, Form, HEIGHT_FEATURE, Method, Metrics, STOREYS_FEATURE,
     SolverReport, feature_names,
 };
-use crate::study::building::Frame;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -115,7 +114,7 @@ pub struct FrameFit {
 }
 
 /// A frame of a building study, all `design` needs to evaluate the fitted forms there: its
-/// `T_1,rigid` and features.
+/// `T_1,rigid` and features (`crate::study::building::Frame::spec` and `Frame::of_spec` convert).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FrameSpec {
     pub storeys: usize,
@@ -129,29 +128,6 @@ pub struct FrameSpec {
     pub storey_heights_m: Vec<f64>,
     /// The stack's relative height `z_stack`.
     pub z_stack: f64,
-}
-
-impl FrameSpec {
-    /// The frame, back (`None` if `stack_floor` is not one).
-    pub fn frame(&self) -> Option<Frame> {
-        Some(Frame {
-            floor_masses: self.floor_masses.clone(),
-            storey_stiffnesses: self.storey_stiffnesses.clone(),
-            storey_heights_m: self.storey_heights_m.clone(),
-            stack_floor: self.stack_floor.parse().ok()?,
-        })
-    }
-
-    pub fn of(f: &Frame) -> Self {
-        Self {
-            storeys: f.storeys(),
-            stack_floor: f.stack_floor.to_string(),
-            floor_masses: f.floor_masses.clone(),
-            storey_stiffnesses: f.storey_stiffnesses.clone(),
-            storey_heights_m: f.storey_heights_m.clone(),
-            z_stack: f.stack_height_ratio(),
-        }
-    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

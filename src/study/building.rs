@@ -23,6 +23,7 @@ use crate::dynamics::building::model::modes;
 use crate::fit::BuildingFeatures;
 use crate::grid::{BuildingAxes, StackFloor};
 use crate::limits::{MAX_AXIS_VALUES, MAX_STOREYS, excerpt};
+use crate::store::fit::FrameSpec;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -185,6 +186,28 @@ pub struct Frame {
 impl Frame {
     pub fn storeys(&self) -> usize {
         self.floor_masses.len()
+    }
+
+    /// The frame as `fit.yaml` stores it.
+    pub fn spec(&self) -> FrameSpec {
+        FrameSpec {
+            storeys: self.storeys(),
+            stack_floor: self.stack_floor.to_string(),
+            floor_masses: self.floor_masses.clone(),
+            storey_stiffnesses: self.storey_stiffnesses.clone(),
+            storey_heights_m: self.storey_heights_m.clone(),
+            z_stack: self.stack_height_ratio(),
+        }
+    }
+
+    /// The frame `fit.yaml` stored (`None` if its `stack_floor` is not one).
+    pub fn of_spec(spec: &FrameSpec) -> Option<Frame> {
+        Some(Frame {
+            floor_masses: spec.floor_masses.clone(),
+            storey_stiffnesses: spec.storey_stiffnesses.clone(),
+            storey_heights_m: spec.storey_heights_m.clone(),
+            stack_floor: spec.stack_floor.parse().ok()?,
+        })
     }
 
     /// A base shear `v_n` (N, the floor masses taken as kg) over the bare building's weight

@@ -6,6 +6,8 @@
 //! * [`building`]: a study over buildings: the `building:` section, `grid.stack_floor`, a frame.
 //! * [`cases`]: the paper's named cases (Section 7.1, Table 2, Section 9).
 //! * [`config`]: the study file (YAML), validated before any work.
+//! * [`design`]: the designer's arithmetic: `T_new` of one structure from a zone's (or frame's)
+//!   data.
 //! * [`ida`]: the `ida:` section, a case's systems on a yielding structure, one traced unit.
 //! * [`motions`]: seeds, spectral matching per zone, the set checks.
 //! * [`physics`]: the physics of a case: damping basis, shared settings, its three systems.
@@ -17,6 +19,7 @@ pub mod attached;
 pub mod building;
 pub mod cases;
 pub mod config;
+pub mod design;
 pub mod ida;
 pub mod motions;
 pub mod physics;

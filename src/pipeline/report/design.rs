@@ -6,7 +6,6 @@
 
 use super::text::num;
 use super::{Files, Inputs, ReportError};
-use crate::design::{ZoneDesign, frame_cases, frame_designs, known_frames};
 use crate::fit::extrapolation::{LOWER_T_P, UPPER_T_RIGID};
 use crate::fit::forms::DAMPING_DEPTH;
 use crate::limits::STRUCTURE_PERIOD_RANGE_S;
@@ -14,6 +13,7 @@ use crate::pipeline::PipelineError;
 use crate::render::design::{FrameInputs, design_page};
 use crate::render::page::escape;
 use crate::store::motions::read_zone_target;
+use crate::study::design::{ZoneDesign, frame_cases, frame_designs, known_frames};
 use serde::Serialize;
 
 /// One zone's (in a building study, one zone and frame's) response ratios per case, in the

@@ -78,7 +78,7 @@ pub enum ReportError {
     #[error(transparent)]
     Chart(#[from] ChartError),
     #[error(transparent)]
-    Design(#[from] crate::design::DesignError),
+    Design(#[from] crate::study::design::DesignError),
 }
 
 /// The fingerprint the report must carry: `grid_fingerprint` is the fit's, or `tnew`'s when the

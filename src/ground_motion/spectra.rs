@@ -3,7 +3,7 @@
 //! the Python module's `spectrum`, in one place. Each job is independent and its result lands
 //! in the job's slot, so the output is the same whatever the number of threads.
 
-use crate::ground_motion::Record;
+use super::Record;
 use crate::spectrum::SpectrumError;
 use crate::spectrum::ductility::{
     DuctilityError, DuctilityOptions, DuctilityPoint, constant_ductility_spectrum,
@@ -50,7 +50,7 @@ pub struct DuctilitySpectrum {
 }
 
 #[derive(Debug, Error)]
-pub enum BatchError {
+pub enum SpectraError {
     #[error("`damping` {0} must be in [0, 1)")]
     Damping(f64),
     #[error("{record}: cannot compute its spectrum: {source}")]
@@ -66,12 +66,12 @@ pub enum BatchError {
 }
 
 /// Refuses a damping ratio outside `[0, 1)` before any work.
-fn check_dampings(dampings: &[f64]) -> Result<(), BatchError> {
+fn check_dampings(dampings: &[f64]) -> Result<(), SpectraError> {
     match dampings
         .iter()
         .find(|z| !(z.is_finite() && (0.0..1.0).contains(*z)))
     {
-        Some(&z) => Err(BatchError::Damping(z)),
+        Some(&z) => Err(SpectraError::Damping(z)),
         None => Ok(()),
     }
 }
@@ -81,7 +81,7 @@ pub fn response_spectra(
     records: &[Record],
     periods_s: &[f64],
     dampings: &[f64],
-) -> Result<Vec<RecordSpectrum>, BatchError> {
+) -> Result<Vec<RecordSpectrum>, SpectraError> {
     check_dampings(dampings)?;
     let jobs: Vec<(&Record, f64)> = records
         .iter()
@@ -90,7 +90,7 @@ pub fn response_spectra(
     jobs.par_iter()
         .map(|&(rec, z)| {
             let s = response_spectrum(&rec.accel_mps2(1.0), rec.dt_s, periods_s, z).map_err(
-                |source| BatchError::Spectrum {
+                |source| SpectraError::Spectrum {
                     record: rec.name.clone(),
                     source,
                 },
@@ -117,7 +117,7 @@ pub fn ductility_spectra(
     dampings: &[f64],
     ductilities: &[f64],
     post_yield_ratio: f64,
-) -> Result<Vec<DuctilitySpectrum>, BatchError> {
+) -> Result<Vec<DuctilitySpectrum>, SpectraError> {
     check_dampings(dampings)?;
     let jobs: Vec<(&Record, f64, f64)> = records
         .iter()
@@ -135,7 +135,7 @@ pub fn ductility_spectra(
             };
             let pts =
                 constant_ductility_spectrum(&rec.accel_mps2(1.0), rec.dt_s, periods_s, mu, opts)
-                    .map_err(|source| BatchError::Ductility {
+                    .map_err(|source| SpectraError::Ductility {
                         record: rec.name.clone(),
                         source,
                     })?;
