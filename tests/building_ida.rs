@@ -7,28 +7,12 @@
 
 mod common;
 
+use common::{ok, slidestack};
+
 use slidestack::store::ida::{IdaAxes, ZoneIda, read_zone_ida};
 use slidestack::study::storey_strength::storey_strength_ratios;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-fn slidestack(args: &[&str], threads: &str) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(args)
-        .env("RAYON_NUM_THREADS", threads)
-        .output()
-        .unwrap()
-}
-
-fn ok(o: Output) -> Output {
-    assert!(
-        o.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use std::process::{Command, Stdio};
 
 fn repo(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path)
@@ -133,12 +117,7 @@ fn the_building_ida_runs_is_deterministic_resumes_and_is_labelled() {
     assert_eq!(std::fs::read(killed.join("ida.h5")).unwrap(), want);
 
     // xarray names every dimension, the frames' among them (scripts/install-deps.sh --test).
-    let python = repo(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh --test",
-        python.display()
-    );
+    let python = common::test_python();
     let script = "import sys, xarray as xr\n\
         ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_V')\n\
         print(list(ds['fractile_curve'].dims), list(ds['theta'].dims), list(ds['run_demand'].dims))\n\

@@ -5,6 +5,8 @@
 
 mod common;
 
+use common::{ok, slidestack};
+
 use slidestack::dynamics::{ExactOptions, G, Ground};
 use slidestack::grid::StackFloor;
 use slidestack::store::motions::read_zone_motions;
@@ -15,19 +17,6 @@ use slidestack::study::building::Frame;
 use slidestack::study::physics::{Physics, SystemKind};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn slidestack(args: &[&str], threads: &str) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(args)
-        .env("RAYON_NUM_THREADS", threads)
-        .output()
-        .unwrap()
-}
-
-fn ok(o: Output) -> Output {
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    o
-}
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
@@ -53,12 +42,7 @@ fn units(dir: &Path) -> usize {
 /// What `script` prints when the tests' Python (scripts/install-deps.sh --test: xarray,
 /// h5netcdf) runs it with `file` as its argument; panics with its stderr if it fails.
 fn python_on(script: &str, file: &Path) -> String {
-    let python = repo(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh --test",
-        python.display()
-    );
+    let python = common::test_python();
     let o = ok(Command::new(python)
         .args(["-c", script])
         .arg(file)

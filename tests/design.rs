@@ -1,18 +1,14 @@
 //! `slidestack design`: Section 9's worked example, the grid interpolation against the stored
 //! values, and refused questions (one line, exit code 2).
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
-fn slidestack(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use common::slidestack;
+
+use std::path::Path;
 
 fn json(args: &[&str]) -> serde_json::Value {
-    let o = slidestack(args);
+    let o = slidestack(args, "2");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     serde_json::from_slice(&o.stdout).unwrap()
 }
@@ -22,7 +18,10 @@ fn worked_example_grid_points_and_refusals() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("quick");
     let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
-    let o = slidestack(&["run", cfg.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let o = slidestack(
+        &["run", cfg.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        "2",
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let study = out.to_str().unwrap();
     let ask = |zone: &str, period: &str, alpha: &str, mu: &str| {
@@ -79,7 +78,7 @@ fn worked_example_grid_points_and_refusals() {
 
     // Outside the grid: refused, or from the fit with --extrapolate.
     let refuse = |args: &[&str], text: &str| {
-        let o = slidestack(args);
+        let o = slidestack(args, "2");
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{err}");
         assert_eq!(err.lines().count(), 1, "{err}");

@@ -23,6 +23,8 @@
 //! iteration in the command: each is within a few ulps of the matrix's norm, a relative error
 //! below ~1e-14 for these well-conditioned frames, inside the same 1e-12.
 
+mod common;
+
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -45,12 +47,7 @@ fn root() -> PathBuf {
 
 /// The probe's answer for `request` (its module doc).
 fn probe(request: &Value) -> Value {
-    let python = root().join(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh --test",
-        python.display()
-    );
+    let python = common::test_python();
     let mut child = Command::new(python)
         .arg(root().join("scripts/browser_probe.py"))
         .stdin(Stdio::piped())

@@ -2,21 +2,14 @@
 //! metrics on all cases and cross-validated, the solver that converged, the box check, the
 //! recommended form among those that pass it; the same `fit.yaml` whatever the thread count.
 
+mod common;
+
+use common::{ok, slidestack};
+
 use slidestack::fit::Form;
 use slidestack::fit::extrapolation::BOX_POINTS;
 use slidestack::store::fit::read_fit;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn slidestack(args: &[&str], threads: &str) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(args)
-        .env("RAYON_NUM_THREADS", threads)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    o
-}
 
 #[test]
 fn fit_stage_on_the_quick_study() {
@@ -27,7 +20,7 @@ fn fit_stage_on_the_quick_study() {
     let out_s = out.to_str().unwrap();
     let mut fit_stdout = String::new();
     for stage in ["motions", "sweep", "tnew", "fit"] {
-        let o = slidestack(&[stage, cfg, "--out", out_s], "2");
+        let o = ok(slidestack(&[stage, cfg, "--out", out_s], "2"));
         if stage == "fit" {
             fit_stdout = String::from_utf8_lossy(&o.stdout).into_owned();
         }
@@ -82,6 +75,6 @@ fn fit_stage_on_the_quick_study() {
     }
     // One thread gives the same file as two.
     let first = std::fs::read(&yaml).unwrap();
-    slidestack(&["fit", cfg, "--out", out_s, "--force"], "1");
+    ok(slidestack(&["fit", cfg, "--out", out_s, "--force"], "1"));
     assert_eq!(std::fs::read(&yaml).unwrap(), first);
 }

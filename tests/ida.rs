@@ -6,28 +6,12 @@
 
 mod common;
 
+use common::{ok, slidestack};
+
 use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, Yielding, simulate_exact};
 use slidestack::ida::trace::{HuntFill, hunt_fill};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-fn slidestack(args: &[&str], threads: &str) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(args)
-        .env("RAYON_NUM_THREADS", threads)
-        .output()
-        .unwrap()
-}
-
-fn ok(o: Output) -> Output {
-    assert!(
-        o.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use std::process::{Command, Stdio};
 
 fn quick() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("configs/ida-quick.yaml")
@@ -93,12 +77,7 @@ fn the_stage_runs_skips_resumes_after_a_kill_and_ignores_the_thread_count() {
     assert_eq!(std::fs::read(one.join("ida.h5")).unwrap(), want);
 
     // xarray opens a zone with its named dimensions (scripts/install-deps.sh --test).
-    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh --test",
-        python.display()
-    );
+    let python = common::test_python();
     let script = "import sys, xarray as xr\n\
         ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_III')\n\
         print(list(ds['fractile_curve'].dims), list(ds['theta'].dims), list(ds['run_demand'].dims))\n\

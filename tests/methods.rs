@@ -12,6 +12,8 @@
 //! `SLIDESTACK_BLESS=1 cargo test --release --test methods` stores the hashes and versions of
 //! this build (after a version was bumped).
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -56,12 +58,7 @@ fn methods_tag(file: &Path) -> String {
 }
 
 fn hashes(files: &[PathBuf]) -> Vec<String> {
-    let python = repo(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh --test",
-        python.display()
-    );
+    let python = common::test_python();
     let o = Command::new(python)
         .arg(repo("scripts/stage-hashes.py"))
         .args(files)

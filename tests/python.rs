@@ -2,18 +2,15 @@
 //! `scripts/install-deps.sh --test` makes and installs the module into (.venv-test/), against the
 //! `slidestack` binary this build made.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
 #[test]
 fn python_module_tests_pass() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let python = root.join(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh --test",
-        python.display()
-    );
+    let python = common::test_python();
     let installed = Command::new(&python)
         .args(["-c", "import slidestack; print(slidestack.__version__)"])
         .output()

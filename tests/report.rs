@@ -7,6 +7,10 @@
 //! the most complete SVG conformance suite, rendering into a pixel buffer the test can read.
 //! Set `SLIDESTACK_REPORT_PNG=DIR` to keep every figure as a PNG in `DIR` for looking at.
 
+mod common;
+
+use common::{ok, slidestack};
+
 use resvg::{tiny_skia, usvg};
 use slidestack::dynamics::{ExactOptions, Ground, System, simulate_exact};
 use slidestack::pipeline::Study;
@@ -20,14 +24,6 @@ use slidestack::study::tnew::{BAND_FLAGS, BandCounts};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
-
-fn slidestack(args: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-}
 
 /// The `<td>` texts of each row of the table with `id`.
 fn table(doc: &roxmltree::Document, id: &str) -> Vec<Vec<String>> {
@@ -211,7 +207,7 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
     let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
     let out = dir.path().join("quick");
     let (c, o) = (cfg.to_str().unwrap(), out.to_str().unwrap());
-    slidestack(&["run", c, "--out", o]);
+    ok(slidestack(&["run", c, "--out", o], "2"));
     let report = out.join("report");
     let (html, shown, svgs) = checked_page(&report);
     let doc = html_document(&html);
@@ -348,7 +344,7 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
             )
         })
         .collect();
-    slidestack(&["report", c, "--out", o, "--force"]);
+    ok(slidestack(&["report", c, "--out", o, "--force"], "2"));
     for (name, bytes) in &before {
         assert!(
             std::fs::read(report.join(name)).unwrap() == *bytes,
@@ -403,7 +399,7 @@ fn a_building_studys_report_shows_the_files_numbers() {
     std::fs::write(&cfg, grid + &ida[ida.find("\nida:").unwrap()..]).unwrap();
     let out = dir.path().join("mdof-quick");
     let (c, o) = (cfg.to_str().unwrap(), out.to_str().unwrap());
-    slidestack(&["run", c, "--out", o]);
+    ok(slidestack(&["run", c, "--out", o], "2"));
     let report = out.join("report");
     let (html, _, svgs) = checked_page(&report);
     assert!(svgs.iter().any(|s| s == "ida.svg"), "{svgs:?}");
@@ -670,7 +666,7 @@ fn a_building_studys_report_shows_the_files_numbers() {
 
     // A forced rebuild writes the same bytes.
     let manifest = std::fs::read(report.join("MANIFEST.sha256")).unwrap();
-    slidestack(&["report", c, "--out", o, "--force"]);
+    ok(slidestack(&["report", c, "--out", o, "--force"], "2"));
     assert_eq!(
         std::fs::read(report.join("MANIFEST.sha256")).unwrap(),
         manifest
@@ -719,8 +715,11 @@ fn a_building_report_compares_the_other_damping_basis_frame_by_frame() {
         err.contains("structure.yaml") && err.contains("is missing"),
         "{err}"
     );
-    slidestack(&["run", s]);
-    slidestack(&["run", r, "--out", out_r.to_str().unwrap()]);
+    ok(slidestack(&["run", s], "2"));
+    ok(slidestack(
+        &["run", r, "--out", out_r.to_str().unwrap()],
+        "2",
+    ));
     let doc_of = |out: &Path| std::fs::read_to_string(out.join("report/index.html")).unwrap();
     let (mine, theirs) = (doc_of(&out_r), doc_of(&out_s));
     let (mine, theirs) = (html_document(&mine), html_document(&theirs));

@@ -3,22 +3,11 @@
 
 mod common;
 
+use common::{ok, slidestack};
+
 use common::fixture;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn slidestack(args: &[&str], threads: &str) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_slidestack"))
-        .args(args)
-        .env("RAYON_NUM_THREADS", threads)
-        .output()
-        .unwrap()
-}
-
-fn ok(o: Output) -> Output {
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    o
-}
+use std::process::Command;
 
 /// A study on two real records, zone III, 24 units of 12 cases.
 fn config(dir: &Path) -> PathBuf {
@@ -123,12 +112,7 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
 
     // xarray opens the group with its named dimensions (Python environment made by
     // scripts/install-deps.sh).
-    let python = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-test/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/install-deps.sh (it installs h5py, xarray, h5netcdf)",
-        python.display()
-    );
+    let python = common::test_python();
     let script = "import sys, xarray as xr\n\
         ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_III')\n\
         print(list(ds['u_stack'].dims), list(ds['slip_peak'].dims))\n\

