@@ -145,3 +145,59 @@ fn worked_example_grid_points_and_refusals() {
     none[2] = empty.to_str().unwrap();
     refuse(&none, "no tnew.h5");
 }
+
+/// The design page's script repeats the designer's arithmetic for every form and every kind of
+/// target spectrum by name, and throws on any other: a new one must be added to it too. The
+/// matches below are exhaustive, so a new variant fails to compile here until it is listed.
+#[test]
+fn the_design_page_handles_every_form_and_target_kind_by_name() {
+    use slidestack::fit::Form;
+    use slidestack::spectrum::target::TargetSpectrum;
+    let js = include_str!("../src/render/design.js");
+    let form_name = |f: Form| match f {
+        Form::Paper => "paper",
+        Form::Bounded => "bounded",
+        Form::Damped => "damped",
+        Form::Fraction => "fraction",
+    };
+    for f in [Form::Paper, Form::Bounded, Form::Damped, Form::Fraction] {
+        assert_eq!(f.name(), form_name(f));
+        let handled = format!("fit.form === \"{}\"", f.name());
+        assert!(js.contains(&handled), "design.js has no `{handled}`");
+    }
+    assert!(
+        js.contains("unknown form"),
+        "design.js must throw on an unknown form"
+    );
+    let kind_name = |t: &TargetSpectrum| match t {
+        TargetSpectrum::Is1893 { .. } => "is1893",
+        TargetSpectrum::Asce7 { .. } => "asce7",
+        TargetSpectrum::Table { .. } => "table",
+    };
+    let table = TargetSpectrum::Table {
+        source: "t.csv".into(),
+        periods_s: vec![0.0, 1.0],
+        sa_g: vec![0.4, 1.0],
+    };
+    for t in [
+        "is1893:zone=III,soil=I".parse().unwrap(),
+        "asce7:sds=1.0,sd1=0.6,tl=8".parse().unwrap(),
+        table,
+    ] {
+        let kind = kind_name(&t);
+        let json = serde_json::to_value(&t).unwrap();
+        assert_eq!(json["kind"], kind, "the page reads `kind`");
+        let handled = [
+            format!("t.kind === \"{kind}\""),
+            format!("t.kind !== \"{kind}\""),
+        ];
+        assert!(
+            handled.iter().any(|h| js.contains(h.as_str())),
+            "design.js does not handle the target kind `{kind}`"
+        );
+    }
+    assert!(
+        js.contains("unknown target kind"),
+        "design.js must throw on an unknown kind"
+    );
+}

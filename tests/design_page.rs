@@ -29,14 +29,10 @@ use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-const OUTPUTS: [&str; 6] = [
-    "t_rigid_s",
-    "t_new_grid_s",
-    "t_new_fit_s",
-    "t_new_paper_s",
-    "sa_tp_g",
-    "sa_new_g",
-];
+/// The one-storey page's numeric outputs, as the page declares them.
+fn outputs() -> Vec<&'static str> {
+    slidestack::render::design::output_ids(false)
+}
 
 /// A question: zone, `T_p`, `α`, `μ`, extrapolate.
 type Question = (&'static str, &'static str, &'static str, &'static str, bool);
@@ -146,7 +142,7 @@ fn query(q: &Question) -> String {
 
 /// The page's elements (`probe`'s `elements`) agree with the command's answer for `q`.
 fn check_page(q: &Question, page: &Value, cli: &Result<Value, String>) {
-    check_outputs(q, &OUTPUTS, page, cli);
+    check_outputs(q, &outputs(), page, cli);
 }
 
 /// [`check_page`] over the outputs `outputs` of a question shown as `q`.
@@ -261,7 +257,7 @@ fn design_page_answers_as_the_command_does() {
         ("V", "1e-300", "1,1", "0.3,0.1", true),
         ("III", "1e9", "1,1", "0.3,0.1", true),
     ];
-    let mut ids: Vec<&str> = OUTPUTS.to_vec();
+    let mut ids: Vec<&str> = outputs();
     ids.extend([
         "error",
         "fit_form",
@@ -425,13 +421,10 @@ type FrameQuestion = (
     &'static str,
 );
 
-/// The outputs of a building study's page: the one-storey page's ([`OUTPUTS`]) and `λ`'s.
+/// The outputs of a building study's page: the one-storey page's and `λ`'s, as the page
+/// declares them.
 fn building_outputs() -> Vec<&'static str> {
-    OUTPUTS
-        .iter()
-        .chain(&["lambda_grid", "lambda_fit"])
-        .copied()
-        .collect()
+    slidestack::render::design::output_ids(true)
 }
 
 /// `slidestack design --json … --storeys N --floor F` for `q`, as [`command`].

@@ -111,13 +111,16 @@ function predict(fit, x, tP, tRigid) {
     const k = x.length;
     return tP + (tRigid - tP) * logistic(dot(p.slice(0, k), x) + p[k]);
   }
-  const z = x.map(Math.log);
-  z.push(z[0] * z[0]);
-  const k = z.length;
-  const span = tRigid - tP;
-  const s1 = logistic(dot(p.slice(0, k), z) + p[k]);
-  const s2 = logistic(dot(p.slice(k + 1, 2 * k + 1), z) + p[2 * k + 1]);
-  return tP * (1.0 - DATA.damping_depth * s2) + span * s1;
+  if (fit.form === "damped") {
+    const z = x.map(Math.log);
+    z.push(z[0] * z[0]);
+    const k = z.length;
+    const span = tRigid - tP;
+    const s1 = logistic(dot(p.slice(0, k), z) + p[k]);
+    const s2 = logistic(dot(p.slice(k + 1, 2 * k + 1), z) + p[2 * k + 1]);
+    return tP * (1.0 - DATA.damping_depth * s2) + span * s1;
+  }
+  throw new Error("design.js: unknown form `" + fit.form + "`: this page predates the study");
 }
 
 // fit/published.rs, PaperEquation::evaluate.
@@ -144,6 +147,9 @@ function saG(t, T) {
     if (T <= ts) return t.sds_g;
     if (T <= t.tl_s) return t.sd1_g / T;
     return t.sd1_g * t.tl_s / (T * T);
+  }
+  if (t.kind !== "table") {
+    throw new Error("design.js: unknown target kind `" + t.kind + "`: this page predates the study");
   }
   const ps = t.periods_s;
   const sa = t.sa_g;
@@ -187,8 +193,8 @@ function frameEntry(zone, storeys, floor) {
   if (typeof floor === "number" && !(floor >= 1 && floor <= storeys)) {
     return refuse("floors 1 … " + storeys + " in a building of " + storeys + " storeys");
   }
-  const k = ZONES.findIndex((z) => z.zone === zone && z.building[0].storeys === storeys &&
-    sameList(floorsOf(parseFloor(z.building[0].stack_floor).floor, storeys), wanted));
+  const k = ZONES.findIndex((z) => z.zone === zone && z.building.frame.storeys === storeys &&
+    sameList(floorsOf(parseFloor(z.building.frame.stack_floor).floor, storeys), wanted));
   return k < 0 ? refuse(FRAMES.known) : { z: ZONES[k], label: FRAMES.labels[k] };
 }
 
@@ -265,8 +271,9 @@ function frameTRigid(spec, period, alphaTotal) {
 // without its features).
 function fitFeatures(z, period, alpha, mu) {
   const x = [period, ...mu, ...alpha];
-  if (!z.building || !z.building[1]) return x;
-  const [spec, bf] = z.building;
+  if (!z.building || !z.building.features) return x;
+  const spec = z.building.frame;
+  const bf = z.building.features;
   if (bf.storeys) x.push(spec.storeys);
   if (bf.height) x.push(stackHeightRatio(spec));
   return x;
@@ -274,7 +281,7 @@ function fitFeatures(z, period, alpha, mu) {
 
 // T_rigid (s) of entry `z` for T_p `period` and the stack's total mass ratio `alphaTotal`.
 function tRigidOf(z, period, alphaTotal) {
-  return z.building ? frameTRigid(z.building[0], period, alphaTotal)
+  return z.building ? frameTRigid(z.building.frame, period, alphaTotal)
     : period * Math.sqrt(1.0 + alphaTotal);
 }
 
@@ -385,9 +392,8 @@ function answer(q) {
     return l.outside || l.value === null ? null : l.value;
   };
   if (z.lambda) {
-    const [values, fitted] = z.lambda;
-    lambdaGrid = onGrid(values);
-    lambdaFit = fitted ? predict(fitted, fitX, q.period, tRigid) : null;
+    lambdaGrid = onGrid(z.lambda.per_case);
+    lambdaFit = z.lambda.fit ? predict(z.lambda.fit, fitX, q.period, tRigid) : null;
   }
   if (z.lambda_code) lambdaCode = onGrid(z.lambda_code);
   const tPaper = aPeriod(paperEquation(z.paper, x), "the paper's equation", notes);
@@ -405,8 +411,8 @@ function answer(q) {
 
 // ---- the form, the URL and the outputs ----
 
-const OUTPUTS = ["t_rigid_s", "t_new_grid_s", "t_new_fit_s", "t_new_paper_s", "sa_tp_g", "sa_new_g"]
-  .concat(FRAMES ? ["lambda_grid", "lambda_fit", "lambda_code_grid"] : []);
+// The numeric outputs: the page's <output class='number'> elements (render/design.rs's rows).
+const OUTPUTS = Array.from(document.querySelectorAll("output.number"), (o) => o.id);
 const $ = (id) => document.getElementById(id);
 const listOf = (s) => s.split(",").map((v) => (v.trim() === "" ? NaN : Number(v)));
 

@@ -76,6 +76,17 @@ const BUILDING_ROWS: [Row; 9] = [
     ),
 ];
 
+/// The ids of the page's numeric outputs, each the JSON key of `slidestack design --json` that
+/// it shows (`building`: a building study's page); the page's script finds them by their class.
+pub fn output_ids(building: bool) -> Vec<&'static str> {
+    let rows: &[Row] = if building {
+        &BUILDING_ROWS
+    } else {
+        &OUTPUT_ROWS
+    };
+    rows.iter().map(|r| r.1).collect()
+}
+
 /// A building study's inputs: the storey counts and floors its selects offer, and its
 /// distinct frames (`3 storeys, stack on the roof`) for the explorer, in stored order.
 pub struct FrameInputs {
@@ -170,8 +181,8 @@ pub fn design_page(
         .iter()
         .map(|(label, id, unit)| {
             format!(
-                "<tr><th scope='row'>{}</th><td><output id='{id}'>–</output> {unit}\
-                 </td></tr>",
+                "<tr><th scope='row'>{}</th><td><output id='{id}' class='number'>–</output> \
+                 {unit}</td></tr>",
                 escape(label)
             )
         })

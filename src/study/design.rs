@@ -185,14 +185,12 @@ pub struct ZoneDesign {
     pub fit: Option<Fitted>,
     /// The paper's Eq. 16 or 17, for zones III and V with two blocks.
     pub paper: Option<PaperEquation>,
-    /// A building study's frame, and the building features of its fit (`None`: the
-    /// one-storey features, a study of one frame).
+    /// A building study's frame and the building features of its fit.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub building: Option<(FrameSpec, Option<BuildingFeatures>)>,
-    /// A building study's `λ` per case of the frame (grid's flat order) and its fitted
-    /// equation.
+    pub building: Option<FrameDesign>,
+    /// A building study's `λ` per case of the frame and its fitted equation.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub lambda: Option<(Vec<f64>, Option<Fitted>)>,
+    pub lambda: Option<LambdaDesign>,
     /// A building study's code-format `λ_code` per case of the frame (grid's flat order).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lambda_code: Option<Vec<f64>>,
@@ -201,6 +199,25 @@ pub struct ZoneDesign {
     /// stay finite and inside `[½·T_p, 1.5·T_rigid]` (`fit.yaml`'s `box_check`). `None` when
     /// it failed that check or there is none: then nothing answers outside the grid.
     pub extrapolation_margin: Option<f64>,
+}
+
+/// A building study's frame as the designer's arithmetic (and the page) needs it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrameDesign {
+    /// The frame as `fit.yaml` stores it.
+    pub frame: FrameSpec,
+    /// The building features of the fit (`None`: the one-storey features, a study of one
+    /// frame).
+    pub features: Option<BuildingFeatures>,
+}
+
+/// A building study's `λ` on one frame.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LambdaDesign {
+    /// `λ` per case of the frame, in the grid's flat order (NaN, `null` in JSON, where none).
+    pub per_case: Vec<f64>,
+    /// The zone's fitted fraction equation.
+    pub fit: Option<Fitted>,
 }
 
 impl ZoneDesign {
@@ -255,10 +272,16 @@ impl ZoneDesign {
             let fitted = zone_fit
                 .and_then(|z| z.lambda.as_ref())
                 .map(FormFit::fitted);
-            (frame_of(&l.lambda), fitted)
+            LambdaDesign {
+                per_case: frame_of(&l.lambda),
+                fit: fitted,
+            }
         });
         let mut data = Self::new(zone, target, grid, frame_of(&t.vars.t_new), zone_fit);
-        data.building = Some((fit.frames[f].clone(), features));
+        data.building = Some(FrameDesign {
+            frame: fit.frames[f].clone(),
+            features,
+        });
         data.lambda = lambda;
         data.lambda_code = t.lambda.as_ref().map(|l| frame_of(&l.lambda_code));
         data
@@ -266,8 +289,8 @@ impl ZoneDesign {
 
     /// A building study's frame, `3 storeys, stack on the roof` (as [`Answer::building`]).
     pub fn frame_label(&self) -> Option<String> {
-        let (spec, _) = self.building.as_ref()?;
-        Some(Frame::of_spec(spec)?.to_string())
+        let b = self.building.as_ref()?;
+        Some(Frame::of_spec(&b.frame)?.to_string())
     }
 }
 
@@ -464,8 +487,8 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
         alpha: q.alpha.clone(),
         mu: q.mu.clone(),
     };
-    let frame = (z.building.as_ref())
-        .and_then(|(spec, features)| Some((Frame::of_spec(spec)?, spec, *features)));
+    let frame =
+        (z.building.as_ref()).and_then(|b| Some((Frame::of_spec(&b.frame)?, &b.frame, b.features)));
     let t_rigid_s = frame
         .as_ref()
         .map_or_else(|| case.t_rigid_s(), |(f, _, _)| f.t_rigid_s(&case));
@@ -520,9 +543,9 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
     });
     let t_new_fit_s = a_period(t_new_fit_s, "the fitted form", &mut notes);
     let (lambda_grid, lambda_fit) = match &z.lambda {
-        Some((values, fitted)) => (
-            z.grid.interpolate(values, &point).ok().flatten(),
-            fitted.as_ref().map(|f| {
+        Some(l) => (
+            z.grid.interpolate(&l.per_case, &point).ok().flatten(),
+            l.fit.as_ref().map(|f| {
                 f.predict(&Sample {
                     x: fit_x,
                     t_rigid_s,
