@@ -67,10 +67,11 @@ pub const IDA: Method = Method {
     version: 1,
 };
 
-/// The report's pages and figures.
+/// The report's pages and figures (7: the design page's data by name, `ZoneDesign`'s
+/// `building` and `lambda`).
 pub const REPORT: Method = Method {
     name: "report",
-    version: 6,
+    version: 7,
 };
 
 /// The methods as they enter a fingerprint: `name-version` joined by spaces.

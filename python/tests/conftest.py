@@ -40,11 +40,11 @@ def cli_json(cli: Path, *args: str):
     return json.loads(run_cli(cli, *args, "--json").stdout)
 
 
-def interrupt_when_held(script: str, args: list[str], point: str, held: Path,
-                        env: dict[str, str] | None = None) -> tuple[str, str]:
-    """Runs `python -c script *args` held by the test hook at `point` (`SLIDESTACK_PAUSE_AT`,
-    src/pipeline/pause.rs), sends SIGINT while it holds there (the hook has written `held`), and
-    returns its (stdout, stderr); the child must end by its KeyboardInterrupt handler (exit 3)."""
+def held_child(script: str, args: list[str], point: str, held: Path,
+               env: dict[str, str] | None = None) -> subprocess.Popen:
+    """Starts `python -c script *args` held by the test hook at `point` (`SLIDESTACK_PAUSE_AT`,
+    src/pipeline/pause.rs) and returns it once it holds there (the hook has written `held`);
+    removing `held` lets it go on."""
     env = dict(os.environ, **(env or {}), SLIDESTACK_PAUSE_AT=point,
                SLIDESTACK_PAUSE_FILE=str(held))
     p = subprocess.Popen([sys.executable, "-c", script, *args], stdout=subprocess.PIPE,
@@ -52,6 +52,15 @@ def interrupt_when_held(script: str, args: list[str], point: str, held: Path,
     while not held.exists():
         assert p.poll() is None, p.communicate()
         time.sleep(0.002)
+    return p
+
+
+def interrupt_when_held(script: str, args: list[str], point: str, held: Path,
+                        env: dict[str, str] | None = None) -> tuple[str, str]:
+    """Runs `python -c script *args` held at `point` ([`held_child`]), sends SIGINT while it
+    holds there, and returns its (stdout, stderr); the child must end by its KeyboardInterrupt
+    handler (exit 3)."""
+    p = held_child(script, args, point, held, env)
     p.send_signal(signal.SIGINT)
     out, err = p.communicate()
     assert p.returncode == 3, (p.returncode, out, err)

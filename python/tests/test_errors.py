@@ -1,11 +1,14 @@
 """Each kind of bad input raises the Python exception of its kind with the CLI's message, and
 nothing brings the interpreter down."""
 
+import json
+import shutil
+
 import numpy as np
 import pytest
 
 import slidestack
-from conftest import ROOT, run_cli
+from conftest import ROOT, held_child, run_cli
 
 
 def cli_error(cli, *args, code=2):
@@ -158,13 +161,34 @@ def test_every_kind_of_fault_has_its_class_and_names_its_place(tmp_path):
         slidestack.motions(small_study(tmp_path, "a-file/o"))
     assert e.value.kind == "io"  # type: ignore[attr-defined]
     assert not isinstance(e.value, FileNotFoundError)
-    # A run that cannot produce its result: one case cannot be fitted.
+    # A grid too small to fit a design equation: bad input naming the key, before any work.
     cfg = small_study(tmp_path, "one")
     for stage in (slidestack.motions, slidestack.sweep, slidestack.tnew):
         stage(cfg)
-    with pytest.raises(slidestack.Error, match="no form could be fitted") as e:
+    with pytest.raises(ValueError, match="the grid gives 1") as e:
         slidestack.fit(cfg)
-    assert e.value.kind == "failed" and isinstance(e.value, RuntimeError)  # type: ignore[attr-defined]
+    assert (e.value.kind, e.value.key) == ("bad_input", "grid")  # type: ignore[attr-defined]
+    # A run that cannot produce its result: a record file changed while the stage ran (held by
+    # the test hook after the config, and its records, were read).
+    record = tmp_path / "RSN960_NORTHR_LOS270.AT2"
+    shutil.copy(ROOT / "tests/fixtures/records/RSN960_NORTHR_LOS270.AT2", record)
+    changing = small_study(tmp_path, "changing")
+    changing["motions"] = {"seeds": {"records": {"files": [str(record)]}}}
+    script = (
+        "import json, sys, slidestack\n"
+        "try:\n"
+        "    slidestack.motions(json.loads(sys.argv[1]))\n"
+        "except slidestack.Error as e:\n"
+        "    print(e.kind, isinstance(e, RuntimeError), e)\n"
+        "    sys.exit(4)\n"
+    )
+    held = tmp_path / "held"
+    p = held_child(script, [json.dumps(changing)], "session.locked", held)
+    record.write_bytes(record.read_bytes() + b"\n")
+    held.unlink()
+    out, err = p.communicate()
+    assert p.returncode == 4, (p.returncode, out, err)
+    assert out.startswith("failed True") and "changed after the study was loaded" in out, out
     # A damaged file: a flipped byte in sweep.h5.
     sweep = tmp_path / "one" / "sweep.h5"
     data = bytearray(sweep.read_bytes())
