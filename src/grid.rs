@@ -190,7 +190,7 @@ impl BuildingAxes {
     }
 
     /// Frames: every `(storeys, stack_floor)` pair.
-    pub fn frames(&self) -> usize {
+    pub fn frame_count(&self) -> usize {
         self.storeys.len() * self.stack_floor.len()
     }
 

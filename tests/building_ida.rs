@@ -61,7 +61,7 @@ fn the_building_ida_runs_is_deterministic_resumes_and_is_labelled() {
     // The stored storey strengths are IS 1893's distribution of c_y (the kernel is tested
     // against the formula by hand, src/study/storey_strength.rs); storey 1 is c_y itself.
     let (axes, z) = zone(&out, "III");
-    assert_eq!(axes.frames(), 2);
+    assert_eq!(axes.frame_count(), 2);
     let stored = z.vars.storey_c_y.as_ref().unwrap();
     let want_c = storey_strength_ratios(0.3, &[1.0; 3], &[3.0; 3]);
     for (i, w) in want_c.iter().enumerate() {
@@ -434,7 +434,7 @@ fn a_frame_that_repeats_a_building_takes_its_traces_which_are_the_traced_ones() 
     for zone_name in ["III", "V"] {
         let (axes, z_both) = zone(&out_both, zone_name);
         let (_, z_roof) = zone(&out_roof, zone_name);
-        assert_eq!(axes.building.as_ref().unwrap().frames(), 2);
+        assert_eq!(axes.building.as_ref().unwrap().frame_count(), 2);
         let (vb, vr) = (&z_both.vars, &z_roof.vars);
         // The case axis holds case·frames + frame: one case, so the frame's index.
         for (what, a, b, axis) in [

@@ -358,7 +358,7 @@ fn several_frames_are_fitted_and_designed_for(out: &Path) {
     let per = grid.cases();
     let t_new = t.vars.t_new.as_slice().unwrap();
     let t_rigid = t.vars.t_rigid.as_slice().unwrap();
-    for f in 0..axes.frames() {
+    for f in 0..axes.frame_count() {
         let (n, floor) = axes.frame(f);
         let (mut observed, mut fitted) = (Vec::new(), Vec::new());
         for c in 0..per {

@@ -43,7 +43,7 @@ fn fit_stage_on_the_quick_study() {
     for z in &report.zones {
         assert!(z.not_fitted.is_empty(), "{:?}", z.not_fitted);
         let forms: Vec<Form> = z.forms.iter().map(|f| f.form).collect();
-        assert_eq!(forms, Form::ALL);
+        assert_eq!(forms, Form::FOR_T_NEW);
         for f in &z.forms {
             let m = f.form.parameter_count(5);
             assert_eq!(f.coefficients.len(), m);

@@ -630,7 +630,7 @@ fn a_building_studys_report_shows_the_files_numbers() {
         let (axes, z) = read_zone_ida(&out.join("ida.h5"), zone).unwrap();
         let b = axes.building.as_ref().unwrap();
         let per = b.stack_floor.len();
-        for f in 0..b.frames() {
+        for f in 0..b.frame_count() {
             let (n, floor) = (b.storeys[f / per], b.stack_floor[f % per]);
             let label = match (n, floor.to_string().as_str()) {
                 (1, _) => format!(

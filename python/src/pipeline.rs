@@ -14,8 +14,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use slidestack::pipeline::lock::LockMode;
 use slidestack::pipeline::{
-    Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, StageState, Study,
-    execute, run_all, status as study_status, sweep, terminal_progress,
+    PipelineError, Progress, Reporter, Session, StageId, StageOptions, StageOutcome, StageState,
+    Study, execute, run_all, status as study_status, sweep, terminal_progress,
 };
 use slidestack::study::config::{ConfigError, StudyConfig};
 use std::io::IsTerminal;
@@ -144,18 +144,18 @@ fn in_session<T: Send + 'static>(
 fn outcome_dict<'py>(
     py: Python<'py>,
     stage: StageId,
-    outcome: &Outcome,
+    outcome: &StageOutcome,
     seconds: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("stage", stage.name())?;
     let (word, files): (&str, Vec<String>) = match outcome {
-        Outcome::UpToDate(p) => ("up_to_date", vec![p.display().to_string()]),
-        Outcome::Wrote(ps) => (
+        StageOutcome::UpToDate(p) => ("up_to_date", vec![p.display().to_string()]),
+        StageOutcome::Wrote(ps) => (
             "wrote",
             ps.iter().map(|p| p.display().to_string()).collect(),
         ),
-        Outcome::ShardDone { k, n } => {
+        StageOutcome::ShardDone { k, n } => {
             d.set_item("shard", (k, n))?;
             ("shard_done", Vec::new())
         }

@@ -17,7 +17,7 @@ pub use slidestack::fault::BadInput;
 use slidestack::ground_motion::{ReadOptions, Record, Units, read_record_with};
 use slidestack::pipeline::lock::{LockError, LockMode};
 use slidestack::pipeline::{
-    Outcome, PipelineError, Progress, Reporter, Session, StageId, StageOptions, Study,
+    PipelineError, Progress, Reporter, Session, StageId, StageOptions, StageOutcome, Study,
 };
 use std::ffi::OsString;
 use std::path::PathBuf;
@@ -76,14 +76,14 @@ impl Reporter for CliReporter {
 }
 
 /// One line saying what a stage did.
-pub fn print_outcome(stage: StageId, outcome: &Outcome, config: &std::path::Path) {
+pub fn print_outcome(stage: StageId, outcome: &StageOutcome, config: &std::path::Path) {
     match outcome {
-        Outcome::UpToDate(p) => println!("{stage}: {} is up to date", p.display()),
-        Outcome::Wrote(paths) => {
+        StageOutcome::UpToDate(p) => println!("{stage}: {} is up to date", p.display()),
+        StageOutcome::Wrote(paths) => {
             let list: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
             println!("{stage}: wrote {}", list.join(" and "));
         }
-        Outcome::ShardDone { k, n } => println!(
+        StageOutcome::ShardDone { k, n } => println!(
             "{stage}: shard {k}/{n} done; run `slidestack merge {}` when every shard is done",
             config.display()
         ),

@@ -25,7 +25,7 @@
 //!   effective live-load fraction `λ` (docs/model.md, "A study over buildings"):
 //!   `λ = σ(w·z + w₀)`, `z = (ln x, (ln T_p)²)` as for the damped form; in `[0, 1]` by
 //!   construction. Its "`T_new`" in a [`Sample`] is the fraction, and `T_p`, `T_rigid` are not
-//!   used. Not in [`Form::ALL`].
+//!   used. Not in [`Form::FOR_T_NEW`].
 //!
 //! `docs/fit.md` tells why this form, these features and this objective, with the numbers
 //! measured on the paper grid.
@@ -62,8 +62,9 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 impl Form {
-    /// Every form, in the order the fit stage reports them.
-    pub const ALL: [Form; 3] = [Form::Paper, Form::Bounded, Form::Damped];
+    /// The forms fitted to `T_new`, in the order the fit stage reports them ([`Form::Fraction`]
+    /// is `λ`'s).
+    pub const FOR_T_NEW: [Form; 3] = [Form::Paper, Form::Bounded, Form::Damped];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -324,7 +325,7 @@ mod tests {
     #[test]
     fn names_match_counts() {
         let f: Vec<String> = ["T_p", "mu_1", "alpha_1"].map(String::from).to_vec();
-        for form in Form::ALL.into_iter().chain([Form::Fraction]) {
+        for form in Form::FOR_T_NEW.into_iter().chain([Form::Fraction]) {
             assert_eq!(form.parameter_names(&f).len(), form.parameter_count(3));
             for s in form.starts(3) {
                 assert_eq!(s.len(), form.parameter_count(3));

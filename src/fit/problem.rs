@@ -455,7 +455,7 @@ mod tests {
                 }
             }
         }
-        for form in Form::ALL {
+        for form in Form::FOR_T_NEW {
             let problem = Problem::new(form, &data).unwrap();
             let p: Vec<f64> = (0..problem.m).map(|j| 0.3 - 0.07 * j as f64).collect();
             let (jac, r) = problem.jacobian_and_residuals(&p);

@@ -364,7 +364,7 @@ struct Probe {
 }
 
 impl Probe {
-    fn new(grid: &Grid, c: &Constraint, n: usize) -> Self {
+    fn new(grid: &MatchGrid, c: &Constraint, n: usize) -> Self {
         let k = ((c.time_s / grid.dt_s).floor().max(0.0) as usize).min(n - 1);
         let rest_s = (c.time_s - k as f64 * grid.dt_s).max(0.0);
         Self {
@@ -392,7 +392,7 @@ const PROBE_LANES: usize = 8;
 /// dot product of a wave with them: the cost of one pass per eight probes plus the waves'
 /// lengths, where stepping every oscillator through every wave costs a pass per wave.
 fn system_matrix(
-    grid: &Grid,
+    grid: &MatchGrid,
     probes: &[Probe],
     waves: &[(usize, Vec<f64>)],
     n: usize,
@@ -411,7 +411,7 @@ fn system_matrix(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn system_matrix_avx2(
-    grid: &Grid,
+    grid: &MatchGrid,
     probes: &[Probe],
     waves: &[(usize, Vec<f64>)],
     n: usize,
@@ -422,7 +422,7 @@ unsafe fn system_matrix_avx2(
 
 #[inline(always)]
 fn system_matrix_generic(
-    grid: &Grid,
+    grid: &MatchGrid,
     probes: &[Probe],
     waves: &[(usize, Vec<f64>)],
     n: usize,
@@ -597,7 +597,7 @@ struct Evaluation {
 }
 
 /// The periods matched and checked, their targets and oscillators.
-struct Grid {
+struct MatchGrid {
     /// Match grid, s: the check grid with as many points of the same log spacing added below
     /// and above as `range_margin` asks (and the target covers).
     periods_s: Vec<f64>,
@@ -610,7 +610,7 @@ struct Grid {
     dt_s: f64,
 }
 
-impl Grid {
+impl MatchGrid {
     fn new(
         settings: &MatchSettings,
         target: &TargetSpectrum,
@@ -658,7 +658,7 @@ impl Grid {
             .expect("an evaluation without a limit is never dropped"))
     }
 
-    /// [`Grid::evaluate`] when its objective is below `limit` (if any), else `None`: the spectrum is
+    /// [`MatchGrid::evaluate`] when its objective is below `limit` (if any), else `None`: the spectrum is
     /// taken eight periods at a time and dropped as soon as the objective's partial sum (of
     /// non-negative terms, in the same order, so never above the whole) reaches `limit`. A
     /// trial that a line search refuses thus costs only the periods up to where it fails.
@@ -779,7 +779,7 @@ struct Step {
 /// The constraints of a step: for each control period (see [`control_indices`]) its peak, and
 /// with `secondary_peaks` the other peaks that must not take over.
 fn constraints(
-    grid: &Grid,
+    grid: &MatchGrid,
     accel: &[f64],
     now: &Evaluation,
     count: usize,
@@ -806,7 +806,7 @@ fn constraints(
     cons
 }
 
-fn build_step(grid: &Grid, n: usize, cons: &[Constraint], settings: &MatchSettings) -> Step {
+fn build_step(grid: &MatchGrid, n: usize, cons: &[Constraint], settings: &MatchSettings) -> Step {
     let waves: Vec<(usize, Vec<f64>)> = cons
         .iter()
         .map(|c| wavelet(grid.periods_s[c.grid], grid.zeta, c.time_s, grid.dt_s, n))
@@ -910,7 +910,7 @@ struct Attempt {
 /// next (denser) pass starting afresh at full gain. The motion kept is the one with the
 /// smallest worst misfit on the check grid seen.
 fn attempt(
-    grid: &Grid,
+    grid: &MatchGrid,
     baseline: &PreparedBaseline,
     (start, start_eval): (&[f64], &Evaluation),
     settings: &MatchSettings,
@@ -1013,7 +1013,7 @@ pub fn match_record_scaled(
     }
     let (lo, hi) = settings.check_range_s;
     target.check_covers(lo, hi)?;
-    let mut grid = Grid::new(settings, target, dt_s)?;
+    let mut grid = MatchGrid::new(settings, target, dt_s)?;
     let baseline = settings.baseline.prepare(accel_g.len(), dt_s)?;
     grid.target_g.iter_mut().for_each(|q| *q *= target_factor);
 
@@ -1164,7 +1164,7 @@ mod tests {
         let target: TargetSpectrum = "is1893:zone=III,soil=I".parse().unwrap();
         let dt = 0.01;
         let n = 4000;
-        let grid = Grid::new(&settings, &target, dt).unwrap();
+        let grid = MatchGrid::new(&settings, &target, dt).unwrap();
         let mut cons: Vec<Constraint> = (0..grid.periods_s.len())
             .step_by(7)
             .enumerate()

@@ -23,7 +23,7 @@
 //!
 //! Fingerprint: T_new's, the forms, the number of folds and the box.
 
-use super::{Outcome, PipelineError, Session, StageId};
+use super::{PipelineError, Session, StageId, StageOutcome};
 use crate::fit::extrapolation::{BOX_MARGIN, BOX_POINTS};
 use crate::fit::{
     BuildingFeatures, DesignBox, FitError, Form, Metrics, Sample, check_box, cross_validate,
@@ -66,7 +66,7 @@ fn design_fractions(lambda: &ndarray::ArrayD<f64>) -> Vec<f64> {
 /// The fingerprint `fit.h5` and `fit.yaml` must carry (`building`: of a building study, which
 /// also fits `λ`).
 pub fn fingerprint(tnew_fingerprint: &str, building: bool) -> String {
-    let forms: Vec<&str> = Form::ALL.iter().map(|f| f.name()).collect();
+    let forms: Vec<&str> = Form::FOR_T_NEW.iter().map(|f| f.name()).collect();
     let mut parts = vec![
         tnew_fingerprint.to_string(),
         format!("folds={FOLDS}"),
@@ -89,7 +89,7 @@ pub fn cases_needed(features: usize) -> usize {
             .find(|&n: &usize| n - n.div_ceil(FOLDS) >= 3 * m)
             .expect("the training cases grow with n")
     };
-    (Form::ALL.iter())
+    (Form::FOR_T_NEW.iter())
         .map(|f| least(f.parameter_count(features)))
         .min()
         .expect("there are forms")
@@ -326,7 +326,7 @@ fn frame_fits(
         .collect()
 }
 
-/// A zone's forms from the stage's jobs, in [`Form::ALL`] order: the fitted ones (each
+/// A zone's forms from the stage's jobs, in [`Form::FOR_T_NEW`] order: the fitted ones (each
 /// described through `reporter`) and the ones that do not apply.
 fn collect_forms(
     s: &Session,
@@ -337,7 +337,7 @@ fn collect_forms(
     let me = StageId::Fit;
     let mut forms = Vec::new();
     let mut not_fitted = Vec::new();
-    for _ in Form::ALL {
+    for _ in Form::FOR_T_NEW {
         match results.next().expect("one result per job")? {
             Ok(f) => forms.push(f),
             Err(nf) => not_fitted.push(nf),
@@ -368,7 +368,7 @@ fn collect_forms(
 }
 
 /// Builds `fit.h5` and `fit.yaml`.
-pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let start = std::time::Instant::now();
     let study = &s.study;
     let me = StageId::Fit;
@@ -448,8 +448,8 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let jobs: Vec<(usize, Form, bool)> = (0..zone_data.len())
         .flat_map(|z| {
             let one = !zone_data[z].one_storey.is_empty();
-            (Form::ALL.map(|f| (z, f, false)).into_iter()).chain(
-                Form::ALL
+            (Form::FOR_T_NEW.map(|f| (z, f, false)).into_iter()).chain(
+                Form::FOR_T_NEW
                     .map(|f| (z, f, true))
                     .into_iter()
                     .filter(move |_| one),
@@ -606,9 +606,9 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
         &format!(
             "{} zones × {} forms, {FOLDS}-fold cross-validated, in {:.1} s",
             report.zones.len(),
-            Form::ALL.len(),
+            Form::FOR_T_NEW.len(),
             start.elapsed().as_secs_f64()
         ),
     );
-    Ok(Outcome::Wrote(vec![h5, yaml]))
+    Ok(StageOutcome::Wrote(vec![h5, yaml]))
 }

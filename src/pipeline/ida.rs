@@ -15,7 +15,7 @@
 //! motions' fingerprint; in a building study also the `building` section and
 //! `grid.stack_floor`.
 
-use super::{Outcome, PipelineError, Session, StageId, Study};
+use super::{PipelineError, Session, StageId, StageOutcome, Study};
 use crate::grid::BuildingAxes;
 use crate::ida::curve::{fractile, on_grid};
 use crate::ida::fragility::{FIT_STATUS_FLAGS, FitStatus, fit_lognormal};
@@ -95,7 +95,7 @@ fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
 }
 
 /// Builds `ida.h5`.
-pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Ida;
     let cfg = section(study)?;
@@ -244,7 +244,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     let path = study.path(me.output());
     write_ida(&path, &meta, &axes, &zones)?;
     s.reporter.info(me, &format!("verified {}", path.display()));
-    Ok(Outcome::Wrote(vec![path]))
+    Ok(StageOutcome::Wrote(vec![path]))
 }
 
 /// `storey_c_y` `[case, storeys, storey]` of a building study (NaN above each building).
@@ -385,7 +385,11 @@ fn zone_vars(
     c_y: Vec<f64>,
 ) -> IdaVars {
     // Cases and frames folded into one axis, case-major (crate::store::ida).
-    let (ns, nc, nr) = (SYSTEMS.len(), cfg.cases.len() * axes.frames(), axes.runs);
+    let (ns, nc, nr) = (
+        SYSTEMS.len(),
+        cfg.cases.len() * axes.frame_count(),
+        axes.runs,
+    );
     let layout = cfg.layout(axes.building.is_some());
     let (nd, ng, nl) = (
         axes.demands.len(),

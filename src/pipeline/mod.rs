@@ -333,7 +333,9 @@ pub fn check_output_dir(out: &Path) -> Result<(), String> {
 /// The frames of a building study in stored order; empty on one storey.
 fn frames_of(cfg: &StudyConfig, building: Option<&BuildingAxes>) -> Vec<Frame> {
     building.map_or_else(Vec::new, |b| {
-        (0..b.frames()).filter_map(|f| cfg.frame(b, f)).collect()
+        (0..b.frame_count())
+            .filter_map(|f| cfg.frame(b, f))
+            .collect()
     })
 }
 
@@ -675,7 +677,7 @@ pub struct StageOptions {
 
 /// What a stage did.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Outcome {
+pub enum StageOutcome {
     /// The output was already up to date.
     UpToDate(PathBuf),
     /// These files were written.
@@ -685,7 +687,11 @@ pub enum Outcome {
 }
 
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
-pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcome, PipelineError> {
+pub fn execute(
+    s: &Session,
+    stage: StageId,
+    opts: StageOptions,
+) -> Result<StageOutcome, PipelineError> {
     s.check_cancelled(stage)?;
     s.study.fingerprint(stage)?;
     for up in s.study.upstream(stage) {
@@ -698,7 +704,7 @@ pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcom
                 if stage == StageId::Sweep && s.exclusive() {
                     sweep::remove_units(&s.study)?;
                 }
-                return Ok(Outcome::UpToDate(path));
+                return Ok(StageOutcome::UpToDate(path));
             }
             StageState::Damaged(why) => s.reporter.warn(stage, &format!("{why}: rebuilding it")),
             StageState::Missing | StageState::Stale => {}
@@ -722,7 +728,7 @@ pub fn execute(s: &Session, stage: StageId, opts: StageOptions) -> Result<Outcom
 pub fn run_all(
     s: &Session,
     opts: StageOptions,
-    mut done: impl FnMut(StageId, &Outcome, f64),
+    mut done: impl FnMut(StageId, &StageOutcome, f64),
 ) -> Result<(), PipelineError> {
     for stage in s.study.stages() {
         let start = std::time::Instant::now();

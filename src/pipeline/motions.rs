@@ -7,7 +7,7 @@
 //! bytes the config loaded; the stage refuses a record whose bytes changed since. Each zone's
 //! target spectrum is stored in `motions.h5`, so later stages never read a table file again.
 
-use super::{Outcome, PipelineError, Session, StageId, Study};
+use super::{PipelineError, Session, StageId, StageOutcome, Study};
 use crate::ground_motion::matching::MatchError;
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
@@ -90,7 +90,7 @@ pub fn read_zones<T>(
 }
 
 /// Builds `motions.h5`.
-pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let cfg = &study.cfg;
     let me = StageId::Motions;
@@ -170,5 +170,5 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     };
     let path = study.path(me.output());
     write_motions(&path, &meta, &seeds, &zones)?;
-    Ok(Outcome::Wrote(vec![path]))
+    Ok(StageOutcome::Wrote(vec![path]))
 }

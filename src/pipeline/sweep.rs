@@ -14,7 +14,7 @@
 //! Fingerprint: the `zones` and `grid` sections (and `building`, when given), the solver, and
 //! the motions' fingerprint.
 
-use super::{Outcome, PipelineError, Session, StageId, Study};
+use super::{PipelineError, Session, StageId, StageOutcome, Study};
 use crate::dynamics::Ground;
 use crate::grid::{BuildingAxes, Grid};
 use crate::ground_motion::Record;
@@ -101,7 +101,7 @@ struct Unit {
 
 /// Frames of the study: its building axes' (1 on one storey).
 fn frames(study: &Study) -> usize {
-    study.building().map_or(1, BuildingAxes::frames)
+    study.building().map_or(1, BuildingAxes::frame_count)
 }
 
 /// Every unit in the fixed order shards count in (the order of the stored axes).
@@ -244,7 +244,7 @@ fn to_columns(r: &UnitResult, frame: Option<(usize, usize)>) -> Columns {
 }
 
 /// Builds `sweep.h5`, or with `shard = Some((K, N))` only that shard's units.
-pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, PipelineError> {
+pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Sweep;
     let grid = study.grid(me)?;
@@ -349,20 +349,20 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<Outcome, Pipe
         );
     }
     if let Some((k, n)) = shard {
-        return Ok(Outcome::ShardDone { k, n });
+        return Ok(StageOutcome::ShardDone { k, n });
     }
     s.pass("sweep.assemble", me)?;
     assemble(s, &units, &all)
 }
 
 /// Assembles `sweep.h5` from the stored units of every shard (`merge`).
-pub fn merge(s: &Session) -> Result<Outcome, PipelineError> {
+pub fn merge(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Sweep;
     study.require(StageId::Motions)?;
     if study.state(me)? == super::StageState::UpToDate {
         remove_units(study)?;
-        return Ok(Outcome::UpToDate(study.path(me.output())));
+        return Ok(StageOutcome::UpToDate(study.path(me.output())));
     }
     let grid = study.grid(me)?;
     let motions = load_motions(study)?;
@@ -376,7 +376,7 @@ pub fn merge(s: &Session) -> Result<Outcome, PipelineError> {
     assemble(s, &units, &all)
 }
 
-fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, PipelineError> {
+fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, PipelineError> {
     let study = units.study;
     let grid = units.grid;
     let dir = study.path(UNITS_DIR);
@@ -507,7 +507,7 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<Outcome, Pipelin
     }
     remove_units(study)?;
     s.reporter.info(me, &format!("verified {}", path.display()));
-    Ok(Outcome::Wrote(vec![path]))
+    Ok(StageOutcome::Wrote(vec![path]))
 }
 
 fn array<T>(
@@ -618,11 +618,11 @@ pub fn run_shard(
     k: usize,
     n: usize,
     opts: super::StageOptions,
-) -> Result<Outcome, PipelineError> {
+) -> Result<StageOutcome, PipelineError> {
     let me = StageId::Sweep;
     s.study.require(StageId::Motions)?;
     if !opts.force && s.study.state(me)? == super::StageState::UpToDate {
-        return Ok(Outcome::UpToDate(s.study.path(me.output())));
+        return Ok(StageOutcome::UpToDate(s.study.path(me.output())));
     }
     build(s, Some((k, n)))
 }

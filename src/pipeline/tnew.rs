@@ -15,7 +15,7 @@
 //!
 //! Fingerprint: the sweep's, the step of the spectrum's period grid, the methods' versions.
 
-use super::{Outcome, PipelineError, Session, StageId, Study};
+use super::{PipelineError, Session, StageId, StageOutcome, Study};
 use crate::dynamics::Ground;
 use crate::grid::Grid;
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
@@ -130,7 +130,7 @@ pub fn read_zone(study: &Study, zone: &str) -> Result<ZoneTnew, PipelineError> {
 }
 
 /// Builds `tnew.h5`.
-pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Tnew;
     let grid = study.grid(me)?;
@@ -374,5 +374,5 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
     };
     let path = study.path(me.output());
     write_tnew(&path, &meta, grid, building, &zones)?;
-    Ok(Outcome::Wrote(vec![path]))
+    Ok(StageOutcome::Wrote(vec![path]))
 }

@@ -62,8 +62,8 @@ pub struct IdaAxes {
 
 impl IdaAxes {
     /// Frames per case (1 on one storey).
-    pub fn frames(&self) -> usize {
-        self.building.as_ref().map_or(1, BuildingAxes::frames)
+    pub fn frame_count(&self) -> usize {
+        self.building.as_ref().map_or(1, BuildingAxes::frame_count)
     }
 
     /// The largest storey count (the length of `storey`).

@@ -682,7 +682,7 @@ impl StudyConfig {
             };
             // Counted in floating point: a product of axis lengths can overflow any integer.
             let cases: f64 = g.axes().shape().iter().map(|&n| n as f64).product::<f64>()
-                * frames.as_ref().map_or(1, BuildingAxes::frames) as f64;
+                * frames.as_ref().map_or(1, BuildingAxes::frame_count) as f64;
             let results = cases * per_zone as f64 * self.zones.len() as f64;
             if results > MAX_CASE_RESULTS as f64 {
                 return err(
@@ -699,9 +699,11 @@ impl StudyConfig {
             let targets: Vec<_> = (0..self.zones.len())
                 .map(|i| (self.zones[i].name.clone(), self.target(i).clone()))
                 .collect();
-            let frames: Option<Vec<Frame>> = frames
-                .as_ref()
-                .map(|a| (0..a.frames()).filter_map(|i| self.frame(a, i)).collect());
+            let frames: Option<Vec<Frame>> = frames.as_ref().map(|a| {
+                (0..a.frame_count())
+                    .filter_map(|i| self.frame(a, i))
+                    .collect()
+            });
             ida.validate(&physics, &targets, frames.as_deref())?;
         }
         let seeds = &self.motions.seeds;

@@ -334,7 +334,7 @@ pub(crate) fn check_frames(
     axes: &BuildingAxes,
     fit_yaml: &Path,
 ) -> Result<(), DesignError> {
-    let agrees = fit.frames.len() == axes.frames()
+    let agrees = fit.frames.len() == axes.frame_count()
         && (fit.frames.iter().enumerate()).all(|(f, a)| {
             let (n, floor) = axes.frame(f);
             a.storeys == n && a.stack_floor == floor.to_string()
@@ -407,7 +407,7 @@ pub(crate) fn frame_index(
             known: format!("floors 1 … {storeys} in a building of {storeys} storeys"),
         });
     }
-    (0..axes.frames())
+    (0..axes.frame_count())
         .map(|f| axes.frame(f))
         .position(|(n, f)| n == storeys && f.floors(n) == wanted)
         .ok_or_else(|| DesignError::UnknownFrame {

@@ -77,7 +77,7 @@ pub enum TnewFlag {
     /// `ū` lies outside the spectrum's range on its period grid: `T_new` is NaN.
     OutsideRange = 2,
     /// Nothing slid: `T_new = T_rigid`.
-    NoSlip = 3,
+    NoSlide = 3,
 }
 
 /// Meaning of the `T_new_flag` codes, for the file attribute.
@@ -96,7 +96,7 @@ pub fn of_attached(t1_s: f64, how: FractionFlag) -> (f64, TnewFlag) {
         FractionFlag::Root => (t1_s, TnewFlag::Unique),
         FractionFlag::Several | FractionFlag::Near => (t1_s, TnewFlag::Several),
         FractionFlag::Below | FractionFlag::Above => (f64::NAN, TnewFlag::OutsideRange),
-        FractionFlag::NoSlide => (t1_s, TnewFlag::NoSlip),
+        FractionFlag::NoSlide => (t1_s, TnewFlag::NoSlide),
     }
 }
 
@@ -134,7 +134,7 @@ impl Band {
     /// `t_rigid_s`; earlier rules win: no slide, no crossing, above, below, several.
     pub fn of(t_p_s: f64, t_rigid_s: f64, t_new_s: f64, flag: TnewFlag) -> Band {
         match flag {
-            TnewFlag::NoSlip => Band::NoSlide,
+            TnewFlag::NoSlide => Band::NoSlide,
             TnewFlag::OutsideRange => Band::NoCrossing,
             _ if t_new_s > t_rigid_s => Band::AboveTrigid,
             _ if t_new_s < t_p_s => Band::BelowTp,
@@ -198,7 +198,7 @@ pub fn t_new(
     if slides {
         period_at_displacement(periods_s, sd_m, u_m, t_rigid_s)
     } else {
-        (t_rigid_s, TnewFlag::NoSlip)
+        (t_rigid_s, TnewFlag::NoSlide)
     }
 }
 
@@ -251,7 +251,7 @@ mod tests {
     #[test]
     fn band_categories_by_precedence() {
         let b = |t: f64, f| Band::of(1.0, 1.5, t, f);
-        assert_eq!(b(1.5, TnewFlag::NoSlip), Band::NoSlide);
+        assert_eq!(b(1.5, TnewFlag::NoSlide), Band::NoSlide);
         assert_eq!(b(f64::NAN, TnewFlag::OutsideRange), Band::NoCrossing);
         assert_eq!(b(1.6, TnewFlag::Several), Band::AboveTrigid);
         assert_eq!(b(0.9, TnewFlag::Unique), Band::BelowTp);

@@ -127,7 +127,7 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
             return Err(StoreError::corrupt(&study.path("tnew.h5"), why).into());
         };
         let motions = sweep.motions.len();
-        let fr = axes.frames();
+        let fr = axes.frame_count();
         let flat = |v: &ndarray::ArrayD<f64>| v.iter().copied().collect::<Vec<f64>>();
         let (u_stack, u_rigid) = (flat(&sweep.vars.u_stack), flat(&sweep.vars.u_rigid));
         let (d_stack, d_rigid) = (flat(&b.drift_ratio_stack), flat(&b.drift_ratio_rigid));

@@ -285,7 +285,7 @@ fn construction(z: &Zone, files: &mut Files) -> Result<(String, Vec<String>), Re
             TnewFlag::Unique => "one crossing".into(),
             TnewFlag::Several => "several crossings, nearest T_rigid".into(),
             TnewFlag::OutsideRange => "no crossing".into(),
-            TnewFlag::NoSlip => "nothing slid: T_rigid".into(),
+            TnewFlag::NoSlide => "nothing slid: T_rigid".into(),
         },
     ];
     Ok((fig, row))

@@ -43,7 +43,7 @@ mod runs;
 mod select;
 mod text;
 
-use super::{Outcome, PipelineError, Session, StageId, Study};
+use super::{PipelineError, Session, StageId, StageOutcome, Study};
 use crate::grid::Grid;
 use crate::ground_motion::Record;
 use crate::render::chart::{self, ChartError, Figure};
@@ -524,7 +524,7 @@ fn not_shown(building: bool) -> Section {
 }
 
 /// Builds the report.
-pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
+pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     if !study.configured(StageId::Sweep) {
         return build_without_grid(s);
@@ -588,7 +588,7 @@ pub fn build(s: &Session) -> Result<Outcome, PipelineError> {
 
 /// The report of a config without a grid: the matched motions and, with an `ida:` section, the
 /// IDA.
-fn build_without_grid(s: &Session) -> Result<Outcome, PipelineError> {
+fn build_without_grid(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let motions = super::sweep::load_motions(study)?;
     let mh5 = study.path("motions.h5");
@@ -644,7 +644,7 @@ fn write(
     summary: &str,
     sections: &[Section],
     files: Files,
-) -> Result<Outcome, PipelineError> {
+) -> Result<StageOutcome, PipelineError> {
     let html = document(
         &format!(
             "slidestack report: {}",
@@ -660,5 +660,5 @@ fn write(
     out.push(("index.html".into(), html.into_bytes()));
     let dir = study.path("report");
     write_report_dir(&dir, study.fingerprint(StageId::Report)?, &out)?;
-    Ok(Outcome::Wrote(vec![dir.join("index.html")]))
+    Ok(StageOutcome::Wrote(vec![dir.join("index.html")]))
 }
