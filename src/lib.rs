@@ -20,6 +20,31 @@
 //! `docs/model.md` states the model, the numbers checked by hand and the choices the paper leaves
 //! open; the code cites its sections as `docs/model.md, "<section>"`.
 
+/// Declares a flag stored as a code (`#[repr(u8)]`, `Debug, Clone, Copy, PartialEq, Eq`) and its
+/// `(code, word)` table for the CF `flag_values`/`flag_meanings` attributes, from one list of
+/// `Variant = code => "word"`: the code, the word and the variant cannot drift apart.
+macro_rules! flag_enum {
+    (
+        $(#[$meta:meta])*
+        $vis:vis enum $name:ident;
+        $(#[$table_meta:meta])*
+        $table_vis:vis const $table:ident;
+        {
+            $($(#[$variant_meta:meta])* $variant:ident = $code:literal => $word:literal,)+
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        #[repr(u8)]
+        $vis enum $name {
+            $($(#[$variant_meta])* $variant = $code,)+
+        }
+
+        $(#[$table_meta])*
+        $table_vis const $table: &[(u8, &str)] = &[$(($name::$variant as u8, $word),)+];
+    };
+}
+
 pub mod case;
 pub mod design;
 pub mod dynamics;

@@ -319,7 +319,7 @@ fn quick_report_renders_references_its_files_and_shows_the_files_numbers() {
         let counts = BandCounts::new(&band, &tn, &tr);
         let r = rows.iter().find(|r| r[0] == zc.name).unwrap();
         let col = |name: &str| head.iter().position(|h| h == name).unwrap();
-        for (code, word) in BAND_FLAGS {
+        for &(code, word) in BAND_FLAGS {
             assert_eq!(
                 r[col(word)],
                 counts.counts[code as usize].to_string(),

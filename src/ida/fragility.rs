@@ -21,28 +21,23 @@ pub const BETA_RANGE: (f64, f64) = (1e-3, 10.0);
 /// The two-sided 95 % standard normal quantile.
 pub const Z_95: f64 = 1.959_963_984_540_054;
 
-/// How a fit ended (stored as a code).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[repr(u8)]
-pub enum FitStatus {
-    Fitted = 0,
-    /// No stripe has an exceedance: `θ` is above the data.
-    NoExceedance = 1,
-    /// Every run of every stripe exceeds: `θ` is below the data.
-    AllExceed = 2,
-    /// `β` on the edge of [`BETA_RANGE`], fewer than two stripes with some but not all runs
-    /// exceeding (`(θ, β)` then lie on a ridge of equal likelihood), or a singular information
-    /// matrix: the estimates are kept, without intervals.
-    Degenerate = 3,
+flag_enum! {
+    /// How a fit ended (stored as a code).
+    pub enum FitStatus;
+    /// `(code, word)` pairs for the CF flag attributes.
+    pub const FIT_STATUS_FLAGS;
+    {
+        Fitted = 0 => "fitted",
+        /// No stripe has an exceedance: `θ` is above the data.
+        NoExceedance = 1 => "no_exceedance",
+        /// Every run of every stripe exceeds: `θ` is below the data.
+        AllExceed = 2 => "all_exceed",
+        /// `β` on the edge of [`BETA_RANGE`], fewer than two stripes with some but not all runs
+        /// exceeding (`(θ, β)` then lie on a ridge of equal likelihood), or a singular information
+        /// matrix: the estimates are kept, without intervals.
+        Degenerate = 3 => "degenerate",
+    }
 }
-
-/// `(code, word)` pairs for the CF flag attributes.
-pub const FIT_STATUS_FLAGS: [(u8, &str); 4] = [
-    (FitStatus::Fitted as u8, "fitted"),
-    (FitStatus::NoExceedance as u8, "no_exceedance"),
-    (FitStatus::AllExceed as u8, "all_exceed"),
-    (FitStatus::Degenerate as u8, "degenerate"),
-];
 
 /// A fitted fragility function; NaN where the status gives no value.
 #[derive(Debug, Clone, Copy, PartialEq)]

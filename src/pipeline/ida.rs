@@ -238,7 +238,7 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
         fingerprint: fp,
         motions_fingerprint: study.fingerprint(StageId::Motions)?,
         config_sha256: &study.config_sha256,
-        fit_flags: &FIT_STATUS_FLAGS,
+        fit_flags: FIT_STATUS_FLAGS,
         settings: &settings,
     };
     let path = study.path(me.output());

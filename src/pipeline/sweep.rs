@@ -481,7 +481,7 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
         config_sha256: &study.config_sha256,
         motions_fingerprint: motions_fp,
         skip_rule_codes: SKIP_RULE_CODES,
-        skip_rule_flags: &SKIP_RULE_FLAGS,
+        skip_rule_flags: SKIP_RULE_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,
         settings: &settings,
     };

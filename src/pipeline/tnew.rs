@@ -367,8 +367,8 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
         sweep_fingerprint: study.fingerprint(StageId::Sweep)?,
         motions_fingerprint: study.fingerprint(StageId::Motions)?,
         flag_codes: TNEW_FLAG_CODES,
-        band_flags: &BAND_FLAGS,
-        lambda_flags: &FRACTION_FLAGS,
+        band_flags: BAND_FLAGS,
+        lambda_flags: FRACTION_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,
         settings: &settings,
     };

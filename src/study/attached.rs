@@ -67,37 +67,27 @@ pub const MATCH_TOL: f64 = 1e-4;
 /// Largest fraction the scan is extended to when no root lies on `[lowest, 1]`.
 pub const MAX_FRACTION: f64 = 2.0;
 
-/// How a fraction was found.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[repr(u8)]
-pub enum FractionFlag {
-    /// One crossing on the scan: its root.
-    Root = 0,
-    /// The target below every scanned value: the scan point of the smallest.
-    Below = 1,
-    /// The target above every scanned value: the scan point of the largest.
-    Above = 2,
-    /// Nothing slid under any motion (the value is computed all the same: 1).
-    NoSlide = 3,
-    /// Several crossings: the matching fraction nearest the stuck mass share.
-    Several = 4,
-    /// No crossing, but a stretch where the value stays within [`MATCH_TOL`] of the target (a
-    /// stationary point): the matching fraction nearest the stuck mass share.
-    Near = 5,
+flag_enum! {
+    /// How a fraction was found.
+    pub enum FractionFlag;
+    /// `(code, word)` of each [`FractionFlag`], for the CF `flag_values`/`flag_meanings`.
+    pub const FRACTION_FLAGS;
+    {
+        /// One crossing on the scan: its root.
+        Root = 0 => "root",
+        /// The target below every scanned value: the scan point of the smallest.
+        Below = 1 => "below_range_clamped",
+        /// The target above every scanned value: the scan point of the largest.
+        Above = 2 => "above_range_clamped",
+        /// Nothing slid under any motion (the value is computed all the same: 1).
+        NoSlide = 3 => "no_slide",
+        /// Several crossings: the matching fraction nearest the stuck mass share.
+        Several = 4 => "several_roots_nearest_stuck_share",
+        /// No crossing, but a stretch where the value stays within [`MATCH_TOL`] of the target (a
+        /// stationary point): the matching fraction nearest the stuck mass share.
+        Near = 5 => "stationary_within_tolerance",
+    }
 }
-
-/// `(code, word)` of each [`FractionFlag`], for the CF `flag_values`/`flag_meanings`.
-pub const FRACTION_FLAGS: [(u8, &str); 6] = [
-    (FractionFlag::Root as u8, "root"),
-    (FractionFlag::Below as u8, "below_range_clamped"),
-    (FractionFlag::Above as u8, "above_range_clamped"),
-    (FractionFlag::NoSlide as u8, "no_slide"),
-    (
-        FractionFlag::Several as u8,
-        "several_roots_nearest_stuck_share",
-    ),
-    (FractionFlag::Near as u8, "stationary_within_tolerance"),
-];
 
 /// Mean peaks over a zone's motions (each summed in motion order, then divided), each over the
 /// bare building: the roof's displacement (m), every storey's shear over the bare building's

@@ -31,29 +31,25 @@ use crate::dynamics::{ExactOptions, G, Ground, Response};
 use crate::grid::Grid;
 use std::collections::HashMap;
 
-/// Which rule gave a case's stack result (stored as `skip_rule`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[repr(u8)]
-pub enum SkipRule {
-    /// The stack was simulated.
-    Simulated = 0,
-    /// No interface can slip: the stack is the rigid system.
-    NoSlip = 1,
-    /// Coefficients never decrease upward (static = kinetic): the stack is the single block.
-    SingleBlock = 2,
+flag_enum! {
+    /// Which rule gave a case's stack result (stored as `skip_rule`).
+    pub enum SkipRule;
+    /// `(code, word)` of each rule, for the CF `flag_values`/`flag_meanings` attributes.
+    pub const SKIP_RULE_FLAGS;
+    {
+        /// The stack was simulated.
+        Simulated = 0 => "simulated",
+        /// No interface can slip: the stack is the rigid system.
+        NoSlip = 1 => "no_slip",
+        /// Coefficients never decrease upward (static = kinetic): the stack is the single block.
+        SingleBlock = 2 => "single_block",
+    }
 }
 
 /// Meaning of the `skip_rule` codes, for the file attribute.
 pub const SKIP_RULE_CODES: &str = "0 simulated; 1 no interface can slip (rigid absolute \
      acceleration never exceeds min μ_s·g): stack = rigid; 2 friction never decreases upward \
      with static = kinetic: stack = single block";
-
-/// `(code, word)` of each rule, for the CF `flag_values`/`flag_meanings` attributes.
-pub const SKIP_RULE_FLAGS: [(u8, &str); 3] = [
-    (SkipRule::Simulated as u8, "simulated"),
-    (SkipRule::NoSlip as u8, "no_slip"),
-    (SkipRule::SingleBlock as u8, "single_block"),
-];
 
 /// What the sweep keeps of one system's run.
 #[derive(Debug, Clone, PartialEq)]

@@ -100,34 +100,27 @@ pub fn of_attached(t1_s: f64, how: FractionFlag) -> (f64, TnewFlag) {
     }
 }
 
-/// Where a case's `T_new` lies against its physical band `[T_p, T_rigid]` (paper Section 10:
-/// generally `T_p < T_new < T_rigid`; docs/model.md, "Derived quantities").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[repr(u8)]
-pub enum Band {
-    /// One crossing, `T_p ≤ T_new ≤ T_rigid`.
-    Band = 0,
-    /// `T_new < T_p`: friction lowered the displacement below the bare structure's.
-    BelowTp = 1,
-    /// `T_new > T_rigid`.
-    AboveTrigid = 2,
-    /// No crossing of the mean displacement spectrum (`T_new` NaN).
-    NoCrossing = 3,
-    /// Inside the band, the nearest of several crossings.
-    SeveralCrossings = 4,
-    /// Nothing slid: `T_new = T_rigid`.
-    NoSlide = 5,
+flag_enum! {
+    /// Where a case's `T_new` lies against its physical band `[T_p, T_rigid]` (paper Section 10:
+    /// generally `T_p < T_new < T_rigid`; docs/model.md, "Derived quantities").
+    pub enum Band;
+    /// `(code, word)` of each [`Band`], for the CF `flag_values`/`flag_meanings` attributes.
+    pub const BAND_FLAGS;
+    {
+        /// One crossing, `T_p ≤ T_new ≤ T_rigid`.
+        Band = 0 => "band",
+        /// `T_new < T_p`: friction lowered the displacement below the bare structure's.
+        BelowTp = 1 => "below_T_p",
+        /// `T_new > T_rigid`.
+        AboveTrigid = 2 => "above_T_rigid",
+        /// No crossing of the mean displacement spectrum (`T_new` NaN).
+        NoCrossing = 3 => "no_crossing",
+        /// Inside the band, the nearest of several crossings.
+        SeveralCrossings = 4 => "several_crossings",
+        /// Nothing slid: `T_new = T_rigid`.
+        NoSlide = 5 => "no_slide",
+    }
 }
-
-/// `(code, word)` of each [`Band`], for the CF `flag_values`/`flag_meanings` attributes.
-pub const BAND_FLAGS: [(u8, &str); 6] = [
-    (Band::Band as u8, "band"),
-    (Band::BelowTp as u8, "below_T_p"),
-    (Band::AboveTrigid as u8, "above_T_rigid"),
-    (Band::NoCrossing as u8, "no_crossing"),
-    (Band::SeveralCrossings as u8, "several_crossings"),
-    (Band::NoSlide as u8, "no_slide"),
-];
 
 impl Band {
     /// The category of `T_new` (s) found as `flag` for a structure of periods `t_p_s`,

@@ -183,7 +183,7 @@ impl<'a> Inputs<'a> {
             let tnew = super::tnew::read_zone(study, &zc.name)?;
             let band_flags = read_band_flags(&th5, &zc.name)?;
             let spectra = read_zone_spectra(&mh5, &zc.name)?;
-            let why = if !same_flags(&band_flags, &BAND_FLAGS) {
+            let why = if !same_flags(&band_flags, BAND_FLAGS) {
                 Some((
                     &th5,
                     "T_new_band's flag_values/flag_meanings are not this version's",
