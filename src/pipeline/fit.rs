@@ -35,6 +35,7 @@ use crate::store::fit::{FitReport, FormFit, FrameFit, NotFitted, ZoneFit, write_
 use crate::study::building::{Frame, fit_features, repeats};
 use crate::study::tnew::{building_samples, samples};
 use rayon::prelude::*;
+use std::collections::HashMap;
 use thiserror::Error;
 
 /// Folds of the cross-validation.
@@ -326,19 +327,37 @@ fn frame_fits(
         .collect()
 }
 
-/// A zone's forms from the stage's jobs, in [`Form::FOR_T_NEW`] order: the fitted ones (each
-/// described through `reporter`) and the ones that do not apply.
+/// One fit of the stage: a form on a zone's cases, or on its one-storey frame's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct FitJob {
+    zone: usize,
+    form: Form,
+    one_storey: bool,
+}
+
+/// What one [`FitJob`] gave.
+type JobResult = Result<Result<FormFit, NotFitted>, FitStageError>;
+
+/// Zone `z`'s forms (on its one-storey frame's cases with `one_storey`) from the stage's
+/// `results`, in [`Form::FOR_T_NEW`] order: the fitted ones (each described through
+/// `reporter`) and the ones that do not apply.
 fn collect_forms(
     s: &Session,
-    zone: &str,
-    what: &str,
-    results: &mut impl Iterator<Item = Result<Result<FormFit, NotFitted>, FitStageError>>,
+    (z, zone): (usize, &str),
+    one_storey: bool,
+    results: &mut HashMap<FitJob, JobResult>,
 ) -> Result<(Vec<FormFit>, Vec<NotFitted>), PipelineError> {
     let me = StageId::Fit;
+    let what = if one_storey { ", one storey" } else { "" };
     let mut forms = Vec::new();
     let mut not_fitted = Vec::new();
-    for _ in Form::FOR_T_NEW {
-        match results.next().expect("one result per job")? {
+    for form in Form::FOR_T_NEW {
+        let job = FitJob {
+            zone: z,
+            form,
+            one_storey,
+        };
+        match results.remove(&job).expect("one result per job")? {
             Ok(f) => forms.push(f),
             Err(nf) => not_fitted.push(nf),
         }
@@ -445,31 +464,41 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     }
     // Per zone every form on its data, then (a building study with a one-storey frame) every
     // form on the one-storey frame's cases.
-    let jobs: Vec<(usize, Form, bool)> = (0..zone_data.len())
-        .flat_map(|z| {
-            let one = !zone_data[z].one_storey.is_empty();
-            (Form::FOR_T_NEW.map(|f| (z, f, false)).into_iter()).chain(
-                Form::FOR_T_NEW
-                    .map(|f| (z, f, true))
-                    .into_iter()
-                    .filter(move |_| one),
-            )
+    let jobs: Vec<FitJob> = (0..zone_data.len())
+        .flat_map(|zone| {
+            let has_one_storey = !zone_data[zone].one_storey.is_empty();
+            [false, true]
+                .into_iter()
+                .filter(move |&one| !one || has_one_storey)
+                .flat_map(move |one_storey| {
+                    Form::FOR_T_NEW.map(|form| FitJob {
+                        zone,
+                        form,
+                        one_storey,
+                    })
+                })
         })
         .collect();
-    let results: Vec<_> = jobs
+    let mut results: HashMap<FitJob, JobResult> = jobs
         .par_iter()
-        .map(|&(z, form, one)| {
+        .map(|&job| {
+            let FitJob {
+                zone: z,
+                form,
+                one_storey: one,
+            } = job;
             let d = &zone_data[z];
             let run = if one {
                 assess(form, &d.one_storey, &one_storey_features, &one_storey_bx)
             } else {
                 assess(form, &d.data, &features, &bx)
             };
-            run.map_err(|source| FitStageError::Fit {
+            let result = run.map_err(|source| FitStageError::Fit {
                 zone: d.zone.clone(),
                 form: form.name(),
                 source,
-            })
+            });
+            (job, result)
         })
         .collect();
     let lambda_fits: Vec<_> = zone_data
@@ -486,16 +515,15 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
             })
         })
         .collect();
-    let mut results = results.into_iter();
     let mut lambda_fits = lambda_fits.into_iter();
     let mut zones = Vec::new();
-    for z in &zone_data {
+    for (zi, z) in zone_data.iter().enumerate() {
         let (zone, data) = (&z.zone, &z.data);
-        let (forms, not_fitted) = collect_forms(s, zone, "", &mut results)?;
+        let (forms, not_fitted) = collect_forms(s, (zi, zone), false, &mut results)?;
         let one_storey = if z.one_storey.is_empty() {
             None
         } else {
-            let (forms, _) = collect_forms(s, zone, ", one storey", &mut results)?;
+            let (forms, _) = collect_forms(s, (zi, zone), true, &mut results)?;
             let (best, _) = recommend(&forms);
             forms.into_iter().find(|f| f.form == best)
         };

@@ -36,6 +36,16 @@ use rayon::prelude::*;
 use std::path::PathBuf;
 use thiserror::Error;
 
+/// One work unit: a case of the `ida:` section under a motion of a zone, on one frame of a
+/// building study (0 on one storey), both systems; indices in stored order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct IdaUnit {
+    zone: usize,
+    motion: usize,
+    case: usize,
+    frame: usize,
+}
+
 /// The fractiles of the summary curves (Vamvatsikos & Cornell 2002, Section 6).
 pub const FRACTILES: [f64; 3] = [0.16, 0.5, 0.84];
 
@@ -109,17 +119,24 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     // of them is traced, and the others take its traces.
     let first = first_of_building(&frames.iter().flatten().cloned().collect::<Vec<_>>());
     let first = |f: usize| first.get(f).copied().unwrap_or(f);
-    let all_units: Vec<(usize, usize, usize, usize)> = motions
+    let all_units: Vec<IdaUnit> = motions
         .iter()
         .enumerate()
-        .flat_map(|(z, ms)| {
-            (0..ms.len()).flat_map(move |m| {
-                (0..cfg.cases.len()).flat_map(move |c| (0..nf).map(move |f| (z, m, c, f)))
+        .flat_map(|(zone, ms)| {
+            (0..ms.len()).flat_map(move |motion| {
+                (0..cfg.cases.len()).flat_map(move |case| {
+                    (0..nf).map(move |frame| IdaUnit {
+                        zone,
+                        motion,
+                        case,
+                        frame,
+                    })
+                })
             })
         })
         .collect();
-    let units: Vec<(usize, usize, usize, usize)> = (all_units.iter())
-        .filter(|u| first(u.3) == u.3)
+    let units: Vec<IdaUnit> = (all_units.iter())
+        .filter(|u| first(u.frame) == u.frame)
         .copied()
         .collect();
     s.reporter.info(
@@ -149,7 +166,13 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let bar = s.reporter.progress(me, units.len() as u64);
     let outs: Vec<UnitOut> = units
         .par_iter()
-        .map(|&(z, m, c, f)| -> Result<UnitOut, PipelineError> {
+        .map(|&u| -> Result<UnitOut, PipelineError> {
+            let IdaUnit {
+                zone: z,
+                motion: m,
+                case: c,
+                frame: f,
+            } = u;
             s.check_cancelled(me)?;
             let rec = &motions[z][m];
             let case = &cfg.cases[c];
@@ -207,7 +230,13 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     );
     let traced: std::collections::BTreeMap<_, _> = units.iter().zip(&outs).collect();
     let outs: Vec<UnitOut> = (all_units.iter())
-        .map(|&(z, m, c, f)| traced[&(z, m, c, first(f))].clone())
+        .map(|&u| {
+            traced[&IdaUnit {
+                frame: first(u.frame),
+                ..u
+            }]
+                .clone()
+        })
         .collect();
     let axes = axes_of(cfg, study.building());
     let mut zones = Vec::new();
