@@ -12,7 +12,7 @@ use common::{ok, slidestack};
 use slidestack::store::ida::{IdaAxes, ZoneIda, read_zone_ida};
 use slidestack::study::storey_strength::storey_strength_ratios;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 fn repo(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path)
@@ -102,16 +102,12 @@ fn the_building_ida_runs_is_deterministic_resumes_and_is_labelled() {
     // once, atomically, at the end; a rerun computes it again).
     let killed = dir.path().join("killed");
     common::copy_motions(&m, &killed);
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
-    cmd.args(["ida", s(&cfg), "--out", s(&killed)])
-        .env("RAYON_NUM_THREADS", "1")
-        .stdout(Stdio::null());
     // Held after its first trace: the stage is computing, nothing written yet.
-    let held = common::Held::arm(&mut cmd, "ida.trace:1", dir.path());
-    let mut child = cmd.spawn().unwrap();
-    held.wait(&mut child);
-    child.kill().unwrap();
-    child.wait().unwrap();
+    common::kill_at(
+        &["ida", s(&cfg), "--out", s(&killed)],
+        "ida.trace:1",
+        dir.path(),
+    );
     assert!(!killed.join("ida.h5").exists());
     ok(slidestack(&["ida", s(&cfg), "--out", s(&killed)], "2"));
     assert_eq!(std::fs::read(killed.join("ida.h5")).unwrap(), want);

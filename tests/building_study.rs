@@ -70,16 +70,12 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
     // Killed with SIGKILL once some units are on disk, then resumed.
     let killed = dir.path().join("killed");
     common::copy_motions(&out, &killed);
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
-    cmd.args(["sweep", cfg_s, "--out", killed.to_str().unwrap()])
-        .env("RAYON_NUM_THREADS", "1")
-        .stdout(std::process::Stdio::null());
     // Held after its third unit is stored: exactly three are on disk at the kill.
-    let held = common::Held::arm(&mut cmd, "sweep.unit:3", dir.path());
-    let mut child = cmd.spawn().unwrap();
-    held.wait(&mut child);
-    child.kill().unwrap();
-    child.wait().unwrap();
+    common::kill_at(
+        &["sweep", cfg_s, "--out", killed.to_str().unwrap()],
+        "sweep.unit:3",
+        dir.path(),
+    );
     let before = units(&killed);
     assert_eq!(before, 3, "{before} units before the kill");
     assert!(!killed.join("sweep.h5").exists());

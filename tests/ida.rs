@@ -11,7 +11,7 @@ use common::{ok, slidestack};
 use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, Yielding, simulate_exact};
 use slidestack::ida::trace::{HuntFill, hunt_fill};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 fn quick() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("configs/ida-quick.yaml")
@@ -50,16 +50,12 @@ fn the_stage_runs_skips_resumes_after_a_kill_and_ignores_the_thread_count() {
     // SIGKILL once the stage has started computing, then a rerun: the same bytes.
     let killed = dir.path().join("killed");
     common::copy_motions(&out, &killed);
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
-    cmd.args(["ida", s(&cfg), "--out", s(&killed)])
-        .env("RAYON_NUM_THREADS", "1")
-        .stdout(Stdio::null());
     // Held after its first trace: the stage is computing, nothing written yet.
-    let held = common::Held::arm(&mut cmd, "ida.trace:1", dir.path());
-    let mut child = cmd.spawn().unwrap();
-    held.wait(&mut child);
-    child.kill().unwrap();
-    child.wait().unwrap();
+    common::kill_at(
+        &["ida", s(&cfg), "--out", s(&killed)],
+        "ida.trace:1",
+        dir.path(),
+    );
     assert!(!killed.join("ida.h5").exists());
     ok(slidestack(&["ida", s(&cfg), "--out", s(&killed)], "2"));
     assert_eq!(std::fs::read(killed.join("ida.h5")).unwrap(), want);

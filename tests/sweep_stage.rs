@@ -48,16 +48,12 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
     // Killed with SIGKILL once some units are on disk, then resumed.
     let killed = dir.path().join("killed");
     common::copy_motions(&out, &killed);
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_slidestack"));
-    cmd.args(["sweep", cfg_s, "--out", killed.to_str().unwrap()])
-        .env("RAYON_NUM_THREADS", "1")
-        .stdout(std::process::Stdio::null());
     // Held after its third unit is stored: exactly three are on disk at the kill.
-    let held = common::Held::arm(&mut cmd, "sweep.unit:3", dir.path());
-    let mut child = cmd.spawn().unwrap();
-    held.wait(&mut child);
-    child.kill().unwrap(); // SIGKILL
-    child.wait().unwrap();
+    common::kill_at(
+        &["sweep", cfg_s, "--out", killed.to_str().unwrap()],
+        "sweep.unit:3",
+        dir.path(),
+    );
     let units = killed.join("sweep.units");
     let count = || {
         std::fs::read_dir(&units)

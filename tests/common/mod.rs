@@ -294,6 +294,20 @@ impl Held {
     }
 }
 
+/// Runs `slidestack args` on one thread, holds it at `point` of the test hook and kills it
+/// there with SIGKILL (`dir` holds the hook's file): what a crash at that moment leaves.
+pub fn kill_at(args: &[&str], point: &str, dir: &Path) {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_slidestack"));
+    cmd.args(args)
+        .env("RAYON_NUM_THREADS", "1")
+        .stdout(std::process::Stdio::null());
+    let held = Held::arm(&mut cmd, point, dir);
+    let mut child = cmd.spawn().unwrap();
+    held.wait(&mut child);
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+}
+
 /// Runs the `slidestack` binary with `args` on `threads` threads.
 pub fn slidestack(args: &[&str], threads: &str) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_slidestack"))
