@@ -139,20 +139,43 @@ fn a_grid_too_small_to_fit_runs_every_stage_but_the_fit() {
     );
 }
 
+/// Every study config shipped in `configs/` loads and configures the stages it is for (a new
+/// config must be listed here); `status --format make` says which, as make reads them.
 #[test]
-fn status_tells_make_the_configured_stages() {
-    for (name, stages) in [
-        ("quick.yaml", "motions sweep tnew fit report"),
+fn every_shipped_study_config_configures_its_stages() {
+    let want = [
+        ("fema-p695-11.yaml", "motions report"),
         ("ida-quick.yaml", "motions ida report"),
+        ("mdof-fema-rigid.yaml", "motions sweep tnew fit report"),
+        ("mdof-fema-structure.yaml", "motions sweep tnew fit report"),
         ("mdof-ida-quick.yaml", "motions sweep tnew ida report"),
         ("mdof-quick.yaml", "motions sweep tnew fit report"),
-    ] {
+        ("mdof-structure.yaml", "motions sweep tnew fit report"),
+        ("mdof.yaml", "motions sweep tnew fit report"),
+        ("paper.yaml", "motions sweep tnew fit report"),
+        ("quick.yaml", "motions sweep tnew fit report"),
+        ("yielding.yaml", "motions sweep tnew fit ida report"),
+    ];
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let mut studies: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let text = std::fs::read_to_string(p).unwrap_or_default();
+            text.lines().any(|l| l.starts_with("zones:"))
+        })
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    studies.sort();
+    let listed: Vec<&str> = want.iter().map(|w| w.0).collect();
+    assert_eq!(studies, listed, "the study configs of configs/");
+    for (name, stages) in want {
         let o = ok(slidestack(
             &["status", s(&config(name)), "--format", "make"],
             "1",
         ));
-        let want = format!("\nSTAGES := {stages}\n");
-        assert!(stdout(&o).contains(&want), "{name}: {}", stdout(&o));
+        let line = format!("\nSTAGES := {stages}\n");
+        assert!(stdout(&o).contains(&line), "{name}: {}", stdout(&o));
     }
 }
 
