@@ -658,8 +658,8 @@ impl MatchGrid {
             .expect("an evaluation without a limit is never dropped"))
     }
 
-    /// [`MatchGrid::evaluate`] when its objective is below `limit` (if any), else `None`: the spectrum is
-    /// taken eight periods at a time and dropped as soon as the objective's partial sum (of
+    /// [`MatchGrid::evaluate`] when its objective is below `limit` (if any), else `None`: the
+    /// spectrum is taken eight periods at a time and dropped as soon as the objective's partial sum (of
     /// non-negative terms, in the same order, so never above the whole) reaches `limit`. A
     /// trial that a line search refuses thus costs only the periods up to where it fails.
     fn evaluate_below(

@@ -149,7 +149,8 @@ function saG(t, T) {
     return t.sd1_g * t.tl_s / (T * T);
   }
   if (t.kind !== "table") {
-    throw new Error("design.js: unknown target kind `" + t.kind + "`: this page predates the study");
+    throw new Error("design.js: unknown target kind `" + t.kind +
+      "`: this page predates the study");
   }
   const ps = t.periods_s;
   const sa = t.sa_g;

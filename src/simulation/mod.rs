@@ -606,8 +606,8 @@ impl Simulation {
     }
 }
 
-/// What one simulation gives: the `simulate --json` contract (docs/simulate.md); field names are relied
-/// on by users and checks.
+/// What one simulation gives: the `simulate --json` contract (docs/simulate.md); field names are
+/// relied on by users and checks.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
     pub record: String,

@@ -83,8 +83,8 @@ pub enum ReportError {
 
 /// The fingerprint the report must carry: `grid_fingerprint` is the fit's, or `tnew`'s when the
 /// grid is too small to fit, or `None` without a grid; with an `ida:` section, `ida.h5`'s too
-/// (the report then shows it), and with `report.compare_with` the compared study's fit's (its `T_new`, `λ`
-/// and fit enter the building section).
+/// (the report then shows it), and with `report.compare_with` the compared study's fit's (its
+/// `T_new`, `λ` and fit enter the building section).
 pub fn fingerprint(
     grid_fingerprint: Option<&str>,
     motions_fingerprint: &str,
