@@ -66,7 +66,7 @@ pub fn run(args: Args) -> Result<()> {
         let frame = m.frame.as_ref().map_or(String::new(), |f| format!(", {f}"));
         let p = if m.frame.is_some() { 4 } else { 3 };
         println!(
-            "{:<5} case {:>3}{frame} (T_p {} s, α {:?}, μ {:?}) at {:.2} × {:.3} g: stack {:.p$}, rigid {:.p$} ({:+.1} %); largest slip {:.4} m",
+            "{:<5} case {:>3}{frame} (T_p {} s, α {:?}, μ {:?}) at {:.2} × {:.3} g: stack {:.p$}, rigid {:.p$} ({:+.1} %); largest slip of any run of the case {:.4} m",
             m.zone,
             m.case,
             m.period_s,

@@ -147,7 +147,7 @@ pub(super) fn ida_section(study: &Study, files: &mut Files) -> Result<Section, P
                     "stack",
                     "rigid load",
                     "stack vs rigid (%)",
-                    "largest slip (m)",
+                    "largest slip of any run of the case (m)",
                 ],
             ),
             &medians,
