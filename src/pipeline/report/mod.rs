@@ -157,11 +157,7 @@ impl<'a> Inputs<'a> {
         let grid = study.grid(StageId::Report)?;
         let physics = study.physics();
         let motions = super::sweep::load_motions(study)?;
-        let (mh5, th5, fyaml) = (
-            study.path("motions.h5"),
-            study.path("tnew.h5"),
-            study.path("fit.yaml"),
-        );
+        let (th5, fyaml) = (study.path("tnew.h5"), study.path("fit.yaml"));
         let n = grid.blocks();
         let fit = match study.configured(StageId::Fit) {
             true => {
@@ -174,28 +170,15 @@ impl<'a> Inputs<'a> {
         };
         let mut zones = Vec::new();
         for (zc, motions) in study.cfg.zones.iter().zip(motions) {
-            if motions.is_empty() {
-                return Err(ReportError::NoMotions {
-                    zone: zc.name.clone(),
-                }
-                .into());
-            }
+            let spectra = zone_spectra(study, &zc.name, &motions)?;
             let tnew = super::tnew::read_zone(study, &zc.name)?;
             let band_flags = read_band_flags(&th5, &zc.name)?;
-            let spectra = read_zone_spectra(&mh5, &zc.name)?;
-            let why = if !same_flags(&band_flags, BAND_FLAGS) {
-                Some((
-                    &th5,
-                    "T_new_band's flag_values/flag_meanings are not this version's",
-                ))
-            } else if spectra.periods_s != study.cfg.motions.matching.check_grid_s() {
-                Some((&mh5, "its check periods are not the config's"))
-            } else {
-                None
-            };
-            if let Some((file, why)) = why {
-                let why = format!("zone_{}: {why}", zc.name);
-                return Err(StoreError::corrupt(file, why).into());
+            if !same_flags(&band_flags, BAND_FLAGS) {
+                let why = format!(
+                    "zone_{}: T_new_band's flag_values/flag_meanings are not this version's",
+                    zc.name
+                );
+                return Err(StoreError::corrupt(&th5, why).into());
             }
             let zf = match &fit {
                 Some(fit) => Some(
@@ -254,6 +237,36 @@ impl<'a> Inputs<'a> {
     }
 }
 
+/// Zone `zone`'s stored spectra of its matched `motions`, refused when it has none or when
+/// `motions.h5` checked them on other periods than the config's.
+fn zone_spectra(
+    study: &Study,
+    zone: &str,
+    motions: &[Record],
+) -> Result<ZoneSpectra, PipelineError> {
+    if motions.is_empty() {
+        return Err(ReportError::NoMotions {
+            zone: zone.to_string(),
+        }
+        .into());
+    }
+    let mh5 = study.path("motions.h5");
+    let spectra = read_zone_spectra(&mh5, zone)?;
+    if spectra.periods_s != study.cfg.motions.matching.check_grid_s() {
+        let why = format!("zone_{zone}: its check periods are not the config's");
+        return Err(StoreError::corrupt(&mh5, why).into());
+    }
+    Ok(spectra)
+}
+
+/// "Matched motions: 3 in Zone III, 3 in Zone V." of a report's facts.
+fn motions_fact(zones: &[ZoneMotions]) -> String {
+    let counts: Vec<String> = (zones.iter())
+        .map(|z| format!("{} in Zone {}", z.count, z.name))
+        .collect();
+    format!("Matched motions: {}.", counts.join(", "))
+}
+
 /// One zone's matched motions and their stored spectra: what every report shows.
 struct ZoneMotions<'a> {
     name: &'a str,
@@ -297,15 +310,10 @@ fn facts(inp: &Inputs) -> Vec<String> {
     } else {
         "T_p"
     };
-    let motions: Vec<String> = inp
-        .zones
-        .iter()
-        .map(|z| format!("{} in Zone {}", z.motions.len(), z.name))
-        .collect();
     let mut facts = vec![
         // Not the output directory: a study's report is the same wherever it is written.
         format!("Config {}.", study.config_path.display()),
-        format!("Matched motions: {}.", motions.join(", ")),
+        motions_fact(&inp.motions()),
         format!(
             "Grid: {period} {} to {} s ({} values); {}; {}; {} cases per {}.",
             num(g.periods_s[0]),
@@ -591,22 +599,10 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
 fn build_without_grid(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let motions = super::sweep::load_motions(study)?;
-    let mh5 = study.path("motions.h5");
-    let mut spectra = Vec::new();
-    for (zc, motions) in study.cfg.zones.iter().zip(&motions) {
-        if motions.is_empty() {
-            return Err(ReportError::NoMotions {
-                zone: zc.name.clone(),
-            }
-            .into());
-        }
-        let s = read_zone_spectra(&mh5, &zc.name)?;
-        if s.periods_s != study.cfg.motions.matching.check_grid_s() {
-            let why = format!("zone_{}: its check periods are not the config's", zc.name);
-            return Err(StoreError::corrupt(&mh5, why).into());
-        }
-        spectra.push(s);
-    }
+    let spectra = (study.cfg.zones.iter())
+        .zip(&motions)
+        .map(|(zc, m)| zone_spectra(study, &zc.name, m))
+        .collect::<Result<Vec<_>, _>>()?;
     let zones: Vec<ZoneMotions> = (study.cfg.zones.iter())
         .zip(&motions)
         .zip(&spectra)
@@ -623,12 +619,9 @@ fn build_without_grid(s: &Session) -> Result<StageOutcome, PipelineError> {
     if ida {
         sections.push(ida::ida_section(study, &mut files)?);
     }
-    let counts: Vec<String> = (zones.iter())
-        .map(|z| format!("{} in Zone {}", z.count, z.name))
-        .collect();
     let facts = vec![
         format!("Config {}.", study.config_path.display()),
-        format!("Matched motions: {}.", counts.join(", ")),
+        motions_fact(&zones),
         format!(
             "No grid: this config runs the motions{}; a `grid` section adds the sweep, T_new and \
              the design equations.",
