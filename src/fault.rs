@@ -15,6 +15,7 @@ use crate::pipeline::motions::MotionsError;
 use crate::pipeline::sweep::SweepStageError;
 use crate::pipeline::{PipelineError, StageState};
 use crate::simulation::SimulationError;
+use crate::simulation::batch::BatchError;
 use crate::spectrum::PeriodsError;
 use crate::spectrum::ductility::DuctilityError;
 use crate::store::StoreError;
@@ -136,6 +137,7 @@ fn known(e: &(dyn Error + 'static)) -> Option<Fault> {
     first_of!(
         PipelineError,
         SimulationError,
+        BatchError,
         DesignError,
         MatchFilesError,
         SpectraError,
@@ -315,8 +317,36 @@ impl Classify for SimulationError {
                 Fault::of(FaultKind::BadInput).file(file)
             }
             SimulationError::Invalid(_) => Fault::of(FaultKind::BadInput),
+            SimulationError::Setting { key, .. } => Fault::of(FaultKind::BadInput).key(key),
             SimulationError::Output(e) => e.fault(),
             SimulationError::Simulation { record, source } => source.fault().file(record),
+        }
+    }
+}
+
+impl Classify for BatchError {
+    fn fault(&self) -> Fault {
+        let case_key = |case: &usize, key: Option<&str>| match key {
+            Some(k) => format!("cases[{case}].{k}"),
+            None => format!("cases[{case}]"),
+        };
+        match self {
+            BatchError::NoCase => Fault::of(FaultKind::BadInput).key("cases"),
+            BatchError::NoRecord => Fault::of(FaultKind::BadInput).key("record"),
+            BatchError::Case { case, source } => {
+                let f = source.fault();
+                let key = case_key(case, f.key.as_deref());
+                Fault {
+                    key: Some(key),
+                    ..f
+                }
+            }
+            BatchError::Mixed { case, .. } => {
+                Fault::of(FaultKind::BadInput).key(case_key(case, None))
+            }
+            BatchError::Run { source, .. } => source.fault(),
+            BatchError::Stopped { .. } => Fault::of(FaultKind::Interrupted),
+            BatchError::Pool { .. } => Fault::of(FaultKind::Failed),
         }
     }
 }

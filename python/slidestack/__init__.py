@@ -7,6 +7,8 @@ and the staged T_new study (motions -> sweep -> tnew -> fit -> report, ida, desi
 >>> import slidestack
 >>> r = slidestack.simulate(period=1.0, alpha=[0.5, 0.5], mu=[0.2, 0.1])
 >>> r["peak_displacement_m"]  # the numbers of ``slidestack simulate --json``
+>>> ds = slidestack.simulate_many([dict(mu=[m, 0.1]) for m in (0.1, 0.2, 0.3)])
+>>> ds["peak_displacement_m"]  # an xarray DataArray over ``case``, the same numbers
 
 Every function releases the GIL while it works. Errors carry the message the command line
 prints and the attributes ``kind``, ``file``, ``key`` and ``line``: bad input raises
@@ -33,6 +35,7 @@ from ._native import (
     sweep,
     tnew,
 )
+from ._batch import simulate_many, spectra
 from ._study import open_study
 
 __all__ = [
@@ -49,6 +52,8 @@ __all__ = [
     "report",
     "run",
     "simulate",
+    "simulate_many",
+    "spectra",
     "spectrum",
     "status",
     "sweep",

@@ -49,6 +49,15 @@ def simulate(
     ``building``/``stacks`` take the case file's mappings; ``config`` a case file whose keys the
     keywords override."""
 
+def simulate_many(
+    cases: Sequence[Mapping[str, Any]],
+    records: Optional[Sequence[_Record]] = None,
+    threads: Optional[int] = None,
+    config: Optional[_Path] = None,
+) -> List[List[Dict[str, Any]]]:
+    """Every case under every record: ``simulate``'s dicts, ``[case][record]``
+    (slidestack.simulate_many labels them as an xarray Dataset)."""
+
 def read_record(
     path: _Path, units: Optional[str] = None, dt: Optional[float] = None
 ) -> Tuple[npt.NDArray[np.float64], float]:
@@ -66,6 +75,14 @@ def spectrum(
     ``sd_m``, ``psv_mps``, ``psa_g``, ``peak_time_s``); a list of them for several damping
     ratios; constant-ductility spectra with ``ductility``. ``periods`` is a SPEC string
     (default ``0.05:4:0.01``) or numbers; ``damping`` defaults to 0.05."""
+
+def spectra(
+    records: Sequence[_Record],
+    periods: Union[str, _Floats, None] = None,
+    damping: Union[float, _Floats, None] = None,
+) -> List[Dict[str, Any]]:
+    """Elastic spectra of every record at every damping ratio: ``spectrum``'s dicts,
+    record-major (slidestack.spectra labels them as an xarray Dataset)."""
 
 def match(
     record: _Record, target: str, settings: Optional[Mapping[str, Any]] = None

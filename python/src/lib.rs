@@ -10,6 +10,7 @@
 //! Errors: the library's classification as Python's exception classes, with the CLI's message
 //! ([`errors`]).
 
+mod batch;
 mod convert;
 mod errors;
 mod interrupt;
@@ -111,31 +112,25 @@ fn simulate<'py>(
     history: bool,
     config: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let keys = [
-        ("period", period),
-        ("alpha", alpha),
-        ("mu", mu),
-        ("mu_static", mu_static),
-        ("damping", damping),
-        ("damping_basis", damping_basis),
-        ("scale", scale),
-        ("structure", structure),
-        ("yield_strength_ratio", yield_strength_ratio),
-        ("post_yield_ratio", post_yield_ratio),
-        ("integrator", integrator),
-        ("rk4_substeps", rk4_substeps),
-        ("building", building),
-        ("stacks", stacks),
+    // In the order of CASE_KEYS.
+    let values = [
+        period,
+        alpha,
+        mu,
+        mu_static,
+        damping,
+        damping_basis,
+        scale,
+        structure,
+        yield_strength_ratio,
+        post_yield_ratio,
+        integrator,
+        rk4_substeps,
+        building,
+        stacks,
     ];
-    if let Some(n) = rk4_substeps.filter(|n| !n.is_none()) {
-        convert::whole(n, "rk4_substeps", 1)?;
-    }
-    let mut mapping = serde_yaml::Mapping::new();
-    for (key, value) in keys {
-        if let Some(v) = value.filter(|v| !v.is_none()) {
-            mapping.insert(key.into(), to_yaml_value(v, key)?);
-        }
-    }
+    let given = CASE_KEYS.into_iter().zip(values);
+    let mut mapping = case_mapping(given.filter_map(|(k, v)| Some((k, v?))))?;
     let samples = match record
         .filter(|r| !r.is_none())
         .map(record_arg)
@@ -148,17 +143,16 @@ fn simulate<'py>(
         Some(RecordArg::Samples(r)) => Some(r),
         None => None,
     };
-    let given: Settings = serde_yaml::from_value(serde_yaml::Value::Mapping(mapping))
-        .map_err(|e| to_py_err(&SimulationError::Invalid(e.to_string())))?;
     let input = |e: SimulationError| to_py_err(&e);
-    let base = match &config {
-        Some(path) => Settings::read(path).map_err(input)?,
-        None => Settings::default(),
-    };
-    let mut sim = given.over(base).map_err(input)?.resolve().map_err(input)?;
-    if let Some(r) = samples {
-        sim.record = r;
+    let given = Settings::from_mapping(mapping).map_err(input)?;
+    let settings = given
+        .over(base_settings(config.as_deref())?)
+        .map_err(input)?;
+    let sim = match samples {
+        Some(r) => settings.resolve_with(r),
+        None => settings.resolve(),
     }
+    .map_err(input)?;
     // The run on a thread of its own, so that Ctrl-C stops it within a few samples' work.
     let cancel = Arc::new(AtomicBool::new(false));
     let watch = Cancel(Arc::clone(&cancel));
@@ -194,6 +188,49 @@ fn simulate<'py>(
         dict.set_item("history", history_dict(py, h, &layout)?)?;
     }
     Ok(dict)
+}
+
+/// The keywords of `simulate` that are a case's keys (`record`, `history` and `config` are not).
+const CASE_KEYS: [&str; 14] = [
+    "period",
+    "alpha",
+    "mu",
+    "mu_static",
+    "damping",
+    "damping_basis",
+    "scale",
+    "structure",
+    "yield_strength_ratio",
+    "post_yield_ratio",
+    "integrator",
+    "rk4_substeps",
+    "building",
+    "stacks",
+];
+
+/// A case's keywords (None values left out: the default applies) as the mapping of a case file.
+fn case_mapping<'a, 'py: 'a>(
+    keys: impl IntoIterator<Item = (&'a str, &'a Bound<'py, PyAny>)>,
+) -> PyResult<serde_yaml::Mapping> {
+    let mut mapping = serde_yaml::Mapping::new();
+    for (key, value) in keys {
+        if value.is_none() {
+            continue;
+        }
+        if key == "rk4_substeps" {
+            convert::whole(value, key, 1)?;
+        }
+        mapping.insert(key.into(), to_yaml_value(value, key)?);
+    }
+    Ok(mapping)
+}
+
+/// The case file `config` names (its keys under the call's), or no keys.
+fn base_settings(config: Option<&std::path::Path>) -> PyResult<Settings> {
+    match config {
+        Some(path) => Settings::read(path).map_err(|e| to_py_err(&e)),
+        None => Ok(Settings::default()),
+    }
 }
 
 /// The time history as numpy arrays: rows in time, a column per body or interface.
@@ -336,6 +373,32 @@ fn spectrum<'py>(
     Ok(out.into_any())
 }
 
+/// Elastic response spectra of many records at many damping ratios (`slidestack spectrum
+/// --json`'s objects, record-major: every damping ratio of the first record, then the next);
+/// slidestack.spectra labels them as an xarray Dataset.
+#[pyfunction]
+#[pyo3(signature = (records, periods=None, damping=None))]
+fn spectra<'py>(
+    py: Python<'py>,
+    records: &Bound<'py, PyList>,
+    periods: Option<&Bound<'py, PyAny>>,
+    damping: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let records = batch::records(py, Some(records))?;
+    let periods = match periods {
+        Some(p) => periods_arg(p)?,
+        None => parse_periods(DEFAULT_PERIODS).map_err(|e| to_py_err(&e))?,
+    };
+    let dampings = match damping {
+        Some(d) => one_or_many(d, "damping")?.0,
+        None => vec![0.05],
+    };
+    let s = py
+        .detach(|| response_spectra(&records, &periods, &dampings))
+        .map_err(|e| to_py_err(&e))?;
+    json_to_py(py, &serde_json::to_string(&s).expect("spectra serialise"))
+}
+
 /// One record matched to a target spectrum (SPEC string as `slidestack match --target`).
 #[pyfunction]
 #[pyo3(name = "match", signature = (record, target, settings=None))]
@@ -442,8 +505,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(read_record, m)?)?;
     m.add_function(wrap_pyfunction!(spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(spectra, m)?)?;
     m.add_function(wrap_pyfunction!(match_, m)?)?;
     m.add_function(wrap_pyfunction!(design, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(_panic, m)?)?;
     pipeline::register(m)?;
     Ok(())

@@ -1,5 +1,6 @@
-"""The Python chapter's notebook-style example (docs/python.md) runs and draws its figure, and the
-three prompt lines of the chapter and of the README's tour print what they show."""
+"""The Python chapter's notebook-style example (docs/python.md) and the README's Monte Carlo run
+and draw their figures, and the three prompt lines of the chapter and of the README's tour print
+what they show."""
 
 import os
 import re
@@ -29,6 +30,21 @@ def test_the_readme_example_runs(tmp_path):
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "fig.svg").read_text().startswith("<?xml")
     assert (out / "tnew.h5").exists()
+
+
+def test_the_readme_monte_carlo_runs(tmp_path):
+    """The README's simulate_many example draws its figure (of 1,000 cases, each of which the
+    README's claim says equals simulate's: python/tests/test_batch.py checks that)."""
+    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S)
+    example = next(b for b in blocks if "simulate_many" in b)
+    figure = tmp_path / "monte-carlo.svg"
+    code = example.replace('fig.savefig("monte-carlo.svg")', f"fig.savefig({str(figure)!r})")
+    assert code != example
+    env = dict(os.environ, MPLBACKEND="Agg")
+    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True,
+                       text=True)
+    assert p.returncode == 0, p.stderr
+    assert figure.read_text().startswith("<?xml")
 
 
 @pytest.mark.parametrize("document", [CHAPTER, "README.md"])

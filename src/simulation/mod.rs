@@ -5,6 +5,7 @@
 //! The physics of the case comes from [`Physics`], as for the study's stages; the yielding model
 //! is docs/model.md, "Yielding structure".
 
+pub mod batch;
 pub mod building;
 
 use crate::dynamics::building::Building;
@@ -146,6 +147,9 @@ pub enum SimulationError {
     },
     #[error("invalid case: {0}")]
     Invalid(String),
+    /// A setting of a call (a Python keyword) of the wrong kind, or unknown.
+    #[error("invalid case: `{key}`: {message}")]
+    Setting { key: String, message: String },
     /// A key of a case file, named with the file.
     #[error("{file}: {message}")]
     Key { file: String, message: String },
@@ -175,6 +179,27 @@ impl Settings {
         Ok(settings)
     }
 
+    /// Settings from a call's keywords as a mapping; a key of the wrong kind, or unknown, is
+    /// named (the first in the mapping's order).
+    pub fn from_mapping(mapping: serde_yaml::Mapping) -> Result<Settings, SimulationError> {
+        use serde_yaml::{Mapping, Value};
+        serde_yaml::from_value(Value::Mapping(mapping.clone())).map_err(|e| {
+            for (key, value) in mapping {
+                let one = Mapping::from_iter([(key.clone(), value)]);
+                if let Err(e) = serde_yaml::from_value::<Settings>(Value::Mapping(one)) {
+                    let key = key
+                        .as_str()
+                        .map_or_else(|| format!("{key:?}"), str::to_string);
+                    return SimulationError::Setting {
+                        key,
+                        message: e.to_string(),
+                    };
+                }
+            }
+            SimulationError::Invalid(e.to_string())
+        })
+    }
+
     /// These settings where given, `base`'s elsewhere: the one place settings from two sources
     /// meet, key by key, whatever the keys.
     pub fn over(self, base: Settings) -> Result<Settings, SimulationError> {
@@ -199,6 +224,24 @@ impl Settings {
     /// The simulation with its defaults, checked: the system built, the record read, the history
     /// format known, all before any simulation.
     pub fn resolve(self) -> Result<Simulation, SimulationError> {
+        self.resolve_reading(|path| match path {
+            Some(path) => ground_motion::read_record(path),
+            None => Ok(ground_motion::builtin()),
+        })
+    }
+
+    /// [`Settings::resolve`] under `record` (read once by the caller for many cases) in place of
+    /// the settings' own.
+    pub fn resolve_with(self, record: Record) -> Result<Simulation, SimulationError> {
+        self.resolve_reading(|_| Ok(record))
+    }
+
+    /// [`Settings::resolve`] with the record from `read` (given the settings' `record`), which
+    /// is asked only once every other setting has passed its checks.
+    fn resolve_reading(
+        self,
+        read: impl FnOnce(Option<&Path>) -> Result<Record, RecordError>,
+    ) -> Result<Simulation, SimulationError> {
         let physics = Physics {
             damping: self.damping.unwrap_or(Physics::DEFAULT.damping),
             basis: self.damping_basis.unwrap_or(Physics::DEFAULT.basis),
@@ -218,22 +261,9 @@ impl Settings {
             crate::store::HistoryFormat::from_path(p).map_err(|e| self.key_error(e.to_string()))?;
             crate::store::atomic::check_output_file(p)?;
         }
-        let record = match &self.record {
-            Some(path) => ground_motion::read_record(path)?,
-            None => ground_motion::builtin(),
-        };
-        let peak_g = record.pga_g() * scale;
-        if peak_g > MAX_PEAK_ACCEL_G {
-            return Err(self.key_error(format!(
-                "`record` {} peaks at {:.3e} g, times `scale` {scale} that is {peak_g:.3e} g, beyond \
-                 the {MAX_PEAK_ACCEL_G:e} g a simulation takes (its results would be round-off; \
-                 a unit or scale mistake?)",
-                self.record
-                    .as_ref()
-                    .map_or(record.name.clone(), |p| p.display().to_string()),
-                record.pga_g(),
-            )));
-        }
+        let record = read(self.record.as_deref())?;
+        let label = (self.record.as_ref()).map_or(record.name.clone(), |p| p.display().to_string());
+        check_peak(&label, &record, scale).map_err(|m| self.key_error(m))?;
         Ok(Simulation {
             record,
             scale,
@@ -318,6 +348,21 @@ impl Settings {
     }
 }
 
+/// Refuses a record (`label` in the message) whose peak times `scale` is beyond what a simulation
+/// takes ([`MAX_PEAK_ACCEL_G`]).
+fn check_peak(label: &str, record: &Record, scale: f64) -> Result<(), String> {
+    let peak_g = record.pga_g() * scale;
+    if peak_g > MAX_PEAK_ACCEL_G {
+        return Err(format!(
+            "`record` {label} peaks at {:.3e} g, times `scale` {scale} that is {peak_g:.3e} g, \
+             beyond the {MAX_PEAK_ACCEL_G:e} g a simulation takes (its results would be round-off; \
+             a unit or scale mistake?)",
+            record.pga_g(),
+        ));
+    }
+    Ok(())
+}
+
 /// The yielding model the settings ask for; `None` for the elastic structure. Each setting is
 /// refused where it does not apply, and required where it does.
 fn yielding(
@@ -392,6 +437,21 @@ impl Simulation {
             Model::OneStorey { system, .. } => Some(system),
             Model::Building { .. } => None,
         }
+    }
+
+    /// This case under `record` instead of its own, the record's peak checked as
+    /// [`Settings::resolve`] checks it.
+    pub fn with_record(&self, record: Record) -> Result<Simulation, SimulationError> {
+        check_peak(&record.name, &record, self.scale).map_err(SimulationError::Invalid)?;
+        Ok(Simulation {
+            record,
+            scale: self.scale,
+            physics: self.physics,
+            model: self.model.clone(),
+            integrator: self.integrator,
+            rk4_substeps: self.rk4_substeps,
+            history: self.history.clone(),
+        })
     }
 
     /// About how long the run takes on a machine like the project's own (docs/faults.md,

@@ -1,0 +1,209 @@
+"""simulate_many: many cases in one call equal one simulate call per case, bit for bit, whatever
+the thread count; labelled dims; bad cases named before any run; Ctrl-C within one run."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+from conftest import ROOT, interrupt_when_held
+
+import slidestack
+from slidestack._batch import _dims_of, _flatten
+
+KOBE = ROOT / "tests/fixtures/records/RSN1111_KOBE_NIS000.AT2"
+
+BUILDING = dict(
+    building={"storeys": 3, "period": 0.6, "floor_masses": [1, 1, 1],
+              "storey_stiffnesses": [3, 2, 1]},
+    stacks=[{"floor": 3, "alpha": [0.5, 0.5], "mu": [0.2, 0.1], "mu_static": [0.25, 0.1]},
+            {"floor": 1, "alpha": [1.0], "mu": [0.3]}],
+)
+
+
+def monte_carlo(n: int, seed: int = 7) -> list[dict]:
+    """The Section 7.1 structure (T_p = 1 s) with a two-block stack, μ₁, μ₂ and α drawn."""
+    rng = np.random.default_rng(seed)
+    return [dict(period=1.0, alpha=[a, a], mu=[m1, m2])
+            for a, m1, m2 in zip(rng.uniform(0.1, 1.0, n), rng.uniform(0.05, 0.4, n),
+                                 rng.uniform(0.05, 0.4, n))]
+
+
+def same(got, value) -> None:
+    """A Dataset value equals simulate's: floats bit for bit, whole numbers as int64, None as NaN
+    (numbers) or "" (strings), a list element by element with NaN beyond its length."""
+    got = np.asarray(got)
+    if value is None:
+        assert got.item() == "" if got.dtype == object else np.isnan(got).all(), got
+    elif isinstance(value, list):
+        for k, v in enumerate(value):
+            same(got[k], v)
+        assert np.isnan(got[len(value):]).all(), got
+    elif isinstance(value, float):
+        assert got.dtype == np.float64 and got.tobytes() == np.float64(value).tobytes(), (
+            got, value)
+    else:
+        assert got.item() == value, (got, value)
+
+
+def check_against_simulate(ds: xr.Dataset, cases: list[dict], records: list, one: bool) -> None:
+    for i, case in enumerate(cases):
+        for j, record in enumerate(records):
+            alone = _flatten(slidestack.simulate(**case, record=record))
+            at = ds.isel(case=i) if one else ds.isel(case=i, record=j)
+            for key, value in alone.items():
+                if key == "record":
+                    assert str(at["record"].values).startswith(value)
+                    continue
+                assert key in ds, f"simulate's `{key}` is not in the Dataset"
+                same(at[key].values, value)
+
+
+def test_a_thousand_cases_are_a_thousand_simulate_calls_on_any_thread_count():
+    cases = monte_carlo(1000)
+    loop = [slidestack.simulate(**c) for c in cases]
+    for threads in (1, 2):
+        ds = slidestack.simulate_many(cases, threads=threads)
+        assert ds.sizes["case"] == 1000 and "record" not in ds.dims
+        for key in ("peak_displacement_m", "switches", "energy_friction"):
+            want = np.array([_flatten(r)[key] for r in loop])
+            assert ds[key].values.tobytes() == want.astype(ds[key].dtype).tobytes(), key
+        for key in ("peak_slip_m", "peak_abs_accel_g"):
+            want = np.array([r[key] for r in loop])
+            assert ds[key].values.tobytes() == want.tobytes(), key
+    check_against_simulate(ds.isel(case=slice(0, 20)), cases[:20], [None], one=True)
+
+
+def test_every_key_of_a_building_case_under_two_records():
+    cases = [BUILDING, dict(BUILDING, damping=0.02, scale=1.5)]
+    accel, dt = slidestack.read_record(KOBE)
+    records = [KOBE, (accel[:800] * 2.0, dt)]
+    ds = slidestack.simulate_many(cases, records)
+    assert ds.sizes == {"case": 2, "record": 2, "floor": 3, "storey": 3, "mode": 3, "stack": 2,
+                        "block": 2, "interface": 2}
+    assert list(ds["record"].values) == [KOBE.name, "array"]
+    assert ds["stacks_peak_slip_m"].dims == ("case", "record", "stack", "interface")
+    assert ds["floor_peak_abs_accel_g"].attrs["units"] == "g"
+    check_against_simulate(ds, cases, records, one=False)
+    # The friction energy per interface, split by stack, sums to the whole.
+    total = ds["stacks_energy_friction_per_interface"].sum(["stack", "interface"])
+    np.testing.assert_allclose(total, ds["energy_friction"], rtol=1e-12)
+
+
+def test_every_list_of_simulate_has_a_dimension():
+    """Every list simulate gives (one storey, yielding, building) has as many dimensions as
+    nested levels: a new list key fails here until LIST_DIMS labels it."""
+    outs = [slidestack.simulate(), slidestack.simulate(structure="bilinear",
+                                                       yield_strength_ratio=0.1,
+                                                       post_yield_ratio=0.05),
+            slidestack.simulate(**BUILDING),
+            slidestack.simulate(**dict(BUILDING, building=dict(
+                BUILDING["building"], structure="epp", yield_strength_ratios=[0.3, 0.3, 0.3])))]
+
+    def depth(v) -> int:
+        return 1 + max([depth(x) for x in v] + [0]) if isinstance(v, list) else 0
+
+    for out in outs:
+        for key, value in _flatten(out).items():
+            if value is None:
+                continue
+            assert len(_dims_of(key, value)) == depth(value), key
+
+
+def test_stacks_of_different_sizes_are_padded_with_nan():
+    cases = [dict(alpha=[1.0], mu=[0.3]), dict(alpha=[0.3, 0.3, 0.3], mu=[0.2, 0.1, 0.05])]
+    ds = slidestack.simulate_many(cases)
+    assert ds.sizes["interface"] == 3 and ds.sizes["body"] == 4
+    assert np.isnan(ds["peak_slip_m"].values[0, 1:]).all()
+    check_against_simulate(ds, cases, [None], one=True)
+
+
+def test_a_dataframe_and_a_dataset_of_cases_are_the_list_of_dicts():
+    cases = monte_carlo(12, seed=3)
+    want = slidestack.simulate_many(cases)
+    df = pd.DataFrame({"period": [c["period"] for c in cases],
+                       "alpha": [c["alpha"] for c in cases],
+                       "mu": [c["mu"] for c in cases]})
+    xr.testing.assert_identical(slidestack.simulate_many(df), want)
+    cases_ds = xr.Dataset({"alpha": (("case", "block"), np.array([c["alpha"] for c in cases])),
+                           "mu": (("case", "interface"), np.array([c["mu"] for c in cases])),
+                           "period": 1.0})
+    xr.testing.assert_identical(slidestack.simulate_many(cases_ds), want)
+
+
+@pytest.mark.parametrize("cases, message, key", [
+    ([{}, {}, {"mu": "x"}], "case 2: invalid case: `mu`: invalid type", "cases[2].mu"),
+    ([{"mux": [0.1]}], "case 0: unknown key `mux`", None),
+    ([{}, {"period": -1.0}], "case 1: invalid case: period_s must be", "cases[1]"),
+    ([{}, BUILDING], "case 1 is a building case and case 0 a one-storey one", "cases[1]"),
+    ([{"record": str(KOBE)}], "case 0: `record` is given once for all the cases", None),
+    ([], "no case to run", "cases"),
+])
+def test_a_bad_case_is_named_before_any_run(cases, message, key):
+    with pytest.raises(ValueError) as e:
+        slidestack.simulate_many(cases)
+    assert str(e.value).startswith(message), e.value
+    assert getattr(e.value, "key", None) == key
+
+
+def test_threads_must_be_a_whole_number():
+    with pytest.raises(ValueError, match="`threads` must be a whole number ≥ 1"):
+        slidestack.simulate_many([{}], threads=0)
+
+
+def test_a_list_of_records_and_one_record():
+    ds = slidestack.simulate_many([{}], [KOBE])
+    assert ds.sizes["record"] == 1
+    one = slidestack.simulate_many([{}], KOBE)
+    assert "record" not in one.dims and str(one["record"].values) == KOBE.name
+    assert math.isclose(float(one["peak_displacement_m"][0]),
+                        float(ds["peak_displacement_m"][0, 0]), rel_tol=0, abs_tol=0)
+
+
+BATCH_SCRIPT = """
+import signal, sys, slidestack
+signal.signal(signal.SIGINT, signal.default_int_handler)
+try:
+    slidestack.simulate_many([{}] * 50, threads=1)
+except KeyboardInterrupt as e:
+    print("KeyboardInterrupt:", e, file=sys.stderr)
+    # The interpreter goes on: the next call runs to its end.
+    print(slidestack.simulate_many([{}] * 3, threads=1).sizes["case"])
+    sys.exit(3)
+print("returned")
+"""
+
+
+def test_ctrl_c_stops_simulate_many_within_one_run(tmp_path):
+    """On one thread, the built-in record's 1,999 samples pass the watch 32 times a run: held
+    at the 40th pass (the second run's 8th), SIGINT stops the batch with one run done."""
+    out, err = interrupt_when_held(BATCH_SCRIPT, [], "simulate.samples:40", tmp_path / "held")
+    assert "stopped (interrupted) with 1 of 50 runs done" in err, err
+    assert out.strip() == "3", out
+
+
+def test_spectra_of_many_records_are_each_records_spectrum():
+    kobe = slidestack.read_record(KOBE)
+    short = (kobe[0][:900] * -0.5, kobe[1])
+    ds = slidestack.spectra([KOBE, short], periods="0.1:2:0.1", damping=[0.02, 0.05])
+    assert dict(ds.sizes) == {"record": 2, "damping": 2, "period": 20}
+    assert list(ds["record"].values) == [KOBE.name, "array"]
+    assert ds["psa_g"].attrs["units"] == "g"
+    for r, (accel, dt) in enumerate([kobe, short]):
+        for z, alone in enumerate(slidestack.spectrum(accel, dt, "0.1:2:0.1", [0.02, 0.05])):
+            assert float(ds["damping"][z]) == alone["damping"]
+            for key in ("sd_m", "psv_mps", "psa_g", "peak_time_s"):
+                assert ds[key].values[r, z].tobytes() == alone[key].tobytes(), key
+            assert ds["period"].values.tobytes() == alone["periods_s"].tobytes()
+
+
+@pytest.mark.parametrize("records, message", [
+    ([], "`records` is empty"),
+    (KOBE, "`records` is a list of records"),
+])
+def test_spectra_refuse_no_records(records, message):
+    with pytest.raises(ValueError, match=message):
+        slidestack.spectra(records)
