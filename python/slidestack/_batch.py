@@ -158,6 +158,13 @@ def _array(values: List[List[Any]], dims: Tuple[str, ...], sizes: Dict[str, int]
     NaN to ``sizes``; None as NaN (numbers) or "" (strings)."""
     import numpy as np
 
+    shape = (len(values), len(values[0])) + tuple(sizes[d] for d in dims)
+    try:
+        whole = np.array(values)
+    except ValueError:  # ragged: some lists shorter
+        whole = None
+    if whole is not None and whole.shape == shape and whole.dtype in (np.float64, np.int64):
+        return whole
     leaves = []
 
     def walk(v: Any, depth: int) -> None:
@@ -170,7 +177,6 @@ def _array(values: List[List[Any]], dims: Tuple[str, ...], sizes: Dict[str, int]
     for row in values:
         for v in row:
             walk(v, 0)
-    shape = (len(values), len(values[0])) + tuple(sizes[d] for d in dims)
     present = [x for x in leaves if x is not None]
     if present and all(isinstance(x, str) for x in present):
         fill: Any = ""
@@ -217,12 +223,11 @@ def _dataset(outcomes: List[List[Dict[str, Any]]], one_record: bool) -> "xarray.
         values: List[Any] = [o.get(key) for row in flat for o in row]
         dims = _dims_of(key, next((v for v in values if v is not None), None))
         dims_of[key] = dims
-        for v in values:
-            level: List[Any] = [v]
-            for d in dims:
-                level = [x for x in level if x is not None]
-                sizes[d] = max([sizes.get(d, 0)] + [len(x) for x in level])
-                level = [y for x in level for y in x]
+        level: List[Any] = values
+        for d in dims:  # the longest list at each nesting level
+            level = [x for x in level if x is not None]
+            sizes[d] = max([sizes.get(d, 0)] + [len(x) for x in level])
+            level = [y for x in level for y in x]
     data = {}
     for key in keys:
         dims = dims_of[key]
