@@ -49,10 +49,14 @@ def same(got, value) -> None:
         assert got.item() == value, (got, value)
 
 
-def check_against_simulate(ds: xr.Dataset, cases: list[dict], records: list, one: bool) -> None:
+def check_against_simulate(ds: xr.Dataset, cases: list[dict], records: list, one: bool,
+                           done: list[dict] | None = None) -> None:
+    """Every key of simulate's dict for each case under each record (`done`: the dicts of one
+    record, already run) equals the Dataset's value."""
     for i, case in enumerate(cases):
         for j, record in enumerate(records):
-            alone = _flatten(slidestack.simulate(**case, record=record))
+            out = done[i] if done is not None else slidestack.simulate(**case, record=record)
+            alone = _flatten(out)
             at = ds.isel(case=i) if one else ds.isel(case=i, record=j)
             for key, value in alone.items():
                 if key == "record":
@@ -68,13 +72,7 @@ def test_a_thousand_cases_are_a_thousand_simulate_calls_on_any_thread_count():
     for threads in (1, 2):
         ds = slidestack.simulate_many(cases, threads=threads)
         assert ds.sizes["case"] == 1000 and "record" not in ds.dims
-        for key in ("peak_displacement_m", "switches", "energy_friction"):
-            want = np.array([_flatten(r)[key] for r in loop])
-            assert ds[key].values.tobytes() == want.astype(ds[key].dtype).tobytes(), key
-        for key in ("peak_slip_m", "peak_abs_accel_g"):
-            want = np.array([r[key] for r in loop])
-            assert ds[key].values.tobytes() == want.tobytes(), key
-    check_against_simulate(ds.isel(case=slice(0, 20)), cases[:20], [None], one=True)
+        check_against_simulate(ds, cases, [None], one=True, done=loop)
 
 
 def test_every_key_of_a_building_case_under_two_records():
