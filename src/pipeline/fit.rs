@@ -405,7 +405,7 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let repeats = repeats(&frames);
     let mut zone_data = Vec::new();
     for zc in &study.cfg.zones {
-        let t = super::tnew::read_zone(study, &zc.name)?;
+        let t = super::files::tnew_zone(study, &zc.name)?;
         let t_rigid: Vec<f64> = t.vars.t_rigid.iter().copied().collect();
         let t_new: Vec<f64> = t.vars.t_new.iter().copied().collect();
         let z = match building {

@@ -20,12 +20,9 @@ use crate::grid::BuildingAxes;
 use crate::ida::curve::{fractile, on_grid};
 use crate::ida::fragility::{FIT_STATUS_FLAGS, FitStatus, fit_lognormal};
 use crate::ida::trace::Trace;
-use crate::spectrum::TargetSpectrum;
-use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
-use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
-use crate::store::motions::read_zone_target;
+use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, write_ida};
 use crate::study::building::first_of_building;
 use crate::study::config::StudyConfig;
 use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
@@ -81,11 +78,6 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
     Some(StageId::Ida.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint])))
 }
 
-/// Every zone's target spectrum as `motions.h5` stores it: the one its motions were matched to.
-fn stored_targets(study: &Study) -> Result<Vec<TargetSpectrum>, StoreError> {
-    super::motions::read_zones(study, read_zone_target)
-}
-
 /// One unit's result.
 #[derive(Clone)]
 struct UnitOut {
@@ -94,7 +86,7 @@ struct UnitOut {
 }
 
 /// The config's `ida:` section, which the stage needs.
-fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
+pub(super) fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
     study
         .cfg
         .ida
@@ -110,9 +102,9 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let me = StageId::Ida;
     let cfg = section(study)?;
     let fp = study.fingerprint(me)?;
-    let motions = super::sweep::load_motions(study)?;
+    let motions = super::files::motions(study)?;
     let physics = study.physics();
-    let targets = stored_targets(study)?;
+    let targets = super::files::targets(study)?;
     let frames = study.frames();
     let nf = frames.len();
     // A frame that is an earlier one's building traces as it does, to the bit: only the first
@@ -373,7 +365,7 @@ fn settings_attrs<'a>(
 }
 
 /// The axes `ida.h5` has for the `ida:` section `cfg` (in a building study of `building`).
-fn axes_of(cfg: &IdaConfig, building: Option<&BuildingAxes>) -> IdaAxes {
+pub(super) fn axes_of(cfg: &IdaConfig, building: Option<&BuildingAxes>) -> IdaAxes {
     IdaAxes {
         systems: SYSTEMS.iter().map(|s| s.key().to_string()).collect(),
         case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
@@ -387,18 +379,6 @@ fn axes_of(cfg: &IdaConfig, building: Option<&BuildingAxes>) -> IdaAxes {
         fractiles: FRACTILES.to_vec(),
         building: building.cloned(),
     }
-}
-
-/// Zone `zone` of `ida.h5` (the caller has required it up to date), refused unless its axes
-/// are the ones the config's `ida:` section gives.
-fn read_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
-    let path = study.path(StageId::Ida.output());
-    let (axes, z) = read_zone_ida(&path, zone)?;
-    if axes != axes_of(section(study)?, study.building()) {
-        let why = format!("zone_{zone}: its axes differ from the config's `ida:` section");
-        return Err(StoreError::corrupt(&path, why).into());
-    }
-    Ok((axes, z))
 }
 
 fn array<T: Clone>(shape: &[usize], fill: T) -> ArrayD<T> {
@@ -564,7 +544,7 @@ pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError
     study.require(StageId::Ida)?;
     let mut rows = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = read_zone(study, &zone.name)?;
+        let (axes, z) = super::files::ida_zone(study, &zone.name)?;
         let v = &z.vars;
         let labels = frame_labels(study);
         let nf = labels.len();
@@ -652,12 +632,12 @@ fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
 pub fn median_demand(study: &Study) -> Result<Vec<MedianDemand>, PipelineError> {
     study.require(StageId::Motions)?;
     study.require(StageId::Ida)?;
-    let targets = stored_targets(study)?;
+    let targets = super::files::targets(study)?;
     let mut rows = Vec::new();
     let labels = frame_labels(study);
     let nf = labels.len();
     for (zone, target) in study.cfg.zones.iter().zip(&targets) {
-        let (axes, z) = read_zone(study, &zone.name)?;
+        let (axes, z) = super::files::ida_zone(study, &zone.name)?;
         let median = FRACTILES.iter().position(|&p| p == 0.5).unwrap_or(1);
         for cf in 0..axes.case_period_s.len() * nf {
             let c = cf / nf;
@@ -736,7 +716,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
     let d = DemandLayout::PRIMARY;
     let mut panels = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = read_zone(study, &zone.name)?;
+        let (axes, z) = super::files::ida_zone(study, &zone.name)?;
         let x = axes.sa_grid_g.clone();
         // The first case in every frame: folded index `f` (crate::store::ida).
         for (f, label) in labels.iter().enumerate() {

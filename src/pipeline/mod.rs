@@ -26,6 +26,7 @@
 //! [`Study::load`], [`Session::open`] and [`execute`]. Nothing here prints: progress goes to a
 //! [`Reporter`].
 
+pub mod files;
 pub mod fit;
 pub mod ida;
 pub mod lock;

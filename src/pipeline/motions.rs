@@ -7,9 +7,8 @@
 //! bytes the config loaded; the stage refuses a record whose bytes changed since. Each zone's
 //! target spectrum is stored in `motions.h5`, so later stages never read a table file again.
 
-use super::{PipelineError, Session, StageId, StageOutcome, Study};
+use super::{PipelineError, Session, StageId, StageOutcome};
 use crate::ground_motion::matching::MatchError;
-use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::motions::{StageMeta, write_motions};
 use crate::study::config::{Seeds, StudyConfig};
@@ -73,20 +72,6 @@ pub fn fingerprint(cfg: &StudyConfig) -> String {
         },
     });
     StageId::Motions.fingerprint(&hash_parts(&[&section.to_string(), &inputs(cfg)]))
-}
-
-/// What `read` gives for each zone of the config, in order, from `motions.h5`.
-pub fn read_zones<T>(
-    study: &Study,
-    read: impl Fn(&Path, &str) -> Result<T, StoreError>,
-) -> Result<Vec<T>, StoreError> {
-    let path = study.path(StageId::Motions.output());
-    study
-        .cfg
-        .zones
-        .iter()
-        .map(|z| read(&path, &z.name))
-        .collect()
 }
 
 /// Builds `motions.h5`.

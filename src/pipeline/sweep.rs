@@ -21,7 +21,6 @@ use crate::ground_motion::Record;
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
-use crate::store::motions::read_zone_motions;
 use crate::store::sweep::{
     BuildingVars, SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep,
 };
@@ -122,11 +121,6 @@ fn all_units(study: &Study, grid: &Grid, motions: &[Vec<Record>]) -> Vec<Unit> {
         }
     }
     v
-}
-
-/// The kept motions of every zone, from `motions.h5`.
-pub fn load_motions(study: &Study) -> Result<Vec<Vec<Record>>, StoreError> {
-    super::motions::read_zones(study, read_zone_motions)
 }
 
 struct Units<'a> {
@@ -249,7 +243,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     let me = StageId::Sweep;
     let grid = study.grid(me)?;
     let fp = study.fingerprint(me)?;
-    let motions = load_motions(study)?;
+    let motions = super::files::motions(study)?;
     let units = Units {
         study,
         grid,
@@ -365,7 +359,7 @@ pub fn merge(s: &Session) -> Result<StageOutcome, PipelineError> {
         return Ok(StageOutcome::UpToDate(study.path(me.output())));
     }
     let grid = study.grid(me)?;
-    let motions = load_motions(study)?;
+    let motions = super::files::motions(study)?;
     let units = Units {
         study,
         grid,
@@ -590,7 +584,7 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError
             0,
         ));
     }
-    let motions = load_motions(study)?;
+    let motions = super::files::motions(study)?;
     let units = Units {
         study,
         grid,

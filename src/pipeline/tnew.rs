@@ -15,17 +15,13 @@
 //!
 //! Fingerprint: the sweep's, the step of the spectrum's period grid, the methods' versions.
 
-use super::{PipelineError, Session, StageId, StageOutcome, Study};
+use super::{PipelineError, Session, StageId, StageOutcome};
 use crate::dynamics::Ground;
 use crate::grid::Grid;
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
-use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::BuildingVars;
-use crate::store::sweep::read_zone_sweep;
-use crate::store::tnew::{
-    AttachedVars, TnewMeta, TnewVars, ZoneTnew, read_zone_tnew_in, write_tnew,
-};
+use crate::store::tnew::{AttachedVars, TnewMeta, TnewVars, ZoneTnew, write_tnew};
 use crate::study::attached::{self, FRACTION_FLAGS, FractionFlag};
 use crate::study::building::Frame;
 use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
@@ -112,30 +108,12 @@ pub fn spectrum_periods_s(grid: &Grid) -> Vec<f64> {
     (1..=steps).map(|k| k as f64 * SD_STEP_S).collect()
 }
 
-/// Zone `zone` of `tnew.h5`, refused unless its grid and its spectrum's periods are the ones
-/// the config gives.
-pub fn read_zone(study: &Study, zone: &str) -> Result<ZoneTnew, PipelineError> {
-    let grid = study.grid(StageId::Tnew)?;
-    let path = study.path(StageId::Tnew.output());
-    let building = study.building();
-    let (axes, frames, t) = read_zone_tnew_in(&path, zone, grid.blocks(), building.is_some())?;
-    let why = if axes != *grid || frames.as_ref() != building {
-        "its grid differs from the config's"
-    } else if t.period_sd_s != spectrum_periods_s(grid) {
-        "its spectrum's periods differ from the config's grid"
-    } else {
-        return Ok(t);
-    };
-    Err(StoreError::corrupt(&path, format!("zone_{zone}: {why}")).into())
-}
-
 /// Builds `tnew.h5`.
 pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Tnew;
     let grid = study.grid(me)?;
-    let motions = super::sweep::load_motions(study)?;
-    let sweep_path = study.path(StageId::Sweep.output());
+    let motions = super::files::motions(study)?;
     let period_sd_s = spectrum_periods_s(grid);
     let n = grid.blocks();
     let physics = study.physics();
@@ -155,19 +133,7 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     shape.extend(grid.shape());
     let mut zones = Vec::new();
     for (z, zc) in study.cfg.zones.iter().enumerate() {
-        let (axes, stored, sw) = read_zone_sweep(&sweep_path, &zc.name, n, building.is_some())?;
-        let names: Vec<&String> = motions[z].iter().map(|r| &r.name).collect();
-        let differs = if axes != *grid || stored.as_ref() != building {
-            Some("its grid differs from the config's")
-        } else if sw.motions.iter().collect::<Vec<_>>() != names {
-            Some("its motions are not those of motions.h5")
-        } else {
-            None
-        };
-        if let Some(why) = differs {
-            let why = format!("zone_{}: {why}", zc.name);
-            return Err(StoreError::corrupt(&sweep_path, why).into());
-        }
+        let sw = super::files::sweep_zone(study, &zc.name, Some(&motions[z]))?;
         let m = sw.motions.len();
         let spectra = motions[z]
             .par_iter()

@@ -16,11 +16,11 @@
 use super::text::fixed;
 use super::{Files, Inputs, ReportError};
 use crate::grid::{BuildingAxes, StackFloor};
+use crate::pipeline::files;
 use crate::pipeline::{PipelineError, StageId};
 use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
 use crate::render::page::{Section, para, table_with_id};
 use crate::store::StoreError;
-use crate::store::sweep::read_zone_sweep;
 use crate::study::building::Frame;
 use plotters::style::RGBColor;
 
@@ -113,11 +113,7 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
     let n_max = axes.max_storeys();
     let mut out = Vec::new();
     for z in &inp.zones {
-        let (g, a, sweep) = read_zone_sweep(&path, &z.name, grid.blocks(), true)?;
-        if g != *grid || a.as_ref() != Some(axes) {
-            let why = format!("zone_{}: its grid differs from the config's", z.name);
-            return Err(StoreError::corrupt(&path, why).into());
-        }
+        let sweep = files::sweep_zone(study, &z.name, None)?;
         let Some(b) = &sweep.vars.building else {
             let why = format!("zone_{}: has no per-floor peaks", z.name);
             return Err(StoreError::corrupt(&path, why).into());

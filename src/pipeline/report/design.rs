@@ -9,10 +9,9 @@ use super::{Files, Inputs, ReportError};
 use crate::fit::extrapolation::{LOWER_T_P, UPPER_T_RIGID};
 use crate::fit::forms::DAMPING_DEPTH;
 use crate::limits::STRUCTURE_PERIOD_RANGE_S;
-use crate::pipeline::PipelineError;
+use crate::pipeline::{PipelineError, files};
 use crate::render::design::{FrameInputs, design_page};
 use crate::render::page::escape;
-use crate::store::motions::read_zone_target;
 use crate::study::design::{ZoneDesign, frame_cases, frame_designs, known_frames};
 use serde::Serialize;
 
@@ -82,7 +81,8 @@ pub(super) fn building_example(inp: &Inputs) -> Option<String> {
 /// Writes `design.html` into `files`.
 pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), PipelineError> {
     let grid = inp.grid;
-    let motions = inp.study.path("motions.h5");
+    // Each zone's stored target, in the config's order, as `inp.zones` is.
+    let targets = files::targets(inp.study)?;
     let mut zones = Vec::new();
     let mut drr = Vec::new();
     let drawn_all = |v: &ndarray::ArrayD<f64>, cases: std::ops::Range<usize>| -> Vec<f64> {
@@ -91,8 +91,7 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
             .collect()
     };
     let mut labels = Vec::new();
-    for z in &inp.zones {
-        let target = read_zone_target(&motions, &z.name)?;
+    for (z, target) in inp.zones.iter().zip(targets) {
         let v = &z.tnew.vars;
         match inp.study.building() {
             None => {

@@ -50,7 +50,7 @@ use crate::render::chart::{self, ChartError, Figure};
 use crate::render::page::{Section, document, escape, figure, list, para, table_with_id};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
-use crate::store::fit::{FitReport, FrameFit, ZoneFit, read_fit};
+use crate::store::fit::{FitReport, FrameFit, ZoneFit};
 use crate::store::motions::{ZoneSpectra, read_zone_spectra};
 use crate::store::report::write_report_dir;
 use crate::store::tnew::{ZoneTnew, read_band_flags};
@@ -156,22 +156,17 @@ impl<'a> Inputs<'a> {
     fn load(study: &'a Study) -> Result<Self, PipelineError> {
         let grid = study.grid(StageId::Report)?;
         let physics = study.physics();
-        let motions = super::sweep::load_motions(study)?;
+        let motions = super::files::motions(study)?;
         let (th5, fyaml) = (study.path("tnew.h5"), study.path("fit.yaml"));
         let n = grid.blocks();
         let fit = match study.configured(StageId::Fit) {
-            true => {
-                let fit =
-                    read_fit(&fyaml)?.ok_or_else(|| StoreError::corrupt(&fyaml, "is missing"))?;
-                fit.check_blocks(&fyaml, n)?;
-                Some(fit)
-            }
+            true => Some(super::files::fit(study)?),
             false => None,
         };
         let mut zones = Vec::new();
         for (zc, motions) in study.cfg.zones.iter().zip(motions) {
             let spectra = zone_spectra(study, &zc.name, &motions)?;
-            let tnew = super::tnew::read_zone(study, &zc.name)?;
+            let tnew = super::files::tnew_zone(study, &zc.name)?;
             let band_flags = read_band_flags(&th5, &zc.name)?;
             if !same_flags(&band_flags, BAND_FLAGS) {
                 let why = format!(
@@ -598,7 +593,7 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
 /// IDA.
 fn build_without_grid(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
-    let motions = super::sweep::load_motions(study)?;
+    let motions = super::files::motions(study)?;
     let spectra = (study.cfg.zones.iter())
         .zip(&motions)
         .map(|(zc, m)| zone_spectra(study, &zc.name, m))
