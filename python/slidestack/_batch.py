@@ -13,10 +13,11 @@ from . import _native
 if TYPE_CHECKING:
     import xarray
 
-#: The dimension of each list in ``simulate``'s dict (nested keys joined by ``_``; a building's
-#: ``stacks`` lists under ``stacks_``, with the dimension ``stack`` before this one). Every list
-#: key is here: tests/test_batch.py checks that none of ``simulate``'s keys is left out.
-LIST_DIMS: Dict[str, str] = {
+#: The dimension of each list in ``simulate``'s dict (a tuple for nested lists; nested keys
+#: joined by ``_``; a building's ``stacks`` lists under ``stacks_``, with ``stack`` before this
+#: one). Every list key is here: tests/test_batch.py checks that none of ``simulate``'s keys is
+#: left out.
+LIST_DIMS: Dict[str, Any] = {
     # one storey
     "alpha": "block",
     "mu": "interface",
@@ -46,7 +47,16 @@ LIST_DIMS: Dict[str, str] = {
     "stacks_peak_slip_m": "interface",
     "stacks_residual_slip_m": "interface",
     "stacks_peak_abs_accel_g": "block",
+    # floor response spectra (floor_spectra asked for): psa_g[damping][floor][period]; the
+    # oscillator's damping ratio is not the structure's (`damping`, a variable)
+    "floor_spectra_periods_s": "period",
+    "floor_spectra_damping": "oscillator_damping",
+    "floor_spectra_psa_g": ("oscillator_damping", "floor", "period"),
 }
+
+#: simulate's lists that label a dimension (the floor spectra's periods and damping ratios)
+#: when every run has the same.
+LABELLING = (("floor_spectra_periods_s", "period"), ("floor_spectra_damping", "oscillator_damping"))
 
 #: Units by the end of a name (the names carry them: docs/python.md).
 _UNIT_SUFFIXES = (
@@ -147,7 +157,8 @@ def _dims_of(key: str, value: Any) -> Tuple[str, ...]:
         inner = LIST_DIMS.get(key) or LIST_DIMS.get(key[len("stacks_") :])
         return ("stack",) if inner is None else ("stack", inner)
     if key in LIST_DIMS:
-        return (LIST_DIMS[key],)
+        dims = LIST_DIMS[key]
+        return dims if isinstance(dims, tuple) else (dims,)
     if isinstance(value, list):
         raise RuntimeError(f"internal: simulate's `{key}` is a list with no dimension in LIST_DIMS")
     return ()
@@ -242,6 +253,12 @@ def _dataset(outcomes: List[List[Dict[str, Any]]], one_record: bool) -> "xarray.
         # body 0 is the structure, 1… the blocks; every other dimension counts from 1 (floor 1,
         # interface 1 = structure–block 1, mode 1, …), as simulate's lists do.
         coords[d] = np.arange(n) if d == "body" else np.arange(1, n + 1)
+    # LABELLING's lists as coordinates where every run has the same; else they stay variables.
+    for key, dim in LABELLING:
+        if key in data:
+            table = data[key].values.reshape(-1, sizes[dim])
+            if (table == table[0]).all():
+                coords[dim] = xr.Variable(dim, table[0], attrs=data.pop(key).attrs)
     ds = xr.Dataset(data, coords=coords)
     if one_record:
         ds = ds.isel(record=0)

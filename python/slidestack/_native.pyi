@@ -37,6 +37,7 @@ def simulate(
     rk4_substeps: Optional[int] = None,
     building: Optional[Mapping[str, Any]] = None,
     stacks: Optional[Sequence[Mapping[str, Any]]] = None,
+    floor_spectra: Optional[Mapping[str, Any]] = None,
     history: bool = False,
     config: Optional[_Path] = None,
 ) -> Dict[str, Any]:
@@ -46,8 +47,9 @@ def simulate(
     Keywords are the case file's keys; None means the default (period 1.0 s, alpha [0.5, 0.5],
     mu [0.2, 0.1], damping 0.05 on the ``rigid`` basis, scale 1, elastic structure, exact
     integrator, the built-in Northridge record). ``record`` is a path or ``(accel_g, dt_s)``;
-    ``building``/``stacks`` take the case file's mappings; ``config`` a case file whose keys the
-    keywords override."""
+    ``building``/``stacks`` take the case file's mappings; ``floor_spectra`` (``{"periods": SPEC
+    or list, "damping": list}``) asks for each floor's response spectra; ``config`` a case file
+    whose keys the keywords override."""
 
 def simulate_many(
     cases: Sequence[Mapping[str, Any]],

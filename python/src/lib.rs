@@ -89,7 +89,7 @@ fn record_arg(obj: &Bound<'_, PyAny>) -> PyResult<RecordArg> {
     record=None, period=None, alpha=None, mu=None, mu_static=None, damping=None,
     damping_basis=None, scale=None, structure=None, yield_strength_ratio=None,
     post_yield_ratio=None, integrator=None, rk4_substeps=None, building=None, stacks=None,
-    history=false, config=None
+    floor_spectra=None, history=false, config=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
@@ -109,6 +109,7 @@ fn simulate<'py>(
     rk4_substeps: Option<&Bound<'py, PyAny>>,
     building: Option<&Bound<'py, PyAny>>,
     stacks: Option<&Bound<'py, PyAny>>,
+    floor_spectra: Option<&Bound<'py, PyAny>>,
     history: bool,
     config: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
@@ -128,6 +129,7 @@ fn simulate<'py>(
         rk4_substeps,
         building,
         stacks,
+        floor_spectra,
     ];
     let given = CASE_KEYS.into_iter().zip(values);
     let mut mapping = case_mapping(given.filter_map(|(k, v)| Some((k, v?))))?;
@@ -191,7 +193,7 @@ fn simulate<'py>(
 }
 
 /// The keywords of `simulate` that are a case's keys (`record`, `history` and `config` are not).
-const CASE_KEYS: [&str; 14] = [
+const CASE_KEYS: [&str; 15] = [
     "period",
     "alpha",
     "mu",
@@ -206,6 +208,7 @@ const CASE_KEYS: [&str; 14] = [
     "rk4_substeps",
     "building",
     "stacks",
+    "floor_spectra",
 ];
 
 /// A case's keywords (None values left out: the default applies) as the mapping of a case file.

@@ -12,7 +12,7 @@ import xarray as xr
 from conftest import ROOT, interrupt_when_held
 
 import slidestack
-from slidestack._batch import _dims_of, _flatten
+from slidestack._batch import LABELLING, _dims_of, _flatten
 
 KOBE = ROOT / "tests/fixtures/records/RSN1111_KOBE_NIS000.AT2"
 
@@ -49,6 +49,9 @@ def same(got, value) -> None:
         assert got.item() == value, (got, value)
 
 
+LABELS = dict(LABELLING)
+
+
 def check_against_simulate(ds: xr.Dataset, cases: list[dict], records: list, one: bool,
                            done: list[dict] | None = None) -> None:
     """Every key of simulate's dict for each case under each record (`done`: the dicts of one
@@ -62,6 +65,7 @@ def check_against_simulate(ds: xr.Dataset, cases: list[dict], records: list, one
                 if key == "record":
                     assert str(at["record"].values).startswith(value)
                     continue
+                key = LABELS.get(key, key) if key not in ds else key
                 assert key in ds, f"simulate's `{key}` is not in the Dataset"
                 same(at[key].values, value)
 
@@ -205,3 +209,16 @@ def test_spectra_of_many_records_are_each_records_spectrum():
 def test_spectra_refuse_no_records(records, message):
     with pytest.raises(ValueError, match=message):
         slidestack.spectra(records)
+
+
+def test_floor_spectra_of_many_cases_are_each_cases():
+    """A building case and its variants with floor_spectra: psa_g over (case,
+    oscillator_damping, floor, period), the periods and damping ratios as coordinates, every
+    value simulate's."""
+    fs = {"periods": [0.1, 0.3, 1.0], "damping": [0.02, 0.05]}
+    cases = [dict(BUILDING, floor_spectra=fs), dict(BUILDING, damping=0.03, floor_spectra=fs)]
+    ds = slidestack.simulate_many(cases)
+    assert ds["floor_spectra_psa_g"].dims == ("case", "oscillator_damping", "floor", "period")
+    assert list(ds["period"].values) == [0.1, 0.3, 1.0]
+    assert list(ds["oscillator_damping"].values) == [0.02, 0.05]
+    check_against_simulate(ds, cases, [None], one=True)

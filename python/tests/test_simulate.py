@@ -69,6 +69,18 @@ def test_building_case_equals_the_cli(cli):
     assert slidestack.simulate(config=ROOT / "configs/building.yaml") == want
 
 
+def test_floor_spectra_equal_the_cli(cli, tmp_path):
+    """`floor_spectra` as a keyword and as a case file's key: the CLI's numbers."""
+    case = tmp_path / "case.yaml"
+    case.write_text((ROOT / "configs/building.yaml").read_text()
+                    + "\nfloor_spectra: {periods: \"0.1:1:0.3\", damping: [0.05]}\n")
+    want = cli_json(cli, "simulate", "--config", str(case))
+    got = slidestack.simulate(scale=1.5, building=BUILDING, stacks=STACKS,
+                              floor_spectra={"periods": "0.1:1:0.3", "damping": [0.05]})
+    assert got == want
+    assert len(got["floor_spectra"]["psa_g"][0]) == 3  # floors
+
+
 def test_rk4_equals_the_cli(cli):
     want = cli_json(cli, "simulate", "--integrator", "rk4", "--rk4-substeps", "4")
     assert slidestack.simulate(integrator="rk4", rk4_substeps=4) == want

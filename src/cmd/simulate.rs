@@ -10,6 +10,7 @@
 
 use anyhow::Result;
 use slidestack::simulation::building::{BuildingSummary, history_layout};
+use slidestack::simulation::floor_spectra::FloorSpectra;
 use slidestack::simulation::{Model, Outcome, Settings, Summary};
 use slidestack::store::{HistoryLayout, write_history};
 use std::path::PathBuf;
@@ -138,9 +139,18 @@ pub fn run(args: Args) -> Result<()> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
-        match &outcome {
-            Outcome::OneStorey(s) => print_table(s),
-            Outcome::Building(b) => print_building(b),
+        let floor_spectra = match &outcome {
+            Outcome::OneStorey(s) => {
+                print_table(s);
+                &s.floor_spectra
+            }
+            Outcome::Building(b) => {
+                print_building(b);
+                &b.floor_spectra
+            }
+        };
+        if let Some(fs) = floor_spectra {
+            print_floor_spectra(fs);
         }
         if let Some(p) = &sim.history {
             println!("history written to {}", p.display());
@@ -150,6 +160,22 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Each floor's largest spectral acceleration and its period, per damping ratio (the spectra
+/// themselves: `--json`).
+fn print_floor_spectra(fs: &FloorSpectra) {
+    for (z, floors) in fs.damping.iter().zip(&fs.psa_g) {
+        let peaks: Vec<String> = (floors.iter().enumerate())
+            .map(|(j, psa)| {
+                let (k, top) = (psa.iter().enumerate()).fold((0, f64::MIN), |(bk, b), (k, &x)| {
+                    if x > b { (k, x) } else { (bk, b) }
+                });
+                format!("floor {} {top:.4} g at {} s", j + 1, fs.periods_s[k])
+            })
+            .collect();
+        println!("floor spectra     ζ {z}: largest PSA {}", peaks.join(", "));
+    }
 }
 
 fn print_building(o: &BuildingSummary) {

@@ -331,6 +331,9 @@ pub struct BuildingSummary {
     pub energy: Energy,
     pub energy_balance_error: f64,
     pub energy_balance_error_max: f64,
+    /// Each floor's response spectra (`floor_spectra:` asked for them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub floor_spectra: Option<super::floor_spectra::FloorSpectra>,
 }
 
 /// The summary of a run of `b`.
@@ -410,6 +413,7 @@ pub fn building_summary(
         energy: e.clone(),
         energy_balance_error: e.balance_error(),
         energy_balance_error_max: r.energy_balance_error_max,
+        floor_spectra: None,
     }
 }
 

@@ -7,6 +7,7 @@
 
 pub mod batch;
 pub mod building;
+pub mod floor_spectra;
 
 use crate::dynamics::building::Building;
 use crate::dynamics::{
@@ -127,6 +128,11 @@ pub struct Settings {
     #[arg(skip)]
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stacks: Option<Vec<building::StackSettings>>,
+    /// Each floor's response spectra (case files only; docs/model.md, "Floor response
+    /// spectra"): `periods` (the `--periods` syntax or a list, s) and `damping` (a list).
+    #[arg(skip)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floor_spectra: Option<floor_spectra::FloorSpectraSettings>,
     /// The case file these settings were read from, for messages.
     #[arg(skip)]
     #[serde(skip)]
@@ -261,6 +267,10 @@ impl Settings {
             crate::store::HistoryFormat::from_path(p).map_err(|e| self.key_error(e.to_string()))?;
             crate::store::atomic::check_output_file(p)?;
         }
+        let floor_spectra = (self.floor_spectra.as_ref())
+            .map(floor_spectra::FloorSpectraSettings::resolve)
+            .transpose()
+            .map_err(|m| self.key_error(m))?;
         let record = read(self.record.as_deref())?;
         let label = (self.record.as_ref()).map_or(record.name.clone(), |p| p.display().to_string());
         check_peak(&label, &record, scale).map_err(|m| self.key_error(m))?;
@@ -272,6 +282,7 @@ impl Settings {
             integrator: self.integrator.unwrap_or(Integrator::Exact),
             rk4_substeps: self.rk4_substeps.unwrap_or(10),
             history: self.history,
+            floor_spectra,
         })
     }
 
@@ -428,6 +439,8 @@ pub struct Simulation {
     pub rk4_substeps: usize,
     /// Where the time history goes, if asked for.
     pub history: Option<PathBuf>,
+    /// The floor response spectra asked for.
+    pub floor_spectra: Option<floor_spectra::FloorSpectraSpec>,
 }
 
 impl Simulation {
@@ -451,6 +464,7 @@ impl Simulation {
             integrator: self.integrator,
             rk4_substeps: self.rk4_substeps,
             history: self.history.clone(),
+            floor_spectra: self.floor_spectra.clone(),
         })
     }
 
@@ -480,7 +494,12 @@ impl Simulation {
                 }
             }
         };
-        samples * per_sample_s
+        // Floor spectra: the case again on its record refined REFINEMENT times.
+        let runs = match self.floor_spectra {
+            Some(_) => 1.0 + floor_spectra::REFINEMENT as f64,
+            None => 1.0,
+        };
+        runs * samples * per_sample_s
     }
 
     /// The record scaled, in m/s².
@@ -552,7 +571,8 @@ impl Simulation {
                     }
                 }
                 .map_err(failed)?;
-                let summary = self.summary(system, *structure, &response);
+                let mut summary = self.summary(system, *structure, &response);
+                summary.floor_spectra = self.floor_spectra_of(watch)?;
                 Ok((Outcome::OneStorey(Box::new(summary)), response.history))
             }
             Model::Building { building, settings } => {
@@ -570,6 +590,10 @@ impl Simulation {
                     (self.integrator, self.rk4_substeps),
                     &r,
                 );
+                let summary = building::BuildingSummary {
+                    floor_spectra: self.floor_spectra_of(watch)?,
+                    ..summary
+                };
                 Ok((Outcome::Building(Box::new(summary)), r.history.take()))
             }
         }
@@ -624,6 +648,16 @@ impl Simulation {
         })
     }
 
+    /// The floor response spectra, when the case asks for them.
+    fn floor_spectra_of(
+        &self,
+        watch: &dyn Watch,
+    ) -> Result<Option<floor_spectra::FloorSpectra>, SimulationError> {
+        (self.floor_spectra.as_ref())
+            .map(|spec| floor_spectra::floor_spectra(self, spec, floor_spectra::REFINEMENT, watch))
+            .transpose()
+    }
+
     fn summary(&self, sys: &System, structure: StructureKind, r: &Response) -> Summary {
         let e = &r.energy;
         let hyst = sys.hysteresis();
@@ -662,6 +696,7 @@ impl Simulation {
             energy: e.clone(),
             energy_balance_error: e.balance_error(),
             energy_balance_error_max: r.energy_balance_error_max,
+            floor_spectra: None,
         }
     }
 }
@@ -708,6 +743,9 @@ pub struct Summary {
     pub energy: Energy,
     pub energy_balance_error: f64,
     pub energy_balance_error_max: f64,
+    /// The structure's response spectra (`floor_spectra:` asked for them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub floor_spectra: Option<floor_spectra::FloorSpectra>,
 }
 
 impl std::str::FromStr for Integrator {

@@ -89,11 +89,11 @@ impl Rng {
 
 type M4 = [[f64; 4]; 4];
 
-fn mat_mul(a: &M4, b: &M4) -> M4 {
-    let mut c = [[0.0; 4]; 4];
-    for i in 0..4 {
-        for k in 0..4 {
-            for j in 0..4 {
+fn mat_mul<const N: usize>(a: &[[f64; N]; N], b: &[[f64; N]; N]) -> [[f64; N]; N] {
+    let mut c = [[0.0; N]; N];
+    for i in 0..N {
+        for k in 0..N {
+            for j in 0..N {
                 c[i][j] += a[i][k] * b[k][j];
             }
         }
@@ -102,7 +102,7 @@ fn mat_mul(a: &M4, b: &M4) -> M4 {
 }
 
 /// `exp(A·t)` by scaling and squaring of a 30-term Taylor series.
-fn expm(a: &M4, t: f64) -> M4 {
+pub fn expm<const N: usize>(a: &[[f64; N]; N], t: f64) -> [[f64; N]; N] {
     let norm = a
         .iter()
         .flatten()
@@ -113,9 +113,9 @@ fn expm(a: &M4, t: f64) -> M4 {
         s += 1;
     }
     let scale = t / 2f64.powi(s);
-    let mut term = [[0.0; 4]; 4];
-    let mut sum = [[0.0; 4]; 4];
-    for i in 0..4 {
+    let mut term = [[0.0; N]; N];
+    let mut sum = [[0.0; N]; N];
+    for i in 0..N {
         term[i][i] = 1.0;
         sum[i][i] = 1.0;
     }
@@ -127,8 +127,8 @@ fn expm(a: &M4, t: f64) -> M4 {
             }
         }
         term = mat_mul(&term, &as_);
-        for i in 0..4 {
-            for j in 0..4 {
+        for i in 0..N {
+            for j in 0..N {
                 sum[i][j] += term[i][j];
             }
         }
@@ -139,10 +139,10 @@ fn expm(a: &M4, t: f64) -> M4 {
     sum
 }
 
-fn apply(m: &M4, y: [f64; 4]) -> [f64; 4] {
-    let mut out = [0.0; 4];
-    for i in 0..4 {
-        out[i] = (0..4).map(|j| m[i][j] * y[j]).sum();
+pub fn apply<const N: usize>(m: &[[f64; N]; N], y: [f64; N]) -> [f64; N] {
+    let mut out = [0.0; N];
+    for i in 0..N {
+        out[i] = (0..N).map(|j| m[i][j] * y[j]).sum();
     }
     out
 }
