@@ -155,12 +155,82 @@ fn bad_ida_keys_are_refused_naming_the_file_and_key_before_any_work() {
         assert!(err.contains(s(&cfg)) && err.contains(key), "{to}: {err}");
         assert!(!out.exists(), "{to}: work started");
     }
+    // `cases: grid` without a grid, and with a grid of more cases than an IDA takes.
+    let listed = "cases:\n    - { period_s: 1.0, alpha: [0.5, 0.5], mu: [0.2, 0.1] }";
+    let big_grid = "grid:\n  period_s: [0.5, 1.0]\n  alpha: [[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, \
+                    0.8, 0.9, 1.0], [0.5]]\n  mu: [[0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, \
+                    0.45, 0.5], [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]]\n";
+    for (i, (extra, says)) in [
+        ("", "and the config has none"),
+        (
+            big_grid,
+            "the grid has 1200 cases; an IDA takes at most 1000",
+        ),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let cfg = dir.path().join(format!("grid{i}.yaml"));
+        let out = dir.path().join(format!("grid-out{i}"));
+        std::fs::write(&cfg, text.replacen(listed, "cases: grid", 1) + extra).unwrap();
+        let o = slidestack(&["ida", s(&cfg), "--out", s(&out)], "1");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains("ida.cases") && err.contains(says), "{err}");
+        assert!(!out.exists(), "work started");
+    }
     // Without an `ida` section: refused, naming the file.
     let cfg = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
     let out = dir.path().join("none");
     let o = slidestack(&["ida", s(&cfg), "--out", s(&out)], "1");
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("needs an `ida` section"));
+}
+
+/// `ida.cases: grid` traces every case of the grid, in its stored order: `ida.h5` holds the
+/// same axes and numbers, zone by zone, as from a file listing those cases, and the same
+/// fingerprint (the section serialises as the list).
+#[test]
+fn cases_grid_traces_every_case_of_the_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(quick()).unwrap();
+    let listed = "cases:\n    - { period_s: 1.0, alpha: [0.5, 0.5], mu: [0.2, 0.1] }";
+    assert!(text.contains(listed));
+    let grid = "grid:\n  period_s: [0.6, 1.0]\n  alpha: [[0.5], [0.5]]\n  mu: [[0.2], [0.1, 0.15]]\n  \
+                damping: 0.05\n  damping_basis: rigid\n";
+    let cases: String = [0.6, 1.0]
+        .iter()
+        .flat_map(|t| {
+            [0.1, 0.15].map(|m2| {
+                format!("\n    - {{ period_s: {t}, alpha: [0.5, 0.5], mu: [0.2, {m2}] }}")
+            })
+        })
+        .collect();
+    let outs: Vec<PathBuf> = [format!("cases:{cases}"), "cases: grid".to_string()]
+        .iter()
+        .enumerate()
+        .map(|(i, ida_cases)| {
+            let cfg = dir.path().join(format!("c{i}.yaml"));
+            let out = dir.path().join(format!("o{i}"));
+            std::fs::write(&cfg, text.replacen(listed, ida_cases, 1) + grid).unwrap();
+            ok(slidestack(&["motions", s(&cfg), "--out", s(&out)], "2"));
+            ok(slidestack(&["ida", s(&cfg), "--out", s(&out)], "2"));
+            out
+        })
+        .collect();
+    let fingerprint = |o: &Path| slidestack::store::h5::stored_fingerprint(&o.join("ida.h5"));
+    assert_eq!(
+        fingerprint(&outs[0]).unwrap(),
+        fingerprint(&outs[1]).unwrap()
+    );
+    for zone in ["III", "V"] {
+        let read = |o: &Path| slidestack::store::ida::read_zone_ida(&o.join("ida.h5"), zone);
+        let (listed, gridded) = (read(&outs[0]).unwrap(), read(&outs[1]).unwrap());
+        assert_eq!(listed.0.case_period_s.len(), 4);
+        // Compared as their Debug text: shortest round-trip numbers, and NaN (a trace's unused
+        // runs) equal to NaN.
+        assert_eq!(format!("{listed:?}"), format!("{gridded:?}"), "zone {zone}");
+    }
 }
 
 /// Hunt & fill on a bare bilinear SDOF: `λ·a_g` on `F_y` gives `λ` times the displacements of

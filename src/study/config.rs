@@ -614,6 +614,14 @@ impl StudyConfig {
         {
             *other = base.join(&*other);
         }
+        if let Some(ida) = cfg.ida.as_mut().filter(|ida| ida.cases.from_grid) {
+            let Some(g) = &cfg.grid else {
+                let why = "`grid` takes every case of the `grid` section, and the config has none";
+                return Err(invalid("ida.cases".into(), why.into()));
+            };
+            validate_grid(g).map_err(|(key, why)| invalid(key, why))?;
+            (ida.cases.expand(&g.axes())).map_err(|why| invalid("ida.cases".into(), why))?;
+        }
         cfg.validate().map_err(|(key, why)| invalid(key, why))?;
         if let Some(r) = &cfg.motions.seeds.records {
             for f in &r.files {

@@ -26,6 +26,7 @@ use crate::dynamics::building::{
 use crate::dynamics::{
     ExactOptions, G, Ground, ModelError, SimError, System, Yielding, simulate_exact,
 };
+use crate::grid::Grid;
 use crate::ida::trace::{HuntFill, Trace, hunt_fill};
 use crate::limits::{
     MAX_ALPHA, MAX_BLOCKS, MAX_IDA_CASES, MAX_IDA_GRID_POINTS, MAX_IDA_PAD_S, MAX_IDA_TRACE_RUNS,
@@ -42,8 +43,8 @@ use thiserror::Error;
 pub struct IdaConfig {
     pub structure: StructureConfig,
     /// The cases traced, each under every motion of every zone (static friction =
-    /// `grid.mu_static_ratio` × kinetic).
-    pub cases: Vec<Case>,
+    /// `grid.mu_static_ratio` × kinetic): a list, or `grid` for every case of the study's grid.
+    pub cases: IdaCases,
     /// Hunt & fill (Vamvatsikos & Cornell 2002), intensities `Sa(T_p, 5 %)` in g.
     pub tracing: HuntFill,
     /// The common intensity grid: `grid_points` equal steps from 0 to `tracing.cap_sa_g`
@@ -63,6 +64,68 @@ pub struct IdaConfig {
     /// Zeros appended to every record so the residual drift is read near rest, s.
     #[serde(default)]
     pub pad_s: f64,
+}
+
+/// `ida.cases`: the cases as a list. A file may write `grid` instead: every case of the study's
+/// grid, in its stored order ([`Grid::case`]), put in the list when the config is read
+/// ([`IdaCases::expand`]), so the stage, its file and its fingerprint see the same list as a
+/// file that writes those cases out (it serialises as the list).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct IdaCases {
+    pub list: Vec<Case>,
+    /// The file wrote `grid`.
+    pub from_grid: bool,
+}
+
+/// The word a file writes for every case of the grid.
+pub const GRID_CASES: &str = "grid";
+
+impl IdaCases {
+    /// The list of `grid`'s cases when the file wrote `grid`; refused above [`MAX_IDA_CASES`].
+    pub fn expand(&mut self, grid: &Grid) -> Result<(), String> {
+        if self.from_grid {
+            if grid.cases() > MAX_IDA_CASES {
+                return Err(format!(
+                    "`{GRID_CASES}`: the grid has {} cases; an IDA takes at most {MAX_IDA_CASES}",
+                    grid.cases()
+                ));
+            }
+            self.list = (0..grid.cases()).map(|i| grid.case(i)).collect();
+        }
+        Ok(())
+    }
+}
+
+impl std::ops::Deref for IdaCases {
+    type Target = Vec<Case>;
+    fn deref(&self) -> &Vec<Case> {
+        &self.list
+    }
+}
+
+impl Serialize for IdaCases {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.list.serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for IdaCases {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        match serde_yaml::Value::deserialize(d)? {
+            serde_yaml::Value::String(w) if w == GRID_CASES => Ok(IdaCases {
+                list: Vec::new(),
+                from_grid: true,
+            }),
+            serde_yaml::Value::String(w) => Err(D::Error::custom(format!(
+                "`{w}`: give a list of cases or `{GRID_CASES}` (every case of the grid)"
+            ))),
+            v => Ok(IdaCases {
+                list: serde_yaml::from_value(v).map_err(D::Error::custom)?,
+                from_grid: false,
+            }),
+        }
+    }
 }
 
 /// The yielding structure: a strength stated directly or from the IS 1893 design force.
