@@ -179,6 +179,16 @@ fn bad_ida_keys_are_refused_naming_the_file_and_key_before_any_work() {
         assert!(err.contains("ida.cases") && err.contains(says), "{err}");
         assert!(!out.exists(), "work started");
     }
+    // A word other than `grid`: refused at the line of the `ida` section.
+    let cfg = dir.path().join("word.yaml");
+    std::fs::write(&cfg, text.replacen(listed, "cases: all", 1)).unwrap();
+    let o = slidestack(&["ida", s(&cfg), "--out", s(&dir.path().join("word"))], "1");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("`all`: give a list of cases or `grid`"),
+        "{err}"
+    );
     // Without an `ida` section: refused, naming the file.
     let cfg = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml");
     let out = dir.path().join("none");

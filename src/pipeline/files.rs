@@ -1,6 +1,7 @@
-//! The stage files as the stages and the report read them: one reader per file kind, each
+//! The stage files as the later stages and the report read them: one reader per file kind, each
 //! refusing as damaged a file whose axes are not the config's, so that no stage reads another
-//! stage's file with checks of its own. (The store layer, [`crate::store`], reads a file by its
+//! stage's file with checks of its own (`ida.h5`, which only its own stage reads for the report,
+//! is read in [`super::ida`]). It imports no stage. (The store layer, [`crate::store`], reads a file by its
 //! path; this layer knows the study it must belong to.)
 
 use super::{PipelineError, StageId, Study};
@@ -8,10 +9,10 @@ use crate::ground_motion::Record;
 use crate::spectrum::TargetSpectrum;
 use crate::store::StoreError;
 use crate::store::fit::{FitReport, read_fit};
-use crate::store::ida::{IdaAxes, ZoneIda, read_zone_ida};
 use crate::store::motions::{read_zone_motions, read_zone_target};
 use crate::store::sweep::{ZoneSweep, read_zone_sweep};
 use crate::store::tnew::{ZoneTnew, read_zone_tnew_in};
+use crate::study::tnew::spectrum_periods_s;
 use std::path::Path;
 
 /// What `read` gives for each zone of the config, in order, from `motions.h5`.
@@ -66,7 +67,7 @@ pub fn tnew_zone(study: &Study, zone: &str) -> Result<ZoneTnew, PipelineError> {
     let (axes, frames, t) = read_zone_tnew_in(&path, zone, grid.blocks(), building.is_some())?;
     let why = if axes != *grid || frames.as_ref() != building {
         "its grid differs from the config's"
-    } else if t.period_sd_s != super::tnew::spectrum_periods_s(grid) {
+    } else if t.period_sd_s != spectrum_periods_s(grid) {
         "its spectrum's periods differ from the config's grid"
     } else {
         return Ok(t);
@@ -80,16 +81,4 @@ pub fn fit(study: &Study) -> Result<FitReport, PipelineError> {
     let fit = read_fit(&path)?.ok_or_else(|| StoreError::corrupt(&path, "is missing"))?;
     fit.check_blocks(&path, study.grid(StageId::Fit)?.blocks())?;
     Ok(fit)
-}
-
-/// Zone `zone` of `ida.h5`, refused unless its axes are the ones the config's `ida:` section
-/// gives.
-pub fn ida_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
-    let path = study.path(StageId::Ida.output());
-    let (axes, z) = read_zone_ida(&path, zone)?;
-    if axes != super::ida::axes_of(super::ida::section(study)?, study.building()) {
-        let why = format!("zone_{zone}: its axes differ from the config's `ida:` section");
-        return Err(StoreError::corrupt(&path, why).into());
-    }
-    Ok((axes, z))
 }

@@ -20,9 +20,10 @@ use crate::grid::BuildingAxes;
 use crate::ida::curve::{fractile, on_grid};
 use crate::ida::fragility::{FIT_STATUS_FLAGS, FitStatus, fit_lognormal};
 use crate::ida::trace::Trace;
+use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
-use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, write_ida};
+use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
 use crate::study::building::first_of_building;
 use crate::study::config::StudyConfig;
 use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
@@ -86,7 +87,7 @@ struct UnitOut {
 }
 
 /// The config's `ida:` section, which the stage needs.
-pub(super) fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
+fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
     study
         .cfg
         .ida
@@ -365,7 +366,7 @@ fn settings_attrs<'a>(
 }
 
 /// The axes `ida.h5` has for the `ida:` section `cfg` (in a building study of `building`).
-pub(super) fn axes_of(cfg: &IdaConfig, building: Option<&BuildingAxes>) -> IdaAxes {
+fn axes_of(cfg: &IdaConfig, building: Option<&BuildingAxes>) -> IdaAxes {
     IdaAxes {
         systems: SYSTEMS.iter().map(|s| s.key().to_string()).collect(),
         case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
@@ -379,6 +380,18 @@ pub(super) fn axes_of(cfg: &IdaConfig, building: Option<&BuildingAxes>) -> IdaAx
         fractiles: FRACTILES.to_vec(),
         building: building.cloned(),
     }
+}
+
+/// Zone `zone` of `ida.h5` (the caller has required it up to date), refused unless its axes
+/// are the ones the config's `ida:` section gives.
+fn read_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
+    let path = study.path(StageId::Ida.output());
+    let (axes, z) = read_zone_ida(&path, zone)?;
+    if axes != axes_of(section(study)?, study.building()) {
+        let why = format!("zone_{zone}: its axes differ from the config's `ida:` section");
+        return Err(StoreError::corrupt(&path, why).into());
+    }
+    Ok((axes, z))
 }
 
 fn array<T: Clone>(shape: &[usize], fill: T) -> ArrayD<T> {
@@ -544,7 +557,7 @@ pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError
     study.require(StageId::Ida)?;
     let mut rows = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = super::files::ida_zone(study, &zone.name)?;
+        let (axes, z) = read_zone(study, &zone.name)?;
         let v = &z.vars;
         let labels = frame_labels(study);
         let nf = labels.len();
@@ -637,7 +650,7 @@ pub fn median_demand(study: &Study) -> Result<Vec<MedianDemand>, PipelineError> 
     let labels = frame_labels(study);
     let nf = labels.len();
     for (zone, target) in study.cfg.zones.iter().zip(&targets) {
-        let (axes, z) = super::files::ida_zone(study, &zone.name)?;
+        let (axes, z) = read_zone(study, &zone.name)?;
         let median = FRACTILES.iter().position(|&p| p == 0.5).unwrap_or(1);
         for cf in 0..axes.case_period_s.len() * nf {
             let c = cf / nf;
@@ -716,7 +729,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
     let d = DemandLayout::PRIMARY;
     let mut panels = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = super::files::ida_zone(study, &zone.name)?;
+        let (axes, z) = read_zone(study, &zone.name)?;
         let x = axes.sa_grid_g.clone();
         // The first case in every frame: folded index `f` (crate::store::ida).
         for (f, label) in labels.iter().enumerate() {

@@ -17,20 +17,18 @@
 
 use super::{PipelineError, Session, StageId, StageOutcome};
 use crate::dynamics::Ground;
-use crate::grid::Grid;
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::sweep::BuildingVars;
 use crate::store::tnew::{AttachedVars, TnewMeta, TnewVars, ZoneTnew, write_tnew};
 use crate::study::attached::{self, FRACTION_FLAGS, FractionFlag};
 use crate::study::building::Frame;
-use crate::study::tnew::{self, BAND_FLAGS, Band, BandCounts, TNEW_FLAG_CODES};
+use crate::study::tnew::{
+    self, BAND_FLAGS, Band, BandCounts, SD_STEP_S, TNEW_FLAG_CODES, spectrum_periods_s,
+};
 use ndarray::{ArrayD, Axis};
 use rayon::prelude::*;
 use thiserror::Error;
-
-/// Step of the period grid of the mean displacement spectrum, s.
-pub const SD_STEP_S: f64 = 0.005;
 
 #[derive(Debug, Error)]
 pub enum TnewError {
@@ -92,20 +90,6 @@ fn swept(
 pub fn fingerprint(sweep_fingerprint: &str) -> String {
     let step = format!("sd_step_s={SD_STEP_S}");
     StageId::Tnew.fingerprint(&hash_parts(&[sweep_fingerprint, &step]))
-}
-
-/// The periods of the mean displacement spectrum: they reach past every `T_rigid` of the grid
-/// (in a building too: a load of at most `α` times each floor's mass lengthens the first mode
-/// by at most `sqrt(1+α)`, Rayleigh's quotient).
-pub fn spectrum_periods_s(grid: &Grid) -> Vec<f64> {
-    let alpha_max: f64 = grid
-        .alpha
-        .iter()
-        .map(|a| a.iter().copied().fold(0.0, f64::max))
-        .sum();
-    let t_max = grid.periods_s.last().copied().unwrap_or(1.0) * (1.0 + alpha_max).sqrt() * 1.5;
-    let steps = (t_max.max(4.0) / SD_STEP_S).ceil() as usize;
-    (1..=steps).map(|k| k as f64 * SD_STEP_S).collect()
 }
 
 /// Builds `tnew.h5`.

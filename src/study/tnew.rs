@@ -17,6 +17,23 @@ use crate::grid::Grid;
 use crate::study::attached::FractionFlag;
 use crate::study::building::Frame;
 
+/// Step of the period grid of the mean displacement spectrum, s.
+pub const SD_STEP_S: f64 = 0.005;
+
+/// The periods of the mean displacement spectrum: they reach past every `T_rigid` of the grid
+/// (in a building too: a load of at most `α` times each floor's mass lengthens the first mode
+/// by at most `sqrt(1+α)`, Rayleigh's quotient).
+pub fn spectrum_periods_s(grid: &Grid) -> Vec<f64> {
+    let alpha_max: f64 = grid
+        .alpha
+        .iter()
+        .map(|a| a.iter().copied().fold(0.0, f64::max))
+        .sum();
+    let t_max = grid.periods_s.last().copied().unwrap_or(1.0) * (1.0 + alpha_max).sqrt() * 1.5;
+    let steps = (t_max.max(4.0) / SD_STEP_S).ceil() as usize;
+    (1..=steps).map(|k| k as f64 * SD_STEP_S).collect()
+}
+
 /// The fit's samples: every case of `grid` (flat over `[T_p][case]`) with a finite `T_new`,
 /// features `(T_p, μ_1 … μ_n, α_1 … α_n)`.
 pub fn samples(grid: &Grid, t_rigid_s: &[f64], t_new_s: &[f64]) -> Vec<Sample> {
