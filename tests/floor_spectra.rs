@@ -150,6 +150,21 @@ fn bad_floor_spectra_are_refused_naming_the_key() {
         let e = s.resolve().unwrap_err().to_string();
         assert!(e.contains(says), "{bad}: {e}");
     }
+    // A record whose history refined 64 times has too short a step for the spectrum: refused
+    // before any run.
+    let dir = tempfile::tempdir().unwrap();
+    let fine = dir.path().join("fine.txt");
+    let rows: String = (0..200)
+        .map(|k| format!("{} {}\n", k as f64 * 2e-4, 0.1))
+        .collect();
+    std::fs::write(&fine, rows).unwrap();
+    let s: Settings = serde_yaml::from_str(&format!(
+        "record: {}\nfloor_spectra: {{damping: [0.05]}}",
+        fine.display()
+    ))
+    .unwrap();
+    let e = s.resolve().unwrap_err().to_string();
+    assert!(e.contains("the record refined 64 times has"), "{e}");
     let unknown = serde_yaml::from_str::<Settings>("floor_spectra: {period: [1.0]}");
     assert!(
         unknown

@@ -16,6 +16,7 @@
 use super::{Simulation, SimulationError};
 use crate::dynamics::Watch;
 use crate::ground_motion::Record;
+use crate::limits::{DT_RANGE_S, MAX_SAMPLES};
 use crate::spectrum::{parse_periods, response_spectrum};
 use serde::{Deserialize, Serialize};
 
@@ -93,6 +94,21 @@ pub struct FloorSpectra {
     pub psa_g: Vec<Vec<Vec<f64>>>,
     /// Samples of the history per record step ([`REFINEMENT`]).
     pub refinement: usize,
+}
+
+/// Refuses a record whose refined history the spectrum cannot take (too many samples, too short
+/// a step: [`crate::limits`]), before any run.
+pub fn check_record(record: &Record, refinement: usize) -> Result<(), String> {
+    let samples = (record.accel_g.len().saturating_sub(1)).saturating_mul(refinement) + 1;
+    let dt_s = record.dt_s / refinement as f64;
+    if samples > MAX_SAMPLES || dt_s < DT_RANGE_S.0 {
+        return Err(format!(
+            "`floor_spectra`: the record refined {refinement} times has {samples} samples {dt_s:e} s \
+             apart; the spectrum takes at most {MAX_SAMPLES} samples at least {:e} s apart",
+            DT_RANGE_S.0
+        ));
+    }
+    Ok(())
 }
 
 /// `record` linearly interpolated to `1/refinement` of its step: the same piecewise-linear
