@@ -110,7 +110,8 @@ def _case_dicts(cases: Any) -> List[Dict[str, Any]]:
     a list value's trailing NaN are left off (cases with fewer blocks than others)."""
     if hasattr(cases, "columns") and hasattr(cases, "to_dict"):
         rows = cases.to_dict("records")
-        return [{k: _plain(v) for k, v in row.items() if not _missing(_plain(v))} for row in rows]
+        plain = [{k: _plain(v) for k, v in row.items()} for row in rows]
+        return [{k: v for k, v in row.items() if not _missing(v)} for row in plain]
     if hasattr(cases, "data_vars") and hasattr(cases, "sizes"):
         if "case" not in cases.sizes:
             raise ValueError("a Dataset of cases needs the dimension `case`")

@@ -6,11 +6,11 @@
 use crate::convert::{json_to_py, warn};
 use crate::errors::{internal, to_py_err};
 use crate::interrupt::on_worker;
-use crate::{CASE_KEYS, Cancel, RecordArg, base_settings, case_mapping, record_arg};
+use crate::{CASE_KEYS, Cancel, base_settings, case_mapping, record_of};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use slidestack::ground_motion::{Record, builtin, read_record};
+use slidestack::ground_motion::{Record, builtin};
 use slidestack::simulation::Settings;
 use slidestack::simulation::batch::{Batch, BatchError};
 use std::path::PathBuf;
@@ -72,13 +72,7 @@ pub fn records(py: Python<'_>, given: Option<&Bound<'_, PyList>>) -> PyResult<Ve
     let Some(given) = given else {
         return Ok(vec![builtin()]);
     };
-    given
-        .iter()
-        .map(|r| match record_arg(&r)? {
-            RecordArg::Path(p) => py.detach(|| read_record(&p)).map_err(|e| to_py_err(&e)),
-            RecordArg::Samples(r) => Ok(r),
-        })
-        .collect()
+    given.iter().map(|r| record_of(py, &r)).collect()
 }
 
 /// Every case under every record: `simulate`'s dicts, a list per case of one per record.

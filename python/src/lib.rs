@@ -31,7 +31,7 @@ use slidestack::ground_motion::spectra::{ductility_spectra, response_spectra};
 use slidestack::ground_motion::{ReadOptions, Record, Units, read_record_with};
 use slidestack::simulation::building::history_layout;
 use slidestack::simulation::{Model, Settings, SimulationError};
-use slidestack::spectrum::{TargetSpectrum, parse_periods};
+use slidestack::spectrum::{TargetSpectrum, parse_periods, periods_from_list};
 use slidestack::store::HistoryLayout;
 use slidestack::study::design::Query;
 use std::path::PathBuf;
@@ -81,6 +81,16 @@ fn record_arg(obj: &Bound<'_, PyAny>) -> PyResult<RecordArg> {
     Record::from_samples(ARRAY_RECORD, dt_s, accel_g)
         .map(RecordArg::Samples)
         .map_err(|e| to_py_err(&e))
+}
+
+/// A record argument as a record: a path read (as `simulate` reads its `record`), or the samples.
+fn record_of(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Record> {
+    match record_arg(obj)? {
+        RecordArg::Path(p) => py
+            .detach(|| read_record_with(&p, &ReadOptions::default()))
+            .map_err(|e| to_py_err(&e)),
+        RecordArg::Samples(r) => Ok(r),
+    }
 }
 
 /// One case under one ground motion: the dict `slidestack simulate --json` prints.
@@ -293,15 +303,11 @@ fn read_record<'py>(
 /// Periods as `parse_periods` reads them: a SPEC string, or numbers written back in shortest
 /// round-trip form (so the same checks apply and the values are the given ones).
 fn periods_arg(obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-    let spec = match obj.extract::<String>() {
-        Ok(s) => s,
-        Err(_) => convert::float_vec(obj, "periods")?
-            .iter()
-            .map(f64::to_string)
-            .collect::<Vec<_>>()
-            .join(","),
-    };
-    parse_periods(&spec).map_err(|e| to_py_err(&e))
+    match obj.extract::<String>() {
+        Ok(s) => parse_periods(&s),
+        Err(_) => periods_from_list(&convert::float_vec(obj, "periods")?),
+    }
+    .map_err(|e| to_py_err(&e))
 }
 
 /// Floats from a number or a sequence, and whether it was one number.
@@ -411,12 +417,7 @@ fn match_<'py>(
     target: &str,
     settings: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let rec = match record_arg(record)? {
-        RecordArg::Path(p) => py
-            .detach(|| read_record_with(&p, &ReadOptions::default()))
-            .map_err(|e| to_py_err(&e))?,
-        RecordArg::Samples(r) => r,
-    };
+    let rec = record_of(py, record)?;
     let spec: TargetSpectrum = target
         .parse()
         .map_err(|e| PyValueError::new_err(format!("invalid `target` `{target}`: {e}")))?;

@@ -17,7 +17,7 @@ use super::{Simulation, SimulationError};
 use crate::dynamics::Watch;
 use crate::ground_motion::Record;
 use crate::limits::{DT_RANGE_S, MAX_SAMPLES};
-use crate::spectrum::{parse_periods, response_spectrum};
+use crate::spectrum::{parse_periods, periods_from_list, response_spectrum};
 use serde::{Deserialize, Serialize};
 
 /// Samples of the refined record per record step.
@@ -60,16 +60,12 @@ impl FloorSpectraSettings {
     /// The periods parsed and every damping ratio checked (`0 ≤ ζ < 1`); a message naming the
     /// key otherwise.
     pub fn resolve(&self) -> Result<FloorSpectraSpec, String> {
-        let text = match &self.periods {
-            None => DEFAULT_PERIODS.to_string(),
-            Some(Periods::Spec(s)) => s.clone(),
-            Some(Periods::List(v)) => {
-                let v: Vec<String> = v.iter().map(f64::to_string).collect();
-                v.join(",")
-            }
-        };
-        let periods_s =
-            parse_periods(&text).map_err(|e| format!("`floor_spectra.periods`: {e}"))?;
+        let periods_s = match &self.periods {
+            None => parse_periods(DEFAULT_PERIODS),
+            Some(Periods::Spec(s)) => parse_periods(s),
+            Some(Periods::List(v)) => periods_from_list(v),
+        }
+        .map_err(|e| format!("`floor_spectra.periods`: {e}"))?;
         let damping = self.damping.clone().unwrap_or(DEFAULT_DAMPING.to_vec());
         if damping.is_empty() {
             return Err("`floor_spectra.damping` is empty: give at least one ratio".into());

@@ -581,7 +581,7 @@ impl Simulation {
             }
             Model::Building { building, settings } => {
                 let mut r = self.run_building(building, accel_mps2, history, watch)?;
-                let summary = building::building_summary(
+                let mut summary = building::building_summary(
                     building,
                     settings,
                     (
@@ -594,10 +594,7 @@ impl Simulation {
                     (self.integrator, self.rk4_substeps),
                     &r,
                 );
-                let summary = building::BuildingSummary {
-                    floor_spectra: self.floor_spectra_of(watch)?,
-                    ..summary
-                };
+                summary.floor_spectra = self.floor_spectra_of(watch)?;
                 Ok((Outcome::Building(Box::new(summary)), r.history.take()))
             }
         }

@@ -11,6 +11,6 @@ pub mod periods;
 pub mod response;
 pub mod target;
 
-pub use periods::{PeriodsError, log_space, parse_periods};
+pub use periods::{PeriodsError, log_space, parse_periods, periods_from_list};
 pub use response::{Peak, ResponseSpectrum, SpectrumError, peak_response, response_spectrum};
 pub use target::{TARGET_DAMPING, TargetError, TargetSpectrum};

@@ -21,6 +21,14 @@ pub fn log_space(lo: f64, hi: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Periods given as numbers (a case file's list, a Python sequence), checked as [`parse_periods`]
+/// checks a list: each written back in shortest round-trip form, so the values are the given
+/// ones.
+pub fn periods_from_list(values: &[f64]) -> Result<Vec<f64>, PeriodsError> {
+    let text: Vec<String> = values.iter().map(f64::to_string).collect();
+    parse_periods(&text.join(","))
+}
+
 /// Parses a period list (module doc): at most [`MAX_PERIODS`] periods, each within
 /// [`PERIOD_RANGE_S`], counted before anything is allocated.
 pub fn parse_periods(text: &str) -> Result<Vec<f64>, PeriodsError> {
