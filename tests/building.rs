@@ -22,6 +22,7 @@ fn stack(floor: usize, alpha: &[f64], mu: &[f64], mu_static: Option<&[f64]>) -> 
         alpha: alpha.to_vec(),
         mu: mu.to_vec(),
         mu_static: mu_static.map(<[f64]>::to_vec),
+        aspect: None,
     }
 }
 

@@ -340,6 +340,29 @@ fn bad_building_input_is_refused_naming_the_file_and_key() {
             format!("{good_building}{good_stack}period: 1.0\n"),
             "period (a key or flag of a one-storey case) does not apply",
         ),
+        (
+            format!(
+                "{good_building}stacks:\n  - floor: 2\n    alpha: [0.5, 0.5]\n    mu: [0.2, 0.1]\n    \
+                 aspect: [0.5]\n"
+            ),
+            "stacks[0].aspect lists 1 values but the stack has 2 blocks",
+        ),
+        (
+            format!("{good_building}{good_stack}    aspect: [0]\n"),
+            "stacks[0].aspect[0] (width over height of the block) must be finite and > 0, got 0.0",
+        ),
+        (
+            format!("{good_building}{good_stack}    aspect: [-1]\n"),
+            "stacks[0].aspect[0] (width over height of the block) must be finite and > 0",
+        ),
+        (
+            format!("{good_building}{good_stack}    aspect: [.nan]\n"),
+            "stacks[0].aspect[0] (width over height of the block) must be finite and > 0, got NaN",
+        ),
+        (
+            format!("{good_building}{good_stack}aspect: [0.5]\n"),
+            "aspect (a key or flag of a one-storey case) does not apply",
+        ),
         (good_stack.to_string(), "`stacks` needs `building`"),
         (
             format!("{good_building}  floors: 3\n"),

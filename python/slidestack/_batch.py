@@ -47,12 +47,18 @@ LIST_DIMS: Dict[str, Any] = {
     "stacks_peak_slip_m": "interface",
     "stacks_residual_slip_m": "interface",
     "stacks_peak_abs_accel_g": "block",
+    # the rocking check (aspect given): a ratio per block
+    "aspect": "block",
     # floor response spectra (floor_spectra asked for): psa_g[damping][floor][period]; the
     # oscillator's damping ratio is not the structure's (`damping`, a variable)
     "floor_spectra_periods_s": "period",
     "floor_spectra_damping": "oscillator_damping",
     "floor_spectra_psa_g": ("oscillator_damping", "floor", "period"),
 }
+
+#: simulate's mappings that may be null (``rocking_onset``: null when the stack never rocks),
+#: with their fields: flattened to one variable per field, NaN where null.
+NULLABLE: Dict[str, Tuple[str, ...]] = {"rocking_onset": ("block", "time_s")}
 
 #: simulate's lists that label a dimension (the floor spectra's periods and damping ratios)
 #: when every run has the same.
@@ -135,12 +141,22 @@ def _flatten(d: Dict[str, Any]) -> Dict[str, Any]:
     split by stack."""
     flat: Dict[str, Any] = {}
     for key, value in d.items():
-        if isinstance(value, dict):
+        if key in NULLABLE:
+            for f in NULLABLE[key]:
+                flat[f"{key}_{f}"] = None if value is None else value[f]
+        elif isinstance(value, dict):
             for k, v in _flatten(value).items():
                 flat[f"{key}_{k}"] = v
         elif key == "stacks":
-            for k in value[0] if value else ():
-                flat[f"stacks_{k}"] = [s[k] for s in value]
+            keys = [k for s in value for k in s]
+            for k in dict.fromkeys(keys):  # every stack's keys, in order
+                if k in NULLABLE:
+                    for f in NULLABLE[k]:
+                        flat[f"stacks_{k}_{f}"] = [
+                            None if s.get(k) is None else s[k][f] for s in value
+                        ]
+                else:
+                    flat[f"stacks_{k}"] = [s.get(k) for s in value]
         else:
             flat[key] = value
     if "stacks_mu" in flat:

@@ -33,6 +33,7 @@ def simulate(
     structure: Optional[str] = None,
     yield_strength_ratio: Optional[float] = None,
     post_yield_ratio: Optional[float] = None,
+    aspect: Optional[_Floats] = None,
     integrator: Optional[str] = None,
     rk4_substeps: Optional[int] = None,
     building: Optional[Mapping[str, Any]] = None,
@@ -47,7 +48,8 @@ def simulate(
     Keywords are the case file's keys; None means the default (period 1.0 s, alpha [0.5, 0.5],
     mu [0.2, 0.1], damping 0.05 on the ``rigid`` basis, scale 1, elastic structure, exact
     integrator, the built-in Northridge record). ``record`` is a path or ``(accel_g, dt_s)``;
-    ``building``/``stacks`` take the case file's mappings; ``floor_spectra`` (``{"periods": SPEC
+    ``building``/``stacks`` take the case file's mappings; ``aspect`` (width over height per block,
+    bottom first) asks for the rocking check (``rocking_onset``); ``floor_spectra`` (``{"periods": SPEC
     or list, "damping": list}``) asks for each floor's response spectra; ``config`` a case file
     whose keys the keywords override."""
 

@@ -98,8 +98,8 @@ fn record_of(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Record> {
 #[pyo3(signature = (
     record=None, period=None, alpha=None, mu=None, mu_static=None, damping=None,
     damping_basis=None, scale=None, structure=None, yield_strength_ratio=None,
-    post_yield_ratio=None, integrator=None, rk4_substeps=None, building=None, stacks=None,
-    floor_spectra=None, history=false, config=None
+    post_yield_ratio=None, aspect=None, integrator=None, rk4_substeps=None, building=None,
+    stacks=None, floor_spectra=None, history=false, config=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
@@ -115,6 +115,7 @@ fn simulate<'py>(
     structure: Option<&Bound<'py, PyAny>>,
     yield_strength_ratio: Option<&Bound<'py, PyAny>>,
     post_yield_ratio: Option<&Bound<'py, PyAny>>,
+    aspect: Option<&Bound<'py, PyAny>>,
     integrator: Option<&Bound<'py, PyAny>>,
     rk4_substeps: Option<&Bound<'py, PyAny>>,
     building: Option<&Bound<'py, PyAny>>,
@@ -135,6 +136,7 @@ fn simulate<'py>(
         structure,
         yield_strength_ratio,
         post_yield_ratio,
+        aspect,
         integrator,
         rk4_substeps,
         building,
@@ -203,7 +205,7 @@ fn simulate<'py>(
 }
 
 /// The keywords of `simulate` that are a case's keys (`record`, `history` and `config` are not).
-const CASE_KEYS: [&str; 15] = [
+const CASE_KEYS: [&str; 16] = [
     "period",
     "alpha",
     "mu",
@@ -214,6 +216,7 @@ const CASE_KEYS: [&str; 15] = [
     "structure",
     "yield_strength_ratio",
     "post_yield_ratio",
+    "aspect",
     "integrator",
     "rk4_substeps",
     "building",

@@ -103,7 +103,9 @@ def test_every_list_of_simulate_has_a_dimension():
                                                        post_yield_ratio=0.05),
             slidestack.simulate(**BUILDING),
             slidestack.simulate(**dict(BUILDING, building=dict(
-                BUILDING["building"], structure="epp", yield_strength_ratios=[0.3, 0.3, 0.3])))]
+                BUILDING["building"], structure="epp", yield_strength_ratios=[0.3, 0.3, 0.3]))),
+            slidestack.simulate(aspect=[0.5, 0.15]),
+            slidestack.simulate(**ROCKING_BUILDING)]
 
     def depth(v) -> int:
         return 1 + max([depth(x) for x in v] + [0]) if isinstance(v, list) else 0
@@ -113,6 +115,29 @@ def test_every_list_of_simulate_has_a_dimension():
             if value is None:
                 continue
             assert len(_dims_of(key, value)) == depth(value), key
+
+
+ROCKING_BUILDING = dict(BUILDING, stacks=[dict(BUILDING["stacks"][0], aspect=[0.5, 0.05]),
+                                          BUILDING["stacks"][1]])
+
+
+def test_the_rocking_onset_is_a_variable_per_field_nan_where_a_stack_never_rocks():
+    """`rocking_onset` (null, or {block, time_s}) as `rocking_onset_block` and
+    `rocking_onset_time_s`: NaN for a stack that never rocks, or one not checked."""
+    cases = [dict(alpha=[0.5, 0.5], mu=[0.3, 0.2], aspect=[0.5, 0.15]),
+             dict(alpha=[0.5, 0.5], mu=[0.3, 0.2], aspect=[1.0, 1.0]),
+             dict(alpha=[0.5, 0.5], mu=[0.3, 0.2])]
+    ds = slidestack.simulate_many(cases)
+    assert ds["aspect"].dims == ("case", "block")
+    block = ds["rocking_onset_block"].values
+    assert block[0] == 2 and np.isnan(block[1:]).all()
+    assert ds["rocking_onset_time_s"].attrs["units"] == "s"
+    check_against_simulate(ds, cases, [None], one=True)
+    ds = slidestack.simulate_many([ROCKING_BUILDING, BUILDING])
+    assert ds["stacks_rocking_onset_block"].dims == ("case", "stack")
+    onset = ds["stacks_rocking_onset_block"].values
+    assert onset[0, 0] == 2 and np.isnan(onset[0, 1]) and np.isnan(onset[1]).all()
+    check_against_simulate(ds, [ROCKING_BUILDING, BUILDING], [None], one=True)
 
 
 def test_stacks_of_different_sizes_are_padded_with_nan():

@@ -44,8 +44,9 @@ use super::closed_form::{
     Basis, Osc, PieceIntegrals, Wave, integral_of_square_decay, integral_of_square_with,
 };
 use super::contact::{Contact, ContactSelector, Contacts, switch_contacts};
-use super::model::System;
+use super::model::{G, System};
 use super::response::{Energy, History, Response};
+use super::rocking::{self, RockingOnset};
 use super::search::{self, Node, Smooth};
 use super::{Ground, SimError};
 use crate::sdof::{self, Piece, decay_piece};
@@ -1102,7 +1103,48 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             let p = &mut self.out.peak_abs_accel_mps2[j];
             *p = p.max(a);
         }
+        self.rocking(t_start, b)?;
         self.settle(ga, slope, b);
+        Ok(())
+    }
+
+    /// The first rocking onset in the piece ending at `b` (starting at `t_start`, s), while
+    /// none is known: per interface `i`, `g = g_n ∓ Σ_j w_ij·a_j ≥ 0` (docs/model.md, "Rocking:
+    /// when a case leaves the model"), the blocks of the structure's cluster moving with its
+    /// acceleration wave, the others with their clusters' constant ones.
+    fn rocking(&mut self, t_start: f64, b: &Basis) -> Result<(), search::SearchError> {
+        let Some(rocking) = self.sys.rocking() else {
+            return Ok(());
+        };
+        if self.out.rocking_onset.is_some() {
+            return Ok(());
+        }
+        let (osc, top) = (self.osc(), self.top[0]);
+        let mut found = None;
+        for i in 0..rocking.blocks() {
+            let (mut on_wave, mut constant) = (0.0, 0.0);
+            for (k, w) in rocking.weights(i).iter().enumerate() {
+                let body = i + 1 + k;
+                if body <= top {
+                    on_wave += w;
+                } else {
+                    constant += w * self.accel_free[self.cluster_of[body]];
+                }
+            }
+            for sign in [1.0, -1.0] {
+                let g = self.a0.affine(-sign * on_wave, G - sign * constant);
+                let at =
+                    search::first_violation(&g.over(osc), &g.start(), &g.node(osc, *b), self.dt)?;
+                found = rocking::earlier(
+                    found,
+                    at.map(|t| RockingOnset {
+                        block: i + 1,
+                        time_s: t_start + t,
+                    }),
+                );
+            }
+        }
+        self.out.rocking_onset = found;
         Ok(())
     }
 

@@ -46,6 +46,7 @@ pub mod exact;
 pub mod model;
 pub mod response;
 pub mod rk4;
+pub mod rocking;
 pub(crate) mod search;
 
 pub use contact::{Contact, ContactSelector};
@@ -53,6 +54,7 @@ pub use exact::{ExactOptions, simulate_exact, simulate_exact_watched};
 pub use model::{DampingBasis, G, Hysteresis, ModelError, System, SystemSpec, Yielding};
 pub use response::{Energy, History, Response};
 pub use rk4::{simulate_rk4, simulate_rk4_watched};
+pub use rocking::{Rocking, RockingOnset};
 pub use search::SearchError;
 
 use crate::limits::{

@@ -88,6 +88,10 @@ pub enum ModelError {
         value: f64,
         kinetic: f64,
     },
+    #[error(
+        "aspect_{index} (width over height of block {index}) must be finite and > 0, got {value}"
+    )]
+    Aspect { index: usize, value: f64 },
     #[error("{what} lists {got} values but the stack has {expected} blocks (one per interface)")]
     Count {
         what: &'static str,
@@ -221,6 +225,8 @@ pub struct System {
     damping: f64,
     /// The bilinear restoring force; `None` for the linear structure.
     hysteresis: Option<Hysteresis>,
+    /// The rocking check of the stack ([`System::with_aspect`]); `None`: not checked.
+    rocking: Option<Box<super::Rocking>>,
 }
 
 /// What a user states about a system; [`System::new`] validates it.
@@ -347,7 +353,20 @@ impl System {
             stiffness,
             damping,
             hysteresis: None,
+            rocking: None,
         })
+    }
+
+    /// The same system with its blocks' width-to-height ratios (bottom first), so that a run
+    /// reports when the stack would start to rock ([`super::rocking`]).
+    pub fn with_aspect(mut self, aspect: &[f64]) -> Result<Self, ModelError> {
+        self.rocking = Some(Box::new(super::Rocking::new(&self.masses[1..], aspect)?));
+        Ok(self)
+    }
+
+    /// The rocking check, when the blocks' ratios are given.
+    pub fn rocking(&self) -> Option<&super::Rocking> {
+        self.rocking.as_deref()
     }
 
     /// The same system on a yielding structure (docs/model.md, "Yielding structure"). Refuses a

@@ -167,6 +167,9 @@ pub struct Response {
     pub energy: Energy,
     /// Largest `|residual(t)| / max_{s≤t} input(s)` over the record samples.
     pub energy_balance_error_max: f64,
+    /// Where and when the stack would first start to rock (the system's blocks' ratios
+    /// given, [`super::System::with_aspect`]); `None` when it never does or is not checked.
+    pub rocking_onset: Option<super::RockingOnset>,
     pub history: Option<History>,
 }
 

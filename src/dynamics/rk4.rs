@@ -30,6 +30,7 @@
 use super::contact::Contact;
 use super::model::{Hysteresis, System};
 use super::response::{Energy, History, Response};
+use super::rocking::RockingOnset;
 use super::{Ground, SimError};
 use crate::limits::{MAX_RK4_SUBSTEPS, RK4_MAX_OMEGA_STEP};
 
@@ -316,6 +317,16 @@ impl<'s> Rk4<'s> {
                 }
                 let ag = |stage_frac: f64| ag_at(k, frac0 + stage_frac / substeps as f64);
                 self.step(h, ag, &mut stages, &mut out.peak_abs_accel_mps2);
+                // Rocking, checked at the sub-steps' starts.
+                if let Some(r) = self.sys.rocking()
+                    && out.rocking_onset.is_none()
+                    && let Some(i) = r.rocking_interface(&stages.abs_start[1..])
+                {
+                    out.rocking_onset = Some(RockingOnset {
+                        block: i + 1,
+                        time_s: t,
+                    });
+                }
                 self.after_step(h, t, &s_before, &mut out);
             }
             let mut e = self.energy.clone();
@@ -386,6 +397,7 @@ impl<'s> Rk4<'s> {
                 for j in 0..nb {
                     peak_abs_accel_mps2[j] = peak_abs_accel_mps2[j].max(st.abs[j].abs());
                 }
+                st.abs_start.copy_from_slice(&st.abs);
             }
             self.rates(&st.xs, &st.vs, ag, &mut st.ke[s]);
         }
@@ -457,6 +469,8 @@ struct Stages {
     xs: Vec<f64>,
     vs: Vec<f64>,
     abs: Vec<f64>,
+    /// The absolute accelerations at the step's start, m/s².
+    abs_start: Vec<f64>,
 }
 
 impl Stages {
@@ -469,6 +483,7 @@ impl Stages {
             xs: vec![0.0; bodies],
             vs: vec![0.0; bodies],
             abs: vec![0.0; bodies],
+            abs_start: vec![0.0; bodies],
         }
     }
 }

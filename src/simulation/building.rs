@@ -8,8 +8,8 @@ use crate::dynamics::building::{
     simulate_building_rk4_watched, simulate_building_watched,
 };
 use crate::dynamics::{
-    DampingBasis, Energy, ExactOptions, G, Ground, History, Watch, simulate_exact_watched,
-    simulate_rk4_watched,
+    DampingBasis, Energy, ExactOptions, G, Ground, History, RockingOnset, Watch,
+    simulate_exact_watched, simulate_rk4_watched,
 };
 use crate::limits::MAX_STOREYS;
 use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
@@ -121,6 +121,10 @@ pub struct StackSettings {
     /// Static friction [default: equal to `mu`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mu_static: Option<Vec<f64>>,
+    /// Width over height of each block, bottom first: asks for the rocking check
+    /// (docs/model.md, "Rocking: when a case leaves the model") [default: not checked].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aspect: Option<Vec<f64>>,
 }
 
 /// Resolves the building keys; `Err` names the key (the caller adds the file).
@@ -212,6 +216,7 @@ pub fn building_spec(
                 alpha: s.alpha.clone(),
                 mu: s.mu.clone(),
                 mu_static: s.mu_static.clone(),
+                aspect: s.aspect.clone(),
             })
         })
         .collect::<Result<Vec<_>, String>>()?;
@@ -294,6 +299,13 @@ pub struct StackSummary {
     pub residual_slip_m: Vec<f64>,
     /// Blocks bottom-up, g.
     pub peak_abs_accel_g: Vec<f64>,
+    /// Width over height per block, as given (absent: rocking not checked).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub aspect: Option<Vec<f64>>,
+    /// With `aspect`: `null`, or the block (1 = bottom) whose base the stack would first rock on,
+    /// and when (docs/model.md, "Rocking: when a case leaves the model").
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rocking_onset: Option<Option<RockingOnset>>,
 }
 
 /// What one building simulation gives: the `simulate --json` contract for a case with
@@ -352,7 +364,8 @@ pub fn building_summary(
         .stacks()
         .iter()
         .zip(&spec.stacks)
-        .map(|(s, st)| {
+        .enumerate()
+        .map(|(si, (s, st))| {
             let range = s.first..s.first + s.blocks;
             StackSummary {
                 floor: st.floor,
@@ -365,6 +378,8 @@ pub fn building_summary(
                     .iter()
                     .map(|a| a / G)
                     .collect(),
+                aspect: st.aspect.clone(),
+                rocking_onset: st.aspect.as_ref().map(|_| r.rocking_onset[si]),
             }
         })
         .collect();

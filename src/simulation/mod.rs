@@ -11,8 +11,8 @@ pub mod floor_spectra;
 
 use crate::dynamics::building::Building;
 use crate::dynamics::{
-    Energy, ExactOptions, G, Ground, History, Response, SimError, System, SystemSpec, Unwatched,
-    Watch, Yielding, simulate_exact_watched, simulate_rk4_watched,
+    Energy, ExactOptions, G, Ground, History, Response, RockingOnset, SimError, System, SystemSpec,
+    Unwatched, Watch, Yielding, simulate_exact_watched, simulate_rk4_watched,
 };
 use crate::ground_motion::{self, Record, RecordError};
 use crate::limits::MAX_PEAK_ACCEL_G;
@@ -114,6 +114,10 @@ pub struct Settings {
     /// Post-yield stiffness over elastic stiffness r (0 ≤ r < 1) of a bilinear structure.
     #[arg(long)]
     pub post_yield_ratio: Option<f64>,
+    /// Width over height of each block, bottom first: reports when the stack would start to
+    /// rock (docs/model.md, "Rocking: when a case leaves the model") [default: not checked].
+    #[arg(long, value_delimiter = ',', num_args = 1..)]
+    pub aspect: Option<Vec<f64>>,
     /// Write the time history to this .h5 or .csv file.
     #[arg(long)]
     pub history: Option<PathBuf>,
@@ -316,6 +320,11 @@ impl Settings {
                 .with_yielding(y)
                 .map_err(|e| SimulationError::Invalid(e.to_string()))?;
         }
+        if let Some(a) = &self.aspect {
+            system = system
+                .with_aspect(a)
+                .map_err(|e| SimulationError::Invalid(e.to_string()))?;
+        }
         Ok(Model::OneStorey { system, structure })
     }
 
@@ -345,6 +354,7 @@ impl Settings {
             ("structure", self.structure.is_some()),
             ("yield_strength_ratio", self.yield_strength_ratio.is_some()),
             ("post_yield_ratio", self.post_yield_ratio.is_some()),
+            ("aspect", self.aspect.is_some()),
         ];
         if let Some((key, _)) = one_storey_keys.iter().find(|(_, given)| *given) {
             return Err(self.key_error(format!(
@@ -697,6 +707,8 @@ impl Simulation {
             energy: e.clone(),
             energy_balance_error: e.balance_error(),
             energy_balance_error_max: r.energy_balance_error_max,
+            aspect: sys.rocking().map(|r| r.aspect().to_vec()),
+            rocking_onset: sys.rocking().map(|_| r.rocking_onset),
             floor_spectra: None,
         }
     }
@@ -744,6 +756,13 @@ pub struct Summary {
     pub energy: Energy,
     pub energy_balance_error: f64,
     pub energy_balance_error_max: f64,
+    /// Width over height per block, as given (absent: rocking not checked).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub aspect: Option<Vec<f64>>,
+    /// With `aspect`: `null`, or the block (1 = bottom) whose base the stack would first rock
+    /// on, and when (docs/model.md, "Rocking: when a case leaves the model").
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rocking_onset: Option<Option<RockingOnset>>,
     /// The structure's response spectra (`floor_spectra:` asked for them).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub floor_spectra: Option<floor_spectra::FloorSpectra>,
@@ -806,7 +825,7 @@ mod tests {
         let yaml = "record: r.AT2\nperiod: 2.0\nalpha: [1.0]\nmu: [0.3]\nmu_static: [0.4]\n\
                     damping: 0.02\ndamping_basis: structure\nscale: 2.0\nintegrator: rk4\n\
                     rk4_substeps: 20\nstructure: bilinear\nyield_strength_ratio: 0.3\n\
-                    post_yield_ratio: 0.05\nhistory: h.csv\n\
+                    post_yield_ratio: 0.05\naspect: [0.4]\nhistory: h.csv\n\
                     building: {storeys: 2, period: 0.5}\n\
                     stacks: [{floor: roof, alpha: [1.0], mu: [0.2]}]\n";
         let file: Settings = serde_yaml::from_str(yaml).unwrap();

@@ -791,7 +791,7 @@ mod tests {
              limit_states: [{ name: LS, drift_ratio: 0.01 }]\n",
         )
         .unwrap();
-        let mut r = BuildingResponse::zeroed(2, 4);
+        let mut r = BuildingResponse::zeroed(2, 4, 1);
         r.storey_peak_drift_m = vec![0.066, 0.04]; // 0.022 and 0.01 of the heights
         r.storey_residual_drift_m = vec![-0.003, 0.008]; // 0.001 and 0.002
         r.floor_peak_abs_accel_mps2 = vec![G, 2.5 * G];

@@ -264,6 +264,7 @@ impl Physics {
                 alpha: alpha.to_vec(),
                 mu: mu.to_vec(),
                 mu_static: Some(mu.iter().map(|m| m * self.mu_static_ratio).collect()),
+                aspect: None,
             })
             .collect();
         let b = Building::new(&spec)?;

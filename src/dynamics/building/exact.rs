@@ -26,7 +26,9 @@
 
 use super::super::contact::{Contact, ContactSelector, Contacts, switch_contacts};
 use super::super::exact::{BREAK_TOLERANCE, ExactOptions};
+use super::super::model::G;
 use super::super::response::{Energy, History};
+use super::super::rocking::{self, RockingOnset};
 use super::super::search::{self, Node};
 use super::super::{Ground, SimError, Unwatched, Watch, watched};
 use super::modal::{ModalError, ModalFn, ModalPoint, Piece, StateModes, mode_terms};
@@ -438,7 +440,7 @@ impl<'b> Integrator<'b> {
                 }
             })
             .collect();
-        let out = BuildingResponse::zeroed(n, nb);
+        let out = BuildingResponse::zeroed(n, nb, b.stacks().len());
         Self {
             b,
             dt,
@@ -549,6 +551,8 @@ impl<'b> Integrator<'b> {
                 if end != h {
                     self.p_end.at(&mode.modes, &self.piece, end);
                 }
+                self.rocking(&mode, t0 + tau, end)
+                    .map_err(|source| SimError::Search { time_s: t0, source })?;
                 self.advance(&mode, ga, slope, end)
                     .map_err(|source| SimError::Search { time_s: t0, source })?;
                 let Some((_, e)) = first else {
@@ -584,6 +588,64 @@ impl<'b> Integrator<'b> {
             }
         }
         self.finish(history)
+    }
+
+    /// The first rocking onset of each checked stack in the piece `[0, end]` (starting at
+    /// `t_start`, s; `self.p_end` at `end`), while none is known: per interface `i`,
+    /// `g = g_n ∓ Σ_j w_ij·a_j ≥ 0` (docs/model.md, "Rocking: when a case leaves the model"),
+    /// the blocks stuck to the floor moving with its acceleration, the others with their free
+    /// clusters' constant ones.
+    fn rocking(&mut self, mode: &Mode, t_start: f64, end: f64) -> Result<(), search::SearchError> {
+        let b = self.b;
+        for (si, s) in b.stacks().iter().enumerate() {
+            let Some(rocking) = &s.rocking else {
+                continue;
+            };
+            if self.out.rocking_onset[si].is_some() {
+                continue;
+            }
+            let mut found = None;
+            for i in 0..s.blocks {
+                let (mut on_floor, mut constant) = (0.0, 0.0);
+                for (k, w) in rocking.weights(i).iter().enumerate() {
+                    match self.holder[s.first + i + k] {
+                        Holder::Floor(_) => on_floor += w,
+                        Holder::Free(c) => constant += w * self.free[c].accel,
+                    }
+                }
+                for sign in [1.0, -1.0] {
+                    let mut g = Func {
+                        row: Some((Row::Accel, s.floor)),
+                        scale: -sign * on_floor,
+                        poly: [
+                            G - sign * (constant + on_floor * self.accel_const[s.floor]),
+                            0.0,
+                            0.0,
+                            0.0,
+                        ],
+                        f0: 0.0,
+                        df0: None,
+                    };
+                    g.f0 = Self::value_at(mode, &g, &self.p_start).0;
+                    if self.clear(mode, &g, end, 0.0, f64::INFINITY) {
+                        continue;
+                    }
+                    let f = self.func(mode, &g);
+                    let n0 = self.node0(mode, &g);
+                    let n1 = self.node_at(mode, &g, &self.p_end);
+                    let at = search::first_violation(&f, &n0, &n1, self.dt)?;
+                    found = rocking::earlier(
+                        found,
+                        at.map(|t| RockingOnset {
+                            block: i + 1,
+                            time_s: t_start + t,
+                        }),
+                    );
+                }
+            }
+            self.out.rocking_onset[si] = found;
+        }
+        Ok(())
     }
 
     fn mode(&self) -> Rc<Mode> {

@@ -8,7 +8,8 @@
 //! its floor and its bottom block. Displacements are relative to the ground.
 
 pub use super::super::model::DampingBasis;
-use super::super::model::{G, System, SystemSpec, Yielding};
+use super::super::model::{G, ModelError, System, SystemSpec, Yielding};
+use super::super::rocking::Rocking;
 use crate::limits::{
     MAX_ALPHA, MAX_BLOCKS, MAX_MU, MAX_STACKS, MAX_STOREYS, STOREY_RATIO_RANGE,
     STRENGTH_RATIO_RANGE, STRUCTURE_PERIOD_RANGE_S,
@@ -35,6 +36,9 @@ pub struct StackSpec {
     pub mu: Vec<f64>,
     /// Static friction coefficients; `None` means equal to the kinetic ones.
     pub mu_static: Option<Vec<f64>>,
+    /// Width-to-height ratio of each block, bottom first; `None`: rocking not checked
+    /// ([`crate::dynamics::rocking`]).
+    pub aspect: Option<Vec<f64>>,
 }
 
 impl StackSpec {
@@ -45,6 +49,7 @@ impl StackSpec {
             alpha: alpha.to_vec(),
             mu: mu.to_vec(),
             mu_static: None,
+            aspect: None,
         }
     }
 }
@@ -190,6 +195,14 @@ pub enum BuildingError {
          it round-off spoils the energy balance)"
     )]
     LoadRatio { floor: usize, ratio: f64 },
+    #[error(
+        "stacks[{stack}].aspect[{index}] (width over height of the block) must be finite and > 0, got {value:?}"
+    )]
+    Aspect {
+        stack: usize,
+        index: usize,
+        value: f64,
+    },
 }
 
 /// One storey's bilinear spring (kinematic hardening), in the terms of the SDOF model.
@@ -214,6 +227,8 @@ pub struct Stack {
     pub first: usize,
     /// Number of blocks.
     pub blocks: usize,
+    /// Its rocking check, when its blocks' ratios are given.
+    pub rocking: Option<Rocking>,
 }
 
 /// A validated building. Construct with [`Building::new`].
@@ -309,11 +324,29 @@ impl Building {
                 mu_s.push(mu_static[b]);
                 above -= m;
             }
+            let rocking = (s.aspect.as_deref())
+                .map(|a| {
+                    Rocking::new(&block_masses, a).map_err(|e| match e {
+                        ModelError::Aspect { index, value } => BuildingError::Aspect {
+                            stack: si,
+                            index: index - 1,
+                            value,
+                        },
+                        _ => BuildingError::StackCount {
+                            stack: si,
+                            key: "aspect",
+                            got: a.len(),
+                            expected: block_masses.len(),
+                        },
+                    })
+                })
+                .transpose()?;
             masses.extend_from_slice(&block_masses);
             stacks.push(Stack {
                 floor,
                 first,
                 blocks: s.alpha.len(),
+                rocking,
             });
         }
         if let Some((f, &ratio)) = load.iter().enumerate().find(|(_, r)| **r > MAX_ALPHA) {
@@ -472,9 +505,14 @@ impl Building {
             return None;
         }
         let m = self.masses[0];
-        let (alpha, mu, mu_static) = match self.spec.stacks.first() {
-            Some(s) => (s.alpha.clone(), s.mu.clone(), s.mu_static.clone()),
-            None => (Vec::new(), Vec::new(), None),
+        let (alpha, mu, mu_static, aspect) = match self.spec.stacks.first() {
+            Some(s) => (
+                s.alpha.clone(),
+                s.mu.clone(),
+                s.mu_static.clone(),
+                s.aspect.clone(),
+            ),
+            None => (Vec::new(), Vec::new(), None, None),
         };
         let spec = SystemSpec {
             // The attached variant's floor carries its stacks: T·sqrt(M/m) (exactly T otherwise).
@@ -485,7 +523,10 @@ impl Building {
             mu,
             mu_static,
         };
-        let sys = System::new(&spec).ok()?;
+        let mut sys = System::new(&spec).ok()?;
+        if let Some(a) = aspect {
+            sys = sys.with_aspect(&a).ok()?;
+        }
         match &self.spec.yielding {
             None => Some(sys),
             // The same F_y = C_y·m·g on the system's mass (the loaded floor's, when attached).
@@ -678,6 +719,7 @@ mod tests {
                 alpha: vec![0.5, 0.5],
                 mu: vec![0.2, 0.1],
                 mu_static: Some(vec![0.25, 0.1]),
+                aspect: None,
             },
             StackSpec::new(1, &[1.0], &[0.3]),
         ];

@@ -1,6 +1,7 @@
 //! What a building simulation returns: per floor, per storey, per stack and the energy terms.
 
 use super::super::response::{Energy, History, Response};
+use super::super::rocking::RockingOnset;
 
 /// The response of a building to one record (docs/model.md, "A multi-storey building"). Peaks
 /// are exact over time (between samples and at switches, one-sided limits included).
@@ -48,14 +49,17 @@ pub struct BuildingResponse {
     pub energy: Energy,
     /// Largest `|residual|/input` at the end of a sample interval (NaN without the balance).
     pub energy_balance_error_max: f64,
+    /// Per stack, where and when it would first start to rock (its blocks' ratios given,
+    /// [`super::StackSpec::aspect`]); `None` when it never does or is not checked.
+    pub rocking_onset: Vec<Option<RockingOnset>>,
     /// Bodies: floors, then blocks; interfaces: every stack's, in order.
     pub history: Option<History>,
 }
 
 impl BuildingResponse {
-    /// A response of `storeys` floors and `blocks` blocks with every peak at zero, to be filled
-    /// by an integrator.
-    pub fn zeroed(storeys: usize, blocks: usize) -> Self {
+    /// A response of `storeys` floors and `blocks` blocks in `stacks` stacks with every peak at
+    /// zero, to be filled by an integrator.
+    pub fn zeroed(storeys: usize, blocks: usize, stacks: usize) -> Self {
         Self {
             floor_peak_displacement_m: vec![0.0; storeys],
             floor_peak_abs_accel_mps2: vec![0.0; storeys],
@@ -68,6 +72,7 @@ impl BuildingResponse {
             block_peak_abs_accel_mps2: vec![0.0; blocks],
             peak_slip_m: vec![0.0; blocks],
             residual_slip_m: vec![0.0; blocks],
+            rocking_onset: vec![None; stacks],
             ..Self::default()
         }
     }
@@ -93,6 +98,11 @@ impl BuildingResponse {
             yield_events: r.yield_events,
             energy: r.energy,
             energy_balance_error_max: r.energy_balance_error_max,
+            rocking_onset: if blocks > 0 {
+                vec![r.rocking_onset]
+            } else {
+                Vec::new()
+            },
             history: r.history,
         }
     }

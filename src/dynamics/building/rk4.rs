@@ -43,6 +43,7 @@
 use super::super::contact::Contact;
 use super::super::model::Hysteresis;
 use super::super::response::{Energy, History};
+use super::super::rocking::RockingOnset;
 use super::super::{Ground, SimError, Unwatched, Watch, watched};
 use super::model::Building;
 use super::response::BuildingResponse;
@@ -460,7 +461,7 @@ impl<'b> Rk4<'b> {
         let dt = ground.dt_s;
         let h = dt / substeps as f64;
         let steps = acc_g.len() - 1;
-        let mut out = BuildingResponse::zeroed(n, blocks);
+        let mut out = BuildingResponse::zeroed(n, blocks, b.stacks().len());
         let mut history = want_history.then(|| History::with_layout(steps + 1, nb, blocks));
         let nr = 2 + blocks + if self.storeys.is_some() { n } else { 0 };
         let mut kx = vec![vec![0.0; nb]; 4];
@@ -568,6 +569,21 @@ impl<'b> Rk4<'b> {
                         }
                         out.peak_base_shear_n = out.storey_peak_shear_n[0];
                         out.peak_overturning_n_m = out.peak_overturning_n_m.max(moment.abs());
+                        // Rocking, checked at the sub-steps' starts.
+                        let t = k as f64 * dt + sub as f64 * h;
+                        for (si, s) in b.stacks().iter().enumerate() {
+                            let Some(r) = &s.rocking else { continue };
+                            let blocks_at = n + s.first;
+                            if out.rocking_onset[si].is_none()
+                                && let Some(i) =
+                                    r.rocking_interface(&abs[blocks_at..blocks_at + s.blocks])
+                            {
+                                out.rocking_onset[si] = Some(RockingOnset {
+                                    block: i + 1,
+                                    time_s: t,
+                                });
+                            }
+                        }
                     }
                     self.rates(&xs, &vs, ag, &mut ke[st]);
                 }
