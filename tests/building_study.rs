@@ -184,7 +184,7 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
         checked[rule as usize] += 1;
         let run = |kind| {
             Physics::DEFAULT
-                .simulate_building(kind, &case, &frame, &ground, &opts)
+                .simulate_building(kind, &case, &frame, &ground, &opts, None)
                 .unwrap()
         };
         let (s, r) = (run(kind), run(SystemKind::Rigid));

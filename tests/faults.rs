@@ -666,6 +666,22 @@ fn inputs_that_used_to_hang_abort_or_mislead_are_refused_at_once() {
             "case results (cases × motions × zones); at most 50000000",
         ),
         (
+            grid(
+                "  period_s: [1]\n  alpha: [[0.5], [0.5]]\n  mu: [[0.1], [0.1]]\n  aspect: [0.5]\n",
+            ),
+            "`grid.aspect`: needs one ratio per block: 2 blocks, 1 ratios",
+        ),
+        (
+            grid(
+                "  period_s: [1]\n  alpha: [[0.5], [0.5]]\n  mu: [[0.1], [0.1]]\n  aspect: [0.5, 0]\n",
+            ),
+            "`grid.aspect[1]`: 0 (width over height of block 2) must be finite and > 0",
+        ),
+        (
+            grid("  period_s: [1]\n  alpha: [[0.5]]\n  mu: [[0.1]]\n  aspect: [.inf]\n"),
+            "`grid.aspect[0]`: inf (width over height of block 1) must be finite and > 0",
+        ),
+        (
             format!("{BASE}  matching: {{ check_periods: 100000000 }}\n"),
             "matching setting `check_periods` = 100000000: must be 2 … 100000",
         ),

@@ -297,3 +297,105 @@ fn a_bad_aspect_is_refused_naming_it() {
         assert!(!err.contains("/nonexistent"), "{err}");
     }
 }
+
+/// A study with `grid.aspect` (configs/quick.yaml with it, one storey): `sweep.h5`'s
+/// `rocks_stack` is, for every zone, motion and case, whether `simulate` of that case under
+/// that motion says it rocks (most cases take a skip rule, whose flag comes from the system
+/// standing in for the stack: here checked against the stack itself); the report's table
+/// counts them; `tnew.h5` keeps each case's share of rocking motions and `design` warns where
+/// it is above 0. The same config without `aspect` stores neither and shows no section.
+#[test]
+fn a_study_stores_which_cases_rock_the_report_counts_them_and_design_warns() {
+    use slidestack::simulation::{Outcome, Settings};
+    use slidestack::store::motions::read_zone_motions;
+    use slidestack::store::sweep::read_zone_sweep;
+    let dir = tempfile::tempdir().unwrap();
+    let quick = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/quick.yaml"),
+    )
+    .unwrap();
+    let config = |name: &str, aspect: &str| {
+        let out = dir.path().join(name);
+        let text = quick
+            .replace(
+                "output_dir: out/quick",
+                &format!("output_dir: {}", out.display()),
+            )
+            .replace(
+                "  damping_basis: rigid\n",
+                &format!("  damping_basis: rigid\n{aspect}"),
+            );
+        let path = dir.path().join(format!("{name}.yaml"));
+        std::fs::write(&path, text).unwrap();
+        common::ok(common::slidestack(&["run", path.to_str().unwrap()], "2"));
+        out
+    };
+    let out = config("rocking", "  aspect: [0.8, 0.25]\n");
+    let (mut runs, mut rocking) = (0, 0);
+    let mut per_zone = Vec::new();
+    for zone in ["III", "V"] {
+        let (grid, _, sweep) = read_zone_sweep(&out.join("sweep.h5"), zone, 2, false).unwrap();
+        let motions = read_zone_motions(&out.join("motions.h5"), zone).unwrap();
+        let rocks = sweep.vars.rocks_stack.expect("stored with grid.aspect");
+        let mut count = 0;
+        for (idx, &flag) in rocks.indexed_iter() {
+            let settings = Settings {
+                period: Some(grid.periods_s[idx[1]]),
+                alpha: Some(vec![grid.alpha[0][idx[2]], grid.alpha[1][idx[3]]]),
+                mu: Some(vec![grid.mu[0][idx[4]], grid.mu[1][idx[5]]]),
+                aspect: Some(vec![0.8, 0.25]),
+                ..Settings::default()
+            };
+            let sim = settings.resolve_with(motions[idx[0]].clone()).unwrap();
+            let (outcome, _) = sim.run(&sim.accel_mps2()).unwrap();
+            let Outcome::OneStorey(s) = outcome else {
+                panic!("one storey")
+            };
+            let rocks = s.rocking_onset.expect("checked").is_some();
+            assert_eq!(flag, u8::from(rocks), "zone {zone} {idx:?}");
+            count += usize::from(rocks);
+            runs += 1;
+        }
+        rocking += count;
+        per_zone.push(format!("{count} of {}", rocks.len()));
+    }
+    assert!(rocking > 0 && rocking < runs, "{rocking} of {runs}");
+    let report = std::fs::read_to_string(out.join("report/index.html")).unwrap();
+    assert!(report.contains("Where the stacks would rock"));
+    for counted in &per_zone {
+        assert!(report.contains(&format!("({counted})")), "{counted}");
+    }
+    // tnew.h5's rocks_share is the flags' mean over the motions, and `design` warns where it
+    // is above 0 (at a grid case, its share exactly).
+    let (grid, _, sweep) = read_zone_sweep(&out.join("sweep.h5"), "V", 2, false).unwrap();
+    let rocks = sweep.vars.rocks_stack.unwrap().mapv(f64::from);
+    let share = rocks.mean_axis(ndarray::Axis(0)).unwrap();
+    let (_, _, t) =
+        slidestack::store::tnew::read_zone_tnew_in(&out.join("tnew.h5"), "V", 2, false).unwrap();
+    assert_eq!(t.rocks_share.as_ref(), Some(&share));
+    let mut warned = [false; 2];
+    for (idx, &s) in share.indexed_iter() {
+        let q = slidestack::study::design::Query {
+            zone: "V".into(),
+            period_s: grid.periods_s[idx[0]],
+            alpha: vec![grid.alpha[0][idx[1]], grid.alpha[1][idx[2]]],
+            mu: vec![grid.mu[0][idx[3]], grid.mu[1][idx[4]]],
+            extrapolate: false,
+            building: None,
+        };
+        let a = slidestack::design::design(&out, &q).unwrap();
+        assert!((a.rocks_share.unwrap() - s).abs() < 1e-12, "{idx:?}");
+        let note = a.notes.iter().any(|n| n.starts_with("rocking:"));
+        assert_eq!(note, s > 0.0, "{idx:?}");
+        warned[usize::from(note)] = true;
+    }
+    assert_eq!(warned, [true, true]);
+    let plain = config("plain", "");
+    let (_, _, sweep) = read_zone_sweep(&plain.join("sweep.h5"), "III", 2, false).unwrap();
+    assert!(sweep.vars.rocks_stack.is_none());
+    let report = std::fs::read_to_string(plain.join("report/index.html")).unwrap();
+    assert!(!report.contains("Where the stacks would rock"));
+    let (_, _, t) =
+        slidestack::store::tnew::read_zone_tnew_in(&plain.join("tnew.h5"), "V", 2, false).unwrap();
+    assert!(t.rocks_share.is_none());
+}

@@ -81,6 +81,7 @@ fn write_sweep_file(path: &Path) {
             slip_peak: zeros(&[2, 2, 1, 2, 1]),
             skip_rule: zeros(&shape),
             single_rule: zeros(&shape),
+            rocks_stack: None,
             building: None,
         },
     };
@@ -137,6 +138,7 @@ fn tnew_zone(band: u8) -> ZoneTnew {
             flag: zeros(&shape),
             band: ArrayD::from_elem(IxDyn(&shape), band),
         },
+        rocks_share: None,
         period_sd_s: vec![0.1, 0.2, 0.3],
         sd_mean_m: vec![0.0; 3],
         roof_participation: Vec::new(),

@@ -24,6 +24,7 @@ fn grid(ratio: f64) -> (Grid, Physics) {
         damping: 0.05,
         damping_basis: Default::default(),
         stack_floor: None,
+        aspect: None,
     };
     (g.axes(), g.physics())
 }
@@ -52,7 +53,11 @@ fn skip_rules_hold(frame: Option<&Frame>, records: usize) {
     // Tolerances: NoSlip compares the rigid SDOF with the stack simulated with every interface
     // stuck (two exact solutions, 1e-9 relative); SingleBlock compares the single block with
     // the stack whose upper interfaces never slip (1e-9, the limit tests' bound is 1e-10).
+    // The rocking flag under a rule is the stand-in's peak against the stuck stack's criterion;
+    // brute force simulates the stack with the check: equal flags (a tie within round-off of
+    // the threshold would be the only way to differ, and none occurs here).
     let mut counts = [0usize; 3];
+    let mut rocking = [[0usize; 2]; 3];
     for ratio in [1.0, 1.5] {
         let (g, physics) = grid(ratio);
         for rec in &real_records()[..records] {
@@ -62,11 +67,31 @@ fn skip_rules_hold(frame: Option<&Frame>, records: usize) {
                 accel_mps2: &accel,
             };
             for p in 0..g.periods_s.len() {
-                let unit = |skip| run_unit(&g, &physics, frame, &ground, p, UnitOptions { skip });
+                let aspect = Some(&ASPECT[..]);
+                let unit = |skip| {
+                    run_unit(
+                        &g,
+                        &physics,
+                        frame,
+                        &ground,
+                        p,
+                        UnitOptions { skip, aspect },
+                    )
+                };
                 let (fast, slow) = (unit(true).unwrap(), unit(false).unwrap());
                 assert!(slow.skip_rule.iter().all(|&r| r == 0));
                 for c in 0..g.cases_per_unit() {
                     counts[fast.skip_rule[c] as usize] += 1;
+                    rocking[fast.skip_rule[c] as usize][fast.rocks_stack[c] as usize] += 1;
+                    assert_eq!(
+                        fast.rocks_stack[c],
+                        slow.rocks_stack[c],
+                        "{} {frame:?} T={} case {c} ({:?}) rule {}: rocks",
+                        rec.name,
+                        g.periods_s[p],
+                        g.stack(c),
+                        fast.skip_rule[c]
+                    );
                     let close = |a: f64, b: f64, what: &str| {
                         let scale = a.abs().max(b.abs()).max(1e-12);
                         assert!(
@@ -137,6 +162,12 @@ fn skip_rules_hold(frame: Option<&Frame>, records: usize) {
             }
         }
     }
-    // Every rule was exercised.
+    // Every rule was exercised, under each some stacks rock, and some stacks do not.
     assert!(counts.iter().all(|&n| n > 0), "{counts:?}");
+    assert!(rocking.iter().all(|r| r[1] > 0), "{rocking:?}");
+    assert!(rocking.iter().any(|r| r[0] > 0), "{rocking:?}");
 }
+
+/// The blocks' width over height in the skip-rule checks: the top block rocks beyond 0.25 g on
+/// its own; the pair, stuck, beyond about 0.2 g.
+const ASPECT: [f64; 2] = [0.8, 0.25];

@@ -468,6 +468,11 @@ impl Study {
         })
     }
 
+    /// The blocks' width-to-height ratios (`grid.aspect`), when the rocking check is asked for.
+    pub fn aspect(&self) -> Option<&[f64]> {
+        self.cfg.grid.as_ref().and_then(|g| g.aspect.as_deref())
+    }
+
     /// The building axes of a building study (`None` on one storey).
     pub fn building(&self) -> Option<&BuildingAxes> {
         self.building.as_ref()

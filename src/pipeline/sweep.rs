@@ -167,8 +167,9 @@ impl Units<'_> {
                 .chain(c.u8s.iter().map(Vec::len))
                 .collect();
             let nmax = self.study.building().map(BuildingAxes::max_storeys);
-            let want = column_lengths(self.grid.cases_per_unit(), self.grid.blocks(), nmax);
-            if found != want || c.f64s.len() != want.len() - 2 {
+            let rocks = self.study.aspect().is_some();
+            let want = column_lengths(self.grid.cases_per_unit(), self.grid.blocks(), nmax, rocks);
+            if found != want || c.u8s.len() != 2 + usize::from(rocks) {
                 return Err(StoreError::shape(&path, "columns", &found, &want));
             }
         }
@@ -180,8 +181,9 @@ impl Units<'_> {
 /// blocks: six `f64` columns (the slip, per interface, last), in a building study whose largest
 /// building has `nmax` storeys eleven more (four per floor or storey, padded to `nmax`, the two
 /// base shears, the two storey shears, padded, the two overturning moments and the stuck
-/// share), then two code columns.
-fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>) -> Vec<usize> {
+/// share), then two code columns, and with `rocks` (the blocks' ratios given) a third, the
+/// rocking flags.
+fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>, rocks: bool) -> Vec<usize> {
     let mut v = vec![cases, cases, cases, cases, cases, cases * blocks];
     if let Some(n) = nmax {
         v.extend([cases * n; 4]);
@@ -190,6 +192,9 @@ fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>) -> Vec<usize
         v.extend([cases; 3]);
     }
     v.extend([cases; 2]);
+    if rocks {
+        v.push(cases);
+    }
     v
 }
 
@@ -231,10 +236,11 @@ fn to_columns(r: &UnitResult, frame: Option<(usize, usize)>) -> Columns {
         f64s.push(r.overturning_rigid.clone());
         f64s.push(r.stuck_share_stack.clone());
     }
-    Columns {
-        f64s,
-        u8s: vec![r.skip_rule.clone(), r.single_rule.clone()],
+    let mut u8s = vec![r.skip_rule.clone(), r.single_rule.clone()];
+    if !r.rocks_stack.is_empty() {
+        u8s.push(r.rocks_stack.clone());
     }
+    Columns { f64s, u8s }
 }
 
 /// Builds `sweep.h5`, or with `shard = Some((K, N))` only that shard's units.
@@ -310,7 +316,10 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
                 frame.as_ref(),
                 &ground,
                 u.period,
-                UnitOptions { skip: true },
+                UnitOptions {
+                    skip: true,
+                    aspect: study.aspect(),
+                },
             )
             .map_err(|source| SweepStageError::Simulation {
                 zone: study.cfg.zones[u.zone].name.clone(),
@@ -457,6 +466,7 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
                 slip_peak: f(5, &shape_i)?,
                 skip_rule: codes(0)?,
                 single_rule: codes(1)?,
+                rocks_stack: study.aspect().map(|_| codes(2)).transpose()?,
                 building: building_vars,
             },
         });
@@ -469,6 +479,10 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
     let mut settings = physics_attrs(&physics).to_vec();
     if let Some(b) = &building_json {
         settings.push(("building", Attr::Str(b)));
+    }
+    let aspect_json = study.aspect().map(|a| serde_json::json!(a).to_string());
+    if let Some(a) = &aspect_json {
+        settings.push(("aspect", Attr::Str(a)));
     }
     let meta = SweepMeta {
         fingerprint: fp,
@@ -549,6 +563,7 @@ fn same_bits(a: &ZoneSweep, b: &ZoneSweep) -> bool {
         && f(&va.slip_peak, &vb.slip_peak)
         && va.skip_rule == vb.skip_rule
         && va.single_rule == vb.single_rule
+        && va.rocks_stack == vb.rocks_stack
         && match (&va.building, &vb.building) {
             (None, None) => true,
             (Some(x), Some(y)) => {

@@ -304,6 +304,7 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
             sd_mean_m,
             roof_participation: per_storeys.clone(),
             lambda,
+            rocks_share: (v.rocks_stack.as_ref()).map(|r| mean(&r.mapv(f64::from))),
         });
         s.pass("tnew.zone", me)?;
     }

@@ -326,6 +326,11 @@ impl<'p> GroupReader<'p> {
     }
 
     /// The names of the group's members.
+    /// Whether the group holds `name`.
+    pub fn has(&self, name: &str) -> bool {
+        self.group.link_exists(name)
+    }
+
     pub fn members(&self) -> Result<Vec<String>, StoreError> {
         self.group.member_names().at(self.file)
     }

@@ -8,6 +8,7 @@
 //!     u_stack, u_single, u_rigid (m), a_stack (g), friction_energy (J/kg),
 //!     skip_rule, single_rule                       [motion, T_p, alpha_1 … alpha_n, mu_1 … mu_n]
 //!     slip_peak (m)                                [… , interface]
+//!     rocks_stack                                  [motion, T_p, …] (with grid.aspect only)
 //! ```
 //! A building study (docs/model.md, "A study over buildings") has two more coordinates,
 //! `storeys` (numbers) and `stack_floor` (strings: a floor number, `roof`, `all`), as dimensions
@@ -68,6 +69,9 @@ pub struct SweepVars {
     pub slip_peak: ArrayD<f64>,
     pub skip_rule: ArrayD<u8>,
     pub single_rule: ArrayD<u8>,
+    /// With `grid.aspect`: 1 where the stack would start to rock (docs/model.md, "Rocking:
+    /// when a case leaves the model"); `None` when not checked.
+    pub rocks_stack: Option<ArrayD<u8>>,
     /// A building study's per-floor peaks and base shear (`None` on one storey).
     pub building: Option<BuildingVars>,
 }
@@ -443,6 +447,18 @@ fn write_zone(
         &[(0, "simulated"), (1, "equals_rigid")],
     )?;
     attach_all(&ds, &scales)?;
+    if let Some(rocks) = &v.rocks_stack {
+        let ds = write_flags(
+            &g,
+            "rocks_stack",
+            rocks.view(),
+            &chunk,
+            "1 when the stack (in a building, any of its stacks) would start to rock: the \
+             sliding-only model does not hold (blocks' width over height: file attribute aspect)",
+            &[(0, "slides_only"), (1, "rocks")],
+        )?;
+        attach_all(&ds, &scales)?;
+    }
     if let (Some(b), Some(bv)) = (building, &v.building) {
         let levels: Vec<f64> = (1..=b.max_storeys()).map(|j| j as f64).collect();
         let floor = coordinate(&g, "floor", &levels, "1", "floor (1 the lowest)")?;
@@ -527,6 +543,9 @@ pub fn read_zone_sweep(
         slip_peak: g.array("slip_peak", &per_interface)?,
         skip_rule: g.array("skip_rule", &shape)?,
         single_rule: g.array("single_rule", &shape)?,
+        rocks_stack: (g.has("rocks_stack"))
+            .then(|| g.array("rocks_stack", &shape))
+            .transpose()?,
     };
     let zone = ZoneSweep {
         name: zone.to_string(),

@@ -59,6 +59,9 @@ pub struct ZoneTnew {
     pub roof_participation: Vec<f64>,
     /// A building study's effective live-load fraction (`None` on one storey).
     pub lambda: Option<AttachedVars>,
+    /// With `grid.aspect`: per case, the share of the motions under which the stack would
+    /// start to rock (the sweep's `rocks_stack`, averaged); `None` when not checked.
+    pub rocks_share: Option<ArrayD<f64>>,
 }
 
 /// A building study's attached fractions of every case (docs/model.md, "The attached
@@ -386,6 +389,18 @@ fn write_zone(
         meta.band_flags,
     )?;
     attach_all(&ds, &scales)?;
+    if let Some(share) = &z.rocks_share {
+        let ds = write_var(
+            &g,
+            "rocks_share",
+            share.view(),
+            &chunk,
+            "1",
+            "share of the motions under which the stack would start to rock (sweep.h5's \
+             rocks_stack averaged): outside the sliding-only model where > 0",
+        )?;
+        attach_all(&ds, &scales)?;
+    }
     if let (Some(l), Some(b)) = (&z.lambda, building) {
         let levels: Vec<f64> = (1..=b.max_storeys()).map(|j| j as f64).collect();
         let storey = coordinate(&g, "storey", &levels, "1", "storey (1 the lowest)")?;
@@ -530,6 +545,9 @@ pub fn read_zone_tnew_in(
         sd_mean_m: sd_mean_m.iter().copied().collect(),
         roof_participation,
         lambda,
+        rocks_share: (g.has("rocks_share"))
+            .then(|| g.array("rocks_share", &shape))
+            .transpose()?,
     };
     Ok((grid, axes, z))
 }

@@ -201,6 +201,11 @@ pub struct GridConfig {
         skip_serializing_if = "Option::is_none"
     )]
     pub stack_floor: Option<OneOrList<FloorKey>>,
+    /// Width over height of each block, bottom first: the sweep then stores whether each case
+    /// would start to rock under each motion (`rocks_stack`; docs/model.md, "Rocking: when a
+    /// case leaves the model"). Absent: not checked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aspect: Option<Vec<f64>>,
 }
 
 impl GridConfig {
@@ -915,6 +920,29 @@ fn validate_grid(g: &GridConfig) -> Result<(), (String, String)> {
     }
     for (i, m) in g.mu.iter().enumerate() {
         check(format!("grid.mu[{i}]"), m, 0.0, false, MAX_MU)?;
+    }
+    if let Some(aspect) = &g.aspect {
+        if aspect.len() != g.alpha.len() {
+            return Err((
+                "grid.aspect".into(),
+                format!(
+                    "needs one ratio per block: {} blocks, {} ratios",
+                    g.alpha.len(),
+                    aspect.len()
+                ),
+            ));
+        }
+        if let Some((i, r)) =
+            (aspect.iter().enumerate()).find(|(_, r)| !(r.is_finite() && **r > 0.0))
+        {
+            return Err((
+                format!("grid.aspect[{i}]"),
+                format!(
+                    "{r} (width over height of block {}) must be finite and > 0",
+                    i + 1
+                ),
+            ));
+        }
     }
     if !(g.mu_static_ratio.is_finite() && g.mu_static_ratio >= 1.0) {
         return Err((

@@ -167,6 +167,11 @@ pub struct Answer {
     /// mode, gives the sliding stack's base shear.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lambda_code_grid: Option<f64>,
+    /// With `grid.aspect`: the share of the motions under which the stack would start to
+    /// rock, by multilinear interpolation in the grid (> 0: some grid case around this one
+    /// leaves the sliding-only model under some motion, and a note says so).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rocks_share: Option<f64>,
     /// Anything the designer should know about these numbers.
     pub notes: Vec<String>,
 }
@@ -194,6 +199,10 @@ pub struct ZoneDesign {
     /// A building study's code-format `λ_code` per case of the frame (grid's flat order).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lambda_code: Option<Vec<f64>>,
+    /// With `grid.aspect`: per case (grid's flat order), the share of the motions under which
+    /// the stack would start to rock (`tnew.h5`'s `rocks_share`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rocks_share: Option<Vec<f64>>,
     /// How far beyond the grid the fitted form answers (`extrapolate`): the margin, a fraction
     /// of each axis's extreme values, of the box on which the recommended form was checked to
     /// stay finite and inside `[½·T_p, 1.5·T_rigid]` (`fit.yaml`'s `box_check`). `None` when
@@ -241,6 +250,7 @@ impl ZoneDesign {
             building: None,
             lambda: None,
             lambda_code: None,
+            rocks_share: None,
             extrapolation_margin: (recommended.map(|f| &f.box_check))
                 .filter(|b| b.passed)
                 .map(|b| b.margin),
@@ -284,6 +294,7 @@ impl ZoneDesign {
         });
         data.lambda = lambda;
         data.lambda_code = t.lambda.as_ref().map(|l| frame_of(&l.lambda_code));
+        data.rocks_share = t.rocks_share.as_ref().map(frame_of);
         data
     }
 
@@ -557,6 +568,17 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
     };
     let lambda_code_grid = (z.lambda_code.as_ref())
         .and_then(|values| z.grid.interpolate(values, &point).ok().flatten());
+    let rocks_share = (z.rocks_share.as_ref())
+        .and_then(|values| z.grid.interpolate(values, &point).ok().flatten());
+    if let Some(share) = rocks_share.filter(|&s| s > 0.0) {
+        notes.push(format!(
+            "rocking: the stack would start to rock under {:.0} % of the motions (interpolated \
+             from the grid cases around this structure): there the sliding-only model's T_new \
+             and λ are outside their model (docs/model.md, \"Rocking: when a case leaves the \
+             model\")",
+            100.0 * share
+        ));
+    }
     let t_new_paper_s = a_period(
         z.paper.and_then(|p| p.evaluate(&x)),
         "the paper's equation",
@@ -587,6 +609,7 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
         lambda_grid,
         lambda_fit,
         lambda_code_grid,
+        rocks_share,
         notes,
     })
 }

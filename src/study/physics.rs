@@ -185,21 +185,26 @@ impl Physics {
         }
     }
 
-    /// System `kind` of `case` on the elastic structure under `ground`, by the exact integrator.
+    /// System `kind` of `case` on the elastic structure under `ground`, by the exact integrator;
+    /// `aspect`: the stack's blocks' width-to-height ratios, for its rocking check (the stack
+    /// system only; docs/model.md, "Rocking: when a case leaves the model").
     pub fn simulate(
         &self,
         kind: SystemKind,
         case: &Case,
         ground: &Ground,
         opts: &ExactOptions,
+        aspect: Option<&[f64]>,
     ) -> Result<Response, CaseError> {
-        let system = self
-            .system(kind, case, None)
-            .map_err(|source| CaseError::Model {
-                case: case.clone(),
-                kind,
-                source,
-            })?;
+        let model = |source| CaseError::Model {
+            case: case.clone(),
+            kind,
+            source,
+        };
+        let mut system = self.system(kind, case, None).map_err(model)?;
+        if let (SystemKind::Stack, Some(a)) = (kind, aspect) {
+            system = system.with_aspect(a).map_err(model)?;
+        }
         simulate_exact(&system, ground, opts).map_err(|source| CaseError::Simulation {
             case: case.clone(),
             kind,
@@ -249,6 +254,19 @@ impl Physics {
         frame: &Frame,
         yielding: Option<StoreyYielding>,
     ) -> Result<Building, BuildingError> {
+        self.building_checked(kind, case, frame, yielding, None)
+    }
+
+    /// [`Physics::yielding_building`] whose stacks (of the stack system) carry the rocking
+    /// check of blocks of ratios `aspect`.
+    fn building_checked(
+        &self,
+        kind: SystemKind,
+        case: &Case,
+        frame: &Frame,
+        yielding: Option<StoreyYielding>,
+        aspect: Option<&[f64]>,
+    ) -> Result<Building, BuildingError> {
         let total = [case.alpha_total()];
         let (alpha, mu) = match kind {
             SystemKind::SingleBlock | SystemKind::Rigid => (&total[..], &case.mu[..1]),
@@ -264,7 +282,9 @@ impl Physics {
                 alpha: alpha.to_vec(),
                 mu: mu.to_vec(),
                 mu_static: Some(mu.iter().map(|m| m * self.mu_static_ratio).collect()),
-                aspect: None,
+                aspect: aspect
+                    .filter(|_| kind == SystemKind::Stack)
+                    .map(<[f64]>::to_vec),
             })
             .collect();
         let b = Building::new(&spec)?;
@@ -277,7 +297,8 @@ impl Physics {
     /// System `kind` of `case` in the building `frame` on the elastic storeys under `ground`,
     /// by the exact integrator. A building of one storey (one stack) is the one-storey case:
     /// it runs as [`Physics::simulate`] runs it, bit for bit and as fast (the building's
-    /// integrator agrees with it to round-off, `tests/building.rs`).
+    /// integrator agrees with it to round-off, `tests/building.rs`). `aspect` as for
+    /// [`Physics::simulate`].
     pub fn simulate_building(
         &self,
         kind: SystemKind,
@@ -285,17 +306,18 @@ impl Physics {
         frame: &Frame,
         ground: &Ground,
         opts: &ExactOptions,
+        aspect: Option<&[f64]>,
     ) -> Result<BuildingResponse, CaseError> {
         if frame.storeys() == 1 {
             return self
-                .simulate(kind, case, ground, opts)
+                .simulate(kind, case, ground, opts, aspect)
                 .map(BuildingResponse::from_one_storey);
         }
         let in_building = |e| CaseError::InBuilding {
             frame: frame.to_string(),
             source: Box::new(e),
         };
-        let b = self.building(kind, case, frame).map_err(|source| {
+        let b = (self.building_checked(kind, case, frame, None, aspect)).map_err(|source| {
             in_building(CaseError::BuildingModel {
                 case: case.clone(),
                 kind,

@@ -27,7 +27,7 @@ use super::building::Frame;
 use super::physics::{CaseError, Physics, SystemKind};
 use crate::case::Case;
 use crate::dynamics::building::BuildingResponse;
-use crate::dynamics::{ExactOptions, G, Ground, Response};
+use crate::dynamics::{ExactOptions, G, Ground, Response, Rocking};
 use crate::grid::Grid;
 use std::collections::HashMap;
 
@@ -82,6 +82,10 @@ struct Peaks {
     /// In a building: the stacks' stuck mass share (NaN on one storey, and for a system
     /// without stacks).
     stuck_share: f64,
+    /// The largest peak absolute acceleration of a block, m/s² (0 without blocks).
+    block_a_mps2: f64,
+    /// Whether a stack started to rock (its rocking checked; false otherwise).
+    rocks: bool,
 }
 
 impl Peaks {
@@ -98,6 +102,10 @@ impl Peaks {
             storey_shear: Vec::new(),
             overturning: f64::NAN,
             stuck_share: f64::NAN,
+            block_a_mps2: r.peak_abs_accel_mps2[1..]
+                .iter()
+                .fold(0.0, |a, &b| a.max(b)),
+            rocks: r.rocking_onset.is_some(),
         }
     }
 
@@ -131,6 +139,8 @@ impl Peaks {
                 .collect(),
             overturning: frame.overturning_ratio(r.peak_overturning_n_m),
             stuck_share: r.stuck_mass_share,
+            block_a_mps2: (r.block_peak_abs_accel_mps2.iter()).fold(0.0, |a, &b| a.max(b)),
+            rocks: r.rocking_onset.iter().any(Option::is_some),
         }
     }
 }
@@ -177,6 +187,9 @@ pub struct UnitResult {
     /// its floor over its mass), per case: exactly 1 where a skip rule shows it never slides
     /// (NaN in a building of one storey).
     pub stuck_share_stack: Vec<f64>,
+    /// With the blocks' ratios given ([`UnitOptions::aspect`]; empty otherwise): 1 where the
+    /// stack (any of its stacks, in a building) would start to rock, per case.
+    pub rocks_stack: Vec<u8>,
 }
 
 impl UnitResult {
@@ -207,6 +220,22 @@ impl UnitResult {
     }
 }
 
+/// Whether `case`'s stack of blocks of ratios `aspect`, every block moving at one absolute
+/// acceleration of peak `peak_mps2`, rocks: some interface's group has `Σ_j w_ij·|a| > g`
+/// ([`Rocking`]; summed in the order the exact integrators sum, so a rule's flag is the
+/// simulated stack's).
+fn stuck_rocks(case: &Case, aspect: &[f64], peak_mps2: f64) -> Result<bool, CaseError> {
+    let rocking = Rocking::new(&case.alpha, aspect).map_err(|source| CaseError::Model {
+        case: case.clone(),
+        kind: SystemKind::Stack,
+        source,
+    })?;
+    Ok((0..rocking.blocks()).any(|i| {
+        let on_floor = rocking.weights(i).iter().fold(0.0, |sum, w| sum + w);
+        G - on_floor * peak_mps2 < 0.0
+    }))
+}
+
 /// Whether peaks were taken in a building (they carry the per-floor profiles).
 fn frame_of(p: &Peaks) -> bool {
     !p.floor_a_g.is_empty()
@@ -214,9 +243,12 @@ fn frame_of(p: &Peaks) -> bool {
 
 /// Options for [`run_unit`].
 #[derive(Debug, Clone, Copy)]
-pub struct UnitOptions {
+pub struct UnitOptions<'a> {
     /// Apply the skip rules (off: simulate every system of every case, for checking them).
     pub skip: bool,
+    /// The blocks' width-to-height ratios, bottom first: check whether each case's stack
+    /// rocks (docs/model.md, "Rocking: when a case leaves the model").
+    pub aspect: Option<&'a [f64]>,
 }
 
 /// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`, on
@@ -227,7 +259,7 @@ pub fn run_unit(
     frame: Option<&Frame>,
     ground: &Ground,
     period_index: usize,
-    opts: UnitOptions,
+    opts: UnitOptions<'_>,
 ) -> Result<UnitResult, CaseError> {
     let tp = grid.periods_s[period_index];
     let n = grid.blocks();
@@ -246,10 +278,10 @@ pub fn run_unit(
                 SystemKind::SingleBlock => 1,
                 SystemKind::Rigid => 0,
             };
-            (physics.simulate_building(kind, case, f, ground, &exact))
+            (physics.simulate_building(kind, case, f, ground, &exact, opts.aspect))
                 .map(|r| Peaks::of_building(r, f, floors, blocks))
         }
-        _ => (physics.simulate(kind, case, ground, &exact)).map(Peaks::of_structure),
+        _ => (physics.simulate(kind, case, ground, &exact, opts.aspect)).map(Peaks::of_structure),
     };
     // Keyed by the bits of α (and the index of μ_1): the same floating-point sum, the same system.
     let mut rigid: HashMap<u64, Peaks> = HashMap::new();
@@ -310,6 +342,17 @@ pub fn run_unit(
             (_, None) => (&single[&skey], false),
         };
         out.push_profiles(profile, r, held);
+        if let Some(aspect) = opts.aspect {
+            // A rule's stack moves as one body with the system standing in for it: with the
+            // floor (NoSlip, or a single block that holds) or with the single block.
+            let rocks = match (rule, &resp) {
+                (_, Some(s)) => s.rocks,
+                (SkipRule::NoSlip, None) => stuck_rocks(&case, aspect, r.a_hold_mps2)?,
+                (_, None) if single_holds => stuck_rocks(&case, aspect, r.a_hold_mps2)?,
+                (_, None) => stuck_rocks(&case, aspect, single[&skey].block_a_mps2)?,
+            };
+            out.rocks_stack.push(u8::from(rocks));
+        }
         match (rule, &resp) {
             (_, Some(s)) => {
                 out.u_stack.push(s.u_m);

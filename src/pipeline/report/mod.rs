@@ -39,6 +39,7 @@ mod fit;
 mod grid;
 mod ida;
 mod motions;
+mod rocking;
 mod runs;
 mod select;
 mod text;
@@ -574,6 +575,7 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     if inp.fit.is_some() {
         sections.push(fit_section(&inp, &mut files)?);
     }
+    sections.extend(rocking::rocking_section(study)?);
     if study.configured(StageId::Ida) {
         sections.push(ida::ida_section(study, &mut files)?);
     }

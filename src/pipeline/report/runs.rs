@@ -26,7 +26,7 @@ pub(super) fn simulate(
         ..ExactOptions::default()
     };
     physics
-        .simulate(kind, case, &ground, &opts)
+        .simulate(kind, case, &ground, &opts, None)
         .map_err(|source| ReportError::Case {
             motion: rec.name.clone(),
             source: Box::new(source),
