@@ -68,10 +68,11 @@ pub const IDA: Method = Method {
 };
 
 /// The report's pages and figures (7: the design page's data by name, `ZoneDesign`'s
-/// `building` and `lambda`).
+/// `building` and `lambda`; 8: where the stacks would rock, the table and the design page's
+/// note).
 pub const REPORT: Method = Method {
     name: "report",
-    version: 7,
+    version: 8,
 };
 
 /// The methods as they enter a fingerprint: `name-version` joined by spaces.

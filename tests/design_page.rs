@@ -75,7 +75,11 @@ fn run_study(dir: &Path) -> PathBuf {
                  - { name: TB, target: \"table:tb.txt\" }\n";
     let start = quick.find("zones:").unwrap();
     let end = quick.find("motions:").unwrap();
-    let cfg = format!("{}{zones}{}", &quick[..start], &quick[end..]);
+    // The blocks' ratios, so that the page's rocking note is checked too.
+    let cfg = format!("{}{zones}{}", &quick[..start], &quick[end..]).replace(
+        "  damping_basis: rigid\n",
+        "  damping_basis: rigid\n  aspect: [0.8, 0.25]\n",
+    );
     std::fs::write(dir.join("design-page.yaml"), cfg).unwrap();
     // Starts at T = 0 (the linear segment), then log-log.
     std::fs::write(
@@ -229,7 +233,7 @@ fn design_page_answers_as_the_command_does() {
     let study = run_study(dir.path());
     let report = study.join("report");
     let design = file_url(&report.join("design.html"));
-    let questions: [Question; 18] = [
+    let questions: [Question; 19] = [
         // Section 9's worked example, both zones of the paper.
         ("III", "0.7", "1,1", "0.3,0.1", false),
         ("V", "0.7", "1,1", "0.3,0.1", false),
@@ -240,6 +244,8 @@ fn design_page_answers_as_the_command_does() {
         ("III", "0.3", "0.1,0.5", "0.1,0.05", false),
         ("V", "2", "1,1", "0.3,0.2", false),
         ("III", "1", "0.75,0.5", "0.3,0.12", false),
+        // A grid point whose stack rocks under every motion: the rocking note.
+        ("V", "0.3", "0.1,0.5", "0.3,0.2", false),
         // The other targets: ASCE 7 (every branch of it between 0.3 and 2 s: the plateau,
         // SD1/T) and the table.
         ("US", "0.45", "0.2,0.8", "0.15,0.1", false),
@@ -320,10 +326,18 @@ fn design_page_answers_as_the_command_does() {
     let seen = answer["pages"].as_array().unwrap();
     assert_eq!(seen.len(), questions.len() + 5);
 
+    let mut rocking = 0;
     for (q, page) in questions.iter().zip(seen) {
-        check_page(q, page, &command(&study, q));
+        let cli = command(&study, q);
+        check_page(q, page, &cli);
         check_quiet(page);
+        let notes = cli
+            .as_ref()
+            .map_or(String::new(), |a| a["notes"].to_string());
+        rocking += usize::from(notes.contains("rocking:"));
     }
+    // The rocking note was among the notes compared (and not on every answer).
+    assert!((1..questions.len()).contains(&rocking), "{rocking}");
     // The command extrapolates inside the box and refuses beyond it (the page as it does).
     for q in questions.iter().filter(|q| q.4) {
         let inside = ["2.4", "0.25"].contains(&q.1);

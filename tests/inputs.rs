@@ -129,7 +129,7 @@ fn a_case_file_is_refused_in_its_own_keys_with_the_line() {
     let d = dir.path();
     let one_storey_keys = "`record`, `period`, `alpha`, `mu`, `mu_static`, `damping`, \
                            `damping_basis`, `scale`, `integrator`, `rk4_substeps`, `structure`, \
-                           `yield_strength_ratio`, `post_yield_ratio`, `history`, `building`, \
+                           `yield_strength_ratio`, `post_yield_ratio`, `aspect`, `history`, `building`, \
                            `stacks`, `floor_spectra`";
     let building = "building:\n  storeys: 2\n  period: 0.5\n";
     let stack = "stacks:\n  - floor: 1\n    alpha: [1]\n    mu: [0.2]\n";

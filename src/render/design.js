@@ -397,12 +397,21 @@ function answer(q) {
     lambdaFit = z.lambda.fit ? predict(z.lambda.fit, fitX, q.period, tRigid) : null;
   }
   if (z.lambda_code) lambdaCode = onGrid(z.lambda_code);
+  // study/design.rs, answer: the interpolated share of rocking motions, and its note.
+  const rocksShare = z.rocks_share ? onGrid(z.rocks_share) : null;
+  if (rocksShare !== null && rocksShare > 0) {
+    notes.push("rocking: the stack would start to rock under some of the motions (rocks_share, " +
+      "interpolated from the grid cases around this structure): there the sliding-only model's " +
+      "T_new and λ are outside their model (docs/model.md, \"Rocking: when a case leaves the " +
+      "model\")");
+  }
   const tPaper = aPeriod(paperEquation(z.paper, x), "the paper's equation", notes);
   const sa = (t) => (fin(t) === null ? null : saG(z.target, t));
   return {
     answer: {
       zone: z.zone, target: z.target.spec, fit_form: z.fit ? z.fit.form : "", building: label,
       lambda_grid: lambdaGrid, lambda_fit: lambdaFit, lambda_code_grid: lambdaCode,
+      rocks_share: rocksShare,
       t_rigid_s: tRigid, t_new_grid_s: tGrid, t_new_fit_s: tFit, t_new_paper_s: tPaper,
       sa_tp_g: saG(z.target, q.period), sa_new_g: sa(tGrid !== null ? tGrid : tFit),
       sa_new_grid_g: sa(tGrid), sa_new_fit_g: sa(tFit), sa_new_paper_g: sa(tPaper), notes,

@@ -570,14 +570,14 @@ pub fn answer(z: &ZoneDesign, q: &Query) -> Result<Answer, DesignError> {
         .and_then(|values| z.grid.interpolate(values, &point).ok().flatten());
     let rocks_share = (z.rocks_share.as_ref())
         .and_then(|values| z.grid.interpolate(values, &point).ok().flatten());
-    if let Some(share) = rocks_share.filter(|&s| s > 0.0) {
-        notes.push(format!(
-            "rocking: the stack would start to rock under {:.0} % of the motions (interpolated \
-             from the grid cases around this structure): there the sliding-only model's T_new \
-             and λ are outside their model (docs/model.md, \"Rocking: when a case leaves the \
-             model\")",
-            100.0 * share
-        ));
+    if rocks_share.is_some_and(|s| s > 0.0) {
+        notes.push(
+            "rocking: the stack would start to rock under some of the motions (rocks_share, \
+             interpolated from the grid cases around this structure): there the sliding-only \
+             model's T_new and λ are outside their model (docs/model.md, \"Rocking: when a case \
+             leaves the model\")"
+                .into(),
+        );
     }
     let t_new_paper_s = a_period(
         z.paper.and_then(|p| p.evaluate(&x)),
