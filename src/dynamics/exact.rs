@@ -928,8 +928,13 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
     /// otherwise it changes nothing and returns `false`.
     fn quiet_interval(&mut self, ga: f64, slope: f64) -> bool {
         let n = self.n;
-        // The cluster arrays are those of the current mode (built at the last piece).
-        if self.top[0] != n || (YIELDS && self.spring.plastic()) {
+        // The cluster arrays are those of the current mode (built at the last piece). A rocking
+        // check still looking for its onset is made on every piece: the peaks so far, which
+        // clear a quiet interval, need not bound its criterion.
+        if self.top[0] != n
+            || (YIELDS && self.spring.plastic())
+            || (self.sys.rocking().is_some() && self.out.rocking_onset.is_none())
+        {
             return false;
         }
         let cluster = self.structure_elastic[n];
