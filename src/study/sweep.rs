@@ -222,8 +222,8 @@ impl UnitResult {
 
 /// Whether `case`'s stack of blocks of ratios `aspect`, every block moving at one absolute
 /// acceleration of peak `peak_mps2`, rocks: some interface's group has `Σ_j w_ij·|a| > g`
-/// ([`Rocking`]; summed in the order the exact integrators sum, so a rule's flag is the
-/// simulated stack's).
+/// ([`Rocking`]), the criterion the integrators search, here at the stand-in's exact peak (the
+/// two can differ only for a peak within round-off of the threshold).
 fn stuck_rocks(case: &Case, aspect: &[f64], peak_mps2: f64) -> Result<bool, CaseError> {
     let rocking = Rocking::new(&case.alpha, aspect).map_err(|source| CaseError::Model {
         case: case.clone(),
