@@ -72,15 +72,7 @@ pub fn design(dir: &Path, q: &Query) -> Result<Answer, DesignError> {
         }
         _ => {
             let zone_fit = fit.zones.iter().find(|z| z.zone == q.zone);
-            let mut data = ZoneDesign::new(
-                &q.zone,
-                target,
-                grid,
-                t.vars.t_new.iter().copied().collect(),
-                zone_fit,
-            );
-            data.rocks_share = (t.rocks_share.as_ref()).map(|r| r.iter().copied().collect());
-            data
+            ZoneDesign::of_zone(&q.zone, target, grid, &t, zone_fit)
         }
     };
     answer(&data, q)

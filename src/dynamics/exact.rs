@@ -1127,15 +1127,10 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         let (osc, top) = (self.osc(), self.top[0]);
         let mut found = None;
         for i in 0..rocking.blocks() {
-            let (mut on_wave, mut constant) = (0.0, 0.0);
-            for (k, w) in rocking.weights(i).iter().enumerate() {
-                let body = i + 1 + k;
-                if body <= top {
-                    on_wave += w;
-                } else {
-                    constant += w * self.accel_free[self.cluster_of[body]];
-                }
-            }
+            // Block j is body j + 1.
+            let (on_wave, constant) = rocking.split(i, |j| {
+                (j + 1 > top).then(|| self.accel_free[self.cluster_of[j + 1]])
+            });
             for sign in [1.0, -1.0] {
                 let g = self.a0.affine(-sign * on_wave, G - sign * constant);
                 let at =

@@ -100,6 +100,32 @@ impl Rocking {
         (0..self.blocks()).find(|&i| self.demand(i, &accel_mps2[i..]).abs() > G)
     }
 
+    /// Interface `interface`'s weights split between the blocks that move with their support's
+    /// acceleration (`free_accel_mps2(j)` is `None` for block `j`, 0-based) and those that move
+    /// at a constant one (`Some(a)`): `(Σ w_ij over the first, Σ w_ij·a_j over the second)`, so
+    /// that `Σ_j w_ij·a_j = first·a_support + second` (what the exact integrators search).
+    pub fn split(
+        &self,
+        interface: usize,
+        free_accel_mps2: impl Fn(usize) -> Option<f64>,
+    ) -> (f64, f64) {
+        let (mut on_support, mut constant) = (0.0, 0.0);
+        for (k, w) in self.weights[interface].iter().enumerate() {
+            match free_accel_mps2(interface + k) {
+                None => on_support += w,
+                Some(a) => constant += w * a,
+            }
+        }
+        (on_support, constant)
+    }
+
+    /// Whether the stack rocks when every block moves at one absolute acceleration of peak
+    /// `peak_mps2` (stuck to its support, or sliding as one body): some interface has
+    /// `Σ_j w_ij·|a| > g`, written as the integrators' switching function `g − Σw·|a| < 0`.
+    pub fn rocks_as_one(&self, peak_mps2: f64) -> bool {
+        (0..self.blocks()).any(|i| G - self.split(i, |_| None).0 * peak_mps2 < 0.0)
+    }
+
     /// `Σ_j w_ij·a_j`, m/s², `accel_above` the accelerations of blocks `i, i+1, …`.
     pub fn demand(&self, interface: usize, accel_above: &[f64]) -> f64 {
         (self.weights[interface].iter())

@@ -257,6 +257,21 @@ impl ZoneDesign {
         }
     }
 
+    /// Zone `zone` of a one-storey study: its stored `T_new` and rocking shares (`t`), its fit
+    /// and its target.
+    pub fn of_zone(
+        zone: &str,
+        target: TargetSpectrum,
+        grid: Grid,
+        t: &ZoneTnew,
+        fit: Option<&ZoneFit>,
+    ) -> Self {
+        let flat = |v: &ndarray::ArrayD<f64>| v.iter().copied().collect::<Vec<f64>>();
+        let mut data = Self::new(zone, target, grid, flat(&t.vars.t_new), fit);
+        data.rocks_share = t.rocks_share.as_ref().map(flat);
+        data
+    }
+
     /// Frame `f` (stored order) of zone `zone` of a building study: the frame's cases of the
     /// zone's stored `T_new` and `λ` (`t` holds every frame's), `fit.yaml`'s frame and
     /// building features, the zone's fits of `T_new` and `λ`.

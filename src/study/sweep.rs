@@ -221,19 +221,16 @@ impl UnitResult {
 }
 
 /// Whether `case`'s stack of blocks of ratios `aspect`, every block moving at one absolute
-/// acceleration of peak `peak_mps2`, rocks: some interface's group has `Σ_j w_ij·|a| > g`
-/// ([`Rocking`]), the criterion the integrators search, here at the stand-in's exact peak (the
-/// two can differ only for a peak within round-off of the threshold).
+/// acceleration of peak `peak_mps2`, rocks ([`Rocking::rocks_as_one`]): the criterion the
+/// integrators search, here at the stand-in's exact peak (the two can differ only for a peak
+/// within round-off of the threshold).
 fn stuck_rocks(case: &Case, aspect: &[f64], peak_mps2: f64) -> Result<bool, CaseError> {
     let rocking = Rocking::new(&case.alpha, aspect).map_err(|source| CaseError::Model {
         case: case.clone(),
         kind: SystemKind::Stack,
         source,
     })?;
-    Ok((0..rocking.blocks()).any(|i| {
-        let on_floor = rocking.weights(i).iter().fold(0.0, |sum, w| sum + w);
-        G - on_floor * peak_mps2 < 0.0
-    }))
+    Ok(rocking.rocks_as_one(peak_mps2))
 }
 
 /// Whether peaks were taken in a building (they carry the per-floor profiles).

@@ -606,13 +606,10 @@ impl<'b> Integrator<'b> {
             }
             let mut found = None;
             for i in 0..s.blocks {
-                let (mut on_floor, mut constant) = (0.0, 0.0);
-                for (k, w) in rocking.weights(i).iter().enumerate() {
-                    match self.holder[s.first + i + k] {
-                        Holder::Floor(_) => on_floor += w,
-                        Holder::Free(c) => constant += w * self.free[c].accel,
-                    }
-                }
+                let (on_floor, constant) = rocking.split(i, |j| match self.holder[s.first + j] {
+                    Holder::Floor(_) => None,
+                    Holder::Free(c) => Some(self.free[c].accel),
+                });
                 for sign in [1.0, -1.0] {
                     let mut g = Func {
                         row: Some((Row::Accel, s.floor)),

@@ -95,16 +95,13 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
         let v = &z.tnew.vars;
         match inp.study.building() {
             None => {
-                let mut data = ZoneDesign::new(
+                zones.push(ZoneDesign::of_zone(
                     &z.name,
                     target,
                     grid.clone(),
-                    v.t_new.iter().copied().collect(),
+                    &z.tnew,
                     Some(z.fit()),
-                );
-                data.rocks_share =
-                    (z.tnew.rocks_share.as_ref()).map(|r| r.iter().copied().collect());
-                zones.push(data);
+                ));
                 drr.push(Ratios {
                     zone: z.name.clone(),
                     drr_1: drawn_all(&v.drr_1, 0..v.drr_1.len()),
