@@ -32,6 +32,7 @@ fn integrators(c: &mut Criterion) {
     };
     let opts = ExactOptions {
         energy_balance: false,
+        abs_velocity: false,
         ..ExactOptions::default()
     };
     let mut g = c.benchmark_group("integrator");

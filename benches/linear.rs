@@ -30,6 +30,7 @@ fn linear(c: &mut Criterion) {
     };
     let opts = ExactOptions {
         energy_balance: false,
+        abs_velocity: false,
         ..ExactOptions::default()
     };
     let mut g = c.benchmark_group("linear");

@@ -14,6 +14,7 @@ const HIST: ExactOptions = ExactOptions {
     history: true,
     max_switches_per_step: 1000,
     energy_balance: true,
+    abs_velocity: true,
 };
 
 /// Exact integrator on real records: input = kinetic + strain + damping + friction to 1e-9 of
@@ -201,6 +202,7 @@ fn switch_guard_gives_clear_error() {
         history: false,
         max_switches_per_step: 0,
         energy_balance: true,
+        abs_velocity: true,
     };
     let msg = simulate_exact(&sys, &ground, &opts)
         .unwrap_err()

@@ -17,6 +17,7 @@ const HIST: ExactOptions = ExactOptions {
     history: true,
     max_switches_per_step: 1000,
     energy_balance: true,
+    abs_velocity: true,
 };
 
 /// A bare structure (no blocks) of period `tp`, bare-structure damping `zeta`.

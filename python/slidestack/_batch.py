@@ -23,6 +23,7 @@ LIST_DIMS: Dict[str, Any] = {
     "mu": "interface",
     "mu_static": "interface",
     "peak_abs_accel_g": "body",
+    "peak_abs_velocity_mps": "body",
     "peak_slip_m": "interface",
     "residual_slip_m": "interface",
     "slip_time_s": "interface",
@@ -37,6 +38,7 @@ LIST_DIMS: Dict[str, Any] = {
     "modes_s": "mode",
     "floor_peak_displacement_m": "floor",
     "floor_peak_abs_accel_g": "floor",
+    "floor_peak_abs_velocity_mps": "floor",
     "storey_peak_drift_m": "storey",
     "storey_peak_drift_ratio": "storey",
     "storey_ductility": "storey",
@@ -47,6 +49,7 @@ LIST_DIMS: Dict[str, Any] = {
     "stacks_peak_slip_m": "interface",
     "stacks_residual_slip_m": "interface",
     "stacks_peak_abs_accel_g": "block",
+    "stacks_peak_abs_velocity_mps": "block",
     # the rocking check (aspect given): a ratio per block
     "aspect": "block",
     # floor response spectra (floor_spectra asked for): psa_g[damping][floor][period]; the

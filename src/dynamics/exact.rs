@@ -64,6 +64,9 @@ pub struct ExactOptions {
     /// `energy.damping` and `energy_balance_error_max` are NaN (friction, kinetic and strain
     /// energy are still exact); the sweep, which stores only friction energy, turns it off.
     pub energy_balance: bool,
+    /// Search the peak absolute velocities (docs/model.md, "Absolute velocities"). Off, they
+    /// are NaN; the study's stages, which do not store them, turn it off.
+    pub abs_velocity: bool,
 }
 
 impl Default for ExactOptions {
@@ -72,6 +75,7 @@ impl Default for ExactOptions {
             history: false,
             max_switches_per_step: 1000,
             energy_balance: true,
+            abs_velocity: true,
         }
     }
 }
@@ -440,6 +444,9 @@ struct ExactRun<'s, const YIELDS: bool, const LONG_PERIODS: bool> {
     bounds: Option<BreakBounds>,
     /// Constant absolute acceleration of each free cluster, m/s².
     accel_free: Vec<f64>,
+    /// The ground's velocity at the piece's start, m/s: the record integrated exactly (it is
+    /// linear between samples).
+    vg: f64,
     events: Vec<Event>,
     slip_start: Vec<f64>,
     out: Response,
@@ -482,6 +489,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             .collect();
         let out = Response {
             peak_abs_accel_mps2: vec![0.0; n + 1],
+            peak_abs_velocity_mps: vec![0.0; n + 1],
             peak_slip_m: vec![0.0; n],
             residual_slip_m: vec![0.0; n],
             slip_time_s: vec![0.0; n],
@@ -515,6 +523,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             a0: Tracked::ZERO,
             bounds: None,
             accel_free: vec![0.0; n + 1],
+            vg: 0.0,
             events: Vec::with_capacity(2 * n),
             slip_start: vec![0.0; n],
             out,
@@ -537,6 +546,8 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             self.record(h, 0.0, accel[0]);
         }
         let mut input_peak = 0.0f64;
+        // The ground's velocity at the sample, m/s (at rest at the record's start).
+        let mut vg_k = 0.0;
         for k in 0..steps {
             super::watched(watch, k, steps)?;
             let t0 = k as f64 * self.dt;
@@ -545,6 +556,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             let mut switches_here = 0;
             loop {
                 let ga = accel[k] + slope * tau;
+                self.vg = vg_k + tau * (accel[k] + 0.5 * slope * tau);
                 if tau == 0.0 && self.quiet_interval(ga, slope) {
                     break;
                 }
@@ -606,6 +618,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
                     break;
                 }
             }
+            vg_k += 0.5 * self.dt * (accel[k] + accel[k + 1]);
             let t1 = (k + 1) as f64 * self.dt;
             if self.opts.energy_balance {
                 let (kinetic, mut strain) = Energy::state_terms(
@@ -973,6 +986,17 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
         if a_lo.abs().max(a_hi.abs()) + curv_a > floor {
             return false;
         }
+        if self.opts.abs_velocity {
+            let v_abs = self.abs_velocity_wave(&vel, ga, slope);
+            let (v_lo, v_hi) = (v_abs.p[0] + v_abs.c, v_abs.eval(&b));
+            let amp_v2 = cluster.natural * cluster.natural * v_abs.amplitude();
+            let curv_v = v_abs.deriv_abs_bound(2, h, 1.0, amp_v2) * h * h / 8.0;
+            let floor_v =
+                (self.out.peak_abs_velocity_mps.iter().copied()).fold(f64::INFINITY, f64::min);
+            if v_lo.abs().max(v_hi.abs()) + curv_v > floor_v {
+                return false;
+            }
+        }
         let (lo, hi) = accel_limits(self.mode_bounds(n, 0.0));
         if a_lo.min(a_hi) - curv_a < lo || a_lo.max(a_hi) + curv_a > hi {
             return false;
@@ -1062,6 +1086,16 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             .plus_constant(-f_above / mass)
     }
 
+    /// `vel + v_g`: a velocity wave relative to the ground made absolute by the ground's
+    /// velocity over the piece, `v_g + a_g·τ + ȧ_g·τ²/2` (`ga`, `slope` at the piece's start).
+    fn abs_velocity_wave(&self, vel: &Wave, ga: f64, slope: f64) -> Wave {
+        let mut w = *vel;
+        w.p[0] += self.vg;
+        w.p[1] += ga;
+        w.p[2] += 0.5 * slope;
+        w
+    }
+
     /// Moves the state to the end of the current piece, accumulating peaks and energy over it.
     fn advance(
         &mut self,
@@ -1108,8 +1142,45 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             let p = &mut self.out.peak_abs_accel_mps2[j];
             *p = p.max(a);
         }
+        if self.opts.abs_velocity {
+            self.abs_velocity_peaks(ga, slope, b)?;
+        }
         self.rocking(t_start, b)?;
         self.settle(ga, slope, b);
+        Ok(())
+    }
+
+    /// Raises the peak absolute velocities over the piece ending at `b`: the structure's
+    /// cluster's wave plus the ground's quadratic, searched like the acceleration; a free
+    /// cluster's is linear (its absolute acceleration is constant), so its ends bound it.
+    fn abs_velocity_peaks(
+        &mut self,
+        ga: f64,
+        slope: f64,
+        b: &Basis,
+    ) -> Result<(), search::SearchError> {
+        let (osc, top) = (self.osc(), self.top[0]);
+        let floor = self.out.peak_abs_velocity_mps[..=top]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let v_abs = self.abs_velocity_wave(&self.vel[0], ga, slope);
+        let v_abs = Tracked::new(v_abs, osc, self.structure_cluster().natural);
+        let mut n0 = v_abs.start();
+        n0.f = self.v[0] + self.vg;
+        let n1 = v_abs.node(osc, *b);
+        let (best_v, _) = search::peak_abs(&v_abs.over(osc), &n0, &n1, floor, self.dt)?;
+        if best_v > floor {
+            for p in &mut self.out.peak_abs_velocity_mps[..=top] {
+                *p = p.max(best_v);
+            }
+        }
+        for j in top + 1..=self.n {
+            let v0 = self.v[j] + self.vg;
+            let v1 = v0 + self.accel_free[self.cluster_of[j]] * b.tau;
+            let p = &mut self.out.peak_abs_velocity_mps[j];
+            *p = p.max(v0.abs()).max(v1.abs());
+        }
         Ok(())
     }
 
@@ -1290,6 +1361,9 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             e.input = f64::NAN;
             e.damping = f64::NAN;
             self.out.energy_balance_error_max = f64::NAN;
+        }
+        if !self.opts.abs_velocity {
+            self.out.peak_abs_velocity_mps.fill(f64::NAN);
         }
         for i in 0..self.n {
             self.out.residual_slip_m[i] = self.x[i + 1] - self.x[i];

@@ -146,6 +146,9 @@ pub struct Response {
     pub peak_displacement_time_s: f64,
     /// Peak |absolute acceleration| of every body, m/s², structure first then blocks bottom-up.
     pub peak_abs_accel_mps2: Vec<f64>,
+    /// Peak |absolute velocity| of every body, m/s, in the same order: the body's velocity
+    /// relative to the ground plus the ground's (docs/model.md, "Absolute velocities").
+    pub peak_abs_velocity_mps: Vec<f64>,
     /// Peak |relative displacement| across each interface, m, interface 1 first.
     pub peak_slip_m: Vec<f64>,
     /// Relative displacement across each interface at the end of the record, m.
@@ -175,7 +178,7 @@ pub struct Response {
 
 impl Response {
     /// Refuses a response with a non-finite peak or energy term (a diverged integration) instead
-    /// of reporting it. NaN energy terms the options left out are not checked.
+    /// of reporting it. NaN energy terms and velocities the options left out are not checked.
     pub fn check_finite(&self) -> Result<(), super::SimError> {
         let e = &self.energy;
         let finite = self.peak_displacement_m.is_finite()
@@ -186,6 +189,7 @@ impl Response {
                 .chain(&self.peak_slip_m)
                 .chain(&self.residual_slip_m)
                 .all(|v| v.is_finite())
+            && self.peak_abs_velocity_mps.iter().all(|v| !v.is_infinite())
             && [e.kinetic, e.strain, e.friction, e.hysteretic]
                 .iter()
                 .all(|v| v.is_finite());

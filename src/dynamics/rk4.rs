@@ -267,6 +267,7 @@ impl<'s> Rk4<'s> {
         let steps = acc_g.len() - 1;
         let mut out = Response {
             peak_abs_accel_mps2: vec![0.0; nb],
+            peak_abs_velocity_mps: vec![0.0; nb],
             peak_slip_m: vec![0.0; n],
             residual_slip_m: vec![0.0; n],
             slip_time_s: vec![0.0; n],
@@ -283,11 +284,19 @@ impl<'s> Rk4<'s> {
             a0 + (a1 - a0) * frac
         };
         let mut input_peak = 0.0f64;
+        // The ground's velocity at the sample, m/s (the record integrated exactly).
+        let mut vg_k = 0.0;
         for k in 0..steps {
             super::watched(watch, k, steps)?;
+            let slope = (acc_g[k + 1] - acc_g[k]) / dt;
             for sub in 0..substeps {
                 let frac0 = sub as f64 / substeps as f64;
                 let t = k as f64 * dt + sub as f64 * h;
+                let tau = sub as f64 * h;
+                let vg = vg_k + tau * (acc_g[k] + 0.5 * slope * tau);
+                for (p, v) in out.peak_abs_velocity_mps.iter_mut().zip(&self.v) {
+                    *p = p.max((v + vg).abs());
+                }
                 self.choose_pattern();
                 switches += self
                     .contacts
@@ -329,6 +338,7 @@ impl<'s> Rk4<'s> {
                 }
                 self.after_step(h, t, &s_before, &mut out);
             }
+            vg_k += 0.5 * dt * (acc_g[k] + acc_g[k + 1]);
             let mut e = self.energy.clone();
             self.fill_state_energy(&mut e);
             input_peak = input_peak.max(e.input.abs());

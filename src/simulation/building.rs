@@ -299,6 +299,8 @@ pub struct StackSummary {
     pub residual_slip_m: Vec<f64>,
     /// Blocks bottom-up, g.
     pub peak_abs_accel_g: Vec<f64>,
+    /// Blocks bottom-up, m/s: relative to the ground plus the ground's.
+    pub peak_abs_velocity_mps: Vec<f64>,
     /// Width over height per block, as given (absent: rocking not checked).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub aspect: Option<Vec<f64>>,
@@ -326,6 +328,8 @@ pub struct BuildingSummary {
     /// Floor 1 first.
     pub floor_peak_displacement_m: Vec<f64>,
     pub floor_peak_abs_accel_g: Vec<f64>,
+    /// Relative to the ground plus the ground's, m/s (pelicun's PFV).
+    pub floor_peak_abs_velocity_mps: Vec<f64>,
     /// Storey 1 first: `δ_i = u_i − u_{i−1}`.
     pub storey_peak_drift_m: Vec<f64>,
     /// `max|δ_i|/h_i`, storey 1 first.
@@ -374,10 +378,11 @@ pub fn building_summary(
                 mu_static: st.mu_static.clone().unwrap_or_else(|| st.mu.clone()),
                 peak_slip_m: r.peak_slip_m[range.clone()].to_vec(),
                 residual_slip_m: r.residual_slip_m[range.clone()].to_vec(),
-                peak_abs_accel_g: r.block_peak_abs_accel_mps2[range]
+                peak_abs_accel_g: r.block_peak_abs_accel_mps2[range.clone()]
                     .iter()
                     .map(|a| a / G)
                     .collect(),
+                peak_abs_velocity_mps: r.block_peak_abs_velocity_mps[range].to_vec(),
                 aspect: st.aspect.clone(),
                 rocking_onset: st.aspect.as_ref().map(|_| r.rocking_onset[si]),
             }
@@ -414,6 +419,7 @@ pub fn building_summary(
         modes_s: b.periods_s().to_vec(),
         floor_peak_displacement_m: r.floor_peak_displacement_m.clone(),
         floor_peak_abs_accel_g: r.floor_peak_abs_accel_mps2.iter().map(|a| a / G).collect(),
+        floor_peak_abs_velocity_mps: r.floor_peak_abs_velocity_mps.clone(),
         storey_peak_drift_m: r.storey_peak_drift_m.clone(),
         storey_peak_drift_ratio: (r.storey_peak_drift_m.iter().zip(&heights))
             .map(|(d, h)| d / h)

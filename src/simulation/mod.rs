@@ -697,6 +697,7 @@ impl Simulation {
             peak_displacement_m: r.peak_displacement_m,
             peak_displacement_time_s: r.peak_displacement_time_s,
             peak_abs_accel_g: r.peak_abs_accel_mps2.iter().map(|a| a / G).collect(),
+            peak_abs_velocity_mps: r.peak_abs_velocity_mps.clone(),
             peak_slip_m: r.peak_slip_m.clone(),
             residual_slip_m: r.residual_slip_m.clone(),
             slip_time_s: r.slip_time_s.clone(),
@@ -742,6 +743,8 @@ pub struct Summary {
     pub peak_displacement_time_s: f64,
     /// Structure, then blocks bottom-up.
     pub peak_abs_accel_g: Vec<f64>,
+    /// Structure, then blocks bottom-up: relative to the ground plus the ground's, m/s.
+    pub peak_abs_velocity_mps: Vec<f64>,
     pub peak_slip_m: Vec<f64>,
     pub residual_slip_m: Vec<f64>,
     pub slip_time_s: Vec<f64>,

@@ -126,6 +126,7 @@ const RUN: ExactOptions = ExactOptions {
     history: false,
     max_switches_per_step: 1000,
     energy_balance: false,
+    abs_velocity: false,
 };
 
 fn point(

@@ -184,6 +184,7 @@ fn next_fraction(f: f64) -> f64 {
 fn options() -> ExactOptions {
     ExactOptions {
         energy_balance: false,
+        abs_velocity: false,
         ..ExactOptions::default()
     }
 }

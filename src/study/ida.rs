@@ -665,6 +665,7 @@ pub fn trace_system(
 ) -> Result<Trace<RunDemand>, SimError> {
     let opts = ExactOptions {
         energy_balance: false,
+        abs_velocity: false,
         ..ExactOptions::default()
     };
     let mut accel = Vec::with_capacity(padded_mps2.len());

@@ -262,9 +262,11 @@ pub fn run_unit(
     let n = grid.blocks();
     let cases = grid.cases_per_unit();
     let mut out = UnitResult::default();
-    // Only friction energy is stored: the input and damping integrals are not needed.
+    // Only friction energy is stored: the input and damping integrals are not needed; nor are
+    // the absolute velocities.
     let exact = ExactOptions {
         energy_balance: false,
+        abs_velocity: false,
         ..ExactOptions::default()
     };
     let floors = frame.map(Frame::floors);

@@ -552,6 +552,7 @@ fn options(case: &StressCase) -> ExactOptions {
         history: true,
         max_switches_per_step: case.max_switches_per_step,
         energy_balance: true,
+        abs_velocity: true,
     }
 }
 

@@ -241,6 +241,22 @@ struct Func {
     df0: Option<f64>,
 }
 
+/// What a peak function is the peak of.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum PeakOf {
+    /// Floor `j`'s displacement.
+    Disp(usize),
+    /// Storey `i`'s drift.
+    Drift(usize),
+    /// Floor `f`'s absolute acceleration (and its riders').
+    Accel(usize),
+    /// Storey `j`'s shear.
+    Shear(usize),
+    /// Floor `f`'s absolute velocity (and its riders').
+    Velocity(usize),
+    Overturning,
+}
+
 /// A floor's acceleration bound (m/s²) with the interface whose static limit sets it.
 type Bound = Option<(f64, usize)>;
 
@@ -347,8 +363,11 @@ struct Integrator<'b> {
     p0: Vec<f64>,
     events: Vec<Event>,
     /// Peak functions: floor displacements, storey drifts, floor accelerations, storey shears,
-    /// the overturning moment.
-    peaks: Vec<Func>,
+    /// floor absolute velocities, the overturning moment.
+    peaks: Vec<(PeakOf, Func)>,
+    /// The ground's velocity at the piece's start, m/s: the record integrated exactly (it is
+    /// linear between samples).
+    vg: f64,
     /// `N × N`, `[j][l] = Σ_{i≥j} C_il`, N·s/m: the dampers' share of storey `j`'s shear per
     /// unit velocity of floor `l` (row 0: `1ᵀ·C`, the base shear's).
     damping_above: Vec<f64>,
@@ -477,6 +496,7 @@ impl<'b> Integrator<'b> {
             p0: vec![0.0; n],
             events: Vec::new(),
             peaks: Vec::new(),
+            vg: 0.0,
             damping_above: (0..n * n)
                 .map(|jl| {
                     let (j, l) = (jl / n, jl % n);
@@ -508,6 +528,8 @@ impl<'b> Integrator<'b> {
             self.record(h, 0.0, accel[0]);
         }
         let mut input_peak = 0.0f64;
+        // The ground's velocity at the sample, m/s (at rest at the record's start).
+        let mut vg_k = 0.0;
         for k in 0..steps {
             watched(watch, k, steps)?;
             let t0 = k as f64 * self.dt;
@@ -516,6 +538,7 @@ impl<'b> Integrator<'b> {
             let mut switches_here = 0;
             loop {
                 let ga = accel[k] + slope * tau;
+                self.vg = vg_k + tau * (accel[k] + 0.5 * slope * tau);
                 self.build(ga, slope)?;
                 let h = self.dt - tau;
                 let mode = self.mode();
@@ -569,6 +592,8 @@ impl<'b> Integrator<'b> {
                     });
                 }
             }
+            vg_k += 0.5 * self.dt * (accel[k] + accel[k + 1]);
+            self.vg = vg_k;
             if self.opts.energy_balance {
                 let (kinetic, strain) = self.state_energy();
                 input_peak = input_peak.max(self.energy.input.abs());
@@ -765,7 +790,7 @@ impl<'b> Integrator<'b> {
                 -slope / 6.0,
             ];
         }
-        self.build_functions(&mode);
+        self.build_functions(&mode, ga, slope);
         Ok(())
     }
 
@@ -870,7 +895,7 @@ impl<'b> Integrator<'b> {
         }
     }
 
-    fn build_functions(&mut self, mode: &Mode) {
+    fn build_functions(&mut self, mode: &Mode, ga: f64, slope: f64) {
         let (n, b) = (self.n, self.b);
         let mut events = std::mem::take(&mut self.events);
         let mut peaks = std::mem::take(&mut self.peaks);
@@ -975,13 +1000,16 @@ impl<'b> Integrator<'b> {
         // Peak functions start at the state; inside the piece the modal values differ from it
         // by round-off only, so they need no anchoring.
         for j in 0..n {
-            peaks.push(Func {
-                row: Some((Row::Disp, j)),
-                scale: 1.0,
-                poly: [0.0; 4],
-                f0: self.x[j],
-                df0: Some(self.v[j]),
-            });
+            peaks.push((
+                PeakOf::Disp(j),
+                Func {
+                    row: Some((Row::Disp, j)),
+                    scale: 1.0,
+                    poly: [0.0; 4],
+                    f0: self.x[j],
+                    df0: Some(self.v[j]),
+                },
+            ));
         }
         for i in 0..n {
             let (x_prev, v_prev) = if i > 0 {
@@ -989,13 +1017,16 @@ impl<'b> Integrator<'b> {
             } else {
                 (0.0, 0.0)
             };
-            peaks.push(Func {
-                row: Some((Row::Drift, i)),
-                scale: 1.0,
-                poly: [0.0; 4],
-                f0: self.x[i] - x_prev,
-                df0: Some(self.v[i] - v_prev),
-            });
+            peaks.push((
+                PeakOf::Drift(i),
+                Func {
+                    row: Some((Row::Drift, i)),
+                    scale: 1.0,
+                    poly: [0.0; 4],
+                    f0: self.x[i] - x_prev,
+                    df0: Some(self.v[i] - v_prev),
+                },
+            ));
         }
         for f in 0..n {
             let mut g = Func {
@@ -1006,7 +1037,7 @@ impl<'b> Integrator<'b> {
                 df0: None,
             };
             g.f0 = Self::value_at(mode, &g, &self.p_start).0;
-            peaks.push(g);
+            peaks.push((PeakOf::Accel(f), g));
         }
         let heights = self.b.storey_heights_m();
         let (mut moment_offset, mut moment) = (0.0, 0.0);
@@ -1017,23 +1048,44 @@ impl<'b> Integrator<'b> {
                 .sum();
             let x_prev = if j > 0 { self.x[j - 1] } else { 0.0 };
             let shear = self.storeys[j].force(self.x[j] - x_prev) + damper;
-            peaks.push(Func {
-                row: Some((Row::Shear, j)),
-                scale: 1.0,
-                poly: [self.offsets[j], 0.0, 0.0, 0.0],
-                f0: shear,
-                df0: None,
-            });
+            peaks.push((
+                PeakOf::Shear(j),
+                Func {
+                    row: Some((Row::Shear, j)),
+                    scale: 1.0,
+                    poly: [self.offsets[j], 0.0, 0.0, 0.0],
+                    f0: shear,
+                    df0: None,
+                },
+            ));
             moment_offset += heights[j] * self.offsets[j];
             moment += heights[j] * shear;
         }
-        peaks.push(Func {
-            row: Some((Row::Overturning, 0)),
-            scale: 1.0,
-            poly: [moment_offset, 0.0, 0.0, 0.0],
-            f0: moment,
-            df0: None,
-        });
+        peaks.push((
+            PeakOf::Overturning,
+            Func {
+                row: Some((Row::Overturning, 0)),
+                scale: 1.0,
+                poly: [moment_offset, 0.0, 0.0, 0.0],
+                f0: moment,
+                df0: None,
+            },
+        ));
+        // Absolute velocity: the floor's relative velocity plus the ground's quadratic.
+        if self.opts.abs_velocity {
+            for j in 0..n {
+                peaks.push((
+                    PeakOf::Velocity(j),
+                    Func {
+                        row: Some((Row::Vel, j)),
+                        scale: 1.0,
+                        poly: [self.vg, ga, 0.5 * slope, 0.0],
+                        f0: self.v[j] + self.vg,
+                        df0: None,
+                    },
+                ));
+            }
+        }
         self.events = events;
         self.peaks = peaks;
     }
@@ -1130,20 +1182,22 @@ impl<'b> Integrator<'b> {
         let dt = self.dt;
         self.loose_mass_time += self.loose_mass_kg * end;
         // Peaks: floor displacements, storey drifts, floor accelerations (with the blocks that
-        // ride on each floor), storey shears, the overturning moment.
+        // ride on each floor), storey shears, floor velocities (with their riders), the
+        // overturning moment.
         for idx in 0..self.peaks.len() {
-            let g = self.peaks[idx];
-            let (kind, j) = (idx / n, idx % n);
-            let best = match kind {
-                0 => self.out.floor_peak_displacement_m[j],
-                1 => self.out.storey_peak_drift_m[j],
-                3 => self.out.storey_peak_shear_n[j],
-                4 => self.out.peak_overturning_n_m,
-                _ => {
-                    let mut floor = self.out.floor_peak_abs_accel_mps2[j];
+            let (of, g) = self.peaks[idx];
+            let best = match of {
+                PeakOf::Disp(j) => self.out.floor_peak_displacement_m[j],
+                PeakOf::Drift(i) => self.out.storey_peak_drift_m[i],
+                PeakOf::Shear(j) => self.out.storey_peak_shear_n[j],
+                PeakOf::Overturning => self.out.peak_overturning_n_m,
+                PeakOf::Accel(f) | PeakOf::Velocity(f) => {
+                    let (floor_peaks, block_peaks) =
+                        self.out.riders(matches!(of, PeakOf::Velocity(_)));
+                    let mut floor = floor_peaks[f];
                     for q in 0..nb {
-                        if self.holder[q] == Holder::Floor(j) {
-                            floor = floor.min(self.out.block_peak_abs_accel_mps2[q]);
+                        if self.holder[q] == Holder::Floor(f) {
+                            floor = floor.min(block_peaks[q]);
                         }
                     }
                     floor
@@ -1157,28 +1211,37 @@ impl<'b> Integrator<'b> {
             let n1 = self.node_at(mode, &g, &self.p_end);
             let (peak, _) = search::peak_abs(&f, &n0, &n1, best, dt)?;
             if peak > best {
-                match kind {
-                    0 => self.out.floor_peak_displacement_m[j] = peak,
-                    1 => self.out.storey_peak_drift_m[j] = peak,
-                    3 => self.out.storey_peak_shear_n[j] = peak,
-                    4 => self.out.peak_overturning_n_m = peak,
-                    _ => {
-                        let p = &mut self.out.floor_peak_abs_accel_mps2[j];
-                        *p = p.max(peak);
+                match of {
+                    PeakOf::Disp(j) => self.out.floor_peak_displacement_m[j] = peak,
+                    PeakOf::Drift(i) => self.out.storey_peak_drift_m[i] = peak,
+                    PeakOf::Shear(j) => self.out.storey_peak_shear_n[j] = peak,
+                    PeakOf::Overturning => self.out.peak_overturning_n_m = peak,
+                    PeakOf::Accel(f) | PeakOf::Velocity(f) => {
+                        let holder = &self.holder;
+                        let (floor_peaks, block_peaks) =
+                            self.out.riders_mut(matches!(of, PeakOf::Velocity(_)));
+                        floor_peaks[f] = floor_peaks[f].max(peak);
                         for q in 0..nb {
-                            if self.holder[q] == Holder::Floor(j) {
-                                let pb = &mut self.out.block_peak_abs_accel_mps2[q];
-                                *pb = pb.max(peak);
+                            if holder[q] == Holder::Floor(f) {
+                                block_peaks[q] = block_peaks[q].max(peak);
                             }
                         }
                     }
                 }
             }
         }
+        // A free cluster's absolute acceleration is constant, so its absolute velocity is linear
+        // over the piece: its ends bound it.
         for c in &self.free {
+            let v0 = self.v[c.bottom] + self.vg;
+            let v1 = v0 + c.accel * end;
             for body in c.bottom..=c.top {
                 let p = &mut self.out.block_peak_abs_accel_mps2[body - n];
                 *p = p.max(c.accel.abs());
+                if self.opts.abs_velocity {
+                    let p = &mut self.out.block_peak_abs_velocity_mps[body - n];
+                    *p = p.max(v0.abs()).max(v1.abs());
+                }
             }
         }
         // New floor state.
@@ -1409,6 +1472,10 @@ impl<'b> Integrator<'b> {
             e.input = f64::NAN;
             e.damping = f64::NAN;
             self.out.energy_balance_error_max = f64::NAN;
+        }
+        if !self.opts.abs_velocity {
+            self.out.floor_peak_abs_velocity_mps.fill(f64::NAN);
+            self.out.block_peak_abs_velocity_mps.fill(f64::NAN);
         }
         for i in 0..n {
             self.out.storey_residual_drift_m[i] = drift(i, &self.x);

@@ -11,6 +11,8 @@ pub struct BuildingResponse {
     pub floor_peak_displacement_m: Vec<f64>,
     /// Peak absolute acceleration of each floor, m/s².
     pub floor_peak_abs_accel_mps2: Vec<f64>,
+    /// Peak absolute velocity of each floor (relative to the ground plus the ground's), m/s.
+    pub floor_peak_abs_velocity_mps: Vec<f64>,
     /// Peak `|δ_i|`, `δ_i = u_i − u_{i−1}`, m, storey 1 first.
     pub storey_peak_drift_m: Vec<f64>,
     /// `max|δ_i| / (F_y,i/k_i)`; `None` when the storeys are elastic.
@@ -37,6 +39,8 @@ pub struct BuildingResponse {
     pub stuck_mass_share: f64,
     /// Peak absolute acceleration of every block, m/s² (stacks in order, bottom-up).
     pub block_peak_abs_accel_mps2: Vec<f64>,
+    /// Peak absolute velocity of every block, m/s (in the same order).
+    pub block_peak_abs_velocity_mps: Vec<f64>,
     /// Peak `|slip|` of every interface relative to the body below, m.
     pub peak_slip_m: Vec<f64>,
     /// Signed slip at the record's end, m.
@@ -63,6 +67,7 @@ impl BuildingResponse {
         Self {
             floor_peak_displacement_m: vec![0.0; storeys],
             floor_peak_abs_accel_mps2: vec![0.0; storeys],
+            floor_peak_abs_velocity_mps: vec![0.0; storeys],
             storey_peak_drift_m: vec![0.0; storeys],
             storey_residual_drift_m: vec![0.0; storeys],
             peak_base_shear_n: 0.0,
@@ -70,6 +75,7 @@ impl BuildingResponse {
             peak_overturning_n_m: 0.0,
             stuck_mass_share: f64::NAN,
             block_peak_abs_accel_mps2: vec![0.0; blocks],
+            block_peak_abs_velocity_mps: vec![0.0; blocks],
             peak_slip_m: vec![0.0; blocks],
             residual_slip_m: vec![0.0; blocks],
             rocking_onset: vec![None; stacks],
@@ -84,6 +90,7 @@ impl BuildingResponse {
         Self {
             floor_peak_displacement_m: vec![r.peak_displacement_m],
             floor_peak_abs_accel_mps2: vec![r.peak_abs_accel_mps2[0]],
+            floor_peak_abs_velocity_mps: vec![r.peak_abs_velocity_mps[0]],
             storey_peak_drift_m: vec![r.peak_displacement_m],
             storey_ductility: r.ductility.map(|d| vec![d]),
             storey_residual_drift_m: vec![r.residual_displacement_m],
@@ -92,6 +99,7 @@ impl BuildingResponse {
             peak_overturning_n_m: f64::NAN,
             stuck_mass_share: f64::NAN,
             block_peak_abs_accel_mps2: r.peak_abs_accel_mps2[1..=blocks].to_vec(),
+            block_peak_abs_velocity_mps: r.peak_abs_velocity_mps[1..=blocks].to_vec(),
             peak_slip_m: r.peak_slip_m,
             residual_slip_m: r.residual_slip_m,
             switches: r.switches,
@@ -107,6 +115,37 @@ impl BuildingResponse {
         }
     }
 
+    /// The floors' and the blocks' peak absolute velocities (`velocity`) or accelerations: a
+    /// block stuck to its floor shares the floor's.
+    pub(super) fn riders(&self, velocity: bool) -> (&[f64], &[f64]) {
+        if velocity {
+            (
+                &self.floor_peak_abs_velocity_mps,
+                &self.block_peak_abs_velocity_mps,
+            )
+        } else {
+            (
+                &self.floor_peak_abs_accel_mps2,
+                &self.block_peak_abs_accel_mps2,
+            )
+        }
+    }
+
+    /// [`Self::riders`], to raise them.
+    pub(super) fn riders_mut(&mut self, velocity: bool) -> (&mut [f64], &mut [f64]) {
+        if velocity {
+            (
+                &mut self.floor_peak_abs_velocity_mps,
+                &mut self.block_peak_abs_velocity_mps,
+            )
+        } else {
+            (
+                &mut self.floor_peak_abs_accel_mps2,
+                &mut self.block_peak_abs_accel_mps2,
+            )
+        }
+    }
+
     /// Refuses a response with a non-finite number.
     pub fn check_finite(&self) -> Result<(), super::super::SimError> {
         let lists = [
@@ -119,7 +158,15 @@ impl BuildingResponse {
             &self.residual_slip_m,
         ];
         let e = &self.energy;
+        let velocities = [
+            &self.floor_peak_abs_velocity_mps,
+            &self.block_peak_abs_velocity_mps,
+        ];
+        // NaN velocities: left out by the options.
         let finite = lists.iter().all(|l| l.iter().all(|x| x.is_finite()))
+            && velocities
+                .iter()
+                .all(|l| l.iter().all(|x| !x.is_infinite()))
             && !self.peak_base_shear_n.is_infinite()
             && !self.peak_overturning_n_m.is_infinite()
             && self.storey_peak_shear_n.iter().all(|x| !x.is_infinite())
