@@ -9,8 +9,9 @@
 # FEMA P695 far-field records (scripts/export-fema-p695.py), and into which it installs the
 # Python module's wheel (scripts/build-wheel, dist/) that tests/python.rs tests with pytest; and
 # a headless Chromium from the system's packages (Debian's chromium-headless-shell), in which
-# tests/design_page.rs opens the report's pages (scripts/browser_probe.py); and GNU make, with
-# which tests/stages.rs runs pipelines/paper.mk.
+# tests/design_page.rs opens the report's pages (scripts/browser_probe.py); GNU make, with
+# which tests/stages.rs runs pipelines/paper.mk; and .venv-pelicun/ with pelicun, with which
+# tests/pelicun.rs runs a FEMA P-58 assessment.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v cargo >/dev/null 2>&1; then
@@ -49,6 +50,21 @@ if [ "${1:-}" = "--test" ]; then
   scripts/build-wheel
   .venv-test/bin/pip install -q --disable-pip-version-check --force-reinstall --no-deps \
     dist/slidestack-*.whl
+fi
+# pelicun (NHERI SimCenter, FEMA P-58), pinned, in an environment of its own (its numpy, scipy
+# and pandas pins stay out of .venv-test): tests/pelicun.rs assesses `export edp`'s files with it.
+# Where it cannot be installed (no route to PyPI) the reason goes to .venv-pelicun.unavailable,
+# which that test prints as it skips; the other tests go on.
+if [ "${1:-}" = "--test" ] && ! .venv-pelicun/bin/python -c "import pelicun" 2>/dev/null; then
+  rm -f .venv-pelicun.unavailable
+  if ! { python3 -m venv .venv-pelicun \
+    && .venv-pelicun/bin/pip install -q --disable-pip-version-check pelicun==3.10.0; } \
+    >.venv-pelicun.log 2>&1; then
+    { echo "pip could not install pelicun==3.10.0 on $(date -u +%F):"; tail -5 .venv-pelicun.log; } \
+      >.venv-pelicun.unavailable
+    echo "warning: pelicun not installed (tests/pelicun.rs will say so): see .venv-pelicun.unavailable" >&2
+  fi
+  rm -f .venv-pelicun.log
 fi
 if [ "${1:-}" = "--test" ] && ! command -v make >/dev/null 2>&1; then
   if command -v apt-get >/dev/null 2>&1; then

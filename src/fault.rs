@@ -319,6 +319,7 @@ impl Classify for SimulationError {
             SimulationError::Invalid(_) => Fault::of(FaultKind::BadInput),
             SimulationError::Setting { key, .. } => Fault::of(FaultKind::BadInput).key(key),
             SimulationError::Output(e) => e.fault(),
+            SimulationError::Store(e) => e.fault(),
             SimulationError::Simulation { record, source } => source.fault().file(record),
         }
     }

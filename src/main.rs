@@ -42,6 +42,9 @@ enum Command {
     Status(cmd::status::Args),
     /// T_new and the design spectral accelerations of one structure, from a finished study.
     Design(cmd::design::Args),
+    /// Demands in other tools' formats.
+    #[command(subcommand)]
+    Export(cmd::export::What),
 }
 
 fn main() -> std::process::ExitCode {
@@ -59,7 +62,7 @@ fn main() -> std::process::ExitCode {
     // the other commands end at once.
     let checked = !matches!(
         cli.command,
-        Command::Spectrum(_) | Command::Match(_) | Command::Design(_)
+        Command::Spectrum(_) | Command::Match(_) | Command::Design(_) | Command::Export(_)
     );
     cmd::interrupt::install(checked);
     let result = match cli.command {
@@ -76,6 +79,7 @@ fn main() -> std::process::ExitCode {
         Command::Run(args) => cmd::run::run(args),
         Command::Status(args) => cmd::status::run(args),
         Command::Design(args) => cmd::design::run(args),
+        Command::Export(what) => cmd::export::run(what),
     };
     match result {
         // A Ctrl-C that came after the work was done is still reported.

@@ -267,3 +267,19 @@ fn a_building_s_peaks_bound_its_refined_history() {
     }
     eprintln!("refined history ×{REFINE}: short of the peak by {worst:.1e} at most");
 }
+
+/// The peak ground velocity of a record linear between samples (the ground row of `export
+/// edp`) in closed form: `a_g` from `A` to `−A` over one step `h` gives `v_g = A·τ − A·τ²/h`,
+/// largest at `τ = h/2` (`A·h/4`) and back to 0 at the end; a step of `A` held for two
+/// intervals and released gives `v_g = 2·A·h` at its end. Exact to round-off.
+#[test]
+fn the_peak_ground_velocity_is_the_closed_form() {
+    use slidestack::ground_motion::peak_ground_velocity_mps;
+    let (a, h) = (3.0, 0.02);
+    let got = peak_ground_velocity_mps(&[a, -a], h);
+    assert!((got - a * h / 4.0).abs() < 1e-15, "{got}");
+    let got = peak_ground_velocity_mps(&[-a, a], h);
+    assert!((got - a * h / 4.0).abs() < 1e-15, "{got}");
+    let got = peak_ground_velocity_mps(&[0.0, a, a, 0.0], h);
+    assert!((got - 2.0 * a * h).abs() < 1e-15, "{got}");
+}

@@ -108,6 +108,14 @@ def design(
     prints. In a building study, ``storeys`` and ``floor`` (a number, ``"roof"`` or ``"all"``)
     name the building, and ``period`` is its bare first-mode period T_1."""
 
+def export_edp(
+    config: _Path, records: Sequence[_Record], out: _Path, attached: bool = False
+) -> _Path:
+    """A building case's FEMA P-58 demands under ``records`` in pelicun's demand-sample format
+    (one row per record: PFA and PFV per floor, the ground as floor 0, PID and RID per storey,
+    a ``Units`` row), written to ``out`` (CSV): what ``slidestack export edp`` writes; with
+    ``attached``, the stacks rigidly attached. Returns ``out``."""
+
 def run(
     config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True
 ) -> Dict[str, Dict[str, Any]]:

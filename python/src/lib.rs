@@ -30,6 +30,7 @@ use slidestack::ground_motion::matching::{MatchSettings, match_record};
 use slidestack::ground_motion::spectra::{ductility_spectra, response_spectra};
 use slidestack::ground_motion::{ReadOptions, Record, Units, read_record_with};
 use slidestack::simulation::building::history_layout;
+use slidestack::simulation::edp::{self, Stacks};
 use slidestack::simulation::{Model, Settings, SimulationError};
 use slidestack::spectrum::{TargetSpectrum, parse_periods, periods_from_list};
 use slidestack::store::HistoryLayout;
@@ -498,6 +499,29 @@ fn design<'py>(
     )
 }
 
+/// A building case's FEMA P-58 demands under `records` (paths or `(accel_g, dt)` pairs) in
+/// pelicun's demand-sample format, written to `out` (CSV): what `slidestack export edp` writes.
+/// Returns `out`.
+#[pyfunction]
+#[pyo3(signature = (config, records, out, attached=false))]
+fn export_edp<'py>(
+    py: Python<'py>,
+    config: PathBuf,
+    records: &Bound<'py, PyList>,
+    out: PathBuf,
+    attached: bool,
+) -> PyResult<PathBuf> {
+    let records = batch::records(py, Some(records))?;
+    let stacks = if attached {
+        Stacks::Attached
+    } else {
+        Stacks::Sliding
+    };
+    py.detach(|| edp::export(&config, &records, stacks, &out))
+        .map_err(|e| to_py_err(&e))?;
+    Ok(out)
+}
+
 /// Panics on purpose: the tests check that a panic reaches Python as an exception (the cargo
 /// profile `python` unwinds) and leaves the interpreter running.
 #[pyfunction]
@@ -515,6 +539,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(spectra, m)?)?;
     m.add_function(wrap_pyfunction!(match_, m)?)?;
     m.add_function(wrap_pyfunction!(design, m)?)?;
+    m.add_function(wrap_pyfunction!(export_edp, m)?)?;
     m.add_function(wrap_pyfunction!(batch::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(_panic, m)?)?;
     pipeline::register(m)?;

@@ -192,3 +192,20 @@ def test_ctrl_c_stops_a_simulation_within_a_few_samples(tmp_path):
     out, err = interrupt_when_held(SIMULATE_SCRIPT, [], "simulate.samples:3", tmp_path / "held")
     assert "stopped at sample 128 of" in err, err
     assert out.strip() == "True", out
+
+
+def test_export_edp_writes_the_clis_file(cli, tmp_path):
+    records = [ROOT / "tests/fixtures/records" / n for n in
+               ("RSN1111_KOBE_NIS000.AT2", "RSN960_NORTHR_LOS270.AT2")]
+    for attached in (False, True):
+        flag = ["--attached"] if attached else []
+        want = tmp_path / f"cli-{attached}.csv"
+        run_cli(cli, "export", "edp", "--config", "configs/building.yaml",
+                "--record", *map(str, records), "--out", str(want), *flag)
+        got = tmp_path / f"py-{attached}.csv"
+        assert slidestack.export_edp(ROOT / "configs/building.yaml", records, got,
+                                     attached=attached) == got
+        assert got.read_bytes() == want.read_bytes()
+    with pytest.raises(ValueError, match="section71-case.yaml.*`building`"):
+        slidestack.export_edp(ROOT / "configs/section71-case.yaml", records,
+                              tmp_path / "no.csv")

@@ -2,6 +2,7 @@
 //! study's stages share [`StudyArgs`], [`CliReporter`] and [`print_outcome`].
 
 pub mod design;
+pub mod export;
 pub mod ida;
 pub mod interrupt;
 pub mod matching;

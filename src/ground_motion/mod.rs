@@ -12,7 +12,8 @@ pub mod stochastic;
 
 pub use process::{BaselineCorrection, ProcessError};
 pub use record::{
-    ReadOptions, Record, RecordError, Units, checked_at2, format_at2, read_record, read_record_with,
+    ReadOptions, Record, RecordError, Units, checked_at2, format_at2, peak_ground_velocity_mps,
+    read_record, read_record_with,
 };
 pub use stochastic::{Envelope, ParameterScatter, StochasticError, StochasticModel};
 

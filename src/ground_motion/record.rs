@@ -33,6 +33,24 @@ use crate::limits::{
 const DT_REL_TOL: f64 = 1e-6;
 
 /// An acceleration record sampled at a constant step.
+/// Peak `|v_g|`, m/s, of a ground acceleration linear between samples (`accel_mps2`, m/s², step
+/// `dt_s`, s) starting at rest: exact, the velocity being the trapezoid sums at the samples and
+/// a parabola between them, whose extremum lies where the acceleration changes sign.
+pub fn peak_ground_velocity_mps(accel_mps2: &[f64], dt_s: f64) -> f64 {
+    let (mut v, mut peak) = (0.0f64, 0.0f64);
+    for w in accel_mps2.windows(2) {
+        let (a0, a1) = (w[0], w[1]);
+        if a0 * a1 < 0.0 {
+            // a(τ) = a0 + (a1 − a0)·τ/dt = 0 at τ = dt·a0/(a0 − a1).
+            let tau = dt_s * a0 / (a0 - a1);
+            peak = peak.max((v + 0.5 * a0 * tau).abs());
+        }
+        v += 0.5 * dt_s * (a0 + a1);
+        peak = peak.max(v.abs());
+    }
+    peak
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Record {
     /// File name (or a label), for messages and output.
@@ -52,6 +70,12 @@ impl Record {
     /// Peak ground acceleration, g.
     pub fn pga_g(&self) -> f64 {
         self.accel_g.iter().fold(0.0, |m, a| m.max(a.abs()))
+    }
+
+    /// Peak ground velocity, m/s, of the record multiplied by `scale`
+    /// ([`peak_ground_velocity_mps`]).
+    pub fn pgv_mps(&self, scale: f64) -> f64 {
+        peak_ground_velocity_mps(&self.accel_mps2(scale), self.dt_s)
     }
 
     pub fn duration_s(&self) -> f64 {

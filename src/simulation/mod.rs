@@ -7,6 +7,7 @@
 
 pub mod batch;
 pub mod building;
+pub mod edp;
 pub mod floor_spectra;
 
 use crate::dynamics::building::Building;
@@ -168,6 +169,9 @@ pub enum SimulationError {
     /// A file to write (`history`) that cannot be made where it is asked for.
     #[error(transparent)]
     Output(#[from] crate::store::atomic::OutputPathError),
+    /// A file (`export edp`'s) that could not be written.
+    #[error(transparent)]
+    Store(#[from] crate::store::StoreError),
     #[error("simulation of {record} failed")]
     Simulation {
         record: String,
