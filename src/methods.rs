@@ -24,10 +24,11 @@ impl std::fmt::Display for Method {
 }
 
 /// The exact event-driven integrators (one storey and building), the systems a case is run as
-/// and the sweep's skip rules (`dynamics`, `study::physics`, `study::sweep`).
+/// and the sweep's skip rules (`dynamics`, `study::physics`, `study::sweep`) (3: a building
+/// study's sweep stores the floors' absolute velocities and the residual drifts).
 pub const INTEGRATOR: Method = Method {
     name: "integrator",
-    version: 2,
+    version: 3,
 };
 
 /// Exact response spectra (`spectrum::response`), with the target spectra they are compared to.

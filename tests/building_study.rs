@@ -204,6 +204,26 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
         assert_eq!(row(&bv.drift_ratio_stack), d(&s.storey_peak_drift_m), "{c}");
         assert_eq!(row(&bv.drift_ratio_rigid), d(&r.storey_peak_drift_m), "{c}");
         assert_eq!(
+            row(&bv.floor_velocity_stack),
+            s.floor_peak_abs_velocity_mps,
+            "{c}"
+        );
+        assert_eq!(
+            row(&bv.floor_velocity_rigid),
+            r.floor_peak_abs_velocity_mps,
+            "{c}"
+        );
+        assert_eq!(
+            row(&bv.residual_drift_ratio_stack),
+            d(&s.storey_residual_drift_m),
+            "{c}"
+        );
+        assert_eq!(
+            row(&bv.residual_drift_ratio_rigid),
+            d(&r.storey_residual_drift_m),
+            "{c}"
+        );
+        assert_eq!(
             bv.base_shear_stack.as_slice().unwrap()[at],
             frame.base_shear_ratio(s.peak_base_shear_n)
         );

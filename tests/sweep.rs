@@ -134,6 +134,26 @@ fn skip_rules_hold(frame: Option<&Frame>, records: usize) {
                             &fast.drift_ratio_rigid,
                             &slow.drift_ratio_rigid,
                         ),
+                        (
+                            "floor_velocity_stack",
+                            &fast.floor_velocity_stack,
+                            &slow.floor_velocity_stack,
+                        ),
+                        (
+                            "floor_velocity_rigid",
+                            &fast.floor_velocity_rigid,
+                            &slow.floor_velocity_rigid,
+                        ),
+                        (
+                            "residual_drift_ratio_stack",
+                            &fast.residual_drift_ratio_stack,
+                            &slow.residual_drift_ratio_stack,
+                        ),
+                        (
+                            "residual_drift_ratio_rigid",
+                            &fast.residual_drift_ratio_rigid,
+                            &slow.residual_drift_ratio_rigid,
+                        ),
                     ] {
                         assert_eq!(a.len(), levels * g.cases_per_unit(), "{what}");
                         for j in c * levels..(c + 1) * levels {

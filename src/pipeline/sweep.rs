@@ -179,10 +179,10 @@ impl Units<'_> {
 
 /// The lengths of the columns [`to_columns`] writes for a unit of `cases` cases of `blocks`
 /// blocks: six `f64` columns (the slip, per interface, last), in a building study whose largest
-/// building has `nmax` storeys eleven more (four per floor or storey, padded to `nmax`, the two
-/// base shears, the two storey shears, padded, the two overturning moments and the stuck
-/// share), then two code columns, and with `rocks` (the blocks' ratios given) a third, the
-/// rocking flags.
+/// building has `nmax` storeys fifteen more (four per floor or storey, padded to `nmax`, the two
+/// base shears, the two storey shears, padded, the two overturning moments, the stuck share,
+/// and four more per floor or storey: the velocities and the residual drifts), then two code
+/// columns, and with `rocks` (the blocks' ratios given) a third, the rocking flags.
 fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>, rocks: bool) -> Vec<usize> {
     let mut v = vec![cases, cases, cases, cases, cases, cases * blocks];
     if let Some(n) = nmax {
@@ -190,6 +190,7 @@ fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>, rocks: bool)
         v.extend([cases; 2]);
         v.extend([cases * n; 2]);
         v.extend([cases; 3]);
+        v.extend([cases * n; 4]);
     }
     v.extend([cases; 2]);
     if rocks {
@@ -235,6 +236,14 @@ fn to_columns(r: &UnitResult, frame: Option<(usize, usize)>) -> Columns {
         f64s.push(r.overturning_stack.clone());
         f64s.push(r.overturning_rigid.clone());
         f64s.push(r.stuck_share_stack.clone());
+        for rows in [
+            &r.floor_velocity_stack,
+            &r.floor_velocity_rigid,
+            &r.residual_drift_ratio_stack,
+            &r.residual_drift_ratio_rigid,
+        ] {
+            f64s.push(padded(rows, n, nmax));
+        }
     }
     let mut u8s = vec![r.skip_rule.clone(), r.single_rule.clone()];
     if !r.rocks_stack.is_empty() {
@@ -446,6 +455,10 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
                     overturning_stack: f(14, &shape)?,
                     overturning_rigid: f(15, &shape)?,
                     stuck_share_stack: f(16, &shape)?,
+                    floor_velocity_stack: f(17, &per_floor)?,
+                    floor_velocity_rigid: f(18, &per_floor)?,
+                    residual_drift_ratio_stack: f(19, &per_floor)?,
+                    residual_drift_ratio_rigid: f(20, &per_floor)?,
                 })
             }
         };

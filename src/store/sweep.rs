@@ -24,6 +24,8 @@
 //!     base_shear_stack, base_shear_rigid (1),
 //!     overturning_stack, overturning_rigid (1),
 //!     stuck_share_stack (1)                        [motion, storeys, stack_floor, T_p, …]
+//!     floor_velocity_stack, floor_velocity_rigid (m s-1)           [… , floor]
+//!     residual_drift_ratio_stack, residual_drift_ratio_rigid (1)   [… , storey]
 //! ```
 //! One padded array per variable rather than one per storey count keeps every variable on the
 //! grid's dimensions (xarray selects `storeys=3` and gets floors 1 … 3 and NaN above).
@@ -102,6 +104,12 @@ pub struct BuildingVars {
     /// The stack's stuck mass share: the time average of its mass moving with its floor, over
     /// its mass (NaN in a building of one storey).
     pub stuck_share_stack: ArrayD<f64>,
+    /// Peak absolute velocity of each floor, m/s (FEMA P-58's PFV).
+    pub floor_velocity_stack: ArrayD<f64>,
+    pub floor_velocity_rigid: ArrayD<f64>,
+    /// Each storey's drift at the record's end over its height, signed.
+    pub residual_drift_ratio_stack: ArrayD<f64>,
+    pub residual_drift_ratio_rigid: ArrayD<f64>,
 }
 
 /// The trailing level axis of a building variable.
@@ -124,7 +132,7 @@ impl BuildingVars {
         &'static str,
         &'static str,
         Level,
-    ); 11] {
+    ); 15] {
         [
             (
                 "floor_accel_stack",
@@ -209,6 +217,36 @@ impl BuildingVars {
                 "time average of the stack's mass moving with its floor over its mass (1: it \
                  never slid; NaN on one storey)",
                 Level::Case,
+            ),
+            (
+                "floor_velocity_stack",
+                &self.floor_velocity_stack,
+                "m s-1",
+                "peak absolute velocity of each floor with the sliding stack",
+                Level::Floor,
+            ),
+            (
+                "floor_velocity_rigid",
+                &self.floor_velocity_rigid,
+                "m s-1",
+                "peak absolute velocity of each floor with the stack rigidly attached",
+                Level::Floor,
+            ),
+            (
+                "residual_drift_ratio_stack",
+                &self.residual_drift_ratio_stack,
+                "1",
+                "interstorey drift at the record's end over the storey height, signed, with \
+                 the sliding stack",
+                Level::Storey,
+            ),
+            (
+                "residual_drift_ratio_rigid",
+                &self.residual_drift_ratio_rigid,
+                "1",
+                "interstorey drift at the record's end over the storey height, signed, with \
+                 the stack rigidly attached",
+                Level::Storey,
             ),
         ]
     }
@@ -530,6 +568,10 @@ pub fn read_zone_sweep(
                 overturning_stack: g.array("overturning_stack", &shape)?,
                 overturning_rigid: g.array("overturning_rigid", &shape)?,
                 stuck_share_stack: g.array("stuck_share_stack", &shape)?,
+                floor_velocity_stack: g.array("floor_velocity_stack", &per_floor)?,
+                floor_velocity_rigid: g.array("floor_velocity_rigid", &per_floor)?,
+                residual_drift_ratio_stack: g.array("residual_drift_ratio_stack", &per_floor)?,
+                residual_drift_ratio_rigid: g.array("residual_drift_ratio_rigid", &per_floor)?,
             })
         }
     };

@@ -70,6 +70,11 @@ struct Peaks {
     floor_a_g: Vec<f64>,
     /// In a building: each storey's peak drift ratio `max|δ_i|/h_i`, storey 1 first.
     drift_ratio: Vec<f64>,
+    /// In a building: each floor's peak absolute velocity, m/s, floor 1 first.
+    floor_v_mps: Vec<f64>,
+    /// In a building: each storey's drift at the record's end over its height (signed),
+    /// storey 1 first.
+    residual_drift_ratio: Vec<f64>,
     /// In a building: peak base shear over the bare building's weight `g·Σm_j` (NaN on one
     /// storey, whose integrator does not give it).
     base_shear: f64,
@@ -98,6 +103,8 @@ impl Peaks {
             friction: r.energy.friction,
             floor_a_g: Vec::new(),
             drift_ratio: Vec::new(),
+            floor_v_mps: Vec::new(),
+            residual_drift_ratio: Vec::new(),
             base_shear: f64::NAN,
             storey_shear: Vec::new(),
             overturning: f64::NAN,
@@ -131,6 +138,11 @@ impl Peaks {
             friction: r.energy.friction,
             floor_a_g: r.floor_peak_abs_accel_mps2.iter().map(|a| a / G).collect(),
             drift_ratio: (r.storey_peak_drift_m.iter().zip(&frame.storey_heights_m))
+                .map(|(d, h)| d / h)
+                .collect(),
+            floor_v_mps: r.floor_peak_abs_velocity_mps.clone(),
+            residual_drift_ratio: (r.storey_residual_drift_m.iter())
+                .zip(&frame.storey_heights_m)
                 .map(|(d, h)| d / h)
                 .collect(),
             base_shear: frame.base_shear_ratio(r.peak_base_shear_n),
@@ -171,6 +183,13 @@ pub struct UnitResult {
     /// In a building: each storey's peak drift ratio, `[case][storey]`, idem.
     pub drift_ratio_stack: Vec<f64>,
     pub drift_ratio_rigid: Vec<f64>,
+    /// In a building: each floor's peak absolute velocity, m/s, `[case][floor]`, idem.
+    pub floor_velocity_stack: Vec<f64>,
+    pub floor_velocity_rigid: Vec<f64>,
+    /// In a building: each storey's drift at the record's end over its height (signed),
+    /// `[case][storey]`, idem.
+    pub residual_drift_ratio_stack: Vec<f64>,
+    pub residual_drift_ratio_rigid: Vec<f64>,
     /// In a building: peak base shear over the bare building's weight, per case, idem (NaN in
     /// a building of one storey).
     pub base_shear_stack: Vec<f64>,
@@ -202,6 +221,12 @@ impl UnitResult {
         self.floor_accel_rigid.extend_from_slice(&r.floor_a_g);
         self.drift_ratio_stack.extend_from_slice(&s.drift_ratio);
         self.drift_ratio_rigid.extend_from_slice(&r.drift_ratio);
+        self.floor_velocity_stack.extend_from_slice(&s.floor_v_mps);
+        self.floor_velocity_rigid.extend_from_slice(&r.floor_v_mps);
+        self.residual_drift_ratio_stack
+            .extend_from_slice(&s.residual_drift_ratio);
+        self.residual_drift_ratio_rigid
+            .extend_from_slice(&r.residual_drift_ratio);
         self.storey_shear_stack.extend_from_slice(&s.storey_shear);
         self.storey_shear_rigid.extend_from_slice(&r.storey_shear);
         if frame_of(s) {
@@ -262,11 +287,11 @@ pub fn run_unit(
     let n = grid.blocks();
     let cases = grid.cases_per_unit();
     let mut out = UnitResult::default();
-    // Only friction energy is stored: the input and damping integrals are not needed; nor are
-    // the absolute velocities.
+    // Only friction energy is stored: the input and damping integrals are not needed; the
+    // absolute velocities only in a building (its floors').
     let exact = ExactOptions {
         energy_balance: false,
-        abs_velocity: false,
+        abs_velocity: frame.is_some(),
         ..ExactOptions::default()
     };
     let floors = frame.map(Frame::floors);
