@@ -206,13 +206,14 @@ fn print_building(o: &BuildingSummary) {
             None => "exact".to_string(),
         }
     );
-    println!("floor  peak u (m)   peak |a| (g)");
+    println!("floor  peak u (m)   peak |a| (g)  peak |v| (m/s)");
     for j in 0..b.storeys {
         println!(
-            "{:>5}  {:<11.6}  {:.4}",
+            "{:>5}  {:<11.6}  {:<12.4}  {:.4}",
             j + 1,
             o.floor_peak_displacement_m[j],
-            o.floor_peak_abs_accel_g[j]
+            o.floor_peak_abs_accel_g[j],
+            o.floor_peak_abs_velocity_mps[j]
         );
     }
     println!("storey  peak drift (m)  residual drift (m)  ductility");
@@ -231,14 +232,15 @@ fn print_building(o: &BuildingSummary) {
     for (i, s) in o.stacks.iter().enumerate() {
         println!(
             "stack {} on floor {}: alpha [{}], mu [{}]; peak slip [{}] m, residual [{}] m, \
-             peak |a| [{}] g",
+             peak |a| [{}] g, peak |v| [{}] m/s",
             i + 1,
             s.floor,
             list(&s.alpha, 3),
             list(&s.mu, 3),
             list(&s.peak_slip_m, 5),
             list(&s.residual_slip_m, 5),
-            list(&s.peak_abs_accel_g, 4)
+            list(&s.peak_abs_accel_g, 4),
+            list(&s.peak_abs_velocity_mps, 4)
         );
     }
     println!(
@@ -304,6 +306,10 @@ fn print_table(o: &Summary) {
     println!(
         "peak abs accel    [{}] g (structure, blocks bottom-up)",
         list(&o.peak_abs_accel_g, 4)
+    );
+    println!(
+        "peak abs velocity [{}] m/s",
+        list(&o.peak_abs_velocity_mps, 4)
     );
     println!("peak slip         [{}] m", list(&o.peak_slip_m, 5));
     println!("residual slip     [{}] m", list(&o.residual_slip_m, 5));
