@@ -81,15 +81,16 @@ fn opts() -> ExactOptions {
 /// A bare structure (no stack) under the three records: its peak absolute velocity from the
 /// one-storey integrator and from the building integrator on one storey equals the matrix
 /// exponential's to 1e-9 of the peak (both are exact; the oracle's bisection and the records'
-/// few thousand steps of round-off are far below). Checked at a short, a middle and a long
-/// period, damped and undamped.
+/// few thousand steps of round-off are far below; measured 1.3e-12). Checked at short, middle
+/// and long periods, damped and undamped; at 40 s the one-storey integrator's state comes from
+/// its cancellation-free form (docs/model.md, "Long periods") while the velocity is its wave's.
 #[test]
 fn a_bare_structure_s_absolute_velocity_is_the_matrix_exponential_s() {
     let mut worst: f64 = 0.0;
     for record in real_records() {
         let accel = record.accel_mps2(1.0);
         let ground = Ground::new(record.dt_s, &accel);
-        for (period, zeta) in [(0.1, 0.05), (0.8, 0.0), (3.0, 0.05)] {
+        for (period, zeta) in [(0.1, 0.05), (0.8, 0.0), (3.0, 0.05), (40.0, 0.05)] {
             let sys = System::new(&SystemSpec {
                 damping_ratio: zeta,
                 ..SystemSpec::new(period, &[], &[])

@@ -209,3 +209,6 @@ def test_export_edp_writes_the_clis_file(cli, tmp_path):
     with pytest.raises(ValueError, match="section71-case.yaml.*`building`"):
         slidestack.export_edp(ROOT / "configs/section71-case.yaml", records,
                               tmp_path / "no.csv")
+    with pytest.raises(ValueError, match="`records`: .*at least one record"):
+        slidestack.export_edp(ROOT / "configs/building.yaml", [], tmp_path / "no.csv")
+    assert not (tmp_path / "no.csv").exists()

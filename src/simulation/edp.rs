@@ -9,6 +9,10 @@ use crate::ground_motion::{Record, peak_ground_velocity_mps};
 use std::io::Write;
 use std::path::Path;
 
+/// Why a case without `building` has no FEMA P-58 demands.
+const NOT_A_BUILDING: &str = "FEMA P-58 demands are a building's: the case needs the key \
+                              `building` (one storey is `building: {storeys: 1, …}`)";
+
 /// `export edp` (the command and Python's `export_edp`): the building case of the file `config`
 /// under each of `records`, its demand sample written to `out` (CSV). Bad input (`out` not a
 /// CSV file that can be made, a case that is not a building) is refused before any run.
@@ -19,13 +23,17 @@ pub fn export(
     out: &Path,
 ) -> Result<Vec<Demands>, SimulationError> {
     crate::store::atomic::check_output_extension(out, "a demand sample", &["csv"])?;
+    if records.is_empty() {
+        return Err(SimulationError::Setting {
+            key: "records".into(),
+            message: "a demand sample needs at least one record (one row per record)".into(),
+        });
+    }
     let sim = Settings::read(config)?.resolve()?;
     if !matches!(sim.model, Model::Building { .. }) {
         return Err(SimulationError::Key {
             file: config.display().to_string(),
-            message: "FEMA P-58 demands are a building's: the case needs the key `building` \
-                      (one storey is `building: {storeys: 1, …}`)"
-                .into(),
+            message: NOT_A_BUILDING.into(),
         });
     }
     let rows = demands(&sim, records, stacks, &Unwatched)?;
@@ -66,11 +74,7 @@ pub fn demands(
     watch: &dyn Watch,
 ) -> Result<Vec<Demands>, SimulationError> {
     let Model::Building { building, settings } = &sim.model else {
-        return Err(SimulationError::Invalid(
-            "FEMA P-58 demands are a building's: the case needs `building` (one storey is \
-             `building: {storeys: 1, …}`)"
-                .into(),
-        ));
+        return Err(SimulationError::Invalid(NOT_A_BUILDING.into()));
     };
     let heights = settings
         .storey_heights()
