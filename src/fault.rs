@@ -6,6 +6,7 @@
 
 use crate::dynamics::building::BuildingError;
 use crate::dynamics::{ModelError, SimError};
+use crate::frame_edp::FrameEdpError;
 use crate::ground_motion::RecordError;
 use crate::ground_motion::matching::MatchError;
 use crate::ground_motion::spectra::SpectraError;
@@ -139,6 +140,7 @@ fn known(e: &(dyn Error + 'static)) -> Option<Fault> {
         SimulationError,
         BatchError,
         DesignError,
+        FrameEdpError,
         MatchFilesError,
         SpectraError,
         ConfigError,
@@ -399,6 +401,25 @@ impl Classify for DesignError {
                 Fault::of(BadInput).file(file.display())
             }
             _ => Fault::of(BadInput),
+        }
+    }
+}
+
+impl Classify for FrameEdpError {
+    fn fault(&self) -> Fault {
+        use FaultKind::*;
+        match self {
+            FrameEdpError::Store(e) => e.fault(),
+            FrameEdpError::Output(e) => e.fault(),
+            FrameEdpError::Missing { dir, file } => {
+                Fault::of(MissingFile).file(dir.join(file).display())
+            }
+            // Files of one study that do not belong together: an earlier stage was rerun.
+            FrameEdpError::OtherMotions { file } => Fault::of(MissingFile).file(file.display()),
+            FrameEdpError::NotBuilding { file } => Fault::of(BadInput).file(file.display()),
+            FrameEdpError::NotHeld { file, key, .. } => {
+                Fault::of(BadInput).file(file.display()).key(key)
+            }
         }
     }
 }

@@ -50,6 +50,7 @@ pub mod design;
 pub mod dynamics;
 pub mod fault;
 pub mod fit;
+pub mod frame_edp;
 pub mod grid;
 pub mod ground_motion;
 pub mod ida;

@@ -235,6 +235,95 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
     eprintln!("profiles checked by skip rule (simulated, no slip, single block): {checked:?}");
     assert!(checked[0] > 0);
 
+    // `export edp --study`: a simulated case's row of motion 1 is the direct run's demands (the
+    // ground's: the motion's PGA and PGV), sliding and attached.
+    let c = (0..per_frame)
+        .find(|&c| z.vars.skip_rule.as_slice().unwrap()[(6 + f) * per_frame + c] == 0)
+        .unwrap();
+    let case = grid.case(c);
+    let (s, r) = {
+        let run = |kind| {
+            Physics::DEFAULT
+                .simulate_building(kind, &case, &frame, &ground, &opts, None)
+                .unwrap()
+        };
+        (run(SystemKind::Stack), run(SystemKind::Rigid))
+    };
+    let join = |v: &[f64]| v.iter().map(f64::to_string).collect::<Vec<_>>().join(",");
+    let (period, alpha, mu) = (case.period_s.to_string(), join(&case.alpha), join(&case.mu));
+    for (flag, want) in [(None, &s), (Some("--attached"), &r)] {
+        let csv = out.join("edp.csv");
+        let mut args = vec![
+            "export",
+            "edp",
+            "--study",
+            out_s,
+            "--zone",
+            "V",
+            "--storeys",
+            "3",
+            "--stack-floor",
+            "roof",
+            "--period",
+            &period,
+            "--alpha",
+            &alpha,
+            "--mu",
+            &mu,
+            "--out",
+            csv.to_str().unwrap(),
+        ];
+        args.extend(flag);
+        ok(slidestack(&args, "1"));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let row: Vec<f64> = text
+            .lines()
+            .nth(3)
+            .unwrap()
+            .split(',')
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        let mut expect = vec![recs[1].pga_g()];
+        expect.extend(want.floor_peak_abs_accel_mps2.iter().map(|a| a / G));
+        expect.push(recs[1].pgv_mps(1.0));
+        expect.extend(&want.floor_peak_abs_velocity_mps);
+        expect.extend(want.storey_peak_drift_m.iter().map(|d| d / 3.0));
+        expect.extend(want.storey_residual_drift_m.iter().map(|d| (d / 3.0).abs()));
+        assert_eq!(row, expect, "{flag:?}");
+    }
+    // A case the study does not hold is refused, naming the key and what it holds.
+    let o = slidestack(
+        &[
+            "export",
+            "edp",
+            "--study",
+            out_s,
+            "--zone",
+            "V",
+            "--storeys",
+            "3",
+            "--stack-floor",
+            "roof",
+            "--period",
+            "0.45",
+            "--alpha",
+            &alpha,
+            "--mu",
+            &mu,
+            "--out",
+            out.join("no.csv").to_str().unwrap(),
+        ],
+        "1",
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("sweep.h5: `period` 0.45 is not in the study"),
+        "{err}"
+    );
+    assert!(!out.join("no.csv").exists());
+
     // T_new per frame: the first mode's, labelled; in one storey the three floors agree.
     ok(slidestack(&["tnew", cfg_s, "--out", out_s], "2"));
     let (_, frames, t) = read_zone_tnew_in(&out.join("tnew.h5"), "V", 2, true).unwrap();

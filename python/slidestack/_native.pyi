@@ -116,6 +116,21 @@ def export_edp(
     a ``Units`` row), written to ``out`` (CSV): what ``slidestack export edp`` writes; with
     ``attached``, the stacks rigidly attached. Returns ``out``."""
 
+def export_frame_edp(
+    study: _Path,
+    zone: str,
+    storeys: int,
+    stack_floor: Union[int, str],
+    period: float,
+    alpha: _Floats,
+    mu: _Floats,
+    out: _Path,
+    attached: bool = False,
+) -> _Path:
+    """One case of a finished building study (its output directory), its FEMA P-58 demands
+    under its zone's motions written to ``out`` as pelicun's demand sample: what ``slidestack
+    export edp --study`` writes. Returns ``out``."""
+
 def run(
     config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True
 ) -> Dict[str, Dict[str, Any]]:

@@ -25,6 +25,7 @@ use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 use slidestack::design::design as design_query;
 use slidestack::dynamics::History;
 use slidestack::dynamics::Watch;
+use slidestack::frame_edp::{FrameQuery, export_frame};
 use slidestack::grid::StackFloor;
 use slidestack::ground_motion::matching::{MatchSettings, match_record};
 use slidestack::ground_motion::spectra::{ductility_spectra, response_spectra};
@@ -522,6 +523,47 @@ fn export_edp<'py>(
     Ok(out)
 }
 
+/// One case of a finished building study (`study`, its output directory), its FEMA P-58
+/// demands under its zone's motions written to `out` (CSV): what `slidestack export edp --study`
+/// writes. Returns `out`.
+#[pyfunction]
+#[pyo3(signature = (study, zone, storeys, stack_floor, period, alpha, mu, out, attached=false))]
+#[allow(clippy::too_many_arguments)]
+fn export_frame_edp<'py>(
+    py: Python<'py>,
+    study: PathBuf,
+    zone: String,
+    storeys: &Bound<'py, PyAny>,
+    stack_floor: &Bound<'py, PyAny>,
+    period: f64,
+    alpha: &Bound<'py, PyAny>,
+    mu: &Bound<'py, PyAny>,
+    out: PathBuf,
+    attached: bool,
+) -> PyResult<PathBuf> {
+    let text = stack_floor.str()?.to_string();
+    let q = FrameQuery {
+        zone,
+        storeys: convert::whole(storeys, "storeys", 1)?,
+        stack_floor: text.parse::<StackFloor>().map_err(|_| {
+            PyValueError::new_err(format!(
+                "stack_floor `{text}`: a floor number, `roof` or `all`"
+            ))
+        })?,
+        period_s: period,
+        alpha: convert::float_vec(alpha, "alpha")?,
+        mu: convert::float_vec(mu, "mu")?,
+    };
+    let stacks = if attached {
+        Stacks::Attached
+    } else {
+        Stacks::Sliding
+    };
+    py.detach(|| export_frame(&study, &q, stacks, &out))
+        .map_err(|e| to_py_err(&e))?;
+    Ok(out)
+}
+
 /// Panics on purpose: the tests check that a panic reaches Python as an exception (the cargo
 /// profile `python` unwinds) and leaves the interpreter running.
 #[pyfunction]
@@ -540,6 +582,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(match_, m)?)?;
     m.add_function(wrap_pyfunction!(design, m)?)?;
     m.add_function(wrap_pyfunction!(export_edp, m)?)?;
+    m.add_function(wrap_pyfunction!(export_frame_edp, m)?)?;
     m.add_function(wrap_pyfunction!(batch::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(_panic, m)?)?;
     pipeline::register(m)?;

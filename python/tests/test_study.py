@@ -304,3 +304,16 @@ def test_design_in_a_building_study_is_the_clis(tmp_path, cli):
         slidestack.design(out, "V", 0.6, [0.25, 0.5], [0.1, 0.05])
     with pytest.raises(ValueError, match="needs both `storeys` and `floor`"):
         slidestack.design(out, "V", 0.6, [0.25, 0.5], [0.1, 0.05], storeys=3)
+    # The same finished study's case as FEMA P-58 demands: the CLI's bytes.
+    for attached in (False, True):
+        flag = ["--attached"] if attached else []
+        want_csv, got_csv = tmp_path / f"cli-{attached}.csv", tmp_path / f"py-{attached}.csv"
+        run_cli(cli, "export", "edp", "--study", str(out), "--zone", "V", "--storeys", "3",
+                "--stack-floor", "roof", "--period", "0.6", "--alpha", "0.25,0.5",
+                "--mu", "0.1,0.05", "--out", str(want_csv), *flag)
+        assert slidestack.export_frame_edp(out, "V", 3, "roof", 0.6, [0.25, 0.5], [0.1, 0.05],
+                                           got_csv, attached=attached) == got_csv
+        assert got_csv.read_bytes() == want_csv.read_bytes()
+    with pytest.raises(ValueError, match="`mu\\[1\\]` 0.07 is not in the study"):
+        slidestack.export_frame_edp(out, "V", 3, "roof", 0.6, [0.25, 0.5], [0.1, 0.07],
+                                    tmp_path / "no.csv")
