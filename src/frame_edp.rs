@@ -1,11 +1,11 @@
 //! `slidestack export edp --study`'s entry point: one case of a finished building study, its
 //! FEMA P-58 demands under each of its zone's motions, read from `sweep.h5` (checked, and made
 //! from that `motions.h5`) and written as pelicun's demand sample
-//! ([`crate::simulation::edp::write_csv`]); docs/building.md, "FEMA P-58 demands through
+//! ([`crate::simulation::edp::write_sample`]); docs/building.md, "FEMA P-58 demands through
 //! pelicun".
 
 use crate::grid::StackFloor;
-use crate::simulation::edp::{Demands, Stacks, write_csv};
+use crate::simulation::edp::{Demands, Stacks, check_sample_path, write_sample};
 use crate::store::StoreError;
 use crate::store::h5::stored_fingerprint;
 use crate::store::motions::read_zone_motions;
@@ -168,10 +168,8 @@ pub fn export_frame(
     stacks: Stacks,
     out: &Path,
 ) -> Result<Vec<Demands>, FrameEdpError> {
-    crate::store::atomic::check_output_extension(out, "a demand sample", &["csv"])?;
+    check_sample_path(out)?;
     let rows = frame_demands(dir, q, stacks)?;
-    let mut bytes = Vec::new();
-    write_csv(&rows, &mut bytes).expect("a CSV written to memory");
-    crate::store::atomic::write_bytes(out, &bytes)?;
+    write_sample(&rows, out)?;
     Ok(rows)
 }

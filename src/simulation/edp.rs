@@ -22,7 +22,7 @@ pub fn export(
     stacks: Stacks,
     out: &Path,
 ) -> Result<Vec<Demands>, SimulationError> {
-    crate::store::atomic::check_output_extension(out, "a demand sample", &["csv"])?;
+    check_sample_path(out)?;
     if records.is_empty() {
         return Err(SimulationError::Setting {
             key: "records".into(),
@@ -37,10 +37,21 @@ pub fn export(
         });
     }
     let rows = demands(&sim, records, stacks, &Unwatched)?;
-    let mut bytes = Vec::new();
-    write_csv(&rows, &mut bytes).expect("a CSV written to memory");
-    crate::store::atomic::write_bytes(out, &bytes)?;
+    write_sample(&rows, out)?;
     Ok(rows)
+}
+
+/// `Err` unless a demand sample (CSV) can be written at `out`, checked before any work.
+pub fn check_sample_path(out: &Path) -> Result<(), crate::store::atomic::OutputPathError> {
+    crate::store::atomic::check_output_extension(out, "a demand sample", &["csv"])
+}
+
+/// Writes `rows` to `out` as the demand sample ([`write_csv`]): the whole file or, failing,
+/// none of it ([`crate::store::atomic::write_bytes`]).
+pub fn write_sample(rows: &[Demands], out: &Path) -> Result<(), crate::store::StoreError> {
+    let mut bytes = Vec::new();
+    write_csv(rows, &mut bytes).expect("a CSV written to memory");
+    crate::store::atomic::write_bytes(out, &bytes)
 }
 
 /// Whether the stacks slide on their floors (the case as stated) or are rigidly attached
