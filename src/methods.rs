@@ -25,10 +25,12 @@ impl std::fmt::Display for Method {
 
 /// The exact event-driven integrators (one storey and building), the systems a case is run as
 /// and the sweep's skip rules (`dynamics`, `study::physics`, `study::sweep`) (3: a building
-/// study's sweep stores the floors' absolute velocities and the residual drifts).
+/// study's sweep stores the floors' absolute velocities and the residual drifts; 4: every
+/// sweep stores the goods' own demands, each block's peak absolute acceleration and velocity
+/// and each interface's residual slip).
 pub const INTEGRATOR: Method = Method {
     name: "integrator",
-    version: 3,
+    version: 4,
 };
 
 /// Exact response spectra (`spectrum::response`), with the target spectra they are compared to.

@@ -125,11 +125,13 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
         print(list(ds['slip_peak'].dims)[-1], [int(n) for n in ds['storeys']], \
               [str(f) for f in ds['stack_floor'].values])\n\
         print(float(ds['u_stack'].sel(storeys=3, stack_floor='roof').isel(motion=0, T_p=0, \
-              alpha_1=0, alpha_2=0, mu_1=0, mu_2=0)) > 0)\n";
+              alpha_1=0, alpha_2=0, mu_1=0, mu_2=0)) > 0)\n\
+        print(list(ds['block_accel_stack'].dims)[-1], list(ds['slip_residual'].dims)[-1], \
+              [int(b) for b in ds['block']], ds['block_velocity_stack'].attrs['units'])\n";
     assert_eq!(
         python_on(script, &out.join("sweep.h5")),
         "['motion', 'storeys', 'stack_floor', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2']\n\
-         interface [1, 3] ['1', 'roof', 'all']\nTrue\n"
+         interface [1, 3] ['1', 'roof', 'all']\nTrue\nblock interface [1, 2] m s-1\n"
     );
 
     // Per-floor demands and base shear: labelled, NaN above a one-storey building's roof.
@@ -223,6 +225,29 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
             d(&r.storey_residual_drift_m),
             "{c}"
         );
+        // The goods' own demands (two blocks, on the roof): the system's blocks, or with a
+        // rule, the body every block moves with.
+        let blocks = |v: &ndarray::ArrayD<f64>| v.as_slice().unwrap()[at * 2..at * 2 + 2].to_vec();
+        let (a_block, v_block, residual) = match kind {
+            SystemKind::Stack => (
+                g(&s.block_peak_abs_accel_mps2),
+                s.block_peak_abs_velocity_mps.clone(),
+                s.residual_slip_m.clone(),
+            ),
+            SystemKind::SingleBlock => (
+                g(&[s.block_peak_abs_accel_mps2[0]; 2]),
+                vec![s.block_peak_abs_velocity_mps[0]; 2],
+                vec![s.residual_slip_m[0], 0.0],
+            ),
+            SystemKind::Rigid => (
+                g(&[r.floor_peak_abs_accel_mps2[2]; 2]),
+                vec![r.floor_peak_abs_velocity_mps[2]; 2],
+                vec![0.0; 2],
+            ),
+        };
+        assert_eq!(blocks(&z.vars.block_accel_stack), a_block, "{c}");
+        assert_eq!(blocks(&z.vars.block_velocity_stack), v_block, "{c}");
+        assert_eq!(blocks(&z.vars.slip_residual), residual, "{c}");
         assert_eq!(
             bv.base_shear_stack.as_slice().unwrap()[at],
             frame.base_shear_ratio(s.peak_base_shear_n)
@@ -617,6 +642,9 @@ fn one_storey_buildings_are_the_one_storey_study() {
         same(&va.a_stack, &vb.a_stack);
         same(&va.friction_energy, &vb.friction_energy);
         same(&va.slip_peak, &vb.slip_peak);
+        same(&va.slip_residual, &vb.slip_residual);
+        same(&va.block_accel_stack, &vb.block_accel_stack);
+        same(&va.block_velocity_stack, &vb.block_velocity_stack);
         assert_eq!(
             va.skip_rule.iter().collect::<Vec<_>>(),
             vb.skip_rule.iter().collect::<Vec<_>>()

@@ -368,6 +368,39 @@ fn a_study_stores_which_cases_rock_the_report_counts_them_and_design_warns() {
             };
             let rocks = s.rocking_onset.expect("checked").is_some();
             assert_eq!(flag, u8::from(rocks), "zone {zone} {idx:?}");
+            // The same runs check the goods' own demands the sweep stores per block: those of
+            // the stack simulated, or under a skip rule of the body every block moves with
+            // (two exact solutions: 1e-9 relative, as tests/sweep.rs; an interface that never
+            // slips ends at 0).
+            for b in 0..2 {
+                let mut at = ndarray::Dimension::slice(&idx).to_vec();
+                at.push(b);
+                let close = |stored: f64, direct: f64, what: &str| {
+                    let scale = stored.abs().max(direct.abs()).max(1e-12);
+                    assert!(
+                        (stored - direct).abs() <= 1e-9 * scale,
+                        "zone {zone} {idx:?} block {}: {what} {stored} vs {direct}",
+                        b + 1
+                    );
+                };
+                close(
+                    sweep.vars.block_accel_stack[&at[..]],
+                    s.peak_abs_accel_g[b + 1],
+                    "block_accel_stack",
+                );
+                close(
+                    sweep.vars.block_velocity_stack[&at[..]],
+                    s.peak_abs_velocity_mps[b + 1],
+                    "block_velocity_stack",
+                );
+                let residual = sweep.vars.slip_residual[&at[..]];
+                assert!(
+                    (residual - s.residual_slip_m[b]).abs() <= 1e-9,
+                    "zone {zone} {idx:?} interface {}: {residual} vs {}",
+                    b + 1,
+                    s.residual_slip_m[b]
+                );
+            }
             count += usize::from(rocks);
             runs += 1;
         }

@@ -1,5 +1,5 @@
 //! The sweep's skip rules against brute force: every system of every case simulated (in a
-//! building, its per-floor profiles and base shear too).
+//! building, its per-floor profiles and base shear too; the goods' own demands, per block).
 
 mod common;
 
@@ -110,6 +110,23 @@ fn skip_rules_hold(frame: Option<&Frame>, records: usize) {
                     for i in 0..g.blocks() {
                         let k = c * g.blocks() + i;
                         assert!((fast.slip_peak[k] - slow.slip_peak[k]).abs() < 1e-9);
+                        // The goods' own demands: an interface that never slips ends at 0
+                        // exactly; a block that moves with its floor (or with the single
+                        // block) has that body's peaks, to the same 1e-9.
+                        assert!((fast.slip_residual[k] - slow.slip_residual[k]).abs() < 1e-9);
+                        close(
+                            fast.block_accel_stack[k],
+                            slow.block_accel_stack[k],
+                            "block_accel_stack",
+                        );
+                        close(
+                            fast.block_velocity_stack[k],
+                            slow.block_velocity_stack[k],
+                            "block_velocity_stack",
+                        );
+                        assert!(
+                            fast.block_accel_stack[k] > 0.0 && fast.block_velocity_stack[k] > 0.0
+                        );
                     }
                     // A building's profiles and base shear, with and without sliding.
                     let levels = frame.map_or(0, Frame::storeys);

@@ -112,6 +112,8 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
     let script = "import sys, xarray as xr\n\
         ds = xr.open_dataset(sys.argv[1], engine='h5netcdf', group='zone_III')\n\
         print(list(ds['u_stack'].dims), list(ds['slip_peak'].dims))\n\
+        print(list(ds['block_accel_stack'].dims)[-1], ds['block_accel_stack'].attrs['units'], \
+              ds['slip_residual'].attrs['units'], int(ds['block_velocity_stack'].isnull().sum()))\n\
         print(ds['T_p'].attrs['units'], ds['u_stack'].attrs['units'], float(ds['mu_1'][1]))\n\
         print(int(ds['u_stack'].isnull().sum()))\n\
         t = xr.open_dataset(sys.argv[2], engine='h5netcdf', group='zone_III')\n\
@@ -133,7 +135,8 @@ fn resume_after_kill_gives_the_same_file_and_shards_and_threads_too() {
     assert_eq!(
         text,
         "['motion', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2'] \
-         ['motion', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2', 'interface']\ns m 0.3\n0\n\
+         ['motion', 'T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2', 'interface']\nblock g m 0\n\
+         s m 0.3\n0\n\
          ['T_p', 'alpha_1', 'alpha_2', 'mu_1', 'mu_2']\nTrue True True\n"
     );
 }

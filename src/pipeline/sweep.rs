@@ -181,8 +181,9 @@ impl Units<'_> {
 /// blocks: six `f64` columns (the slip, per interface, last), in a building study whose largest
 /// building has `nmax` storeys fifteen more (four per floor or storey, padded to `nmax`, the two
 /// base shears, the two storey shears, padded, the two overturning moments, the stuck share,
-/// and four more per floor or storey: the velocities and the residual drifts), then two code
-/// columns, and with `rocks` (the blocks' ratios given) a third, the rocking flags.
+/// and four more per floor or storey: the velocities and the residual drifts), then three per
+/// interface or block (the residual slips, the blocks' accelerations and velocities), then two
+/// code columns, and with `rocks` (the blocks' ratios given) a third, the rocking flags.
 fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>, rocks: bool) -> Vec<usize> {
     let mut v = vec![cases, cases, cases, cases, cases, cases * blocks];
     if let Some(n) = nmax {
@@ -192,6 +193,7 @@ fn column_lengths(cases: usize, blocks: usize, nmax: Option<usize>, rocks: bool)
         v.extend([cases; 3]);
         v.extend([cases * n; 4]);
     }
+    v.extend([cases * blocks; 3]);
     v.extend([cases; 2]);
     if rocks {
         v.push(cases);
@@ -245,6 +247,9 @@ fn to_columns(r: &UnitResult, frame: Option<(usize, usize)>) -> Columns {
             f64s.push(padded(rows, n, nmax));
         }
     }
+    f64s.push(r.slip_residual.clone());
+    f64s.push(r.block_accel_stack.clone());
+    f64s.push(r.block_velocity_stack.clone());
     let mut u8s = vec![r.skip_rule.clone(), r.single_rule.clone()];
     if !r.rocks_stack.is_empty() {
         u8s.push(r.rocks_stack.clone());
@@ -462,6 +467,8 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
                 })
             }
         };
+        // The goods' columns follow the building's (`column_lengths`).
+        let goods = if building.is_some() { 21 } else { 6 };
         let codes = |i: usize| -> Result<ArrayD<u8>, PipelineError> {
             let flat: Vec<u8> = cols.iter().flat_map(|c| c.u8s[i].iter().copied()).collect();
             array(flat, &shape, &dir)
@@ -477,6 +484,9 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
                 a_stack: f(3, &shape)?,
                 friction_energy: f(4, &shape)?,
                 slip_peak: f(5, &shape_i)?,
+                slip_residual: f(goods, &shape_i)?,
+                block_accel_stack: f(goods + 1, &shape_i)?,
+                block_velocity_stack: f(goods + 2, &shape_i)?,
                 skip_rule: codes(0)?,
                 single_rule: codes(1)?,
                 rocks_stack: study.aspect().map(|_| codes(2)).transpose()?,

@@ -4,10 +4,11 @@
 //! /                     attrs: contents, slidestack_version, fingerprint, config_sha256,
 //!                              motions_fingerprint, skip_rule_codes, + the writer's extra attrs
 //! /zone_<name>/         attrs: target
-//!     motion, T_p, alpha_1 … alpha_n, mu_1 … mu_n, interface    coordinates (dimension scales)
+//!     motion, T_p, alpha_1 … alpha_n, mu_1 … mu_n, interface, block    coordinates
 //!     u_stack, u_single, u_rigid (m), a_stack (g), friction_energy (J/kg),
 //!     skip_rule, single_rule                       [motion, T_p, alpha_1 … alpha_n, mu_1 … mu_n]
-//!     slip_peak (m)                                [… , interface]
+//!     slip_peak, slip_residual (m)                 [… , interface]
+//!     block_accel_stack (g), block_velocity_stack (m s-1)           [… , block]
 //!     rocks_stack                                  [motion, T_p, …] (with grid.aspect only)
 //! ```
 //! A building study (docs/model.md, "A study over buildings") has two more coordinates,
@@ -69,6 +70,13 @@ pub struct SweepVars {
     pub a_stack: ArrayD<f64>,
     pub friction_energy: ArrayD<f64>,
     pub slip_peak: ArrayD<f64>,
+    /// Slip of each interface at the record's end, m (signed; a building with a stack on
+    /// several floors: the one of the largest magnitude).
+    pub slip_residual: ArrayD<f64>,
+    /// The goods' own demands: each block's peak absolute acceleration, g, and velocity, m/s
+    /// (a building with a stack on several floors: the largest over them).
+    pub block_accel_stack: ArrayD<f64>,
+    pub block_velocity_stack: ArrayD<f64>,
     pub skip_rule: ArrayD<u8>,
     pub single_rule: ArrayD<u8>,
     /// With `grid.aspect`: 1 where the stack would start to rock (docs/model.md, "Rocking:
@@ -467,6 +475,53 @@ fn write_zone(
     )?;
     attach_all(&ds, &scales)?;
     attach_scale(&ds, &iface, scales.len())?;
+    let several = building.is_some();
+    let ds = write_var(
+        &g,
+        "slip_residual",
+        v.slip_residual.view(),
+        &chunk_i,
+        "m",
+        if several {
+            "slip of each interface at the record's end, signed (with a stack on every floor: \
+             the one of the largest magnitude)"
+        } else {
+            "slip of each interface at the record's end, signed"
+        },
+    )?;
+    attach_all(&ds, &scales)?;
+    attach_scale(&ds, &iface, scales.len())?;
+    let block: Vec<f64> = (1..=n).map(|i| i as f64).collect();
+    let block = coordinate(
+        &g,
+        "block",
+        &block,
+        "1",
+        "block (1 = the lowest, resting on interface 1)",
+    )?;
+    for (name, data, units, long) in [
+        (
+            "block_accel_stack",
+            &v.block_accel_stack,
+            "g",
+            "peak absolute acceleration of each block",
+        ),
+        (
+            "block_velocity_stack",
+            &v.block_velocity_stack,
+            "m s-1",
+            "peak absolute velocity of each block",
+        ),
+    ] {
+        let long = if several {
+            format!("{long} (with a stack on every floor: the largest over them)")
+        } else {
+            long.to_string()
+        };
+        let ds = write_var(&g, name, data.view(), &chunk_i, units, &long)?;
+        attach_all(&ds, &scales)?;
+        attach_scale(&ds, &block, scales.len())?;
+    }
     let ds = write_flags(
         &g,
         "skip_rule",
@@ -583,6 +638,9 @@ pub fn read_zone_sweep(
         a_stack: g.array("a_stack", &shape)?,
         friction_energy: g.array("friction_energy", &shape)?,
         slip_peak: g.array("slip_peak", &per_interface)?,
+        slip_residual: g.array("slip_residual", &per_interface)?,
+        block_accel_stack: g.array("block_accel_stack", &per_interface)?,
+        block_velocity_stack: g.array("block_velocity_stack", &per_interface)?,
         skip_rule: g.array("skip_rule", &shape)?,
         single_rule: g.array("single_rule", &shape)?,
         rocks_stack: (g.has("rocks_stack"))

@@ -87,8 +87,17 @@ struct Peaks {
     /// In a building: the stacks' stuck mass share (NaN on one storey, and for a system
     /// without stacks).
     stuck_share: f64,
-    /// The largest peak absolute acceleration of a block, m/s² (0 without blocks).
-    block_a_mps2: f64,
+    /// The largest peak absolute velocity of the floors carrying a stack, m/s (the
+    /// structure's on one storey): a block that moves with its floor moves at it.
+    v_hold_mps: f64,
+    /// Peak absolute acceleration of each block, m/s², bottom first; with a stack on several
+    /// floors, the largest over them (empty without blocks).
+    block_a_mps2: Vec<f64>,
+    /// Peak absolute velocity of each block, m/s, idem.
+    block_v_mps: Vec<f64>,
+    /// Slip of each interface at the record's end, m (signed); with a stack on several
+    /// floors, the one of the largest magnitude.
+    residual_slip_m: Vec<f64>,
     /// Whether a stack started to rock (its rocking checked; false otherwise).
     rocks: bool,
 }
@@ -109,9 +118,10 @@ impl Peaks {
             storey_shear: Vec::new(),
             overturning: f64::NAN,
             stuck_share: f64::NAN,
-            block_a_mps2: r.peak_abs_accel_mps2[1..]
-                .iter()
-                .fold(0.0, |a, &b| a.max(b)),
+            v_hold_mps: r.peak_abs_velocity_mps[0],
+            block_a_mps2: r.peak_abs_accel_mps2[1..].to_vec(),
+            block_v_mps: r.peak_abs_velocity_mps[1..].to_vec(),
+            residual_slip_m: r.residual_slip_m,
             rocks: r.rocking_onset.is_some(),
         }
     }
@@ -123,11 +133,20 @@ impl Peaks {
             .iter()
             .map(|&f| r.floor_peak_abs_accel_mps2[f - 1])
             .fold(0.0, f64::max);
-        let slip_m = (0..blocks)
+        let v_hold_mps = floors
+            .iter()
+            .map(|&f| r.floor_peak_abs_velocity_mps[f - 1])
+            .fold(0.0, f64::max);
+        let largest = |values: &[f64]| -> Vec<f64> {
+            (0..blocks)
+                .map(|i| of_block(values, blocks, i).fold(0.0, f64::max))
+                .collect()
+        };
+        let slip_m = largest(&r.peak_slip_m);
+        let residual_slip_m = (0..blocks)
             .map(|i| {
-                (r.peak_slip_m.iter().skip(i).step_by(blocks.max(1)))
-                    .copied()
-                    .fold(0.0, f64::max)
+                of_block(&r.residual_slip_m, blocks, i)
+                    .fold(0.0, |a: f64, b: f64| if b.abs() > a.abs() { b } else { a })
             })
             .collect();
         Self {
@@ -151,10 +170,18 @@ impl Peaks {
                 .collect(),
             overturning: frame.overturning_ratio(r.peak_overturning_n_m),
             stuck_share: r.stuck_mass_share,
-            block_a_mps2: (r.block_peak_abs_accel_mps2.iter()).fold(0.0, |a, &b| a.max(b)),
+            v_hold_mps,
+            block_a_mps2: largest(&r.block_peak_abs_accel_mps2),
+            block_v_mps: largest(&r.block_peak_abs_velocity_mps),
+            residual_slip_m,
             rocks: r.rocking_onset.iter().any(Option::is_some),
         }
     }
+}
+
+/// Block (or interface) `i` of every stack of `blocks` blocks, stacks in order.
+fn of_block(values: &[f64], blocks: usize, i: usize) -> impl Iterator<Item = f64> + '_ {
+    values.iter().skip(i).step_by(blocks.max(1)).copied()
 }
 
 /// Results of one work unit, one entry per case (order of [`Grid::case`]).
@@ -168,6 +195,13 @@ pub struct UnitResult {
     pub a_stack: Vec<f64>,
     /// Peak slip per interface, m, `[case][interface]` row-major.
     pub slip_peak: Vec<f64>,
+    /// Slip per interface at the record's end (signed), m, `[case][interface]`.
+    pub slip_residual: Vec<f64>,
+    /// The goods' own demands: each block's peak absolute acceleration, g, and velocity, m/s,
+    /// `[case][block]` (block `i` rests on interface `i`); with a stack on several floors, the
+    /// largest over them.
+    pub block_accel_stack: Vec<f64>,
+    pub block_velocity_stack: Vec<f64>,
     /// Energy dissipated by friction in the stack, J per kg of structure mass.
     pub friction_energy: Vec<f64>,
     pub skip_rule: Vec<u8>,
@@ -287,11 +321,9 @@ pub fn run_unit(
     let n = grid.blocks();
     let cases = grid.cases_per_unit();
     let mut out = UnitResult::default();
-    // Only friction energy is stored: the input and damping integrals are not needed; the
-    // absolute velocities only in a building (its floors').
+    // Only friction energy is stored: the input and damping integrals are not needed.
     let exact = ExactOptions {
         energy_balance: false,
-        abs_velocity: frame.is_some(),
         ..ExactOptions::default()
     };
     let floors = frame.map(Frame::floors);
@@ -373,7 +405,7 @@ pub fn run_unit(
                 (_, Some(s)) => s.rocks,
                 (SkipRule::NoSlip, None) => stuck_rocks(&case, aspect, r.a_hold_mps2)?,
                 (_, None) if single_holds => stuck_rocks(&case, aspect, r.a_hold_mps2)?,
-                (_, None) => stuck_rocks(&case, aspect, single[&skey].block_a_mps2)?,
+                (_, None) => stuck_rocks(&case, aspect, single[&skey].block_a_mps2[0])?,
             };
             out.rocks_stack.push(u8::from(rocks));
         }
@@ -382,12 +414,14 @@ pub fn run_unit(
                 out.u_stack.push(s.u_m);
                 out.a_stack.push(s.a_mps2 / G);
                 out.slip_peak.extend_from_slice(&s.slip_m);
+                out.slip_residual.extend_from_slice(&s.residual_slip_m);
                 out.friction_energy.push(s.friction);
             }
             (SkipRule::NoSlip, None) => {
                 out.u_stack.push(r.u_m);
                 out.a_stack.push(r.a_mps2 / G);
                 out.slip_peak.extend(std::iter::repeat_n(0.0, n));
+                out.slip_residual.extend(std::iter::repeat_n(0.0, n));
                 out.friction_energy.push(0.0);
             }
             (_, None) => {
@@ -396,10 +430,28 @@ pub fn run_unit(
                 out.a_stack.push(s.a_mps2 / G);
                 out.slip_peak.push(s.slip_m.first().copied().unwrap_or(0.0));
                 out.slip_peak.extend(std::iter::repeat_n(0.0, n - 1));
+                out.slip_residual
+                    .push(s.residual_slip_m.first().copied().unwrap_or(0.0));
+                out.slip_residual.extend(std::iter::repeat_n(0.0, n - 1));
                 out.friction_energy
                     .push(if single_holds { 0.0 } else { s.friction });
             }
         }
+        // Every block of a stack a rule stands in for moves with the stand-in's one body: its
+        // floor (the rigid system, whose floors' peaks are the ones carrying a stack) or the
+        // single block.
+        let (block_a_mps2, block_v_mps) = match (rule, &resp) {
+            (_, Some(s)) => (s.block_a_mps2.clone(), s.block_v_mps.clone()),
+            (SkipRule::NoSlip, None) => (vec![r.a_hold_mps2; n], vec![r.v_hold_mps; n]),
+            (_, None) if single_holds => (vec![r.a_hold_mps2; n], vec![r.v_hold_mps; n]),
+            (_, None) => {
+                let one = &single[&skey];
+                (vec![one.block_a_mps2[0]; n], vec![one.block_v_mps[0]; n])
+            }
+        };
+        out.block_accel_stack
+            .extend(block_a_mps2.iter().map(|a| a / G));
+        out.block_velocity_stack.extend_from_slice(&block_v_mps);
     }
     Ok(out)
 }
