@@ -72,10 +72,10 @@ pub const IDA: Method = Method {
 
 /// The report's pages and figures (7: the design page's data by name, `ZoneDesign`'s
 /// `building` and `lambda`; 8: where the stacks would rock, the table and the design page's
-/// note).
+/// note; 9: the design page's `rocks_share` row).
 pub const REPORT: Method = Method {
     name: "report",
-    version: 8,
+    version: 9,
 };
 
 /// The methods as they enter a fingerprint: `name-version` joined by spaces.

@@ -29,9 +29,10 @@ use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-/// The one-storey page's numeric outputs, as the page declares them.
+/// The one-storey page's numeric outputs, as the page declares them (its study checks that
+/// the stacks rock: `rocks_share` among them).
 fn outputs() -> Vec<&'static str> {
-    slidestack::render::design::output_ids(false)
+    slidestack::render::design::output_ids(false, true)
 }
 
 /// A question: zone, `T_p`, `α`, `μ`, extrapolate.
@@ -438,7 +439,7 @@ type FrameQuestion = (
 /// The outputs of a building study's page: the one-storey page's and `λ`'s, as the page
 /// declares them.
 fn building_outputs() -> Vec<&'static str> {
-    slidestack::render::design::output_ids(true)
+    slidestack::render::design::output_ids(true, false)
 }
 
 /// `slidestack design --json … --storeys N --floor F` for `q`, as [`command`].

@@ -76,15 +76,44 @@ const BUILDING_ROWS: [Row; 9] = [
     ),
 ];
 
-/// The ids of the page's numeric outputs, each the JSON key of `slidestack design --json` that
-/// it shows (`building`: a building study's page); the page's script finds them by their class.
-pub fn output_ids(building: bool) -> Vec<&'static str> {
-    let rows: &[Row] = if building {
-        &BUILDING_ROWS
+/// The row of a study that checks whether its stacks rock (`grid.aspect`).
+const ROCKS_ROW: Row = (
+    "Share of the motions under which the stack would rock (interpolated; where above 0 the \
+     sliding-only model's answers are outside their model)",
+    "rocks_share",
+    "",
+);
+
+/// The answers' rows of a study's page (`building`: a building study's; `rocking`: a study that
+/// checks whether its stacks rock).
+fn output_rows(building: bool, rocking: bool) -> Vec<Row> {
+    let mut rows = if building {
+        BUILDING_ROWS.to_vec()
     } else {
-        &OUTPUT_ROWS
+        OUTPUT_ROWS.to_vec()
     };
-    rows.iter().map(|r| r.1).collect()
+    if rocking {
+        rows.push(ROCKS_ROW);
+    }
+    rows
+}
+
+/// The ids of the page's numeric outputs, each the JSON key of `slidestack design --json` that
+/// it shows (`building`, `rocking`: as [`PageForm`]); the page's script finds them by their
+/// class.
+pub fn output_ids(building: bool, rocking: bool) -> Vec<&'static str> {
+    output_rows(building, rocking).iter().map(|r| r.1).collect()
+}
+
+/// What a study's page asks and answers: its zones, its stacks' `blocks` blocks, the input
+/// hints (`ranges`: `T_p`, then each `α`, then each `μ`), a building study's storey and floor
+/// inputs, and whether the study checks that its stacks rock (the `rocks_share` row).
+pub struct PageForm<'a> {
+    pub zones: &'a [String],
+    pub blocks: usize,
+    pub ranges: &'a [String],
+    pub building: Option<&'a FrameInputs>,
+    pub rocking: bool,
 }
 
 /// A building study's inputs: the storey counts and floors its selects offer, and its
@@ -117,20 +146,18 @@ fn input(id: &str, label: &str, hint: &str) -> String {
     )
 }
 
-/// The page of a study whose stacks have `blocks` blocks and whose zones are `zones`: `title`,
-/// an introduction (HTML) and `data`, the JSON the script reads (`zones`: each zone's
-/// `design::ZoneDesign`, in a building study each zone and frame's; `drr`: `DRR_1`, `DRR_2`
-/// per case of each; `damping_depth`; a building study's `frames`). `building`: a building
-/// study's storey and floor inputs.
-pub fn design_page(
-    title: &str,
-    intro: &str,
-    zones: &[String],
-    blocks: usize,
-    ranges: &[String],
-    building: Option<&FrameInputs>,
-    data: &str,
-) -> String {
+/// The page of a study asking and answering as `form` says: `title`, an introduction (HTML)
+/// and `data`, the JSON the script reads (`zones`: each zone's `design::ZoneDesign`, in a
+/// building study each zone and frame's; `drr`: `DRR_1`, `DRR_2` per case of each;
+/// `damping_depth`; a building study's `frames`).
+pub fn design_page(title: &str, intro: &str, form: &PageForm, data: &str) -> String {
+    let PageForm {
+        zones,
+        blocks,
+        ranges,
+        building,
+        rocking,
+    } = *form;
     let zone_options: String = zones
         .iter()
         .map(|z| format!("<option value='{0}'>{0}</option>", escape(z)))
@@ -173,11 +200,7 @@ pub fn design_page(
             hint(blocks + i),
         );
     }
-    let rows: &[Row] = match building {
-        None => &OUTPUT_ROWS,
-        Some(_) => &BUILDING_ROWS,
-    };
-    let rows: String = rows
+    let rows: String = output_rows(building.is_some(), rocking)
         .iter()
         .map(|(label, id, unit)| {
             format!(

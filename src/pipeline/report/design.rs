@@ -10,7 +10,7 @@ use crate::fit::extrapolation::{LOWER_T_P, UPPER_T_RIGID};
 use crate::fit::forms::DAMPING_DEPTH;
 use crate::limits::STRUCTURE_PERIOD_RANGE_S;
 use crate::pipeline::{PipelineError, files};
-use crate::render::design::{FrameInputs, design_page};
+use crate::render::design::{FrameInputs, PageForm, design_page};
 use crate::render::page::escape;
 use crate::study::design::{ZoneDesign, frame_cases, frame_designs, known_frames};
 use serde::Serialize;
@@ -198,13 +198,17 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
             q = escape(example)
         ),
     };
+    let form = PageForm {
+        zones: &names,
+        blocks: grid.blocks(),
+        ranges: &ranges,
+        building: frame_inputs.as_ref(),
+        rocking: inp.study.aspect().is_some(),
+    };
     let html = design_page(
         &format!("T_new for your structure: {}", report_name(inp)),
         &intro,
-        &names,
-        grid.blocks(),
-        &ranges,
-        frame_inputs.as_ref(),
+        &form,
         &data,
     );
     files.files.push(("design.html".into(), html.into_bytes()));
