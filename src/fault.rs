@@ -417,7 +417,7 @@ impl Classify for FrameEdpError {
             // Files of one study that do not belong together: an earlier stage was rerun.
             FrameEdpError::OtherMotions { file } => Fault::of(MissingFile).file(file.display()),
             FrameEdpError::NotBuilding { file } => Fault::of(BadInput).file(file.display()),
-            FrameEdpError::NotHeld { file, key, .. } => {
+            FrameEdpError::NotHeld { file, key, .. } | FrameEdpError::Blocks { file, key, .. } => {
                 Fault::of(BadInput).file(file.display()).key(key)
             }
         }

@@ -38,6 +38,14 @@ pub enum FrameEdpError {
     NotBuilding { file: PathBuf },
     #[error("{file}: made from another motions.h5: rerun the study")]
     OtherMotions { file: PathBuf },
+    /// A list of another length than the study's stacks have blocks.
+    #[error("{file}: `{key}` lists {given} values; the study's stacks have {blocks} blocks")]
+    Blocks {
+        file: PathBuf,
+        key: String,
+        given: usize,
+        blocks: usize,
+    },
     /// A value the study does not hold, named by its key, with the values it holds.
     #[error("{file}: `{key}` {given} is not in the study (it holds {held})")]
     NotHeld {
@@ -84,8 +92,12 @@ pub fn frame_demands(
     let axes = axes.expect("a building study's zone has its frame axes");
     for (key, values) in [("alpha", &q.alpha), ("mu", &q.mu)] {
         if values.len() != blocks {
-            let given = format!("lists {} values", values.len());
-            return Err(not_held(key, given, format!("{blocks} blocks")));
+            return Err(FrameEdpError::Blocks {
+                file: sweep.clone(),
+                key: key.to_string(),
+                given: values.len(),
+                blocks,
+            });
         }
     }
     let list = |v: &[String]| v.join(", ");

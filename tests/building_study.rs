@@ -317,37 +317,48 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
         expect.extend(want.storey_residual_drift_m.iter().map(|d| (d / 3.0).abs()));
         assert_eq!(row, expect, "{flag:?}");
     }
-    // A case the study does not hold is refused, naming the key and what it holds.
-    let o = slidestack(
-        &[
-            "export",
-            "edp",
-            "--study",
-            out_s,
-            "--zone",
-            "V",
-            "--storeys",
-            "3",
-            "--stack-floor",
-            "roof",
-            "--period",
+    // A case the study does not hold is refused, naming the key and what it holds; a list of
+    // another length than the stacks' blocks, naming the key and the count.
+    for (period, alpha, why) in [
+        (
             "0.45",
-            "--alpha",
-            &alpha,
-            "--mu",
-            &mu,
-            "--out",
-            out.join("no.csv").to_str().unwrap(),
-        ],
-        "1",
-    );
-    assert_eq!(o.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        err.contains("sweep.h5: `period` 0.45 is not in the study"),
-        "{err}"
-    );
-    assert!(!out.join("no.csv").exists());
+            alpha.as_str(),
+            "sweep.h5: `period` 0.45 is not in the study",
+        ),
+        (
+            period.as_str(),
+            "0.5",
+            "sweep.h5: `alpha` lists 1 values; the study's stacks have 2 blocks",
+        ),
+    ] {
+        let o = slidestack(
+            &[
+                "export",
+                "edp",
+                "--study",
+                out_s,
+                "--zone",
+                "V",
+                "--storeys",
+                "3",
+                "--stack-floor",
+                "roof",
+                "--period",
+                period,
+                "--alpha",
+                alpha,
+                "--mu",
+                &mu,
+                "--out",
+                out.join("no.csv").to_str().unwrap(),
+            ],
+            "1",
+        );
+        assert_eq!(o.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(why), "{err}");
+        assert!(!out.join("no.csv").exists());
+    }
 
     // T_new per frame: the first mode's, labelled; in one storey the three floors agree.
     ok(slidestack(&["tnew", cfg_s, "--out", out_s], "2"));
