@@ -3,12 +3,13 @@
 #   make -f pipelines/paper.mk                          # configs/paper.yaml -> out/paper/report
 #   make -f pipelines/paper.mk CONFIG=configs/quick.yaml OUT=out/quick
 #   make -f pipelines/paper.mk CONFIG=configs/ida-quick.yaml OUT=out/ida-quick   # motions, ida, report
+#   make -f pipelines/paper.mk CONFIG=configs/mdof-floors-quick.yaml OUT=out/floors  # … floors, report
 #   make -f pipelines/paper.mk sweep                    # up to one stage
 #   make -f pipelines/paper.mk -B FORCE=1               # recompute every stage
 #
 # make runs exactly the stages the config configures, as `slidestack run` does: motions and the
 # report always, sweep and tnew with a `grid` section, fit when that grid has enough cases to fit
-# a design equation, ida with an `ida:` section. It asks the binary which
+# a design equation, ida with an `ida:` section, floors with a `floor_spectra:` section. It asks the binary which
 # (`slidestack status --format make` into OUT/make/stages.mk, remade when the config or the
 # binary changes) before it decides anything else.
 #
@@ -44,8 +45,9 @@ sweep: $(OUT)/sweep.h5
 tnew: $(OUT)/tnew.h5
 fit: $(OUT)/fit.h5
 ida: $(OUT)/ida.h5
+floors: $(OUT)/floors.h5
 report: $(OUT)/report/index.html
-.PHONY: all motions sweep tnew fit ida report always
+.PHONY: all motions sweep tnew fit ida floors report always
 
 # STAGES: the stages the config configures, in order (written by the binary; under a name of
 # its own per make, then renamed, so two makes into one OUT at once both read a whole file).
@@ -61,6 +63,7 @@ file_sweep := $(OUT)/sweep.h5
 file_tnew := $(OUT)/tnew.h5
 file_fit := $(OUT)/fit.h5
 file_ida := $(OUT)/ida.h5
+file_floors := $(OUT)/floors.h5
 REPORT_INPUTS := $(foreach s,$(filter-out report,$(STAGES)),$(file_$(s)))
 
 # Built only when missing, also under make -B (which remakes every target, this one included).
@@ -89,6 +92,10 @@ $(OUT)/fit.h5: $(OUT)/tnew.h5 $(CONFIG) $(SLIDESTACK)
 
 $(OUT)/ida.h5: $(OUT)/motions.h5 $(CONFIG) $(SLIDESTACK)
 	'$(SLIDESTACK)' ida '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
+	@touch -c '$@'
+
+$(OUT)/floors.h5: $(OUT)/motions.h5 $(CONFIG) $(SLIDESTACK)
+	'$(SLIDESTACK)' floors '$(CONFIG)' --out '$(OUT)' $(STAGE_FLAGS)
 	@touch -c '$@'
 
 $(OUT)/report/index.html: $(REPORT_INPUTS) $(CONFIG) $(SLIDESTACK)

@@ -4,7 +4,7 @@
 #   2. the sweep as a job array, task K computing shard K of N (`sweep --shard K/N`),
 #   3. one finishing job, started when every task has ended (`afterany`), that checks every work
 #      unit is there, merges them and runs the later stages the config configures (tnew, fit,
-#      ida with an `ida:` section, report).
+#      ida with an `ida:` section, floors with a `floor_spectra:` section, report).
 # Each part is left out when its file is already up to date (`slidestack status`), so submitting
 # a finished study submits nothing. Run with --help for the options; pipelines/README.md has the
 # walk-through.

@@ -26,6 +26,44 @@ impl Case {
     pub fn t_rigid_s(&self) -> f64 {
         self.period_s * (1.0 + self.alpha_total()).sqrt()
     }
+
+    /// Checks a case of a config's list whose cases have `blocks` blocks (those of its first):
+    /// the period in range, one `α` and one `μ` per block, each in range; the key
+    /// (`period_s`, `alpha`, `mu`) and why otherwise.
+    pub fn check(&self, blocks: usize) -> Result<(), (&'static str, String)> {
+        use crate::limits::{MAX_ALPHA, MAX_BLOCKS, MAX_MU, PERIOD_RANGE_S};
+        let (lo, hi) = PERIOD_RANGE_S;
+        if !(self.period_s.is_finite() && self.period_s >= lo && self.period_s <= hi) {
+            return Err((
+                "period_s",
+                format!("{} must be in [{lo}, {hi}]", self.period_s),
+            ));
+        }
+        let n = self.alpha.len();
+        if n == 0 || n > MAX_BLOCKS || n != blocks {
+            return Err((
+                "alpha",
+                format!(
+                    "{n} blocks: every case needs the same number, 1 to {MAX_BLOCKS} ({blocks} in \
+                     the first)"
+                ),
+            ));
+        }
+        if self.mu.len() != blocks {
+            return Err(("mu", format!("needs one value per interface ({blocks})")));
+        }
+        if self.alpha.iter().any(|a| !(a.is_finite() && *a > 0.0)) || self.alpha_total() > MAX_ALPHA
+        {
+            return Err((
+                "alpha",
+                format!("values must be > 0 with a sum ≤ {MAX_ALPHA}"),
+            ));
+        }
+        if (self.mu.iter()).any(|m| !(m.is_finite() && (0.0..=MAX_MU).contains(m))) {
+            return Err(("mu", format!("values must be in [0, {MAX_MU}]")));
+        }
+        Ok(())
+    }
 }
 
 /// `T_p = 1 s, α = [0.5, 0.5], μ = [0.2, 0.1]`.

@@ -11,6 +11,7 @@ use crate::ground_motion::RecordError;
 use crate::ground_motion::matching::MatchError;
 use crate::ground_motion::spectra::SpectraError;
 use crate::match_files::MatchFilesError;
+use crate::pipeline::floors::FloorsStageError;
 use crate::pipeline::lock::LockError;
 use crate::pipeline::motions::MotionsError;
 use crate::pipeline::sweep::SweepStageError;
@@ -220,6 +221,13 @@ impl Classify for PipelineError {
             PipelineError::Ida(crate::pipeline::ida::IdaStageError::NoSection { config }) => {
                 Fault::of(BadInput).file(config.display()).key("ida")
             }
+            PipelineError::Floors(e) => match e {
+                FloorsStageError::NoSection { config } => Fault::of(BadInput)
+                    .file(config.display())
+                    .key("floor_spectra"),
+                FloorsStageError::Record { .. } => Fault::of(BadInput).key("floor_spectra"),
+                FloorsStageError::Unit { .. } => Fault::of(Failed),
+            },
             PipelineError::Report(crate::pipeline::report::ReportError::Design(e)) => e.fault(),
             PipelineError::Tnew(_)
             | PipelineError::Fit(_)

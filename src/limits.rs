@@ -125,6 +125,10 @@ pub const DUCTILITY_SCAN_STEP: f64 = 0.98;
 /// ten times that bounds a config's mistake (a first step of 1e-9 g) instead of running for days.
 pub const MAX_IDA_TRACE_RUNS: usize = 200;
 
+/// Cases of a `floor_spectra:` section: each runs on every frame under every motion of every
+/// zone, twice (sliding, attached), on its record refined 64 times.
+pub const MAX_FLOOR_SPECTRA_CASES: usize = 100;
+
 /// Cases of an IDA section: each is traced under every motion of every zone, twice (the stack
 /// and the rigidly attached load).
 pub const MAX_IDA_CASES: usize = 1_000;

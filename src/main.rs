@@ -35,8 +35,10 @@ enum Command {
     Report(cmd::StudyArgs),
     /// Incremental dynamic analysis of a yielding structure (the `ida:` section) → ida.h5.
     Ida(cmd::ida::Args),
-    /// The whole study: motions, sweep, tnew, fit, report, and ida with an `ida:` section (each
-    /// skipped when up to date).
+    /// Floor response spectra of listed cases (the `floor_spectra:` section) → floors.h5.
+    Floors(cmd::StudyArgs),
+    /// The whole study: motions, sweep, tnew, fit, report, ida with an `ida:` section and
+    /// floors with a `floor_spectra:` section (each skipped when up to date).
     Run(cmd::StudyArgs),
     /// What is on disk for every stage of a study (for people and job scripts).
     Status(cmd::status::Args),
@@ -76,6 +78,7 @@ fn main() -> std::process::ExitCode {
         Command::Fit(args) => cmd::stage::run(args, StageId::Fit),
         Command::Report(args) => cmd::stage::run(args, StageId::Report),
         Command::Ida(args) => cmd::ida::run(args),
+        Command::Floors(args) => cmd::stage::run(args, StageId::Floors),
         Command::Run(args) => cmd::run::run(args),
         Command::Status(args) => cmd::status::run(args),
         Command::Design(args) => cmd::design::run(args),

@@ -70,6 +70,13 @@ pub const IDA: Method = Method {
     version: 1,
 };
 
+/// A study's floor response spectra: the refinement of the record and the spectra of the
+/// floors' histories (`spectrum::floor`, `study::floors`, the floors stage).
+pub const FLOORS: Method = Method {
+    name: "floors",
+    version: 1,
+};
+
 /// The report's pages and figures (7: the design page's data by name, `ZoneDesign`'s
 /// `building` and `lambda`; 8: where the stacks would rock, the table and the design page's
 /// note; 9: the design page's `rocks_share` row).

@@ -890,8 +890,8 @@ fn stage_files_of_other_shapes_are_refused_not_indexed() {
     write_unit(&unit, &id, &columns).unwrap();
     run(&["merge", c, "--out", o], PLAIN).fails(
         1,
-        "III_000_003.unit: columns has shape [11, 12, 12, 12, 12, 24, 12, 12] where its \
-         dimensions give [12, 12, 12, 12, 12, 24, 12, 12]",
+        "III_000_003.unit: columns has shape [11, 12, 12, 12, 12, 24, 24, 24, 24, 12, 12] \
+         where its dimensions give [12, 12, 12, 12, 12, 24, 24, 24, 24, 12, 12]",
     );
     let r = run(&["sweep", c, "--out", o], PLAIN).ok();
     assert!(r.stderr.contains("computing it again"), "{}", r.stderr);

@@ -148,6 +148,7 @@ fn every_shipped_study_config_configures_its_stages() {
         ("ida-quick.yaml", "motions ida report"),
         ("mdof-fema-rigid.yaml", "motions sweep tnew fit report"),
         ("mdof-fema-structure.yaml", "motions sweep tnew fit report"),
+        ("mdof-floors-quick.yaml", "motions sweep tnew floors report"),
         ("mdof-ida-quick.yaml", "motions sweep tnew ida report"),
         ("mdof-quick.yaml", "motions sweep tnew fit report"),
         ("mdof-structure.yaml", "motions sweep tnew fit report"),
@@ -226,6 +227,32 @@ fn make_runs_the_configured_stages_with_the_bytes_of_run() {
     for (path, (_, ino)) in &b {
         assert_eq!(*ino, again[path].1, "{} was rewritten", path.display());
     }
+}
+
+/// make's plan for a config with a `floor_spectra:` section (`make -n`: what it would run)
+/// includes the floors stage, before the report.
+#[test]
+fn make_plans_the_floors_stage_where_the_config_has_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let mk = Path::new(env!("CARGO_MANIFEST_DIR")).join("pipelines/paper.mk");
+    let o = std::process::Command::new("make")
+        .args(["-n", "-f", s(&mk)])
+        .arg(format!("CONFIG={}", s(&config("mdof-floors-quick.yaml"))))
+        .arg("OUT=out")
+        .arg(format!("SLIDESTACK={}", env!("CARGO_BIN_EXE_slidestack")))
+        .current_dir(dir.path())
+        .output()
+        .expect("make (scripts/install-deps.sh --test installs it)");
+    let text = stdout(&ok(o));
+    let at = |stage: &str| {
+        text.find(&format!("slidestack' {stage} "))
+            .unwrap_or_else(|| panic!("{stage}: {text}"))
+    };
+    assert!(
+        at("tnew") < at("floors") && at("floors") < at("report"),
+        "{text}"
+    );
+    assert!(!text.contains("slidestack' fit "), "{text}");
 }
 
 /// `cases_needed(k)` against the fit itself: with one case fewer every form refuses (in the

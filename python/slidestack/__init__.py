@@ -2,7 +2,7 @@
 
 Seismic response of a structure (one storey or a shear building) carrying stacks of sliding rigid
 blocks with Coulomb friction, exact event-driven simulation, response spectra, spectral matching,
-and the staged T_new study (motions -> sweep -> tnew -> fit -> report, ida, design).
+and the staged T_new study (motions -> sweep -> tnew -> fit -> report, ida, floors, design).
 
 >>> import slidestack
 >>> r = slidestack.simulate(period=1.0, alpha=[0.5, 0.5], mu=[0.2, 0.1])
@@ -24,6 +24,7 @@ from ._native import (
     export_edp,
     export_frame_edp,
     fit,
+    floors,
     ida,
     match,
     merge,
@@ -47,6 +48,7 @@ __all__ = [
     "export_edp",
     "export_frame_edp",
     "fit",
+    "floors",
     "ida",
     "match",
     "merge",

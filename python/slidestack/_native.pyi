@@ -156,6 +156,9 @@ def fit(
 def ida(
     config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True
 ) -> Dict[str, Any]: ...
+def floors(
+    config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True
+) -> Dict[str, Any]: ...
 def report(
     config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True
 ) -> Dict[str, Any]: ...

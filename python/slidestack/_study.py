@@ -9,7 +9,7 @@ if TYPE_CHECKING:
     import xarray
 
 #: The stage files open_study reads, in the order the stages write them.
-STAGE_FILES = ("motions", "sweep", "tnew", "fit", "ida")
+STAGE_FILES = ("motions", "sweep", "tnew", "fit", "ida", "floors")
 
 
 def _decode_flags(ds: "xarray.Dataset") -> "xarray.Dataset":
@@ -39,7 +39,8 @@ def _decode_flags(ds: "xarray.Dataset") -> "xarray.Dataset":
 def open_study(out: Union[str, "os.PathLike[str]"]) -> Dict[str, Dict[str, "xarray.Dataset"]]:
     """The study in output directory ``out`` as ``{file: {zone: Dataset}}``.
 
-    ``file`` is the stage (``motions``, ``sweep``, ``tnew``, ``fit``, ``ida``; those present),
+    ``file`` is the stage (``motions``, ``sweep``, ``tnew``, ``fit``, ``ida``, ``floors``; those
+    present),
     ``zone`` the zone's name (group ``zone_NAME``; ``""`` for a file's root variables). The
     Datasets have the files' labelled dimensions and units, with CF conventions decoded and each
     CF flag variable ``X`` given a ``X_meaning`` of strings. Needs xarray, h5netcdf and h5py

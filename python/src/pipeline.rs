@@ -237,6 +237,11 @@ stage_fn!(tnew, StageId::Tnew, "The tnew stage (`slidestack tnew`).");
 stage_fn!(fit, StageId::Fit, "The fit stage (`slidestack fit`).");
 stage_fn!(ida, StageId::Ida, "The ida stage (`slidestack ida`).");
 stage_fn!(
+    floors,
+    StageId::Floors,
+    "The floors stage (`slidestack floors`): floor response spectra."
+);
+stage_fn!(
     report,
     StageId::Report,
     "The report stage (`slidestack report`)."
@@ -336,6 +341,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tnew, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(ida, m)?)?;
+    m.add_function(wrap_pyfunction!(floors, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
     m.add_function(wrap_pyfunction!(status, m)?)?;

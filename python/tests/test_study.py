@@ -317,3 +317,19 @@ def test_design_in_a_building_study_is_the_clis(tmp_path, cli):
     with pytest.raises(ValueError, match="`mu\\[1\\]` 0.07 is not in the study"):
         slidestack.export_frame_edp(out, "V", 3, "roof", 0.6, [0.25, 0.5], [0.1, 0.07],
                                     tmp_path / "no.csv")
+
+
+def test_floors_is_the_clis_and_open_study_labels_it(tmp_path, cli):
+    """configs/mdof-floors-quick.yaml's floors stage from the module and from the CLI: the same
+    floors.h5; open_study gives its spectra with their labelled dimensions."""
+    cfg = ROOT / "configs/mdof-floors-quick.yaml"
+    py_out, cli_out = tmp_path / "py", tmp_path / "cli"
+    run_cli(cli, "motions", str(cfg), "--out", str(cli_out))
+    copy_motions(cli_out, py_out)
+    run_cli(cli, "floors", str(cfg), "--out", str(cli_out))
+    assert slidestack.floors(cfg, out=py_out)["outcome"] == "wrote"
+    assert (py_out / "floors.h5").read_bytes() == (cli_out / "floors.h5").read_bytes()
+    psa = slidestack.open_study(py_out)["floors"]["V"]["psa_stack"]
+    assert psa.dims == ("motion", "case", "storeys", "stack_floor", "damping", "floor", "period")
+    roof = psa.sel(storeys=3, stack_floor="roof", damping=0.05, floor=3).mean("motion")
+    assert float(roof.max()) > 0 and psa.attrs["units"] == "g"

@@ -62,6 +62,42 @@ pub struct Record {
 }
 
 impl Record {
+    /// The record linearly interpolated to `1/refinement` of its step: the same
+    /// piecewise-linear ground motion, sampled `refinement` times as densely (floor response
+    /// spectra, [`crate::spectrum::floor`]).
+    pub fn refined(&self, refinement: usize) -> Record {
+        let a = &self.accel_g;
+        let mut fine = Vec::with_capacity((a.len().saturating_sub(1)) * refinement + 1);
+        for w in a.windows(2) {
+            for i in 0..refinement {
+                fine.push(w[0] + (w[1] - w[0]) * (i as f64 / refinement as f64));
+            }
+        }
+        fine.extend(a.last());
+        Record {
+            name: self.name.clone(),
+            dt_s: self.dt_s / refinement as f64,
+            accel_g: fine,
+        }
+    }
+
+    /// Refuses a record whose [`Self::refined`] history a spectrum cannot take (too many
+    /// samples, too short a step: [`crate::limits`]), before any run.
+    pub fn check_refinable(&self, refinement: usize) -> Result<(), String> {
+        use crate::limits::{DT_RANGE_S, MAX_SAMPLES};
+        let samples = (self.accel_g.len().saturating_sub(1)).saturating_mul(refinement) + 1;
+        let dt_s = self.dt_s / refinement as f64;
+        if samples > MAX_SAMPLES || dt_s < DT_RANGE_S.0 {
+            return Err(format!(
+                "`floor_spectra`: the record refined {refinement} times has {samples} samples \
+                 {dt_s:e} s apart; the spectrum takes at most {MAX_SAMPLES} samples at least {:e} \
+                 s apart",
+                DT_RANGE_S.0
+            ));
+        }
+        Ok(())
+    }
+
     /// Acceleration in m/s², multiplied by `scale`.
     pub fn accel_mps2(&self, scale: f64) -> Vec<f64> {
         self.accel_g.iter().map(|a| a * scale * G).collect()

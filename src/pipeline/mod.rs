@@ -28,6 +28,7 @@
 
 pub mod files;
 pub mod fit;
+pub mod floors;
 pub mod ida;
 pub mod lock;
 pub mod motions;
@@ -55,16 +56,19 @@ pub enum StageId {
     Fit,
     /// Incremental dynamic analysis of a yielding structure (only with an `ida:` section).
     Ida,
+    /// Floor response spectra of listed cases (only with a `floor_spectra:` section).
+    Floors,
     Report,
 }
 
 impl StageId {
-    pub const ALL: [StageId; 6] = [
+    pub const ALL: [StageId; 7] = [
         StageId::Motions,
         StageId::Sweep,
         StageId::Tnew,
         StageId::Fit,
         StageId::Ida,
+        StageId::Floors,
         StageId::Report,
     ];
 
@@ -77,6 +81,7 @@ impl StageId {
             StageId::Fit => "fit",
             StageId::Report => "report",
             StageId::Ida => "ida",
+            StageId::Floors => "floors",
         }
     }
 
@@ -90,6 +95,7 @@ impl StageId {
             StageId::Fit => "fit.h5",
             StageId::Report => "report/index.html",
             StageId::Ida => "ida.h5",
+            StageId::Floors => "floors.h5",
         }
     }
 
@@ -102,7 +108,7 @@ impl StageId {
             StageId::Tnew => &[StageId::Motions, StageId::Sweep],
             StageId::Fit => &[StageId::Tnew],
             StageId::Report => &[StageId::Motions, StageId::Tnew, StageId::Fit],
-            StageId::Ida => &[StageId::Motions],
+            StageId::Ida | StageId::Floors => &[StageId::Motions],
         }
     }
 }
@@ -120,6 +126,7 @@ impl StageId {
             // The report simulates the paper's named cases.
             StageId::Report => &[REPORT, INTEGRATOR],
             StageId::Ida => &[INTEGRATOR, SPECTRUM, IDA],
+            StageId::Floors => &[INTEGRATOR, SPECTRUM, FLOORS],
         }
     }
 
@@ -183,6 +190,8 @@ pub enum PipelineError {
     Report(#[from] report::ReportError),
     #[error(transparent)]
     Ida(#[from] ida::IdaStageError),
+    #[error(transparent)]
+    Floors(#[from] floors::FloorsStageError),
     /// The reporter asked the run to stop ([`Reporter::cancelled`]).
     #[error("{0}: interrupted; what it stored is kept and the next run resumes from there")]
     Cancelled(StageId),
@@ -288,6 +297,8 @@ struct Fingerprints {
     fit: Option<String>,
     /// `None` without an `ida` section.
     ida: Option<String>,
+    /// `None` without a `floor_spectra` section.
+    floors: Option<String>,
     report: String,
 }
 
@@ -384,6 +395,7 @@ impl Study {
         let compared = (compare.as_deref()).and_then(|c| c.fingerprints.fit.clone());
         let motions_fp = motions::fingerprint(&cfg);
         let ida = ida::fingerprint(&cfg, &motions_fp);
+        let floors = floors::fingerprint(&cfg, &motions_fp);
         let sweep = grid.as_ref().map(|_| sweep::fingerprint(&cfg, &motions_fp));
         let tnew = sweep.as_deref().map(tnew::fingerprint);
         let fit_cases = grid
@@ -400,6 +412,7 @@ impl Study {
             fit.as_deref().or(tnew.as_deref()),
             &motions_fp,
             ida.as_deref(),
+            floors.as_deref(),
             compared.as_deref(),
         );
         Ok(Self {
@@ -416,6 +429,7 @@ impl Study {
                 tnew,
                 fit,
                 ida,
+                floors,
                 report,
             },
             compare,
@@ -434,6 +448,7 @@ impl Study {
             StageId::Tnew => f.tnew.is_some(),
             StageId::Fit => f.fit.is_some(),
             StageId::Ida => f.ida.is_some(),
+            StageId::Floors => f.floors.is_some(),
         }
     }
 
@@ -454,8 +469,12 @@ impl Study {
         let mut up: Vec<StageId> = (stage.upstream().iter().copied())
             .filter(|&s| self.configured(s))
             .collect();
-        if stage == StageId::Report && self.configured(StageId::Ida) {
-            up.push(StageId::Ida);
+        if stage == StageId::Report {
+            up.extend(
+                [StageId::Ida, StageId::Floors]
+                    .into_iter()
+                    .filter(|&s| self.configured(s)),
+            );
         }
         up
     }
@@ -534,6 +553,12 @@ impl Study {
             }),
             StageId::Ida => f.ida.as_deref().ok_or_else(|| {
                 ida::IdaStageError::NoSection {
+                    config: self.config_path.clone(),
+                }
+                .into()
+            }),
+            StageId::Floors => f.floors.as_deref().ok_or_else(|| {
+                floors::FloorsStageError::NoSection {
                     config: self.config_path.clone(),
                 }
                 .into()
@@ -723,6 +748,7 @@ pub fn execute(
         StageId::Fit => fit::build(s),
         StageId::Report => report::build(s),
         StageId::Ida => ida::build(s),
+        StageId::Floors => floors::build(s),
     }?;
     // A Ctrl-C that came while the output was being finished is reported, the output kept.
     s.pass("stage.done", stage)?;

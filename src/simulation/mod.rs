@@ -283,7 +283,8 @@ impl Settings {
         let label = (self.record.as_ref()).map_or(record.name.clone(), |p| p.display().to_string());
         check_peak(&label, &record, scale).map_err(|m| self.key_error(m))?;
         if floor_spectra.is_some() {
-            floor_spectra::check_record(&record, floor_spectra::REFINEMENT)
+            record
+                .check_refinable(floor_spectra::REFINEMENT)
                 .map_err(|m| self.key_error(m))?;
         }
         Ok(Simulation {

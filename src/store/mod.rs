@@ -14,6 +14,7 @@ pub mod atomic;
 pub mod checksum;
 pub mod fingerprint;
 pub mod fit;
+pub mod floors;
 pub mod h5;
 pub mod history;
 pub mod ida;

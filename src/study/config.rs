@@ -49,6 +49,9 @@ pub struct StudyConfig {
     /// Incremental dynamic analysis of a yielding structure; required by `ida`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ida: Option<IdaConfig>,
+    /// Floor response spectra of listed cases on every frame; required by `floors`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floor_spectra: Option<super::floors::FloorsConfig>,
     /// A study over buildings: the structure is a shear building (docs/model.md, "A study over
     /// buildings").
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -718,6 +721,14 @@ impl StudyConfig {
                     .collect()
             });
             ida.validate(&physics, &targets, frames.as_deref())?;
+        }
+        if let Some(floors) = &self.floor_spectra {
+            let frames: Option<Vec<Frame>> = frames.as_ref().map(|a| {
+                (0..a.frame_count())
+                    .filter_map(|i| self.frame(a, i))
+                    .collect()
+            });
+            floors.validate(&self.physics(), frames.as_deref())?;
         }
         let seeds = &self.motions.seeds;
         if seeds.stochastic.is_some() == seeds.records.is_some() {

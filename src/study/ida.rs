@@ -29,8 +29,8 @@ use crate::dynamics::{
 use crate::grid::Grid;
 use crate::ida::trace::{HuntFill, Trace, hunt_fill};
 use crate::limits::{
-    MAX_ALPHA, MAX_BLOCKS, MAX_IDA_CASES, MAX_IDA_GRID_POINTS, MAX_IDA_PAD_S, MAX_IDA_TRACE_RUNS,
-    MAX_MU, MAX_TARGET_DUCTILITY, PERIOD_RANGE_S, STRENGTH_RATIO_RANGE,
+    MAX_IDA_CASES, MAX_IDA_GRID_POINTS, MAX_IDA_PAD_S, MAX_IDA_TRACE_RUNS, MAX_TARGET_DUCTILITY,
+    STRENGTH_RATIO_RANGE,
 };
 use crate::spectrum::TargetSpectrum;
 use crate::spectrum::target::ZoneScaling;
@@ -425,43 +425,8 @@ impl IdaConfig {
         let n = self.blocks();
         for (i, c) in self.cases.iter().enumerate() {
             let key = |k: &str| format!("cases[{i}].{k}");
-            if !(c.period_s.is_finite()
-                && c.period_s >= PERIOD_RANGE_S.0
-                && c.period_s <= PERIOD_RANGE_S.1)
-            {
-                return err(
-                    &key("period_s"),
-                    format!(
-                        "{} must be in [{}, {}]",
-                        c.period_s, PERIOD_RANGE_S.0, PERIOD_RANGE_S.1
-                    ),
-                );
-            }
-            if c.alpha.is_empty() || c.alpha.len() > MAX_BLOCKS || c.alpha.len() != n {
-                return err(
-                    &key("alpha"),
-                    format!(
-                        "{} blocks: every case needs the same number, 1 to {MAX_BLOCKS} ({n} in the first)",
-                        c.alpha.len()
-                    ),
-                );
-            }
-            if c.mu.len() != n {
-                return err(&key("mu"), format!("needs one value per interface ({n})"));
-            }
-            let total: f64 = c.alpha.iter().sum();
-            if c.alpha.iter().any(|a| !(a.is_finite() && *a > 0.0)) || total > MAX_ALPHA {
-                return err(
-                    &key("alpha"),
-                    format!("values must be > 0 with a sum ≤ {MAX_ALPHA}"),
-                );
-            }
-            if c.mu
-                .iter()
-                .any(|m| !(m.is_finite() && (0.0..=MAX_MU).contains(m)))
-            {
-                return err(&key("mu"), format!("values must be in [0, {MAX_MU}]"));
-            }
+            c.check(n).or_else(|(k, why)| err(&key(k), why))?;
+            let total = c.alpha_total();
             physics
                 .check(total)
                 .map_err(|why| (format!("ida.{}", key("alpha")), why))?;

@@ -6,6 +6,8 @@
 //! * [`building`]: a study over buildings: the `building:` section, `grid.stack_floor`, a frame.
 //! * [`cases`]: the paper's named cases (Section 7.1, Table 2, Section 9).
 //! * [`config`]: the study file (YAML), validated before any work.
+//! * [`floors`]: floor response spectra of listed cases on every frame (`floor_spectra:`),
+//!   and the code's floor amplifications (ASCE 7-16, 7-22).
 //! * [`design`]: the designer's arithmetic: `T_new` of one structure from a zone's (or frame's)
 //!   data.
 //! * [`ida`]: the `ida:` section, a case's systems on a yielding structure, one traced unit.
@@ -20,6 +22,7 @@ pub mod building;
 pub mod cases;
 pub mod config;
 pub mod design;
+pub mod floors;
 pub mod ida;
 pub mod motions;
 pub mod physics;

@@ -36,6 +36,7 @@ mod building;
 mod cases;
 mod design;
 mod fit;
+mod floors;
 mod grid;
 mod ida;
 mod motions;
@@ -90,11 +91,15 @@ pub fn fingerprint(
     grid_fingerprint: Option<&str>,
     motions_fingerprint: &str,
     ida_fingerprint: Option<&str>,
+    floors_fingerprint: Option<&str>,
     compared_fit_fingerprint: Option<&str>,
 ) -> String {
     let mut parts: Vec<&str> = grid_fingerprint.into_iter().collect();
     parts.push(motions_fingerprint);
     parts.extend(ida_fingerprint);
+    if let Some(f) = floors_fingerprint {
+        parts.extend(["floors", f]);
+    }
     if let Some(c) = compared_fit_fingerprint {
         parts.extend(["compare_with", c]);
     }
@@ -579,6 +584,9 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     if study.configured(StageId::Ida) {
         sections.push(ida::ida_section(study, &mut files)?);
     }
+    if study.configured(StageId::Floors) {
+        sections.push(floors::floors_section(study, &mut files)?);
+    }
     sections.push(not_shown(building));
     if inp.fit.is_some() {
         design::design_file(&inp, &mut files)?;
@@ -615,6 +623,9 @@ fn build_without_grid(s: &Session) -> Result<StageOutcome, PipelineError> {
     let ida = study.configured(StageId::Ida);
     if ida {
         sections.push(ida::ida_section(study, &mut files)?);
+    }
+    if study.configured(StageId::Floors) {
+        sections.push(floors::floors_section(study, &mut files)?);
     }
     let facts = vec![
         format!("Config {}.", study.config_path.display()),

@@ -1,0 +1,445 @@
+//! The floors stage: the floor response spectra of the `floor_spectra:` section's cases, each
+//! on every frame, under every matched motion, sliding and attached → `floors.h5` (layout in
+//! [`crate::store::floors`]; one unit's numerics in [`crate::study::floors`]).
+//!
+//! Units (one zone, one motion, one case, one frame) run in parallel and are collected in their
+//! fixed order, so the file's bytes do not depend on the thread count; a frame that is an
+//! earlier one's building takes that frame's spectra. The file is written once, atomically, at
+//! the end (a run killed before leaves nothing; the rerun computes everything again).
+//!
+//! Fingerprint: the `zones` and `floor_spectra` sections, the grid's physics, in a building
+//! study the `building` section and `grid.stack_floor`, and the motions' fingerprint.
+
+use super::{PipelineError, Session, StageId, StageOutcome, Study};
+use crate::spectrum::floor::REFINEMENT;
+use crate::store::StoreError;
+use crate::store::fingerprint::fingerprint as hash_parts;
+use crate::store::floors::{FloorsAxes, FloorsMeta, ZoneFloors, read_zone_floors, write_floors};
+use crate::store::h5::Attr;
+use crate::study::building::first_of_building;
+use crate::study::config::StudyConfig;
+use crate::study::floors::{FloorUnit, FloorsConfig, FloorsError, floor_unit};
+use ndarray::{ArrayD, IxDyn};
+use rayon::prelude::*;
+use std::path::PathBuf;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum FloorsStageError {
+    #[error("{}: the `floors` stage needs a `floor_spectra` section", config.display())]
+    NoSection { config: PathBuf },
+    #[error("zone {zone}, motion {motion}: {why}")]
+    Record {
+        zone: String,
+        motion: String,
+        why: String,
+    },
+    #[error("zone {zone}, motion {motion}, case {case}{frame}: {source}")]
+    Unit {
+        zone: String,
+        motion: String,
+        case: usize,
+        /// `, 3 storeys, stack on the roof` in a building study, else empty.
+        frame: String,
+        source: Box<FloorsError>,
+    },
+}
+
+/// The fingerprint `floors.h5` must carry, `None` without a `floor_spectra` section.
+pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<String> {
+    let floors = cfg.floor_spectra.as_ref()?;
+    let p = cfg.physics();
+    let mut section = serde_json::json!({
+        "zones": cfg.zones, "floor_spectra": floors, "refinement": REFINEMENT,
+        "physics": { "damping": p.damping, "basis": p.basis, "mu_static_ratio": p.mu_static_ratio },
+    });
+    if let Some(b) = &cfg.building {
+        section["building"] = serde_json::json!(b);
+        let floors = cfg.grid.as_ref().and_then(|g| g.stack_floor.as_ref());
+        section["stack_floor"] = serde_json::json!(floors);
+    }
+    Some(StageId::Floors.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint])))
+}
+
+/// The config's `floor_spectra:` section, which the stage needs.
+pub fn section(study: &Study) -> Result<&FloorsConfig, FloorsStageError> {
+    (study.cfg.floor_spectra.as_ref()).ok_or_else(|| FloorsStageError::NoSection {
+        config: study.config_path.clone(),
+    })
+}
+
+/// The axes the config gives every zone of `floors.h5`.
+pub fn axes_of(study: &Study) -> Result<FloorsAxes, PipelineError> {
+    let cfg = section(study)?;
+    let spec = cfg.spec().map_err(|why| PipelineError::BadInput {
+        file: study.config_path.clone(),
+        why,
+    })?;
+    Ok(FloorsAxes {
+        case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
+        case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
+        case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
+        damping: spec.damping,
+        periods_s: spec.periods_s,
+        floors: study.building().map_or(1, |b| b.max_storeys()),
+        building: study.building().cloned(),
+    })
+}
+
+/// Builds `floors.h5`.
+pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
+    let study = &s.study;
+    let me = StageId::Floors;
+    let cfg = section(study)?;
+    let fp = study.fingerprint(me)?;
+    let axes = axes_of(study)?;
+    let spec = cfg.spec().map_err(|why| PipelineError::BadInput {
+        file: study.config_path.clone(),
+        why,
+    })?;
+    let motions = super::files::motions(study)?;
+    // Every record refined before any run: one whose history the spectrum cannot take is
+    // refused here, naming it.
+    for (z, ms) in motions.iter().enumerate() {
+        for m in ms {
+            m.check_refinable(REFINEMENT)
+                .map_err(|why| FloorsStageError::Record {
+                    zone: study.cfg.zones[z].name.clone(),
+                    motion: m.name.clone(),
+                    why,
+                })?;
+        }
+    }
+    let physics = study.physics();
+    let frames = study.frames();
+    let nf = frames.len();
+    let first = first_of_building(&frames.iter().flatten().cloned().collect::<Vec<_>>());
+    let first = |f: usize| first.get(f).copied().unwrap_or(f);
+    // (zone, motion, case, frame) in stored order; only a building's first frame is run.
+    let all: Vec<[usize; 4]> = (motions.iter().enumerate())
+        .flat_map(|(z, ms)| {
+            (0..ms.len()).flat_map(move |m| {
+                (0..cfg.cases.len()).flat_map(move |c| (0..nf).map(move |f| [z, m, c, f]))
+            })
+        })
+        .collect();
+    let units: Vec<[usize; 4]> = all
+        .iter()
+        .filter(|u| first(u[3]) == u[3])
+        .copied()
+        .collect();
+    s.reporter.info(
+        me,
+        &format!(
+            "{} units (motions × cases{}), each two runs on the record refined {REFINEMENT} \
+             times and {} spectra of {} periods per floor",
+            units.len(),
+            if study.building().is_some() {
+                " × distinct buildings"
+            } else {
+                ""
+            },
+            spec.damping.len(),
+            spec.periods_s.len()
+        ),
+    );
+    let bar = s.reporter.progress(me, units.len() as u64);
+    let outs: Vec<FloorUnit> = units
+        .par_iter()
+        .map(|&[z, m, c, f]| -> Result<FloorUnit, PipelineError> {
+            s.check_cancelled(me)?;
+            let rec = &motions[z][m];
+            let frame = frames[f].as_ref();
+            let unit =
+                floor_unit(&physics, &cfg.cases[c], frame, rec, &spec).map_err(|source| {
+                    FloorsStageError::Unit {
+                        zone: study.cfg.zones[z].name.clone(),
+                        motion: rec.name.clone(),
+                        case: c,
+                        frame: frame.map_or(String::new(), |f| format!(", {f}")),
+                        source: Box::new(source),
+                    }
+                })?;
+            bar.inc();
+            Ok(unit)
+        })
+        .collect::<Result<_, _>>()?;
+    bar.finish();
+    let done: std::collections::BTreeMap<[usize; 4], &FloorUnit> =
+        units.iter().copied().zip(&outs).collect();
+    let mut zones = Vec::new();
+    for (z, zc) in study.cfg.zones.iter().enumerate() {
+        let ms = &motions[z];
+        let unit = |m: usize, c: usize, f: usize| done[&[z, m, c, first(f)]];
+        zones.push(zone_floors(
+            &axes,
+            ms.len(),
+            nf,
+            unit,
+            |m| unit(m, 0, 0).pga_g,
+            ZoneNames {
+                name: zc.name.clone(),
+                target: zc.target.clone(),
+                motions: ms.iter().map(|r| r.name.clone()).collect(),
+            },
+        ));
+    }
+    let physics_attrs = super::sweep::physics_attrs(&physics);
+    let building_json = super::sweep::building_attr(study);
+    let mut settings: Vec<(&str, Attr)> = physics_attrs.to_vec();
+    settings.push(("refinement", Attr::F64(REFINEMENT as f64)));
+    if let Some(b) = &building_json {
+        settings.push(("building", Attr::Str(b)));
+    }
+    let meta = FloorsMeta {
+        fingerprint: fp,
+        motions_fingerprint: study.fingerprint(StageId::Motions)?,
+        config_sha256: &study.config_sha256,
+        settings: &settings,
+    };
+    let path = study.path(me.output());
+    write_floors(&path, &meta, &axes, &zones)?;
+    s.reporter.info(me, &format!("verified {}", path.display()));
+    Ok(StageOutcome::Wrote(vec![path]))
+}
+
+/// A zone's names.
+struct ZoneNames {
+    name: String,
+    target: String,
+    motions: Vec<String>,
+}
+
+/// One zone's variables from its units: `unit(m, c, f)` of motion `m`, case `c`, frame `f`
+/// (stored order: `[motion, case, frame]`, the frame split into `storeys, stack_floor`), padded
+/// with NaN above each building's roof.
+fn zone_floors<'u>(
+    axes: &FloorsAxes,
+    motions: usize,
+    frames: usize,
+    unit: impl Fn(usize, usize, usize) -> &'u FloorUnit,
+    pga: impl Fn(usize) -> f64,
+    names: ZoneNames,
+) -> ZoneFloors {
+    let cases = axes.case_period_s.len();
+    let (nd, nfl, np) = (axes.damping.len(), axes.floors, axes.periods_s.len());
+    let mut head = vec![motions, cases];
+    head.extend(axes.building.iter().flat_map(|b| b.shape()));
+    let shape = |tail: &[usize]| {
+        let mut v = head.clone();
+        v.extend_from_slice(tail);
+        IxDyn(&v).clone()
+    };
+    let mut pfa = [
+        ArrayD::from_elem(shape(&[nfl]), f64::NAN),
+        ArrayD::from_elem(shape(&[nfl]), f64::NAN),
+    ];
+    let mut psa = [
+        ArrayD::from_elem(shape(&[nd, nfl, np]), f64::NAN),
+        ArrayD::from_elem(shape(&[nd, nfl, np]), f64::NAN),
+    ];
+    for m in 0..motions {
+        for c in 0..cases {
+            for f in 0..frames {
+                let u = unit(m, c, f);
+                for s in 0..2 {
+                    // The frame axis folded: [motion, case, frame, …] in row-major order.
+                    let base = (m * cases + c) * frames + f;
+                    let floors = u.pfa_g[s].len();
+                    let pfa_rows = pfa[s].as_slice_mut().expect("standard layout");
+                    pfa_rows[base * nfl..base * nfl + floors].copy_from_slice(&u.pfa_g[s]);
+                    let psa_rows = psa[s].as_slice_mut().expect("standard layout");
+                    for (d, per_floor) in u.psa_g[s].iter().enumerate() {
+                        for (j, spectrum) in per_floor.iter().enumerate() {
+                            let at = ((base * nd + d) * nfl + j) * np;
+                            psa_rows[at..at + np].copy_from_slice(spectrum);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let [pfa_stack, pfa_rigid] = pfa;
+    let [psa_stack, psa_rigid] = psa;
+    ZoneFloors {
+        name: names.name,
+        target: names.target,
+        pga_g: (0..motions).map(pga).collect(),
+        motions: names.motions,
+        pfa_stack,
+        pfa_rigid,
+        psa_stack,
+        psa_rigid,
+    }
+}
+
+/// Zone `zone` of `floors.h5` (the caller has required it up to date), refused unless its axes
+/// are the ones the config's `floor_spectra:` section gives.
+pub fn read_zone(study: &Study, zone: &str) -> Result<(FloorsAxes, ZoneFloors), PipelineError> {
+    let path = study.path(StageId::Floors.output());
+    let (axes, z) = read_zone_floors(&path, zone, study.building().is_some())?;
+    if axes != axes_of(study)? {
+        let why =
+            format!("zone_{zone}: its axes differ from the config's `floor_spectra:` section");
+        return Err(StoreError::corrupt(&path, why).into());
+    }
+    Ok((axes, z))
+}
+
+/// One floor of one case on one building of a zone: the measured amplifications, means over
+/// the zone's motions, beside the code's (docs/model.md, "Floor response spectra", "In a study").
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloorRow {
+    pub zone: String,
+    /// 1-based, as `floor_spectra.cases` lists them.
+    pub case: usize,
+    /// The building (`3 storeys, stack on the roof`); `None` on one storey.
+    pub frame: Option<String>,
+    pub floor: usize,
+    /// The floor's height over the roof's.
+    pub z_over_h: f64,
+    /// `PFA/PGA`, the mean over the motions of each motion's ratio: stacks sliding, attached.
+    pub pfa_ratio_stack: f64,
+    pub pfa_ratio_rigid: f64,
+    /// ASCE 7-16's `1 + 2z/h` and ASCE 7-22's `H_f` at `T_a` = the case's `T_1`.
+    pub asce7_16: f64,
+    pub asce7_22: f64,
+    /// The largest of the mean floor spectrum (the first damping ratio) over the mean PFA:
+    /// stacks sliding, attached.
+    pub psa_peak_ratio_stack: f64,
+    pub psa_peak_ratio_rigid: f64,
+}
+
+/// Every floor of every case on every distinct building of every zone, from `floors.h5`.
+pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError> {
+    use crate::study::floors::{asce7_16_height_factor, asce7_22_h_f};
+    study.require(StageId::Floors)?;
+    let frames = study.frames();
+    let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
+    let mut rows = Vec::new();
+    for zone in &study.cfg.zones {
+        let (axes, z) = read_zone(study, &zone.name)?;
+        let (nm, nc, nf) = (z.motions.len(), axes.case_period_s.len(), frames.len());
+        let (nd, nfl, np) = (axes.damping.len(), axes.floors, axes.periods_s.len());
+        for c in 0..nc {
+            for (f, frame) in frames.iter().enumerate() {
+                if frame.is_some() && !distinct.contains(&f) {
+                    continue;
+                }
+                let floors = frame.as_ref().map_or(1, |fr| fr.storeys());
+                let heights = frame.as_ref().map(|fr| fr.storey_heights_m.clone());
+                let roof: f64 = heights.as_ref().map_or(1.0, |h| h.iter().sum());
+                for j in 0..floors {
+                    let z_over_h = heights
+                        .as_ref()
+                        .map_or(1.0, |h| h[..=j].iter().sum::<f64>() / roof);
+                    // Row-major offsets: [motion, case, frame, …].
+                    let base = |m: usize| (m * nc + c) * nf + f;
+                    let pfa = |a: &ArrayD<f64>, m: usize| {
+                        a.as_slice().expect("standard layout")[base(m) * nfl + j]
+                    };
+                    let ratio = |a: &ArrayD<f64>| {
+                        (0..nm).map(|m| pfa(a, m) / z.pga_g[m]).sum::<f64>() / nm as f64
+                    };
+                    let peak = |psa: &ArrayD<f64>, pfa_of: &ArrayD<f64>| {
+                        let s = psa.as_slice().expect("standard layout");
+                        let mean_pfa = (0..nm).map(|m| pfa(pfa_of, m)).sum::<f64>() / nm as f64;
+                        (0..np)
+                            .map(|p| {
+                                (0..nm)
+                                    .map(|m| s[((base(m) * nd) * nfl + j) * np + p])
+                                    .sum::<f64>()
+                                    / nm as f64
+                            })
+                            .fold(f64::NEG_INFINITY, f64::max)
+                            / mean_pfa
+                    };
+                    rows.push(FloorRow {
+                        zone: zone.name.clone(),
+                        case: c + 1,
+                        frame: frame.as_ref().map(|fr| fr.to_string()),
+                        floor: j + 1,
+                        z_over_h,
+                        pfa_ratio_stack: ratio(&z.pfa_stack),
+                        pfa_ratio_rigid: ratio(&z.pfa_rigid),
+                        asce7_16: asce7_16_height_factor(z_over_h),
+                        asce7_22: asce7_22_h_f(z_over_h, axes.case_period_s[c]),
+                        psa_peak_ratio_stack: peak(&z.psa_stack, &z.pfa_stack),
+                        psa_peak_ratio_rigid: peak(&z.psa_rigid, &z.pfa_rigid),
+                    });
+                }
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// The report's figure: per zone and distinct building, the first case's mean floor spectra
+/// (the first damping ratio) of the roof and of the middle floor, stacks sliding (solid) and
+/// attached (dashed).
+pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, PipelineError> {
+    use crate::render::chart::{Axis, Figure, Panel, Series, Stroke};
+    study.require(StageId::Floors)?;
+    let frames = study.frames();
+    let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
+    let mut panels = Vec::new();
+    for zone in &study.cfg.zones {
+        let (axes, z) = read_zone(study, &zone.name)?;
+        let (nm, nc, nf) = (z.motions.len(), axes.case_period_s.len(), frames.len());
+        let (nd, nfl, np) = (axes.damping.len(), axes.floors, axes.periods_s.len());
+        for (f, frame) in frames.iter().enumerate() {
+            if frame.is_some() && !distinct.contains(&f) {
+                continue;
+            }
+            let floors = frame.as_ref().map_or(1, |fr| fr.storeys());
+            let mut shown = vec![floors];
+            if floors >= 3 {
+                shown.insert(0, floors.div_ceil(2));
+            }
+            let mut series = Vec::new();
+            for &j in &shown {
+                for (name, psa, dashed) in [
+                    ("sliding", &z.psa_stack, false),
+                    ("attached", &z.psa_rigid, true),
+                ] {
+                    let s = psa.as_slice().expect("standard layout");
+                    let mean: Vec<f64> = (0..np)
+                        .map(|p| {
+                            (0..nm)
+                                .map(|m| s[((((m * nc) * nf + f) * nd) * nfl + j - 1) * np + p])
+                                .sum::<f64>()
+                                / nm as f64
+                        })
+                        .collect();
+                    let where_ = if j == floors {
+                        "roof".to_string()
+                    } else {
+                        format!("floor {j}")
+                    };
+                    let line =
+                        Series::line(format!("{where_}, {name}"), axes.periods_s.clone(), mean);
+                    series.push(if dashed {
+                        line.stroke(Stroke::Dashed, 2)
+                    } else {
+                        line
+                    });
+                }
+            }
+            let at = frame.as_ref().map_or(String::new(), |fr| format!(", {fr}"));
+            panels.push(Panel::xy(
+                format!(
+                    "zone {}{at}: T_p = {} s, α = {:?}, μ = {:?}, ζ = {}",
+                    zone.name,
+                    axes.case_period_s[0],
+                    axes.case_alpha[0],
+                    axes.case_mu[0],
+                    axes.damping[0]
+                ),
+                Axis::new("oscillator period (s)"),
+                Axis::new("mean floor PSA (g)"),
+                series,
+            ));
+        }
+    }
+    Ok(Figure::grid("Floor response spectra", panels, 2))
+}

@@ -1,0 +1,198 @@
+//! The floor response spectra of a study (`floor_spectra:`; docs/model.md, "Floor response
+//! spectra", "In a study"): listed cases, each on every frame, under every motion of every
+//! zone, with the stacks sliding and with them rigidly attached. One unit is one case on one
+//! frame under one motion; the stage ([`crate::pipeline::floors`]) runs the units and stores
+//! them.
+
+use super::building::Frame;
+use super::physics::{CaseError, Physics, SystemKind};
+use crate::case::Case;
+use crate::dynamics::building::BuildingResponse;
+use crate::dynamics::{ExactOptions, G, Ground};
+use crate::ground_motion::Record;
+use crate::limits::MAX_FLOOR_SPECTRA_CASES;
+use crate::spectrum::floor::{
+    FloorSpectraSettings, FloorSpectraSpec, Periods, REFINEMENT, floor_psa_g,
+};
+use serde::{Deserialize, Serialize};
+
+/// The `floor_spectra:` section of a study config.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FloorsConfig {
+    /// Oscillator periods, s: the `--periods` syntax or a list [default: 0.05:4:0.01].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub periods: Option<Periods>,
+    /// Oscillator damping ratios [default: [0.05]].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<Vec<f64>>,
+    /// The cases (a building's `period_s` is its bare first-mode period `T_1`), each on every
+    /// frame of a building study (static friction = `grid.mu_static_ratio` × kinetic).
+    pub cases: Vec<Case>,
+}
+
+/// The two systems of every unit, in stored order: the stack sliding, then rigidly attached.
+pub const SYSTEMS: [SystemKind; 2] = [SystemKind::Stack, SystemKind::Rigid];
+
+impl FloorsConfig {
+    /// The periods and damping ratios, checked.
+    pub fn spec(&self) -> Result<FloorSpectraSpec, String> {
+        FloorSpectraSettings {
+            periods: self.periods.clone(),
+            damping: self.damping.clone(),
+        }
+        .resolve()
+    }
+
+    /// The section checked before any work: its spectra and cases (each as the physics and
+    /// every frame can build it); the key under `floor_spectra.` and why otherwise.
+    pub fn validate(
+        &self,
+        physics: &Physics,
+        frames: Option<&[Frame]>,
+    ) -> Result<(), (String, String)> {
+        let err = |k: &str, w: String| Err((format!("floor_spectra.{k}"), w));
+        if let Err(why) = self.spec() {
+            // resolve() names `floor_spectra.periods` or `.damping` itself.
+            let key = if why.contains("damping") {
+                "damping"
+            } else {
+                "periods"
+            };
+            return err(key, why);
+        }
+        if self.cases.is_empty() || self.cases.len() > MAX_FLOOR_SPECTRA_CASES {
+            return err(
+                "cases",
+                format!(
+                    "{} cases; needs 1 to {MAX_FLOOR_SPECTRA_CASES}",
+                    self.cases.len()
+                ),
+            );
+        }
+        let blocks = self.cases[0].alpha.len();
+        for (i, c) in self.cases.iter().enumerate() {
+            let key = |k: &str| format!("cases[{i}].{k}");
+            c.check(blocks).or_else(|(k, why)| err(&key(k), why))?;
+            physics
+                .check(c.alpha_total())
+                .or_else(|why| err(&key("alpha"), why))?;
+            for frame in frames.unwrap_or_default() {
+                physics.building(SystemKind::Stack, c, frame).map_err(|e| {
+                    (
+                        format!("floor_spectra.{}", key("alpha")),
+                        format!("{frame}: {e}"),
+                    )
+                })?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What one unit stores: per system ([`SYSTEMS`]), each floor's spectra `[damping][floor]
+/// [period]` (g) and peak absolute acceleration (g), floor 1 first; and the motion's PGA (g).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloorUnit {
+    pub psa_g: [Vec<Vec<Vec<f64>>>; 2],
+    pub pfa_g: [Vec<f64>; 2],
+    pub pga_g: f64,
+}
+
+/// One system's run on the refined record, its history kept.
+fn run(
+    physics: &Physics,
+    kind: SystemKind,
+    case: &Case,
+    frame: Option<&Frame>,
+    ground: &Ground,
+) -> Result<BuildingResponse, CaseError> {
+    let opts = ExactOptions {
+        history: true,
+        energy_balance: false,
+        abs_velocity: false,
+        ..ExactOptions::default()
+    };
+    match frame {
+        Some(f) => physics.simulate_building(kind, case, f, ground, &opts, None),
+        None => (physics.simulate(kind, case, ground, &opts, None))
+            .map(BuildingResponse::from_one_storey),
+    }
+}
+
+/// `case` on `frame` (`None`: one storey) under `record`: each floor's spectra as `spec` asks,
+/// from its history on the record refined [`REFINEMENT`] times, with the stack sliding and
+/// rigidly attached.
+pub fn floor_unit(
+    physics: &Physics,
+    case: &Case,
+    frame: Option<&Frame>,
+    record: &Record,
+    spec: &FloorSpectraSpec,
+) -> Result<FloorUnit, FloorsError> {
+    let fine = record.refined(REFINEMENT);
+    let accel = fine.accel_mps2(1.0);
+    let ground = Ground::new(fine.dt_s, &accel);
+    let floors = frame.map_or(1, Frame::storeys);
+    let mut psa_g: [Vec<Vec<Vec<f64>>>; 2] = Default::default();
+    let mut pfa_g: [Vec<f64>; 2] = Default::default();
+    for (s, kind) in SYSTEMS.into_iter().enumerate() {
+        let r = run(physics, kind, case, frame, &ground)?;
+        let h = r
+            .history
+            .as_ref()
+            .expect("a run asked for its history keeps it");
+        psa_g[s] = floor_psa_g(h, floors, fine.dt_s, spec)?;
+        pfa_g[s] = (r.floor_peak_abs_accel_mps2.iter())
+            .map(|a| a / G)
+            .collect();
+    }
+    Ok(FloorUnit {
+        psa_g,
+        pfa_g,
+        pga_g: record.pga_g(),
+    })
+}
+
+/// Why a unit could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum FloorsError {
+    #[error(transparent)]
+    Case(#[from] CaseError),
+    #[error("the floor spectrum: {0}")]
+    Spectrum(#[from] crate::spectrum::SpectrumError),
+}
+
+/// The height factor of ASCE 7-16 Eq. 13.3-1, `1 + 2·z/h`: the floor's acceleration over the
+/// ground's at height `z` of a building `h` tall.
+pub fn asce7_16_height_factor(z_over_h: f64) -> f64 {
+    1.0 + 2.0 * z_over_h
+}
+
+/// ASCE 7-22's `H_f` (Eq. 13.3-4), the floor's acceleration over the ground's at height `z` of
+/// a building `h` tall whose approximate fundamental period is `t_a_s`:
+/// `1 + a_1·(z/h) + a_2·(z/h)^10`, `a_1 = min(1/T_a, 2.5)`, `a_2 = max(1 − (0.4/T_a)², 0)`.
+pub fn asce7_22_h_f(z_over_h: f64, t_a_s: f64) -> f64 {
+    let a1 = (1.0 / t_a_s).min(2.5);
+    let a2 = (1.0 - (0.4 / t_a_s).powi(2)).max(0.0);
+    1.0 + a1 * z_over_h + a2 * z_over_h.powi(10)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The code's factors at their ends: the ground (1), the roof (ASCE 7-16: 3); ASCE 7-22 at
+    /// `T_a = 0.4 s` has `a_1 = 2.5`, `a_2 = 0`; at `T_a = 1 s`, `a_1 = 1`, `a_2 = 0.84`.
+    #[test]
+    fn the_code_factors_at_their_ends() {
+        assert_eq!(asce7_16_height_factor(0.0), 1.0);
+        assert_eq!(asce7_16_height_factor(1.0), 3.0);
+        assert_eq!(asce7_22_h_f(0.0, 1.0), 1.0);
+        assert!((asce7_22_h_f(1.0, 0.4) - 3.5).abs() < 1e-15);
+        assert!((asce7_22_h_f(1.0, 1.0) - 2.84).abs() < 1e-15);
+        assert!((asce7_22_h_f(0.5, 1.0) - (1.5 + 0.84 * 0.5f64.powi(10))).abs() < 1e-15);
+        // Short periods: a_1 capped at 2.5, a_2 at 0.
+        assert!((asce7_22_h_f(1.0, 0.1) - 3.5).abs() < 1e-15);
+    }
+}
