@@ -53,13 +53,17 @@ impl FloorsConfig {
     ) -> Result<(), (String, String)> {
         let err = |k: &str, w: String| Err((format!("floor_spectra.{k}"), w));
         if let Err(why) = self.spec() {
-            // resolve() names `floor_spectra.periods` or `.damping` itself.
-            let key = if why.contains("damping") {
+            // resolve() begins its message with the key, `floor_spectra.periods` or `.damping`.
+            let key = if why.starts_with("`floor_spectra.damping`") {
                 "damping"
             } else {
                 "periods"
             };
-            return err(key, why);
+            let why = why
+                .trim_start_matches(&format!("`floor_spectra.{key}`"))
+                .trim_start_matches(':')
+                .trim();
+            return err(key, why.to_string());
         }
         if self.cases.is_empty() || self.cases.len() > MAX_FLOOR_SPECTRA_CASES {
             return err(
