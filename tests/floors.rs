@@ -169,3 +169,64 @@ fn bad_floor_spectra_sections_are_refused_naming_the_key() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("needs a `floor_spectra` section"), "{err}");
 }
+
+/// One storey (configs/quick.yaml's motions and physics): the floor is the structure; its
+/// stored spectra are `simulate`'s of the case file, bit for bit; a stack whose friction no
+/// motion overcomes (μ = 5) has the spectra of the stack attached, to 1e-9 of the largest
+/// ordinate (two exact solutions of one model, as the sweep's no-slip rule).
+#[test]
+fn on_one_storey_the_floor_is_the_structure_and_a_stack_that_cannot_slide_is_attached() {
+    let dir = tempfile::tempdir().unwrap();
+    let quick = std::fs::read_to_string(repo("configs/quick.yaml")).unwrap();
+    let out = dir.path().join("out");
+    let cfg = dir.path().join("one.yaml");
+    let section = "floor_spectra:\n  periods: \"0.05:4:0.1\"\n  cases:\n    \
+                   - { period_s: 0.6, alpha: [0.5, 0.5], mu: [0.2, 0.1] }\n    \
+                   - { period_s: 0.6, alpha: [0.5, 0.5], mu: [5, 5] }\n";
+    std::fs::write(
+        &cfg,
+        quick.replace("output_dir: out/quick", &format!("output_dir: {}", s(&out))) + section,
+    )
+    .unwrap();
+    ok(slidestack(&["motions", s(&cfg)], "2"));
+    ok(slidestack(&["floors", s(&cfg)], "2"));
+    let (axes, z) = read_zone_floors(&out.join("floors.h5"), "III", false).unwrap();
+    assert_eq!((axes.floors, axes.damping.as_slice()), (1, &[0.05][..]));
+    assert_eq!(z.psa_stack.shape(), [3, 2, 1, 1, 40]);
+    let motions = read_zone_motions(&out.join("motions.h5"), "III").unwrap();
+    let largest = |a: &ndarray::ArrayD<f64>, m: usize, c: usize| {
+        (0..40).fold(0.0f64, |x, p| x.max(a[[m, c, 0, 0, p]]))
+    };
+    let mut worst = 0.0f64;
+    for (m, record) in motions.iter().enumerate() {
+        let settings: Settings = serde_yaml::from_str(
+            "period: 0.6\nalpha: [0.5, 0.5]\nmu: [0.2, 0.1]\ndamping: 0.05\n\
+             damping_basis: rigid\nfloor_spectra: { periods: \"0.05:4:0.1\" }\n",
+        )
+        .unwrap();
+        let sim = settings.resolve_with(record.clone()).unwrap();
+        let (outcome, _) = sim.run(&sim.accel_mps2()).unwrap();
+        let Outcome::OneStorey(one) = outcome else {
+            panic!("one storey")
+        };
+        let fs = one.floor_spectra.as_ref().expect("asked for");
+        let stored: Vec<f64> = (0..40).map(|p| z.psa_stack[[m, 0, 0, 0, p]]).collect();
+        assert_eq!(stored, fs.psa_g[0][0], "motion {m}");
+        // The stage's peak is from the run on the refined record, simulate's from the record's
+        // own: two exact peaks of one history (1e-9, as above).
+        let direct = one.peak_abs_accel_g[0];
+        assert!(
+            (z.pfa_stack[[m, 0, 0]] - direct).abs() <= 1e-9 * direct,
+            "motion {m}"
+        );
+        let scale = largest(&z.psa_rigid, m, 1);
+        for p in 0..40 {
+            let d = (z.psa_stack[[m, 1, 0, 0, p]] - z.psa_rigid[[m, 1, 0, 0, p]]).abs();
+            worst = worst.max(d / scale);
+        }
+    }
+    eprintln!("a stack that cannot slide against the stack attached: {worst:e}");
+    assert!(worst <= 1e-9, "{worst}");
+    // The sliding stack's spectra differ from the attached ones.
+    assert_ne!(largest(&z.psa_stack, 0, 0), largest(&z.psa_rigid, 0, 0));
+}

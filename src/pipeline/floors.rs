@@ -16,7 +16,7 @@ use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::floors::{FloorsAxes, FloorsMeta, ZoneFloors, read_zone_floors, write_floors};
 use crate::store::h5::Attr;
-use crate::study::building::first_of_building;
+use crate::study::building::{Frame, first_of_building};
 use crate::study::config::StudyConfig;
 use crate::study::floors::{FloorUnit, FloorsConfig, FloorsError, floor_unit};
 use ndarray::{ArrayD, IxDyn};
@@ -210,9 +210,45 @@ struct ZoneNames {
     motions: Vec<String>,
 }
 
-/// One zone's variables from its units: `unit(m, c, f)` of motion `m`, case `c`, frame `f`
-/// (stored order: `[motion, case, frame]`, the frame split into `storeys, stack_floor`), padded
-/// with NaN above each building's roof.
+/// Where a value of a zone's variables lies in their flat row-major arrays
+/// ([`crate::store::floors`]: `[motion, case, frame, …]`, the frame axis `storeys ×
+/// stack_floor` folded into one).
+struct Offsets {
+    cases: usize,
+    frames: usize,
+    damping: usize,
+    floors: usize,
+    periods: usize,
+}
+
+impl Offsets {
+    fn of(axes: &FloorsAxes, frames: usize) -> Self {
+        Self {
+            cases: axes.case_period_s.len(),
+            frames,
+            damping: axes.damping.len(),
+            floors: axes.floors,
+            periods: axes.periods_s.len(),
+        }
+    }
+
+    fn unit(&self, m: usize, c: usize, f: usize) -> usize {
+        (m * self.cases + c) * self.frames + f
+    }
+
+    /// Floor `j`'s peak of `pfa_*`.
+    fn pfa(&self, m: usize, c: usize, f: usize, j: usize) -> usize {
+        self.unit(m, c, f) * self.floors + j
+    }
+
+    /// The first period of floor `j`'s spectrum at damping ratio `d` in `psa_*`.
+    fn psa(&self, m: usize, c: usize, f: usize, d: usize, j: usize) -> usize {
+        ((self.unit(m, c, f) * self.damping + d) * self.floors + j) * self.periods
+    }
+}
+
+/// One zone's variables from its units: `unit(m, c, f)` of motion `m`, case `c`, frame `f`,
+/// padded with NaN above each building's roof.
 fn zone_floors<'u>(
     axes: &FloorsAxes,
     motions: usize,
@@ -221,38 +257,30 @@ fn zone_floors<'u>(
     pga: impl Fn(usize) -> f64,
     names: ZoneNames,
 ) -> ZoneFloors {
-    let cases = axes.case_period_s.len();
-    let (nd, nfl, np) = (axes.damping.len(), axes.floors, axes.periods_s.len());
-    let mut head = vec![motions, cases];
+    let o = Offsets::of(axes, frames);
+    let mut head = vec![motions, o.cases];
     head.extend(axes.building.iter().flat_map(|b| b.shape()));
-    let shape = |tail: &[usize]| {
-        let mut v = head.clone();
-        v.extend_from_slice(tail);
-        IxDyn(&v).clone()
+    let nan = |tail: &[usize]| {
+        let mut shape = head.clone();
+        shape.extend_from_slice(tail);
+        ArrayD::from_elem(IxDyn(&shape), f64::NAN)
     };
-    let mut pfa = [
-        ArrayD::from_elem(shape(&[nfl]), f64::NAN),
-        ArrayD::from_elem(shape(&[nfl]), f64::NAN),
-    ];
-    let mut psa = [
-        ArrayD::from_elem(shape(&[nd, nfl, np]), f64::NAN),
-        ArrayD::from_elem(shape(&[nd, nfl, np]), f64::NAN),
-    ];
+    let mut pfa = [nan(&[o.floors]), nan(&[o.floors])];
+    let per_floor = [o.damping, o.floors, o.periods];
+    let mut psa = [nan(&per_floor), nan(&per_floor)];
     for m in 0..motions {
-        for c in 0..cases {
+        for c in 0..o.cases {
             for f in 0..frames {
                 let u = unit(m, c, f);
                 for s in 0..2 {
-                    // The frame axis folded: [motion, case, frame, …] in row-major order.
-                    let base = (m * cases + c) * frames + f;
-                    let floors = u.pfa_g[s].len();
-                    let pfa_rows = pfa[s].as_slice_mut().expect("standard layout");
-                    pfa_rows[base * nfl..base * nfl + floors].copy_from_slice(&u.pfa_g[s]);
-                    let psa_rows = psa[s].as_slice_mut().expect("standard layout");
-                    for (d, per_floor) in u.psa_g[s].iter().enumerate() {
-                        for (j, spectrum) in per_floor.iter().enumerate() {
-                            let at = ((base * nd + d) * nfl + j) * np;
-                            psa_rows[at..at + np].copy_from_slice(spectrum);
+                    let at = o.pfa(m, c, f, 0);
+                    let rows = pfa[s].as_slice_mut().expect("standard layout");
+                    rows[at..at + u.pfa_g[s].len()].copy_from_slice(&u.pfa_g[s]);
+                    let rows = psa[s].as_slice_mut().expect("standard layout");
+                    for (d, floors) in u.psa_g[s].iter().enumerate() {
+                        for (j, spectrum) in floors.iter().enumerate() {
+                            let at = o.psa(m, c, f, d, j);
+                            rows[at..at + o.periods].copy_from_slice(spectrum);
                         }
                     }
                 }
@@ -310,49 +338,79 @@ pub struct FloorRow {
     pub psa_peak_ratio_rigid: f64,
 }
 
+/// One zone of `floors.h5` with what reading it takes: its axes and offsets, and the study's
+/// frames to show (each distinct building once; on one storey the structure), with their
+/// stored index.
+struct Shown {
+    axes: FloorsAxes,
+    zone: ZoneFloors,
+    offsets: Offsets,
+    frames: Vec<(usize, Option<Frame>)>,
+}
+
+impl Shown {
+    fn read(study: &Study, zone: &str) -> Result<Self, PipelineError> {
+        let (axes, zone) = read_zone(study, zone)?;
+        let all = study.frames();
+        let offsets = Offsets::of(&axes, all.len());
+        let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
+        let frames = (all.into_iter().enumerate())
+            .filter(|(f, frame)| frame.is_none() || distinct.contains(f))
+            .collect();
+        Ok(Self {
+            axes,
+            zone,
+            offsets,
+            frames,
+        })
+    }
+
+    fn motions(&self) -> usize {
+        self.zone.motions.len()
+    }
+
+    /// The mean over the motions of `values(m)`.
+    fn mean(&self, values: impl Fn(usize) -> f64) -> f64 {
+        (0..self.motions()).map(values).sum::<f64>() / self.motions() as f64
+    }
+
+    /// The mean over the motions of floor `j`'s spectrum (case `c`, frame `f`, the first
+    /// damping ratio) in `psa`.
+    fn mean_spectrum(&self, psa: &ArrayD<f64>, c: usize, f: usize, j: usize) -> Vec<f64> {
+        let s = psa.as_slice().expect("standard layout");
+        (0..self.offsets.periods)
+            .map(|p| self.mean(|m| s[self.offsets.psa(m, c, f, 0, j) + p]))
+            .collect()
+    }
+
+    /// Floor `j`'s peak (case `c`, frame `f`) under motion `m` in `pfa`.
+    fn pfa(&self, pfa: &ArrayD<f64>, m: usize, c: usize, f: usize, j: usize) -> f64 {
+        pfa.as_slice().expect("standard layout")[self.offsets.pfa(m, c, f, j)]
+    }
+}
+
 /// Every floor of every case on every distinct building of every zone, from `floors.h5`.
 pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError> {
     use crate::study::floors::{asce7_16_height_factor, asce7_22_h_f};
     study.require(StageId::Floors)?;
-    let frames = study.frames();
-    let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
     let mut rows = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = read_zone(study, &zone.name)?;
-        let (nm, nc, nf) = (z.motions.len(), axes.case_period_s.len(), frames.len());
-        let (nd, nfl, np) = (axes.damping.len(), axes.floors, axes.periods_s.len());
-        for c in 0..nc {
-            for (f, frame) in frames.iter().enumerate() {
-                if frame.is_some() && !distinct.contains(&f) {
-                    continue;
-                }
-                let floors = frame.as_ref().map_or(1, |fr| fr.storeys());
+        let v = Shown::read(study, &zone.name)?;
+        let z = &v.zone;
+        for c in 0..v.offsets.cases {
+            for (f, frame) in &v.frames {
+                let f = *f;
                 let heights = frame.as_ref().map(|fr| fr.storey_heights_m.clone());
-                let roof: f64 = heights.as_ref().map_or(1.0, |h| h.iter().sum());
-                for j in 0..floors {
-                    let z_over_h = heights
-                        .as_ref()
-                        .map_or(1.0, |h| h[..=j].iter().sum::<f64>() / roof);
-                    // Row-major offsets: [motion, case, frame, …].
-                    let base = |m: usize| (m * nc + c) * nf + f;
-                    let pfa = |a: &ArrayD<f64>, m: usize| {
-                        a.as_slice().expect("standard layout")[base(m) * nfl + j]
-                    };
-                    let ratio = |a: &ArrayD<f64>| {
-                        (0..nm).map(|m| pfa(a, m) / z.pga_g[m]).sum::<f64>() / nm as f64
-                    };
-                    let peak = |psa: &ArrayD<f64>, pfa_of: &ArrayD<f64>| {
-                        let s = psa.as_slice().expect("standard layout");
-                        let mean_pfa = (0..nm).map(|m| pfa(pfa_of, m)).sum::<f64>() / nm as f64;
-                        (0..np)
-                            .map(|p| {
-                                (0..nm)
-                                    .map(|m| s[((base(m) * nd) * nfl + j) * np + p])
-                                    .sum::<f64>()
-                                    / nm as f64
-                            })
-                            .fold(f64::NEG_INFINITY, f64::max)
-                            / mean_pfa
+                // One storey: the structure is the roof.
+                let heights = heights.unwrap_or_else(|| vec![1.0]);
+                let roof: f64 = heights.iter().sum();
+                for j in 0..heights.len() {
+                    let z_over_h = heights[..=j].iter().sum::<f64>() / roof;
+                    let ratio = |pfa: &ArrayD<f64>| v.mean(|m| v.pfa(pfa, m, c, f, j) / z.pga_g[m]);
+                    let peak = |psa: &ArrayD<f64>, pfa: &ArrayD<f64>| {
+                        let spectrum = v.mean_spectrum(psa, c, f, j);
+                        spectrum.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                            / v.mean(|m| v.pfa(pfa, m, c, f, j))
                     };
                     rows.push(FloorRow {
                         zone: zone.name.clone(),
@@ -363,7 +421,7 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
                         pfa_ratio_stack: ratio(&z.pfa_stack),
                         pfa_ratio_rigid: ratio(&z.pfa_rigid),
                         asce7_16: asce7_16_height_factor(z_over_h),
-                        asce7_22: asce7_22_h_f(z_over_h, axes.case_period_s[c]),
+                        asce7_22: asce7_22_h_f(z_over_h, v.axes.case_period_s[c]),
                         psa_peak_ratio_stack: peak(&z.psa_stack, &z.pfa_stack),
                         psa_peak_ratio_rigid: peak(&z.psa_rigid, &z.pfa_rigid),
                     });
@@ -375,49 +433,34 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
 }
 
 /// The report's figure: per zone and distinct building, the first case's mean floor spectra
-/// (the first damping ratio) of the roof and of the middle floor, stacks sliding (solid) and
-/// attached (dashed).
+/// (the first damping ratio) of the roof and, from three storeys, the middle floor, stacks
+/// sliding (solid) and attached (dashed).
 pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, PipelineError> {
     use crate::render::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Floors)?;
-    let frames = study.frames();
-    let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
     let mut panels = Vec::new();
     for zone in &study.cfg.zones {
-        let (axes, z) = read_zone(study, &zone.name)?;
-        let (nm, nc, nf) = (z.motions.len(), axes.case_period_s.len(), frames.len());
-        let (nd, nfl, np) = (axes.damping.len(), axes.floors, axes.periods_s.len());
-        for (f, frame) in frames.iter().enumerate() {
-            if frame.is_some() && !distinct.contains(&f) {
-                continue;
-            }
-            let floors = frame.as_ref().map_or(1, |fr| fr.storeys());
+        let v = Shown::read(study, &zone.name)?;
+        let a = &v.axes;
+        for (f, frame) in &v.frames {
+            let floors = frame.as_ref().map_or(1, Frame::storeys);
             let mut shown = vec![floors];
             if floors >= 3 {
                 shown.insert(0, floors.div_ceil(2));
             }
             let mut series = Vec::new();
             for &j in &shown {
+                let place = if j == floors {
+                    "roof".to_string()
+                } else {
+                    format!("floor {j}")
+                };
                 for (name, psa, dashed) in [
-                    ("sliding", &z.psa_stack, false),
-                    ("attached", &z.psa_rigid, true),
+                    ("sliding", &v.zone.psa_stack, false),
+                    ("attached", &v.zone.psa_rigid, true),
                 ] {
-                    let s = psa.as_slice().expect("standard layout");
-                    let mean: Vec<f64> = (0..np)
-                        .map(|p| {
-                            (0..nm)
-                                .map(|m| s[((((m * nc) * nf + f) * nd) * nfl + j - 1) * np + p])
-                                .sum::<f64>()
-                                / nm as f64
-                        })
-                        .collect();
-                    let where_ = if j == floors {
-                        "roof".to_string()
-                    } else {
-                        format!("floor {j}")
-                    };
-                    let line =
-                        Series::line(format!("{where_}, {name}"), axes.periods_s.clone(), mean);
+                    let mean = v.mean_spectrum(psa, 0, *f, j - 1);
+                    let line = Series::line(format!("{place}, {name}"), a.periods_s.clone(), mean);
                     series.push(if dashed {
                         line.stroke(Stroke::Dashed, 2)
                     } else {
@@ -429,11 +472,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
             panels.push(Panel::xy(
                 format!(
                     "zone {}{at}: T_p = {} s, α = {:?}, μ = {:?}, ζ = {}",
-                    zone.name,
-                    axes.case_period_s[0],
-                    axes.case_alpha[0],
-                    axes.case_mu[0],
-                    axes.damping[0]
+                    zone.name, a.case_period_s[0], a.case_alpha[0], a.case_mu[0], a.damping[0]
                 ),
                 Axis::new("oscillator period (s)"),
                 Axis::new("mean floor PSA (g)"),
