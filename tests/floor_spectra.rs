@@ -105,6 +105,38 @@ fn a_stack_that_cannot_slide_gives_the_cascades_spectrum() {
     assert_eq!(fs.refinement, REFINEMENT);
 }
 
+/// The other limit: a frictionless stack (`μ = 0`) exerts no force on its structure, so the
+/// floor is the bare structure (`T_p`) with the case's damper, which the rigid basis sizes for
+/// the loaded structure: `ζ_s = ζ·sqrt(1 + α)` of the bare one. Its spectrum is the cascade's,
+/// to the same 1e-5.
+#[test]
+fn a_frictionless_stack_leaves_the_bare_structures_spectrum() {
+    let sim = case(
+        "period: 0.5\nalpha: [0.5, 0.5]\nmu: [0.0, 0.0]\ndamping: 0.05\n\
+         floor_spectra: {periods: [0.05, 0.1, 0.2, 0.5, 0.7, 1.0, 2.0, 4.0], \
+         damping: [0.02, 0.05]}",
+    );
+    let (fs, _) = spectra_of(&sim);
+    let ws = std::f64::consts::TAU / 0.5;
+    let zs = 0.05 * 2f64.sqrt();
+    let accel = sim.accel_mps2();
+    let oracle: Vec<Vec<Vec<f64>>> = (fs.damping.iter())
+        .map(|&z| {
+            vec![
+                (fs.periods_s.iter())
+                    .map(|&t| {
+                        let w = std::f64::consts::TAU / t;
+                        w * w * cascade_peak(ws, zs, w, z, sim.record.dt_s, &accel, 256) / G
+                    })
+                    .collect(),
+            ]
+        })
+        .collect();
+    let err = max_relative(&fs.psa_g, &oracle);
+    println!("frictionless: largest relative difference from the cascade {err:e}");
+    assert!(err < 1e-5, "largest relative difference {err:e}");
+}
+
 /// Where stacks slide, each switch makes a floor's acceleration jump, which a history linear
 /// between samples spreads over one sample: the error falls as the first power of the step.
 /// The stored spectrum (history at `dt/64`) against the one of a history at `dt/256`: within
