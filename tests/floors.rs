@@ -114,7 +114,9 @@ fn a_study_stores_floor_spectra_as_simulate_gives_them_and_reports_them_beside_t
     // the stored arrays' mean ratios beside ASCE 7-16's 3 and ASCE 7-22's H_f at T_a = 1 s.
     let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
     assert!(html.contains("Floor response spectra"));
-    assert!(out.join("report/floors.svg").exists());
+    let svg = std::fs::read_to_string(out.join("report/floors.svg")).unwrap();
+    assert!(svg.contains("roof, sliding") && svg.contains("roof, ASCE 7-16"));
+    assert!(svg.contains("floor 2, attached"));
     let ratio = |pfa: &ndarray::ArrayD<f64>| {
         (0..3)
             .map(|m| pfa[[m, 0, 1, 1, 2]] / z.pga_g[m])

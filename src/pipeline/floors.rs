@@ -400,12 +400,10 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
         for c in 0..v.offsets.cases {
             for (f, frame) in &v.frames {
                 let f = *f;
-                let heights = frame.as_ref().map(|fr| fr.storey_heights_m.clone());
-                // One storey: the structure is the roof.
-                let heights = heights.unwrap_or_else(|| vec![1.0]);
-                let roof: f64 = heights.iter().sum();
-                for j in 0..heights.len() {
-                    let z_over_h = heights[..=j].iter().sum::<f64>() / roof;
+                let floors = frame.as_ref().map_or(1, Frame::storeys);
+                for j in 0..floors {
+                    // One storey: the structure is the roof.
+                    let z_over_h = frame.as_ref().map_or(1.0, |fr| fr.height_ratio(j + 1));
                     let ratio = |pfa: &ArrayD<f64>| v.mean(|m| v.pfa(pfa, m, c, f, j) / z.pga_g[m]);
                     let peak = |psa: &ArrayD<f64>, pfa: &ArrayD<f64>| {
                         let spectrum = v.mean_spectrum(psa, c, f, j);
@@ -432,9 +430,23 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
     Ok(rows)
 }
 
+/// ASCE 7-16's floor spectrum at height `z/h` (Eq. 13.3-1 with `R_p/I_p = 1`, `0.4·S_DS` the
+/// motions' mean PGA, g): `a_p·(1 + 2z/h)·PGA`, `a_p` 1 for a rigid component (period at most
+/// 0.06 s) and 2.5 for a flexible one, over `axes`' periods: the step's corners.
+fn asce7_16_floor_spectrum(z_over_h: f64, pga_g: f64, axes: &FloorsAxes) -> (Vec<f64>, Vec<f64>) {
+    use crate::study::floors::{RIGID_COMPONENT_PERIOD_S, asce7_16_height_factor};
+    let floor = asce7_16_height_factor(z_over_h) * pga_g;
+    let (lo, hi) = (axes.periods_s[0], axes.periods_s[axes.periods_s.len() - 1]);
+    let knee = RIGID_COMPONENT_PERIOD_S.clamp(lo, hi);
+    (
+        vec![lo, knee, knee, hi],
+        vec![floor, floor, 2.5 * floor, 2.5 * floor],
+    )
+}
+
 /// The report's figure: per zone and distinct building, the first case's mean floor spectra
 /// (the first damping ratio) of the roof and, from three storeys, the middle floor, stacks
-/// sliding (solid) and attached (dashed).
+/// sliding (solid) and attached (dashed), and ASCE 7-16's floor spectrum there (dotted).
 pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, PipelineError> {
     use crate::render::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Floors)?;
@@ -467,6 +479,11 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
                         line
                     });
                 }
+                let z_over_h = frame.as_ref().map_or(1.0, |fr| fr.height_ratio(j));
+                let (x, y) = asce7_16_floor_spectrum(z_over_h, v.mean(|m| v.zone.pga_g[m]), a);
+                series.push(
+                    Series::line(format!("{place}, ASCE 7-16"), x, y).stroke(Stroke::Dotted, 2),
+                );
             }
             let at = frame.as_ref().map_or(String::new(), |fr| format!(", {fr}"));
             panels.push(Panel::xy(

@@ -289,6 +289,11 @@ impl Frame {
         self.storey_heights_m.iter().sum()
     }
 
+    /// Floor `floor`'s height over the roof's, `z/h` (floor 1 the lowest).
+    pub fn height_ratio(&self, floor: usize) -> f64 {
+        self.storey_heights_m[..floor].iter().sum::<f64>() / self.height_m()
+    }
+
     /// An overturning moment at the base (N·m) over the bare building's weight times its
     /// height.
     pub fn overturning_ratio(&self, m_n_m: f64) -> f64 {

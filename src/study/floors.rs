@@ -167,6 +167,10 @@ pub enum FloorsError {
     Spectrum(#[from] crate::spectrum::SpectrumError),
 }
 
+/// ASCE 7-16 Table 13.5-1's footnote: a component whose period is at most 0.06 s is rigid
+/// (`a_p = 1`), a longer one flexible (`a_p = 2.5`), s.
+pub const RIGID_COMPONENT_PERIOD_S: f64 = 0.06;
+
 /// The height factor of ASCE 7-16 Eq. 13.3-1, `1 + 2·z/h`: the floor's acceleration over the
 /// ground's at height `z` of a building `h` tall.
 pub fn asce7_16_height_factor(z_over_h: f64) -> f64 {

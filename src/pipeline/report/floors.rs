@@ -17,7 +17,9 @@ pub(super) fn floors_section(study: &Study, files: &mut Files) -> Result<Section
             "Mean floor response spectra (pseudo-acceleration of an oscillator standing on the \
              floor, the first damping ratio) of the first case, over the zone's motions: the roof \
              and, with three storeys or more, the middle floor, with the stacks sliding (solid) \
-             and rigidly attached (dashed).",
+             and rigidly attached (dashed), and ASCE 7-16's floor spectrum at that height \
+             (dotted: Eq. 13.3-1 with R_p/I_p = 1 and the motions' mean PGA for 0.4·S_DS, \
+             a_p = 1 up to 0.06 s and 2.5 beyond).",
         )
         .map_err(|e: ReportError| PipelineError::from(e))?;
     let f2 = |x: f64| format!("{x:.2}");
