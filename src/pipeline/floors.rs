@@ -176,11 +176,11 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
             ms.len(),
             nf,
             unit,
-            |m| unit(m, 0, 0).pga_g,
             ZoneNames {
                 name: zc.name.clone(),
                 target: zc.target.clone(),
                 motions: ms.iter().map(|r| r.name.clone()).collect(),
+                pga_g: ms.iter().map(|r| r.pga_g()).collect(),
             },
         ));
     }
@@ -203,11 +203,12 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     Ok(StageOutcome::Wrote(vec![path]))
 }
 
-/// A zone's names.
+/// A zone's names, and its motions' peak ground accelerations, g.
 struct ZoneNames {
     name: String,
     target: String,
     motions: Vec<String>,
+    pga_g: Vec<f64>,
 }
 
 /// Where a value of a zone's variables lies in their flat row-major arrays
@@ -254,7 +255,6 @@ fn zone_floors<'u>(
     motions: usize,
     frames: usize,
     unit: impl Fn(usize, usize, usize) -> &'u FloorUnit,
-    pga: impl Fn(usize) -> f64,
     names: ZoneNames,
 ) -> ZoneFloors {
     let o = Offsets::of(axes, frames);
@@ -292,7 +292,7 @@ fn zone_floors<'u>(
     ZoneFloors {
         name: names.name,
         target: names.target,
-        pga_g: (0..motions).map(pga).collect(),
+        pga_g: names.pga_g,
         motions: names.motions,
         pfa_stack,
         pfa_rigid,

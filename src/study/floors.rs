@@ -95,12 +95,11 @@ impl FloorsConfig {
 }
 
 /// What one unit stores: per system ([`SYSTEMS`]), each floor's spectra `[damping][floor]
-/// [period]` (g) and peak absolute acceleration (g), floor 1 first; and the motion's PGA (g).
+/// [period]` (g) and peak absolute acceleration (g), floor 1 first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FloorUnit {
     pub psa_g: [Vec<Vec<Vec<f64>>>; 2],
     pub pfa_g: [Vec<f64>; 2],
-    pub pga_g: f64,
 }
 
 /// One system's run on the refined record, its history kept.
@@ -151,11 +150,7 @@ pub fn floor_unit(
             .map(|a| a / G)
             .collect();
     }
-    Ok(FloorUnit {
-        psa_g,
-        pfa_g,
-        pga_g: record.pga_g(),
-    })
+    Ok(FloorUnit { psa_g, pfa_g })
 }
 
 /// Why a unit could not be made.
