@@ -78,7 +78,7 @@ fn main() -> std::process::ExitCode {
         Command::Fit(args) => cmd::stage::run(args, StageId::Fit),
         Command::Report(args) => cmd::stage::run(args, StageId::Report),
         Command::Ida(args) => cmd::ida::run(args),
-        Command::Floors(args) => cmd::stage::run(args, StageId::Floors),
+        Command::Floors(args) => cmd::floors::run(args),
         Command::Run(args) => cmd::run::run(args),
         Command::Status(args) => cmd::status::run(args),
         Command::Design(args) => cmd::design::run(args),

@@ -48,7 +48,14 @@ fn a_study_stores_floor_spectra_as_simulate_gives_them_and_reports_them_beside_t
     // One thread: the same bytes.
     let one = dir.path().join("b");
     common::copy_motions(&out, &one);
-    ok(slidestack(&["floors", s(&cfg), "--out", s(&one)], "1"));
+    let o = ok(slidestack(&["floors", s(&cfg), "--out", s(&one)], "1"));
+    // The command prints the report's table, a row per floor of every distinct building.
+    let printed = String::from_utf8_lossy(&o.stdout);
+    assert!(printed.contains("ASCE7-16"), "{printed}");
+    assert_eq!(
+        printed.matches("3 storeys, stack on the roof").count(),
+        2 * 3
+    );
     assert_eq!(
         std::fs::read(out.join("floors.h5")).unwrap(),
         std::fs::read(one.join("floors.h5")).unwrap()

@@ -3,6 +3,7 @@
 
 pub mod design;
 pub mod export;
+pub mod floors;
 pub mod ida;
 pub mod interrupt;
 pub mod matching;
