@@ -11,7 +11,7 @@
 //! study the `building` section and `grid.stack_floor`, and the motions' fingerprint.
 
 use super::{PipelineError, Session, StageId, StageOutcome, Study};
-use crate::spectrum::floor::REFINEMENT;
+use crate::spectrum::floor::{FloorSpectraSpec, REFINEMENT};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::floors::{FloorsAxes, FloorsMeta, ZoneFloors, read_zone_floors, write_floors};
@@ -71,9 +71,9 @@ pub fn section(study: &Study) -> Result<&FloorsConfig, FloorsStageError> {
 /// The axes the config gives every zone of `floors.h5`.
 pub fn axes_of(study: &Study) -> Result<FloorsAxes, PipelineError> {
     let cfg = section(study)?;
-    let spec = cfg.spec().map_err(|why| PipelineError::BadInput {
+    let spec = cfg.spec().map_err(|(key, why)| PipelineError::BadInput {
         file: study.config_path.clone(),
-        why,
+        why: format!("`floor_spectra.{key}`: {why}"),
     })?;
     Ok(FloorsAxes {
         case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
@@ -93,10 +93,10 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let cfg = section(study)?;
     let fp = study.fingerprint(me)?;
     let axes = axes_of(study)?;
-    let spec = cfg.spec().map_err(|why| PipelineError::BadInput {
-        file: study.config_path.clone(),
-        why,
-    })?;
+    let spec = FloorSpectraSpec {
+        periods_s: axes.periods_s.clone(),
+        damping: axes.damping.clone(),
+    };
     let motions = super::files::motions(study)?;
     // Every record refined before any run: one whose history the spectrum cannot take is
     // refused here, naming it.

@@ -58,21 +58,30 @@ impl FloorSpectraSettings {
     /// The periods parsed and every damping ratio checked (`0 ≤ ζ < 1`); a message naming the
     /// key otherwise.
     pub fn resolve(&self) -> Result<FloorSpectraSpec, String> {
+        self.checked().map_err(|(key, why)| match key {
+            "periods" => format!("`floor_spectra.periods`: {why}"),
+            _ => format!("`floor_spectra.{key}` {why}"),
+        })
+    }
+
+    /// [`Self::resolve`], a refusal as the key under `floor_spectra.` (`periods`, `damping`)
+    /// and why.
+    pub fn checked(&self) -> Result<FloorSpectraSpec, (&'static str, String)> {
         let periods_s = match &self.periods {
             None => parse_periods(DEFAULT_PERIODS),
             Some(Periods::Spec(s)) => parse_periods(s),
             Some(Periods::List(v)) => periods_from_list(v),
         }
-        .map_err(|e| format!("`floor_spectra.periods`: {e}"))?;
+        .map_err(|e| ("periods", e.to_string()))?;
         let damping = self.damping.clone().unwrap_or(DEFAULT_DAMPING.to_vec());
         if damping.is_empty() {
-            return Err("`floor_spectra.damping` is empty: give at least one ratio".into());
+            return Err(("damping", "is empty: give at least one ratio".into()));
         }
         if let Some(z) = damping
             .iter()
             .find(|z| !(z.is_finite() && (0.0..1.0).contains(*z)))
         {
-            return Err(format!("`floor_spectra.damping` {z} must be in [0, 1)"));
+            return Err(("damping", format!("{z} must be in [0, 1)")));
         }
         Ok(FloorSpectraSpec { periods_s, damping })
     }

@@ -35,13 +35,14 @@ pub struct FloorsConfig {
 pub const SYSTEMS: [SystemKind; 2] = [SystemKind::Stack, SystemKind::Rigid];
 
 impl FloorsConfig {
-    /// The periods and damping ratios, checked.
-    pub fn spec(&self) -> Result<FloorSpectraSpec, String> {
+    /// The periods and damping ratios, checked; the key under `floor_spectra.` and why
+    /// otherwise.
+    pub fn spec(&self) -> Result<FloorSpectraSpec, (&'static str, String)> {
         FloorSpectraSettings {
             periods: self.periods.clone(),
             damping: self.damping.clone(),
         }
-        .resolve()
+        .checked()
     }
 
     /// The section checked before any work: its spectra and cases (each as the physics and
@@ -52,18 +53,8 @@ impl FloorsConfig {
         frames: Option<&[Frame]>,
     ) -> Result<(), (String, String)> {
         let err = |k: &str, w: String| Err((format!("floor_spectra.{k}"), w));
-        if let Err(why) = self.spec() {
-            // resolve() begins its message with the key, `floor_spectra.periods` or `.damping`.
-            let key = if why.starts_with("`floor_spectra.damping`") {
-                "damping"
-            } else {
-                "periods"
-            };
-            let why = why
-                .trim_start_matches(&format!("`floor_spectra.{key}`"))
-                .trim_start_matches(':')
-                .trim();
-            return err(key, why.to_string());
+        if let Err((key, why)) = self.spec() {
+            return err(key, why);
         }
         if self.cases.is_empty() || self.cases.len() > MAX_FLOOR_SPECTRA_CASES {
             return err(

@@ -398,14 +398,19 @@ pub fn run_unit(
             (_, None) => (&single[&skey], false),
         };
         out.push_profiles(profile, r, held);
+        // A rule's stack moves as one body with the system standing in for it: with the floor
+        // (`held`: NoSlip, or a single block that holds; the rigid system's peaks on the floors
+        // carrying a stack) or with the single block. Its peak absolute acceleration (m/s²)
+        // and velocity (m/s).
+        let one_body = if held {
+            (profile.a_hold_mps2, profile.v_hold_mps)
+        } else {
+            (profile.block_a_mps2[0], profile.block_v_mps[0])
+        };
         if let Some(aspect) = opts.aspect {
-            // A rule's stack moves as one body with the system standing in for it: with the
-            // floor (NoSlip, or a single block that holds) or with the single block.
-            let rocks = match (rule, &resp) {
-                (_, Some(s)) => s.rocks,
-                (SkipRule::NoSlip, None) => stuck_rocks(&case, aspect, r.a_hold_mps2)?,
-                (_, None) if single_holds => stuck_rocks(&case, aspect, r.a_hold_mps2)?,
-                (_, None) => stuck_rocks(&case, aspect, single[&skey].block_a_mps2[0])?,
+            let rocks = match &resp {
+                Some(s) => s.rocks,
+                None => stuck_rocks(&case, aspect, one_body.0)?,
             };
             out.rocks_stack.push(u8::from(rocks));
         }
@@ -437,21 +442,20 @@ pub fn run_unit(
                     .push(if single_holds { 0.0 } else { s.friction });
             }
         }
-        // Every block of a stack a rule stands in for moves with the stand-in's one body: its
-        // floor (the rigid system, whose floors' peaks are the ones carrying a stack) or the
-        // single block.
-        let (block_a_mps2, block_v_mps) = match (rule, &resp) {
-            (_, Some(s)) => (s.block_a_mps2.clone(), s.block_v_mps.clone()),
-            (SkipRule::NoSlip, None) => (vec![r.a_hold_mps2; n], vec![r.v_hold_mps; n]),
-            (_, None) if single_holds => (vec![r.a_hold_mps2; n], vec![r.v_hold_mps; n]),
-            (_, None) => {
-                let one = &single[&skey];
-                (vec![one.block_a_mps2[0]; n], vec![one.block_v_mps[0]; n])
+        // Every block of a stack a rule stands in for moves with the stand-in's one body.
+        match &resp {
+            Some(s) => {
+                out.block_accel_stack
+                    .extend(s.block_a_mps2.iter().map(|a| a / G));
+                out.block_velocity_stack.extend_from_slice(&s.block_v_mps);
             }
-        };
-        out.block_accel_stack
-            .extend(block_a_mps2.iter().map(|a| a / G));
-        out.block_velocity_stack.extend_from_slice(&block_v_mps);
+            None => {
+                out.block_accel_stack
+                    .extend(std::iter::repeat_n(one_body.0 / G, n));
+                out.block_velocity_stack
+                    .extend(std::iter::repeat_n(one_body.1, n));
+            }
+        }
     }
     Ok(out)
 }
