@@ -122,7 +122,9 @@ fn a_study_stores_floor_spectra_as_simulate_gives_them_and_reports_them_beside_t
     let html = std::fs::read_to_string(out.join("report/index.html")).unwrap();
     assert!(html.contains("Floor response spectra"));
     let svg = std::fs::read_to_string(out.join("report/floors.svg")).unwrap();
-    assert!(svg.contains("roof, sliding") && svg.contains("roof, ASCE 7-16"));
+    for series in ["roof, sliding", "roof, ASCE 7-16", "roof, ASCE 7-22"] {
+        assert!(svg.contains(series), "{series}");
+    }
     assert!(svg.contains("floor 2, attached"));
     let ratio = |pfa: &ndarray::ArrayD<f64>| {
         (0..3)

@@ -430,27 +430,57 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
     Ok(rows)
 }
 
-/// ASCE 7-16's floor spectrum at height `z/h` (Eq. 13.3-1 with `R_p/I_p = 1`, `0.4·S_DS` the
-/// motions' mean PGA, g): `a_p·(1 + 2z/h)·PGA`, `a_p` 1 for a rigid component (period at most
-/// 0.06 s) and 2.5 for a flexible one, over `axes`' periods: the step's corners.
-fn asce7_16_floor_spectrum(z_over_h: f64, pga_g: f64, axes: &FloorsAxes) -> (Vec<f64>, Vec<f64>) {
-    use crate::study::floors::{RIGID_COMPONENT_PERIOD_S, asce7_16_height_factor};
-    let floor = asce7_16_height_factor(z_over_h) * pga_g;
-    let (lo, hi) = (axes.periods_s[0], axes.periods_s[axes.periods_s.len() - 1]);
+/// A code's floor spectrum drawn as a step over the periods `periods_s` span (its corners):
+/// `floor_g` for a rigid component (period at most 0.06 s), `resonant` times it for a flexible
+/// one.
+fn code_floor_spectrum(floor_g: f64, resonant: f64, periods_s: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    use crate::study::floors::RIGID_COMPONENT_PERIOD_S;
+    let (lo, hi) = (periods_s[0], periods_s[periods_s.len() - 1]);
     let knee = RIGID_COMPONENT_PERIOD_S.clamp(lo, hi);
     (
         vec![lo, knee, knee, hi],
-        vec![floor, floor, 2.5 * floor, 2.5 * floor],
+        vec![floor_g, floor_g, resonant * floor_g, resonant * floor_g],
     )
+}
+
+/// The codes' floor spectra at height `z/h` of a building whose `T_a` is `t_a_s`, with
+/// `0.4·S_DS` the motions' mean PGA (g) and the component's `I_p = 1`: ASCE 7-16 Eq. 13.3-1
+/// with `R_p = 1`, `(1 + 2z/h)·PGA` times `a_p` (1, then 2.5); ASCE 7-22 Eq. 13.3-1 with
+/// `R_po = 1`, `H_f·PGA/R_μ` times `C_AR` (1, then 2.2), `R_μ` an elastic frame's (1.3).
+fn code_floor_spectra(
+    z_over_h: f64,
+    t_a_s: f64,
+    pga_g: f64,
+    periods_s: &[f64],
+) -> [(&'static str, (Vec<f64>, Vec<f64>)); 2] {
+    use crate::study::floors::{
+        ASCE7_22_C_AR_RESONANT, asce7_16_height_factor, asce7_22_h_f, asce7_22_r_mu,
+    };
+    let elastic_r_mu = asce7_22_r_mu(1.0, 1.0, 1.0);
+    [
+        (
+            "ASCE 7-16",
+            code_floor_spectrum(asce7_16_height_factor(z_over_h) * pga_g, 2.5, periods_s),
+        ),
+        (
+            "ASCE 7-22",
+            code_floor_spectrum(
+                asce7_22_h_f(z_over_h, t_a_s) * pga_g / elastic_r_mu,
+                ASCE7_22_C_AR_RESONANT,
+                periods_s,
+            ),
+        ),
+    ]
 }
 
 /// The report's figure: per zone and distinct building, the first case's mean floor spectra
 /// (the first damping ratio) of the roof and, from three storeys, the middle floor, stacks
-/// sliding (solid) and attached (dashed), and ASCE 7-16's floor spectrum there (dotted).
+/// sliding (solid) and attached (dashed), and ASCE 7-16's and ASCE 7-22's floor spectra there
+/// (dotted).
 pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, PipelineError> {
     use crate::render::chart::{Axis, Figure, Panel, Series, Stroke};
     study.require(StageId::Floors)?;
-    let mut panels = Vec::new();
+    let (mut panels, mut title) = (Vec::new(), None);
     for zone in &study.cfg.zones {
         let v = Shown::read(study, &zone.name)?;
         let a = &v.axes;
@@ -480,22 +510,56 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
                     });
                 }
                 let z_over_h = frame.as_ref().map_or(1.0, |fr| fr.height_ratio(j));
-                let (x, y) = asce7_16_floor_spectrum(z_over_h, v.mean(|m| v.zone.pga_g[m]), a);
-                series.push(
-                    Series::line(format!("{place}, ASCE 7-16"), x, y).stroke(Stroke::Dotted, 2),
-                );
+                let pga_g = v.mean(|m| v.zone.pga_g[m]);
+                for (code, (x, y)) in
+                    code_floor_spectra(z_over_h, a.case_period_s[0], pga_g, &a.periods_s)
+                {
+                    series.push(
+                        Series::line(format!("{place}, {code}"), x, y).stroke(Stroke::Dotted, 2),
+                    );
+                }
             }
             let at = frame.as_ref().map_or(String::new(), |fr| format!(", {fr}"));
-            panels.push(Panel::xy(
+            // The case is every panel's: the figure's title names it.
+            title.get_or_insert_with(|| {
                 format!(
-                    "zone {}{at}: T_p = {} s, α = {:?}, μ = {:?}, ζ = {}",
-                    zone.name, a.case_period_s[0], a.case_alpha[0], a.case_mu[0], a.damping[0]
-                ),
+                    "Floor response spectra: T_p = {} s, α = {:?}, μ = {:?}, ζ = {}",
+                    a.case_period_s[0], a.case_alpha[0], a.case_mu[0], a.damping[0]
+                )
+            });
+            panels.push(Panel::xy(
+                format!("zone {}{at}", zone.name),
                 Axis::new("oscillator period (s)"),
                 Axis::new("mean floor PSA (g)"),
                 series,
             ));
         }
     }
-    Ok(Figure::grid("Floor response spectra", panels, 2))
+    let title = title.unwrap_or_else(|| "Floor response spectra".into());
+    Ok(Figure::grid(title, panels, 2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The codes' lines by hand at the roof of a building with `T_a = 1 s` under a PGA of
+    /// 0.2 g: ASCE 7-16 `3·0.2 = 0.6` g, then `2.5·0.6 = 1.5` g; ASCE 7-22
+    /// `H_f = 1 + 1 + 0.84 = 2.84`, `2.84·0.2/1.3 = 0.43692…` g, then `2.2` times it; the step
+    /// at 0.06 s, the ends at the periods' ends.
+    #[test]
+    fn the_codes_floor_spectra_by_hand_at_a_roof() {
+        let [(c16, (x16, y16)), (c22, (x22, y22))] =
+            code_floor_spectra(1.0, 1.0, 0.2, &[0.05, 4.0]);
+        assert_eq!((c16, c22), ("ASCE 7-16", "ASCE 7-22"));
+        assert_eq!(x16, [0.05, 0.06, 0.06, 4.0]);
+        assert_eq!(x22, x16);
+        let close = |a: &[f64], b: [f64; 4]| a.iter().zip(b).all(|(a, b)| (a - b).abs() < 1e-12);
+        assert!(close(&y16, [0.6, 0.6, 1.5, 1.5]), "{y16:?}");
+        let rigid = 2.84 * 0.2 / 1.3;
+        assert!(
+            close(&y22, [rigid, rigid, 2.2 * rigid, 2.2 * rigid]),
+            "{y22:?}"
+        );
+    }
 }

@@ -172,6 +172,20 @@ pub fn asce7_22_h_f(z_over_h: f64, t_a_s: f64) -> f64 {
     1.0 + a1 * z_over_h + a2 * z_over_h.powi(10)
 }
 
+/// ASCE 7-22's component resonance ductility factor `C_AR` (Tables 13.5-1 and 13.6-1) of a
+/// component supported above grade whose period is near the building's (the value most of the
+/// tables' flexible rows take; a rigid component takes 1, and "other" equipment support
+/// structures 2.8). Read from the tables as public `F_p` calculators transcribe them
+/// (FpCalcApp's `data/mech.json`), not from the standard itself.
+pub const ASCE7_22_C_AR_RESONANT: f64 = 2.2;
+
+/// ASCE 7-22's structure ductility reduction factor `R_μ = (1.1·R/(I_e·Ω_0))^½ ≥ 1.3` of a
+/// building with response modification `r`, importance `i_e` and overstrength `omega_0`; an
+/// elastic frame (`R = Ω_0 = I_e = 1`) takes the floor, 1.3.
+pub fn asce7_22_r_mu(r: f64, i_e: f64, omega_0: f64) -> f64 {
+    (1.1 * r / (i_e * omega_0)).sqrt().max(1.3)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -188,5 +202,15 @@ mod tests {
         assert!((asce7_22_h_f(0.5, 1.0) - (1.5 + 0.84 * 0.5f64.powi(10))).abs() < 1e-15);
         // Short periods: a_1 capped at 2.5, a_2 at 0.
         assert!((asce7_22_h_f(1.0, 0.1) - 3.5).abs() < 1e-15);
+    }
+
+    /// `R_μ` at its floor (an elastic frame: `√1.1` is below 1.3) and above it, against a
+    /// published worked example (a frame with `R = 6.5`, `Ω_0 = 3`, `I_e = 1`: 1.544, to the
+    /// example's three decimals).
+    #[test]
+    fn the_ductility_factor_at_its_floor_and_above() {
+        assert_eq!(asce7_22_r_mu(1.0, 1.0, 1.0), 1.3);
+        assert_eq!(asce7_22_r_mu(1.5, 1.0, 1.0), 1.3);
+        assert!((asce7_22_r_mu(6.5, 1.0, 3.0) - 1.544).abs() < 5e-4);
     }
 }

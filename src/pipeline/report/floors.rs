@@ -17,9 +17,12 @@ pub(super) fn floors_section(study: &Study, files: &mut Files) -> Result<Section
             "Mean floor response spectra (pseudo-acceleration of an oscillator standing on the \
              floor, the first damping ratio) of the first case, over the zone's motions: the roof \
              and, with three storeys or more, the middle floor, with the stacks sliding (solid) \
-             and rigidly attached (dashed), and ASCE 7-16's floor spectrum at that height \
-             (dotted: Eq. 13.3-1 with R_p/I_p = 1 and the motions' mean PGA for 0.4·S_DS, \
-             a_p = 1 up to 0.06 s and 2.5 beyond).",
+             and rigidly attached (dashed), and the codes' floor spectra at that height \
+             (dotted; Eq. 13.3-1 of each with I_p = 1 and the motions' mean PGA for 0.4·S_DS, \
+             rigid up to 0.06 s): ASCE 7-16 with R_p = 1, a_p = 1 then 2.5, times 1 + 2z/h; \
+             ASCE 7-22 with R_po = 1, C_AR = 1 then 2.2 (a resonant component above grade), \
+             times H_f/R_μ, R_μ = 1.3 (an elastic frame: R = Ω_0 = I_e = 1; T_a the case's \
+             bare T_1).",
         )
         .map_err(|e: ReportError| PipelineError::from(e))?;
     let f2 = |x: f64| format!("{x:.2}");
@@ -67,7 +70,7 @@ pub(super) fn floors_section(study: &Study, files: &mut Files) -> Result<Section
          (1 + 2z/h) and ASCE 7-22 Eq. 13.3-4 (H_f, with T_a the case's bare first-mode period \
          T_1) give it for an elastic building; peak PSA/PFA is the largest ordinate of the mean \
          floor spectrum over the mean PFA, the component amplification (ASCE 7-16 takes a_p up \
-         to 2.5). The cases are the config's `floor_spectra.cases`, each on every building.",
+         to 2.5; ASCE 7-22's C_AR, 2.2 for a resonant component above grade). The cases are the config's `floor_spectra.cases`, each on every building.",
     ) + &fig
         + &table_with_id("floor-amplification", &headers, &rows);
     Ok(Section::new("floors", "Floor response spectra", body))
