@@ -430,10 +430,13 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
     Ok(rows)
 }
 
+/// A step line's corners: periods, s, and ordinates, g.
+type Corners = (Vec<f64>, Vec<f64>);
+
 /// A code's floor spectrum drawn as a step over the periods `periods_s` span (its corners):
 /// `floor_g` for a rigid component (period at most 0.06 s), `resonant` times it for a flexible
 /// one.
-fn code_floor_spectrum(floor_g: f64, resonant: f64, periods_s: &[f64]) -> (Vec<f64>, Vec<f64>) {
+fn code_floor_spectrum(floor_g: f64, resonant: f64, periods_s: &[f64]) -> Corners {
     use crate::study::floors::RIGID_COMPONENT_PERIOD_S;
     let (lo, hi) = (periods_s[0], periods_s[periods_s.len() - 1]);
     let knee = RIGID_COMPONENT_PERIOD_S.clamp(lo, hi);
@@ -452,7 +455,7 @@ fn code_floor_spectra(
     t_a_s: f64,
     pga_g: f64,
     periods_s: &[f64],
-) -> [(&'static str, (Vec<f64>, Vec<f64>)); 2] {
+) -> [(&'static str, Corners); 2] {
     use crate::study::floors::{
         ASCE7_22_C_AR_RESONANT, asce7_16_height_factor, asce7_22_h_f, asce7_22_r_mu,
     };

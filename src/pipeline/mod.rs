@@ -183,7 +183,7 @@ pub enum PipelineError {
     #[error(transparent)]
     Sweep(#[from] sweep::SweepStageError),
     #[error(transparent)]
-    Tnew(#[from] tnew::TnewError),
+    Tnew(#[from] crate::study::tnew::TnewError),
     #[error(transparent)]
     Fit(#[from] fit::FitStageError),
     #[error(transparent)]

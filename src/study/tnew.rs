@@ -11,11 +11,28 @@
 //! to `T_rigid` (in log period); the stack can only soften the structure up to the rigidly
 //! attached mass, and the crossing near `T_rigid` is the one that continues the `μ → ∞` limit.
 //! The flag says which case applied.
+//!
+//! A zone ([`zone`]): every case of every frame of a building study (docs/model.md, "A study
+//! over buildings") alike; one storey keeps the paper's `T_new`, bit for bit; a building of
+//! several storeys reads it off the attached fraction of the roof's mean peak displacement, the
+//! first-mode period of the building carrying that fraction of its stack (and keeps the
+//! first-mode definition as `T_new_first_mode`). Its cases also get their attached fractions
+//! ([`crate::study::attached`]: `λ` of the base shear, of each storey's shear and of the
+//! overturning moment, `λ_code`), which run the linear building with part of the stack
+//! attached.
 
+use crate::dynamics::Ground;
 use crate::fit::{BuildingFeatures, Sample, features};
-use crate::grid::Grid;
-use crate::study::attached::FractionFlag;
-use crate::study::building::Frame;
+use crate::grid::{BuildingAxes, Grid};
+use crate::ground_motion::Record;
+use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
+use crate::store::sweep::{BuildingVars, SweepVars};
+use crate::store::tnew::{AttachedVars, TnewVars, ZoneTnew};
+use crate::study::attached::{self, AttachedError, CaseFractions, FRACTION_FLAGS, FractionFlag};
+use crate::study::building::{Frame, repeats};
+use crate::study::physics::Physics;
+use ndarray::{ArrayD, Axis};
+use rayon::prelude::*;
 
 /// Step of the period grid of the mean displacement spectrum, s.
 pub const SD_STEP_S: f64 = 0.005;
@@ -251,6 +268,397 @@ pub fn period_at_displacement(
                 .expect("non-empty");
             (best, TnewFlag::Several)
         }
+    }
+}
+
+// A zone's `T_new`: what the stage computes between reading the sweep and writing `tnew.h5`.
+
+/// Why a zone's `T_new` could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum TnewError {
+    #[error("zone {zone}: spectrum of motion {motion}: {source}")]
+    Spectrum {
+        zone: String,
+        motion: String,
+        source: SpectrumError,
+    },
+    #[error("zone {zone}: the attached fractions: {source}")]
+    Attached {
+        zone: String,
+        source: Box<AttachedError>,
+    },
+}
+
+impl TnewError {
+    /// Whether `keep_going` said stop (Ctrl-C), rather than an input the zone cannot take.
+    pub fn is_stopped(&self) -> bool {
+        matches!(self, Self::Attached { source, .. } if matches!(**source, AttachedError::Stopped))
+    }
+}
+
+/// What a zone's `T_new` is made from: the study's shape, the zone's motions and its sweep.
+pub struct ZoneInputs<'a> {
+    pub name: &'a str,
+    pub target: &'a str,
+    pub grid: &'a Grid,
+    pub physics: &'a Physics,
+    /// A building study's axes (`None` on one storey): the stored shape and `N_max`.
+    pub building: Option<&'a BuildingAxes>,
+    /// The study's frames in stored order (`[None]` on one storey).
+    pub frames: &'a [Option<Frame>],
+    pub motions: &'a [Record],
+    /// The zone's sweep, its motion axis the order of `motions`.
+    pub sweep: &'a SweepVars,
+    /// Asked before each case of the attached fractions (Ctrl-C).
+    pub keep_going: &'a (dyn Fn() -> bool + Sync),
+}
+
+/// A zone's `T_new` and what the stage reports of it.
+pub struct ZoneOutcome {
+    pub tnew: ZoneTnew,
+    /// The zone's cases (over the frames).
+    pub cases: usize,
+    pub bands: BandCounts,
+    /// A building study's effective live-load fractions, counted.
+    pub fractions: Option<FractionCounts>,
+}
+
+/// How a zone's `λ` fell over the cases of its distinct buildings (a frame that repeats another
+/// is its copy, [`crate::study::building::repeats`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FractionCounts {
+    pub cases: usize,
+    /// Cases per flag word, in [`FRACTION_FLAGS`]' order.
+    pub by_flag: Vec<(&'static str, usize)>,
+    /// Cases whose `λ` is below 0.
+    pub below_zero: usize,
+}
+
+impl FractionCounts {
+    fn new(fractions: &[CaseFractions], frames: &[Frame], per_frame: usize) -> Self {
+        let repeated = repeats(frames);
+        let counted: Vec<&CaseFractions> = (0..frames.len())
+            .filter(|&f| !repeated[f])
+            .flat_map(|f| &fractions[f * per_frame..(f + 1) * per_frame])
+            .collect();
+        let by_flag = (FRACTION_FLAGS.iter())
+            .map(|&(code, word)| {
+                let k = (counted.iter())
+                    .filter(|x| x.storey[0].1 as u8 == code)
+                    .count();
+                (word, k)
+            })
+            .collect();
+        Self {
+            cases: counted.len(),
+            by_flag,
+            below_zero: counted.iter().filter(|x| x.storey[0].0 < 0.0).count(),
+        }
+    }
+
+    /// One line: the cases counted, per flag, and below 0.
+    pub fn summary(&self) -> String {
+        let counts: Vec<String> = (self.by_flag.iter())
+            .map(|(word, k)| format!("{word} {k}"))
+            .collect();
+        format!(
+            "over the {} cases of the distinct buildings: {}; {} below 0 (the stack lowers the \
+             base shear below the bare building's)",
+            self.cases,
+            counts.join(", "),
+            self.below_zero
+        )
+    }
+}
+
+/// A zone's `T_new` (paper Section 7.1; a building of several storeys: `T_1` of the attached
+/// fraction of its roof's mean peak displacement, docs/model.md, "A study over buildings"),
+/// its `DRR`s and, in a building study, its attached fractions.
+pub fn zone(inp: &ZoneInputs) -> Result<ZoneOutcome, TnewError> {
+    let (grid, v) = (inp.grid, inp.sweep);
+    let period_sd_s = spectrum_periods_s(grid);
+    let sd_mean_m = mean_displacement_spectrum(inp.name, inp.motions, &period_sd_s)?;
+    let m = inp.motions.len();
+    // Means over the motion axis (summed in motion order, then divided).
+    let mean = |v: &ArrayD<f64>| v.sum_axis(Axis(0)) / m as f64;
+    let (u_stack, u_single, u_rigid) = (mean(&v.u_stack), mean(&v.u_single), mean(&v.u_rigid));
+    let per_frame = grid.cases();
+    let cases = inp.frames.len() * per_frame;
+    let slides = slides(&v.slip_peak, m, cases, grid.blocks());
+    let mut shape: Vec<usize> = inp.building.iter().flat_map(|b| b.shape()).collect();
+    shape.extend(grid.shape());
+    let shaped = |v: Vec<f64>| {
+        ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
+    };
+    let frames: Vec<Frame> = inp.frames.iter().flatten().cloned().collect();
+    let fractions = match (&v.building, inp.building) {
+        (Some(bv), Some(_)) => Some(attached_fractions(
+            inp, &frames, bv, &u_stack, &u_rigid, &slides,
+        )?),
+        _ => None,
+    };
+    let participation: Vec<f64> = (inp.frames.iter())
+        .map(|f| f.as_ref().map_or(1.0, Frame::roof_participation))
+        .collect();
+    let p = CasePeriods::of(
+        grid,
+        inp.frames,
+        &participation,
+        (&period_sd_s, &sd_mean_m),
+        &u_stack,
+        &slides,
+        fractions.as_deref(),
+    );
+    let bands = BandCounts::new(&p.band, &p.t_new, &p.t_rigid);
+    let lambda = match (&fractions, inp.building) {
+        (Some(l), Some(axes)) => Some(attached_vars(
+            l,
+            &shape,
+            axes.max_storeys(),
+            shaped(p.t_first_mode.clone()),
+        )),
+        _ => None,
+    };
+    let vars = TnewVars {
+        drr_1: &u_stack / &u_rigid,
+        drr_2: &u_single / &u_rigid,
+        u_stack_mean: u_stack,
+        u_single_mean: u_single,
+        u_rigid_mean: u_rigid,
+        t_rigid: shaped(p.t_rigid),
+        t_new: shaped(p.t_new),
+        slides: shaped(slides.iter().map(|&b| f64::from(u8::from(b))).collect()),
+        flag: shaped(p.flag),
+        band: ArrayD::from_shape_vec(shape.clone(), p.band).expect("one code per case"),
+    };
+    // Γ_1·φ_1,N per storey count (stored).
+    let roof_participation = match inp.building {
+        None => Vec::new(),
+        Some(b) => (0..b.storeys.len())
+            .map(|s| participation[s * b.stack_floor.len()])
+            .collect(),
+    };
+    Ok(ZoneOutcome {
+        fractions: (fractions.as_deref()).map(|l| FractionCounts::new(l, &frames, per_frame)),
+        tnew: ZoneTnew {
+            name: inp.name.to_string(),
+            target: inp.target.to_string(),
+            vars,
+            period_sd_s,
+            sd_mean_m,
+            roof_participation,
+            lambda,
+            rocks_share: (v.rocks_stack.as_ref()).map(|r| mean(&r.mapv(f64::from))),
+        },
+        cases,
+        bands,
+    })
+}
+
+/// The zone's mean 5 %-damped displacement spectrum at `periods_s`, m (summed in motion order,
+/// then divided).
+fn mean_displacement_spectrum(
+    zone: &str,
+    motions: &[Record],
+    periods_s: &[f64],
+) -> Result<Vec<f64>, TnewError> {
+    let spectra = (motions.par_iter())
+        .map(|r| {
+            response_spectrum(&r.accel_mps2(1.0), r.dt_s, periods_s, TARGET_DAMPING)
+                .map(|s| s.sd_m())
+                .map_err(|source| TnewError::Spectrum {
+                    zone: zone.to_string(),
+                    motion: r.name.clone(),
+                    source,
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((0..periods_s.len())
+        .map(|p| spectra.iter().map(|s| s[p]).sum::<f64>() / motions.len() as f64)
+        .collect())
+}
+
+/// Whether each case slides: any interface slips under any motion (`slip_peak`, `[motion,
+/// (frame,) case…, interface]`, folded over its first and last axes).
+fn slides(slip_peak: &ArrayD<f64>, motions: usize, cases: usize, blocks: usize) -> Vec<bool> {
+    let slip = (slip_peak.view())
+        .into_shape_with_order((motions, cases, blocks))
+        .expect("slip_peak has shape [motion, cases, interface]");
+    (0..cases)
+        .map(|c| slip.index_axis(Axis(1), c).iter().any(|&x| x > 0.0))
+        .collect()
+}
+
+/// Every case's periods and flags, flat over `[frame][case]`.
+struct CasePeriods {
+    t_rigid: Vec<f64>,
+    t_new: Vec<f64>,
+    /// The first-mode definition (one storey: the paper's `T_new`).
+    t_first_mode: Vec<f64>,
+    flag: Vec<f64>,
+    band: Vec<u8>,
+}
+
+impl CasePeriods {
+    /// One storey keeps the paper's `T_new`; a building of several storeys reads it off the
+    /// attached fraction of its roof's mean peak displacement (`fractions`' `roof`).
+    fn of(
+        grid: &Grid,
+        frames: &[Option<Frame>],
+        participation: &[f64],
+        (period_sd_s, sd_mean_m): (&[f64], &[f64]),
+        u_stack: &ArrayD<f64>,
+        slides: &[bool],
+        fractions: Option<&[CaseFractions]>,
+    ) -> Self {
+        let per_frame = grid.cases();
+        let cases = slides.len();
+        let mut p = Self {
+            t_rigid: Vec::with_capacity(cases),
+            t_new: Vec::with_capacity(cases),
+            t_first_mode: Vec::with_capacity(cases),
+            flag: Vec::with_capacity(cases),
+            band: Vec::with_capacity(cases),
+        };
+        for (c, (&us, &slid)) in u_stack.iter().zip(slides).enumerate() {
+            let case = grid.case(c % per_frame);
+            let frame = &frames[c / per_frame];
+            let (tr, u) = match frame {
+                None => (case.t_rigid_s(), us),
+                Some(frame) => (frame.t_rigid_s(&case), us / participation[c / per_frame]),
+            };
+            let (first_mode, paper_flag) = t_new(period_sd_s, sd_mean_m, u, tr, slid);
+            let (tn, f) = match (frame, fractions) {
+                (Some(fr), Some(l)) if fr.storeys() > 1 => {
+                    let (fraction, how) = l[c].roof;
+                    of_attached(fr.t1_attached_s(&case, fraction), how)
+                }
+                _ => (first_mode, paper_flag),
+            };
+            p.t_rigid.push(tr);
+            p.t_new.push(tn);
+            p.t_first_mode.push(first_mode);
+            p.flag.push(f64::from(f as u8));
+            p.band.push(Band::of(case.period_s, tr, tn, f) as u8);
+        }
+        p
+    }
+}
+
+/// The building's attached fractions of every case (docs/model.md, "The attached fraction").
+fn attached_fractions(
+    inp: &ZoneInputs,
+    frames: &[Frame],
+    bv: &BuildingVars,
+    u_stack: &ArrayD<f64>,
+    u_rigid: &ArrayD<f64>,
+    slides: &[bool],
+) -> Result<Vec<CaseFractions>, TnewError> {
+    let accels: Vec<Vec<f64>> = inp.motions.iter().map(|r| r.accel_mps2(1.0)).collect();
+    let grounds: Vec<Ground> = (inp.motions.iter().zip(&accels))
+        .map(|(r, a)| Ground::new(r.dt_s, a))
+        .collect();
+    let per_frame = inp.grid.cases();
+    let swept = swept(bv, u_stack, u_rigid, frames, per_frame, inp.motions.len());
+    attached::zone_fractions(
+        inp.physics,
+        inp.grid,
+        frames,
+        &grounds,
+        &swept,
+        slides,
+        inp.keep_going,
+    )
+    .map_err(|e| TnewError::Attached {
+        zone: inp.name.to_string(),
+        source: Box::new(e),
+    })
+}
+
+/// The sweep's means over the motions (summed in motion order, then divided) of every case of
+/// a building study's zone that [`attached::zone_fractions`] needs: per case (flat over
+/// `[frame][case]`) the stack's and the rigid system's mean peaks and the mean stuck share,
+/// `None` in a building of one storey (its integrator gives neither the shears nor the share).
+fn swept(
+    bv: &BuildingVars,
+    u_stack: &ArrayD<f64>,
+    u_rigid: &ArrayD<f64>,
+    frames: &[Frame],
+    per_frame: usize,
+    motions: usize,
+) -> Vec<attached::Swept> {
+    let cases = frames.len() * per_frame;
+    let nmax = bv.storey_shear_stack.shape().last().copied().unwrap_or(0);
+    let mean = |v: &ArrayD<f64>| {
+        let sum = v.sum_axis(Axis(0)) / motions as f64;
+        sum.into_iter().collect::<Vec<f64>>()
+    };
+    let (ss, sr) = (mean(&bv.storey_shear_stack), mean(&bv.storey_shear_rigid));
+    let (os, or) = (mean(&bv.overturning_stack), mean(&bv.overturning_rigid));
+    let share = mean(&bv.stuck_share_stack);
+    let (us, ur): (Vec<f64>, Vec<f64>) = (
+        u_stack.iter().copied().collect(),
+        u_rigid.iter().copied().collect(),
+    );
+    (0..cases)
+        .map(|c| {
+            let n = frames[c / per_frame].storeys();
+            (n > 1).then(|| {
+                let means = |roof: f64, shear: &[f64], moment: f64| attached::Means {
+                    roof_m: roof,
+                    storey_shear: shear[c * nmax..c * nmax + n].to_vec(),
+                    overturning: moment,
+                };
+                (means(us[c], &ss, os[c]), means(ur[c], &sr, or[c]), share[c])
+            })
+        })
+        .collect()
+}
+
+/// The stored attached fractions (`tnew.h5`'s `AttachedVars`), shaped as the zone's cases
+/// (`shape`), the per-storey ones with a trailing axis of `nmax` (NaN, 255 for flags, above a
+/// building's roof).
+fn attached_vars(
+    l: &[CaseFractions],
+    shape: &[usize],
+    nmax: usize,
+    t_new_first_mode: ArrayD<f64>,
+) -> AttachedVars {
+    let per_case = |get: &dyn Fn(&CaseFractions) -> f64| {
+        ArrayD::from_shape_vec(shape.to_vec(), l.iter().map(get).collect())
+            .expect("one value per case of the grid")
+    };
+    let flags = |get: &dyn Fn(&CaseFractions) -> FractionFlag| {
+        ArrayD::from_shape_vec(shape.to_vec(), l.iter().map(|x| get(x) as u8).collect())
+            .expect("one code per case of the grid")
+    };
+    let mut storey_shape = shape.to_vec();
+    storey_shape.push(nmax);
+    let storey = |get: &dyn Fn(&(f64, FractionFlag)) -> f64| {
+        let v = (l.iter())
+            .flat_map(|x| (0..nmax).map(|i| x.storey.get(i).map_or(f64::NAN, get)))
+            .collect();
+        ArrayD::from_shape_vec(storey_shape.clone(), v).expect("one per case and storey")
+    };
+    AttachedVars {
+        base_shear_stack_mean: per_case(&|x| x.stack.storey_shear[0]),
+        base_shear_rigid_mean: per_case(&|x| x.rigid.storey_shear[0]),
+        base_shear_bare_mean: per_case(&|x| x.bare.storey_shear[0]),
+        base_shear_ratio_bare: per_case(&|x| x.stack.storey_shear[0] / x.bare.storey_shear[0]),
+        base_shear_ratio_rigid: per_case(&|x| x.stack.storey_shear[0] / x.rigid.storey_shear[0]),
+        stuck_share_mean: per_case(&|x| x.share),
+        lambda: per_case(&|x| x.storey[0].0),
+        flag: flags(&|x| x.storey[0].1),
+        lambda_storey: storey(&|s| s.0),
+        lambda_storey_flag: storey(&|s| f64::from(s.1 as u8))
+            .mapv(|v| if v.is_nan() { 255 } else { v as u8 }),
+        lambda_overturning: per_case(&|x| x.overturning.0),
+        lambda_overturning_flag: flags(&|x| x.overturning.1),
+        lambda_code: per_case(&|x| x.code.0),
+        lambda_code_flag: flags(&|x| x.code.1),
+        attached_fraction_roof: per_case(&|x| x.roof.0),
+        attached_fraction_roof_flag: flags(&|x| x.roof.1),
+        t_new_first_mode,
     }
 }
 
