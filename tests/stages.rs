@@ -8,7 +8,7 @@ mod common;
 
 use common::{ok, slidestack};
 use slidestack::fit::{FitError, Form, Sample, cross_validate, fit};
-use slidestack::pipeline::fit::{FOLDS, cases_needed};
+use slidestack::study::equations::{FOLDS, cases_needed};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

@@ -167,7 +167,7 @@ pub enum PipelineError {
     },
     #[error("{}: the `{stage}` stage needs a `grid` section", config.display())]
     NoGrid { config: PathBuf, stage: StageId },
-    /// The grid has fewer cases than any design equation needs ([`fit::case_count`]).
+    /// The grid has fewer cases than any design equation needs ([`crate::study::equations::case_count`]).
     #[error(
         "{}: the `fit` stage needs at least {needed} cases (over the distinct frames) to fit \
          and cross-validate a design equation; the grid gives {cases}",
@@ -185,7 +185,7 @@ pub enum PipelineError {
     #[error(transparent)]
     Tnew(#[from] crate::study::tnew::TnewError),
     #[error(transparent)]
-    Fit(#[from] fit::FitStageError),
+    Fit(#[from] crate::study::equations::EquationError),
     #[error(transparent)]
     Report(#[from] report::ReportError),
     #[error(transparent)]
@@ -293,7 +293,7 @@ struct Fingerprints {
     sweep: Option<String>,
     tnew: Option<String>,
     /// `None` without a grid, or with one too small to fit a design equation to
-    /// ([`fit::case_count`]).
+    /// ([`crate::study::equations::case_count`]).
     fit: Option<String>,
     /// `None` without an `ida` section.
     ida: Option<String>,
@@ -314,7 +314,7 @@ pub struct Study {
     grid: Option<Grid>,
     /// The building axes of a building study.
     building: Option<BuildingAxes>,
-    /// The cases a fit would have and the least it needs ([`fit::case_count`]); `None`
+    /// The cases a fit would have and the least it needs ([`crate::study::equations::case_count`]); `None`
     /// without a grid.
     fit_cases: Option<(usize, usize)>,
     fingerprints: Fingerprints,
@@ -400,7 +400,7 @@ impl Study {
         let tnew = sweep.as_deref().map(tnew::fingerprint);
         let fit_cases = grid
             .as_ref()
-            .map(|g| fit::case_count(g, &frames_of(&cfg, building.as_ref())));
+            .map(|g| crate::study::equations::case_count(g, &frames_of(&cfg, building.as_ref())));
         let fit = match (&tnew, fit_cases) {
             (Some(t), Some((cases, needed))) if cases >= needed => {
                 Some(fit::fingerprint(t, building.is_some()))
@@ -438,7 +438,7 @@ impl Study {
 
     /// Whether the config configures `stage`: motions and the report always; sweep and `tnew`
     /// with a `grid` section; the fit with a grid of enough cases to fit a design equation to
-    /// ([`fit::case_count`]); the IDA with an `ida:` section. `run`, make and Slurm run exactly
+    /// ([`crate::study::equations::case_count`]); the IDA with an `ida:` section. `run`, make and Slurm run exactly
     /// these stages.
     pub fn configured(&self, stage: StageId) -> bool {
         let f = &self.fingerprints;

@@ -5,7 +5,7 @@
 //! (the paper's references \[12\] and \[14\]: the portion of the live load a code counts as
 //! seismic weight); to each storey's shear and to the overturning moment at the base, the same
 //! question for what a code user checks above the base; to the roof displacement, the fraction
-//! whose first-mode period is a building's `T_new` (`pipeline::tnew`).
+//! whose first-mode period is a building's `T_new` ([`super::tnew::zone`]).
 //!
 //! **The family.** `B(f)` is the building carrying `f` of every stack rigidly attached
 //! ([`crate::dynamics::building::Building::with_stacks_attached_fraction`]: the same `K` and the

@@ -8,6 +8,8 @@
 //! * [`config`]: the study file (YAML), validated before any work.
 //! * [`floors`]: floor response spectra of listed cases on every frame (`floor_spectra:`),
 //!   and the code's floor amplifications (ASCE 7-16, 7-22).
+//! * [`equations`]: the design equations: every form fitted to each zone's `T_new` (and a
+//!   building study's `λ`), cross-validated and box-checked, the recommended one.
 //! * [`design`]: the designer's arithmetic: `T_new` of one structure from a zone's (or frame's)
 //!   data.
 //! * [`ida`]: the `ida:` section, a case's systems on a yielding structure, one traced unit.
@@ -22,6 +24,7 @@ pub mod building;
 pub mod cases;
 pub mod config;
 pub mod design;
+pub mod equations;
 pub mod floors;
 pub mod ida;
 pub mod motions;
