@@ -16,36 +16,18 @@
 //! `grid.stack_floor`.
 
 use super::{PipelineError, Session, StageId, StageOutcome, Study};
-use crate::grid::BuildingAxes;
-use crate::ida::curve::{fractile, on_grid};
-use crate::ida::fragility::{FIT_STATUS_FLAGS, FitStatus, fit_lognormal};
-use crate::ida::trace::Trace;
+use crate::ida::fragility::FIT_STATUS_FLAGS;
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
-use crate::store::ida::{IdaAxes, IdaMeta, IdaVars, ZoneIda, read_zone_ida, write_ida};
-use crate::study::building::first_of_building;
+use crate::store::ida::{IdaAxes, IdaMeta, ZoneIda, read_zone_ida, write_ida};
 use crate::study::config::StudyConfig;
-use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS, padded, sa_g, trace_system};
+use crate::study::ida::{DemandLayout, IdaConfig, SYSTEMS};
+use crate::study::ida_zone::{FRACTILES, UnitPlan, UnitTraces, axes_of, trace_unit, zone_ida};
 use crate::study::physics::Physics;
-use crate::study::storey_strength::storey_strength_ratios;
-use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
 use std::path::PathBuf;
 use thiserror::Error;
-
-/// One work unit: a case of the `ida:` section under a motion of a zone, on one frame of a
-/// building study (0 on one storey), both systems; indices in stored order.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-struct IdaUnit {
-    zone: usize,
-    motion: usize,
-    case: usize,
-    frame: usize,
-}
-
-/// The fractiles of the summary curves (Vamvatsikos & Cornell 2002, Section 6).
-pub const FRACTILES: [f64; 3] = [0.16, 0.5, 0.84];
 
 #[derive(Debug, Error)]
 pub enum IdaStageError {
@@ -79,13 +61,6 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
     Some(StageId::Ida.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint])))
 }
 
-/// One unit's result.
-#[derive(Clone)]
-struct UnitOut {
-    record_sa_g: f64,
-    traces: Vec<Trace<RunDemand>>,
-}
-
 /// The config's `ida:` section, which the stage needs.
 fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
     study
@@ -108,30 +83,9 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let targets = super::files::targets(study)?;
     let frames = study.frames();
     let nf = frames.len();
-    // A frame that is an earlier one's building traces as it does, to the bit: only the first
-    // of them is traced, and the others take its traces.
-    let first = first_of_building(&frames.iter().flatten().cloned().collect::<Vec<_>>());
-    let first = |f: usize| first.get(f).copied().unwrap_or(f);
-    let all_units: Vec<IdaUnit> = motions
-        .iter()
-        .enumerate()
-        .flat_map(|(zone, ms)| {
-            (0..ms.len()).flat_map(move |motion| {
-                (0..cfg.cases.len()).flat_map(move |case| {
-                    (0..nf).map(move |frame| IdaUnit {
-                        zone,
-                        motion,
-                        case,
-                        frame,
-                    })
-                })
-            })
-        })
-        .collect();
-    let units: Vec<IdaUnit> = (all_units.iter())
-        .filter(|u| first(u.frame) == u.frame)
-        .copied()
-        .collect();
+    let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
+    let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
+    let units = &plan.traced;
     s.reporter.info(
         me,
         &format!(
@@ -147,7 +101,7 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
                 String::new()
             },
             SYSTEMS.len(),
-            match all_units.len() - units.len() {
+            match plan.all.len() - units.len() {
                 0 => String::new(),
                 n => format!("; {n} units of frames that repeat a building take its traces"),
             },
@@ -155,57 +109,35 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
         ),
     );
     let start = std::time::Instant::now();
-    let samples = std::sync::atomic::AtomicUsize::new(0);
     let bar = s.reporter.progress(me, units.len() as u64);
-    let outs: Vec<UnitOut> = units
+    let outs: Vec<UnitTraces> = units
         .par_iter()
-        .map(|&u| -> Result<UnitOut, PipelineError> {
-            let IdaUnit {
-                zone: z,
-                motion: m,
-                case: c,
-                frame: f,
-            } = u;
+        .map(|&u| -> Result<UnitTraces, PipelineError> {
             s.check_cancelled(me)?;
-            let rec = &motions[z][m];
-            let case = &cfg.cases[c];
-            let frame = frames[f].as_ref();
-            let fail = |system: &'static str, why: String| IdaStageError::Simulation {
-                zone: study.cfg.zones[z].name.clone(),
-                motion: rec.name.clone(),
-                case: c,
+            let (record, frame) = (&motions[u.zone][u.motion], frames[u.frame].as_ref());
+            let traced = trace_unit(
+                cfg,
+                &physics,
+                &targets[u.zone],
+                &cfg.cases[u.case],
+                frame,
+                record,
+            )
+            .map_err(|f| IdaStageError::Simulation {
+                zone: study.cfg.zones[u.zone].name.clone(),
+                motion: record.name.clone(),
+                case: u.case,
                 frame: frame.map_or(String::new(), |f| format!(", {f}")),
-                system,
-                why,
-            };
-            let accel = rec.accel_mps2(1.0);
-            let record_sa_g = sa_g(&accel, rec.dt_s, case.period_s)
-                .map_err(|e| fail(SYSTEMS[0].key(), e.to_string()))?;
-            let padded = padded(&accel, rec.dt_s, cfg.pad_s);
-            let c_y = cfg.strength_ratio(&targets[z], case);
-            let systems = cfg
-                .systems(&physics, case, c_y, frame)
-                .map_err(|e| fail(SYSTEMS[0].key(), e.to_string()))?;
-            let heights = frame.map(|f| f.storey_heights_m.as_slice());
-            let traces = systems
-                .iter()
-                .zip(SYSTEMS)
-                .map(|(sys, kind)| {
-                    trace_system(cfg, sys, heights, &padded, rec.dt_s, record_sa_g)
-                        .map_err(|e| fail(kind.key(), e.to_string()))
-                })
-                .collect::<Result<Vec<_>, _>>()?;
-            let runs: usize = traces.iter().map(|t| t.runs.len()).sum();
-            samples.fetch_add(runs * padded.len(), std::sync::atomic::Ordering::Relaxed);
+                system: f.system,
+                why: f.why,
+            })?;
             bar.inc();
             s.pass("ida.trace", me)?;
-            Ok(UnitOut {
-                record_sa_g,
-                traces,
-            })
+            Ok(traced)
         })
         .collect::<Result<Vec<_>, _>>()?;
     bar.finish();
+    let samples: usize = outs.iter().map(|o| o.samples).sum();
     let runs: usize = outs
         .iter()
         .flat_map(|o| o.traces.iter().map(|t| t.runs.len()))
@@ -218,40 +150,21 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
             "{runs} runs in {secs:.1} s ({:.0} runs/s); {:.0} ns per simulated record sample \
              per thread ({threads} threads)",
             runs as f64 / secs.max(1e-9),
-            secs * 1e9 * threads as f64 / samples.into_inner().max(1) as f64
+            secs * 1e9 * threads as f64 / samples.max(1) as f64
         ),
     );
-    let traced: std::collections::BTreeMap<_, _> = units.iter().zip(&outs).collect();
-    let outs: Vec<UnitOut> = (all_units.iter())
-        .map(|&u| {
-            traced[&IdaUnit {
-                frame: first(u.frame),
-                ..u
-            }]
-                .clone()
-        })
-        .collect();
+    let outs = plan.expand(&outs);
     let axes = axes_of(cfg, study.building());
     let mut zones = Vec::new();
     let mut at = 0;
     for (z, zc) in study.cfg.zones.iter().enumerate() {
         let count = motions[z].len() * cfg.cases.len() * nf;
-        let slice = &outs[at..at + count];
+        let names = motions[z].iter().map(|m| m.name.clone()).collect();
+        let (zone, target) = ((zc.name.as_str(), zc.target.as_str()), &targets[z]);
+        let building = study.cfg.building.as_ref();
+        let units = &outs[at..at + count];
+        zones.push(zone_ida(cfg, &axes, building, zone, target, names, units));
         at += count;
-        let c_y: Vec<f64> = cfg
-            .cases
-            .iter()
-            .map(|c| cfg.strength_ratio(&targets[z], c))
-            .collect();
-        let storey_c_y = storey_c_y(study, &axes, &c_y);
-        let mut vars = zone_vars(cfg, &axes, motions[z].len(), slice, c_y);
-        vars.storey_c_y = storey_c_y;
-        zones.push(ZoneIda {
-            name: zc.name.clone(),
-            target: zc.target.clone(),
-            records: motions[z].iter().map(|m| m.name.clone()).collect(),
-            vars,
-        });
     }
     let c_y_rule = c_y_rule(cfg, study.building().is_some());
     let building_json = super::sweep::building_attr(study);
@@ -267,23 +180,6 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     write_ida(&path, &meta, &axes, &zones)?;
     s.reporter.info(me, &format!("verified {}", path.display()));
     Ok(StageOutcome::Wrote(vec![path]))
-}
-
-/// `storey_c_y` `[case, storeys, storey]` of a building study (NaN above each building).
-fn storey_c_y(study: &Study, axes: &IdaAxes, c_y: &[f64]) -> Option<ArrayD<f64>> {
-    let b = axes.building.as_ref()?;
-    let section = study.cfg.building.as_ref()?;
-    let mut a = array(&[c_y.len(), b.storeys.len(), axes.max_storeys()], f64::NAN);
-    for (c, &cy) in c_y.iter().enumerate() {
-        for (k, &n) in b.storeys.iter().enumerate() {
-            let f = section.frame(n, crate::grid::StackFloor::Roof);
-            let ratios = storey_strength_ratios(cy, &f.floor_masses, &f.storey_heights_m);
-            for (i, r) in ratios.into_iter().enumerate() {
-                a[[c, k, i]] = r;
-            }
-        }
-    }
-    Some(a)
 }
 
 /// How the structure's strength is set, in words (in a building: the base-shear coefficient
@@ -365,23 +261,6 @@ fn settings_attrs<'a>(
     settings
 }
 
-/// The axes `ida.h5` has for the `ida:` section `cfg` (in a building study of `building`).
-fn axes_of(cfg: &IdaConfig, building: Option<&BuildingAxes>) -> IdaAxes {
-    IdaAxes {
-        systems: SYSTEMS.iter().map(|s| s.key().to_string()).collect(),
-        case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
-        case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
-        case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
-        runs: cfg.tracing.max_runs(),
-        sa_grid_g: cfg.grid_sa_g(),
-        demands: cfg.demand_names(building.is_some()),
-        limit_states: cfg.limit_states.iter().map(|l| l.name.clone()).collect(),
-        limit_state_definitions: cfg.limit_states.iter().map(|l| l.definition()).collect(),
-        fractiles: FRACTILES.to_vec(),
-        building: building.cloned(),
-    }
-}
-
 /// Zone `zone` of `ida.h5` (the caller has required it up to date), refused unless its axes
 /// are the ones the config's `ida:` section gives.
 fn read_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
@@ -392,147 +271,6 @@ fn read_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineEr
         return Err(StoreError::corrupt(&path, why).into());
     }
     Ok((axes, z))
-}
-
-fn array<T: Clone>(shape: &[usize], fill: T) -> ArrayD<T> {
-    ArrayD::from_elem(IxDyn(shape), fill)
-}
-
-/// One zone's variables from its units (record-major, then case).
-fn zone_vars(
-    cfg: &IdaConfig,
-    axes: &IdaAxes,
-    records: usize,
-    units: &[UnitOut],
-    c_y: Vec<f64>,
-) -> IdaVars {
-    // Cases and frames folded into one axis, case-major (crate::store::ida).
-    let (ns, nc, nr) = (
-        SYSTEMS.len(),
-        cfg.cases.len() * axes.frame_count(),
-        axes.runs,
-    );
-    let layout = cfg.layout(axes.building.is_some());
-    let (nd, ng, nl) = (
-        axes.demands.len(),
-        axes.sa_grid_g.len(),
-        cfg.limit_states.len(),
-    );
-    let grid = &axes.sa_grid_g;
-    let mut v = IdaVars {
-        c_y: ArrayD::from_shape_vec(IxDyn(&[cfg.cases.len()]), c_y).expect("one per case"),
-        storey_c_y: None,
-        record_sa_g: array(&[records, nc], f64::NAN),
-        run_sa_g: array(&[ns, records, nc, nr], f64::NAN),
-        run_demand: array(&[ns, records, nc, nr, nd], f64::NAN),
-        run_collapsed: array(&[ns, records, nc, nr], 255u8),
-        run_slip_exceeded: array(&[ns, records, nc, nr], 255u8),
-        collapse_sa_g: array(&[ns, records, nc], f64::NAN),
-        curve: array(&[ns, records, nc, ng, nd], f64::NAN),
-        fractile_curve: array(&[ns, nc, FRACTILES.len(), ng, nd], f64::NAN),
-        exceed_fraction: array(&[ns, nc, nl, ng], f64::NAN),
-        fragility_curve: array(&[ns, nc, nl, ng], f64::NAN),
-        theta_sa_g: array(&[ns, nc, nl], f64::NAN),
-        beta: array(&[ns, nc, nl], f64::NAN),
-        theta_ci_low_sa_g: array(&[ns, nc, nl], f64::NAN),
-        theta_ci_high_sa_g: array(&[ns, nc, nl], f64::NAN),
-        beta_ci_low: array(&[ns, nc, nl], f64::NAN),
-        beta_ci_high: array(&[ns, nc, nl], f64::NAN),
-        fit_status: array(&[ns, nc, nl], 255u8),
-    };
-    for (u, out) in units.iter().enumerate() {
-        let (r, c) = (u / nc, u % nc);
-        v.record_sa_g[[r, c]] = out.record_sa_g;
-        for (s, t) in out.traces.iter().enumerate() {
-            for (k, run) in t.runs.iter().enumerate() {
-                v.run_sa_g[[s, r, c, k]] = run.sa_g;
-                v.run_collapsed[[s, r, c, k]] = u8::from(run.collapsed);
-                v.run_slip_exceeded[[s, r, c, k]] = u8::from(run.demand.slip_exceeded);
-                for (d, x) in run.demand.values.iter().enumerate() {
-                    v.run_demand[[s, r, c, k, d]] = *x;
-                }
-            }
-            if let Some((_, hi)) = t.capacity_sa_g() {
-                v.collapse_sa_g[[s, r, c]] = hi;
-            }
-            let sa: Vec<f64> = t.runs.iter().map(|x| x.sa_g).collect();
-            let collapsed: Vec<bool> = t.runs.iter().map(|x| x.collapsed).collect();
-            for d in 0..nd {
-                let demand: Vec<f64> = t.runs.iter().map(|x| x.demand.values[d]).collect();
-                for (j, y) in on_grid(&sa, &demand, &collapsed, grid)
-                    .into_iter()
-                    .enumerate()
-                {
-                    v.curve[[s, r, c, j, d]] = y;
-                }
-            }
-        }
-    }
-    let n = cfg.blocks();
-    // Each limit state's stripes (`[system, case, limit state]`, intensities, runs, exceedances).
-    let mut stripes = Vec::new();
-    for s in 0..ns {
-        for c in 0..nc {
-            for j in 0..ng {
-                for d in 0..nd {
-                    let vals: Vec<f64> = (0..records).map(|r| v.curve[[s, r, c, j, d]]).collect();
-                    for (q, &p) in FRACTILES.iter().enumerate() {
-                        v.fractile_curve[[s, c, q, j, d]] = fractile(&vals, p);
-                    }
-                }
-            }
-            for (l, ls) in cfg.limit_states.iter().enumerate() {
-                let (mut x, mut trials, mut exceed) = (Vec::new(), Vec::new(), Vec::new());
-                for (j, &sa) in grid.iter().enumerate() {
-                    let (mut nj, mut zj) = (0u32, 0u32);
-                    let (d0, over_blocks) = layout.of_limit(ls);
-                    for r in 0..records {
-                        let value = if over_blocks {
-                            (0..n)
-                                .map(|i| v.curve[[s, r, c, j, d0 + i]])
-                                .fold(f64::NEG_INFINITY, f64::max)
-                        } else {
-                            v.curve[[s, r, c, j, d0]]
-                        };
-                        if value.is_nan() {
-                            continue;
-                        }
-                        let threshold = ls.threshold();
-                        nj += 1;
-                        zj += u32::from(value >= threshold);
-                    }
-                    if nj > 0 {
-                        v.exceed_fraction[[s, c, l, j]] = zj as f64 / nj as f64;
-                        x.push(sa);
-                        trials.push(nj);
-                        exceed.push(zj);
-                    }
-                }
-                stripes.push(([s, c, l], x, trials, exceed));
-            }
-        }
-    }
-    // The fits are independent, each sequential: in parallel, the same bits on any thread count.
-    let fits: Vec<_> = stripes
-        .par_iter()
-        .map(|(_, x, trials, exceed)| fit_lognormal(x, trials, exceed))
-        .collect();
-    for ((at, ..), f) in stripes.iter().zip(fits) {
-        let [s, c, l] = *at;
-        v.theta_sa_g[*at] = f.theta_sa_g;
-        v.beta[*at] = f.beta;
-        v.theta_ci_low_sa_g[*at] = f.theta_ci_sa_g.0;
-        v.theta_ci_high_sa_g[*at] = f.theta_ci_sa_g.1;
-        v.beta_ci_low[*at] = f.beta_ci.0;
-        v.beta_ci_high[*at] = f.beta_ci.1;
-        v.fit_status[*at] = f.status as u8;
-        if matches!(f.status, FitStatus::Fitted | FitStatus::Degenerate) {
-            for (j, &sa) in grid.iter().enumerate() {
-                v.fragility_curve[[s, c, l, j]] = f.probability(sa);
-            }
-        }
-    }
-    v
 }
 
 /// One row of the fragility table.

@@ -13,6 +13,8 @@
 //! * [`design`]: the designer's arithmetic: `T_new` of one structure from a zone's (or frame's)
 //!   data.
 //! * [`ida`]: the `ida:` section, a case's systems on a yielding structure, one traced unit.
+//! * [`ida_zone`]: one zone of the IDA: a unit traced, the zone's curves, fractiles and
+//!   fragilities.
 //! * [`motions`]: seeds, spectral matching per zone, the set checks.
 //! * [`physics`]: the physics of a case: damping basis, shared settings, its three systems.
 //! * [`storey_strength`]: a building's storey strengths from a base-shear coefficient (IS 1893).
@@ -27,6 +29,7 @@ pub mod design;
 pub mod equations;
 pub mod floors;
 pub mod ida;
+pub mod ida_zone;
 pub mod motions;
 pub mod physics;
 pub mod storey_strength;
