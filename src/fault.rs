@@ -12,6 +12,7 @@ use crate::ground_motion::matching::MatchError;
 use crate::ground_motion::spectra::SpectraError;
 use crate::match_files::MatchFilesError;
 use crate::pipeline::floors::FloorsStageError;
+use crate::pipeline::ida::IdaStageError;
 use crate::pipeline::lock::LockError;
 use crate::pipeline::motions::MotionsError;
 use crate::pipeline::sweep::SweepStageError;
@@ -218,9 +219,14 @@ impl Classify for PipelineError {
                 SweepStageError::Verify { file, .. } => Fault::of(DamagedFile).file(file.display()),
                 SweepStageError::Simulation { .. } => Fault::of(Failed),
             },
-            PipelineError::Ida(crate::pipeline::ida::IdaStageError::NoSection { config }) => {
-                Fault::of(BadInput).file(config.display()).key("ida")
-            }
+            PipelineError::Ida(e) => match e {
+                IdaStageError::NoSection { config } => {
+                    Fault::of(BadInput).file(config.display()).key("ida")
+                }
+                IdaStageError::Shard { .. } => Fault::of(BadInput).key("shard"),
+                IdaStageError::BadUnits { dir, .. } => Fault::of(DamagedFile).file(dir.display()),
+                IdaStageError::Simulation { .. } => Fault::of(Failed),
+            },
             PipelineError::Floors(e) => match e {
                 FloorsStageError::NoSection { config } => Fault::of(BadInput)
                     .file(config.display())
@@ -229,10 +235,9 @@ impl Classify for PipelineError {
                 FloorsStageError::Unit { .. } => Fault::of(Failed),
             },
             PipelineError::Report(crate::pipeline::report::ReportError::Design(e)) => e.fault(),
-            PipelineError::Tnew(_)
-            | PipelineError::Fit(_)
-            | PipelineError::Report(_)
-            | PipelineError::Ida(_) => Fault::of(Failed),
+            PipelineError::Tnew(_) | PipelineError::Fit(_) | PipelineError::Report(_) => {
+                Fault::of(Failed)
+            }
             PipelineError::Cancelled(_) => Fault::of(Interrupted),
         }
     }

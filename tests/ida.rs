@@ -1,6 +1,7 @@
 //! The IDA stage end to end on `configs/ida-quick.yaml`: it runs, a rerun is skipped, a
 //! `kill -9` then a rerun gives the same bytes, so does one thread against two, xarray reads the
-//! labelled dimensions; bad `ida:` keys are refused before any work; the report shows the IDA
+//! labelled dimensions; shards, a killed shard and a damaged unit give the unsharded bytes; bad
+//! `ida:` keys are refused before any work; the report shows the IDA
 //! and needs `ida.h5`. And hunt & fill on a bare bilinear SDOF, whose response is homogeneous in
 //! the intensity (docs/model.md, "For a study stage").
 
@@ -92,6 +93,84 @@ fn the_stage_runs_skips_resumes_after_a_kill_and_ignores_the_thread_count() {
         ],
         "{text}"
     );
+}
+
+/// `ida --shard K/N` on the one-storey and the building IDA: the shards in any order and
+/// thread count, one of them killed (SIGKILL) after its first unit and run again, a unit file
+/// damaged before the assembly: `ida` then gives the unsharded run's bytes, and its unit files
+/// are gone. A split into more shards than units is bad input (exit 2).
+#[test]
+fn shards_a_kill_and_a_damaged_unit_give_the_unsharded_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    for config in ["configs/ida-quick.yaml", "configs/mdof-ida-quick.yaml"] {
+        let cfg = repo.join(config);
+        let name = config
+            .trim_start_matches("configs/")
+            .trim_end_matches(".yaml");
+        let (whole, split) = (
+            dir.path().join(name),
+            dir.path().join(format!("{name}-split")),
+        );
+        ok(slidestack(&["motions", s(&cfg), "--out", s(&whole)], "2"));
+        common::copy_motions(&whole, &split);
+        ok(slidestack(&["ida", s(&cfg), "--out", s(&whole)], "2"));
+        let want = std::fs::read(whole.join("ida.h5")).unwrap();
+
+        let shard = |k: &str, threads: &str| {
+            let o = ok(slidestack(
+                &["ida", s(&cfg), "--out", s(&split), "--shard", k],
+                threads,
+            ));
+            assert!(String::from_utf8_lossy(&o.stdout).contains(&format!("shard {k} done")));
+        };
+        shard("3/3", "1");
+        common::kill_at(
+            &["ida", s(&cfg), "--out", s(&split), "--shard", "1/3"],
+            "ida.trace:1",
+            dir.path(),
+        );
+        shard("1/3", "2");
+        shard("2/3", "2");
+        assert!(!split.join("ida.h5").exists());
+        let units = split.join("ida.units");
+        let mut files: Vec<PathBuf> = (std::fs::read_dir(&units).unwrap())
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        assert!(files.len() >= 3, "{files:?}");
+        // One byte of a stored unit flipped: refused by its checksum, traced again.
+        let mut bytes = std::fs::read(&files[1]).unwrap();
+        bytes[40] ^= 1;
+        std::fs::write(&files[1], bytes).unwrap();
+        let o = ok(slidestack(&["ida", s(&cfg), "--out", s(&split)], "1"));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("fails its checksum") && err.contains("computing it again"),
+            "{err}"
+        );
+        assert_eq!(
+            std::fs::read(split.join("ida.h5")).unwrap(),
+            want,
+            "{config}"
+        );
+        assert!(!units.exists());
+
+        let o = slidestack(
+            &[
+                "ida",
+                s(&cfg),
+                "--out",
+                s(&split),
+                "--shard",
+                "1/999",
+                "--force",
+            ],
+            "1",
+        );
+        assert_eq!(o.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("shard 1/999: needs 1 ≤ K ≤ N ≤"));
+    }
 }
 
 #[test]

@@ -154,7 +154,11 @@ def fit(
     config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True
 ) -> Dict[str, Any]: ...
 def ida(
-    config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True
+    config: _Config,
+    out: Optional[_Path] = None,
+    force: bool = False,
+    wait: bool = True,
+    shard: Optional[Tuple[int, int]] = None,
 ) -> Dict[str, Any]: ...
 def floors(
     config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True

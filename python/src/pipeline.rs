@@ -15,7 +15,7 @@ use pyo3::types::{PyDict, PyList, PyString};
 use slidestack::pipeline::lock::LockMode;
 use slidestack::pipeline::{
     PipelineError, Progress, Reporter, Session, StageId, StageOptions, StageOutcome, StageState,
-    Study, execute, run_all, status as study_status, sweep, terminal_progress,
+    Study, execute, ida, run_all, status as study_status, sweep, terminal_progress,
 };
 use slidestack::study::config::{ConfigError, StudyConfig};
 use std::io::IsTerminal;
@@ -235,7 +235,6 @@ stage_fn!(
 );
 stage_fn!(tnew, StageId::Tnew, "The tnew stage (`slidestack tnew`).");
 stage_fn!(fit, StageId::Fit, "The fit stage (`slidestack fit`).");
-stage_fn!(ida, StageId::Ida, "The ida stage (`slidestack ida`).");
 stage_fn!(
     floors,
     StageId::Floors,
@@ -246,6 +245,46 @@ stage_fn!(
     StageId::Report,
     "The report stage (`slidestack report`)."
 );
+
+/// A `shard=(k, n)` keyword: `None` when absent, else `1 ≤ k ≤ n` (the stage checks `n`
+/// against its work units).
+fn shard_pair(shard: Option<&Bound<'_, PyAny>>) -> PyResult<Option<(usize, usize)>> {
+    let Some(shard) = shard.filter(|s| !s.is_none()) else {
+        return Ok(None);
+    };
+    let pair: Vec<Bound<'_, PyAny>> = (shard.extract().ok())
+        .filter(|p: &Vec<Bound<'_, PyAny>>| p.len() == 2)
+        .ok_or_else(|| PyValueError::new_err("`shard` must be a pair (k, n) of whole numbers"))?;
+    let (k, n) = (
+        crate::convert::whole(&pair[0], "shard", 1)?,
+        crate::convert::whole(&pair[1], "shard", 1)?,
+    );
+    if k == 0 || k > n {
+        return Err(PyValueError::new_err(format!(
+            "`shard` ({k}, {n}): needs 1 ≤ k ≤ n"
+        )));
+    }
+    Ok(Some((k, n)))
+}
+
+/// A stage that can be split: the whole stage, or with `shard=(k, n)` only that shard's units
+/// (`run_shard`), in a session shared with the other shards.
+fn sharded_stage<'py>(
+    py: Python<'py>,
+    stage: StageId,
+    run_shard: fn(&Session, usize, usize, StageOptions) -> Result<StageOutcome, PipelineError>,
+    (config, out, force, wait): (&Bound<'py, PyAny>, Option<PathBuf>, bool, bool),
+    shard: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let Some((k, n)) = shard_pair(shard)? else {
+        return one_stage(py, stage, config, out, force, wait);
+    };
+    let config = ConfigArg::from_py(config)?;
+    let outcome = in_session(py, config, out, LockMode::Shared, wait, move |s| {
+        run_shard(s, k, n, StageOptions { force })
+    })?;
+    outcome_dict(py, stage, &outcome, None)
+}
 
 /// The sweep stage (`slidestack sweep`); with `shard=(k, n)` only that shard's units.
 #[pyfunction]
@@ -258,26 +297,24 @@ fn sweep_<'py>(
     wait: bool,
     shard: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let Some(shard) = shard.filter(|s| !s.is_none()) else {
-        return one_stage(py, StageId::Sweep, config, out, force, wait);
-    };
-    let pair: Vec<Bound<'py, PyAny>> = (shard.extract().ok())
-        .filter(|p: &Vec<Bound<'py, PyAny>>| p.len() == 2)
-        .ok_or_else(|| PyValueError::new_err("`shard` must be a pair (k, n) of whole numbers"))?;
-    let (k, n) = (
-        crate::convert::whole(&pair[0], "shard", 1)?,
-        crate::convert::whole(&pair[1], "shard", 1)?,
-    );
-    if k == 0 || k > n {
-        return Err(PyValueError::new_err(format!(
-            "`shard` ({k}, {n}): needs 1 ≤ k ≤ n"
-        )));
-    }
-    let config = ConfigArg::from_py(config)?;
-    let outcome = in_session(py, config, out, LockMode::Shared, wait, move |s| {
-        sweep::run_shard(s, k, n, StageOptions { force })
-    })?;
-    outcome_dict(py, StageId::Sweep, &outcome, None)
+    let args = (config, out, force, wait);
+    sharded_stage(py, StageId::Sweep, sweep::run_shard, args, shard)
+}
+
+/// The ida stage (`slidestack ida`); with `shard=(k, n)` only that shard's units, which a later
+/// call without it assembles.
+#[pyfunction]
+#[pyo3(name = "ida", signature = (config, out=None, force=false, wait=true, shard=None))]
+fn ida_<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    out: Option<PathBuf>,
+    force: bool,
+    wait: bool,
+    shard: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let args = (config, out, force, wait);
+    sharded_stage(py, StageId::Ida, ida::run_shard, args, shard)
 }
 
 /// Assembles `sweep.h5` when every shard is done (`slidestack merge`).
@@ -340,7 +377,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep_, m)?)?;
     m.add_function(wrap_pyfunction!(tnew, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
-    m.add_function(wrap_pyfunction!(ida, m)?)?;
+    m.add_function(wrap_pyfunction!(ida_, m)?)?;
     m.add_function(wrap_pyfunction!(floors, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;

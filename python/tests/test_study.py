@@ -286,6 +286,22 @@ def test_shards_and_merge_make_the_same_sweep(quick, tmp_path):
         slidestack.sweep(QUICK, out=out, shard=(3, 2))
 
 
+def test_ida_shards_make_the_unsharded_ida(tmp_path):
+    """slidestack.ida(shard=(k, n)) traces its share; a call without it assembles the bytes of an
+    unsharded run; a shard beyond the units is a ValueError naming `shard`."""
+    cfg = ROOT / "configs/ida-quick.yaml"
+    whole, split = tmp_path / "whole", tmp_path / "split"
+    slidestack.motions(cfg, out=whole)
+    copy_motions(whole, split)
+    assert slidestack.ida(cfg, out=whole)["outcome"] == "wrote"
+    for k in (2, 1):
+        assert slidestack.ida(cfg, out=split, shard=(k, 2))["shard"] == (k, 2)
+    assert slidestack.ida(cfg, out=split)["outcome"] == "wrote"
+    assert (split / "ida.h5").read_bytes() == (whole / "ida.h5").read_bytes()
+    with pytest.raises(ValueError, match="shard 1/99: needs 1 ≤ K ≤ N ≤ 6"):
+        slidestack.ida(cfg, out=split, shard=(1, 99), force=True)
+
+
 def test_design_in_a_building_study_is_the_clis(tmp_path, cli):
     """configs/mdof-quick.yaml through its fit by the CLI; the module's design of one frame is
     the CLI's, and asking a building study without a frame raises ValueError naming the keys."""

@@ -1,6 +1,7 @@
-//! `slidestack ida CONFIG [--figure SVG]`: the incremental dynamic analysis stage
+//! `slidestack ida CONFIG [--figure SVG | --shard K/N]`: the incremental dynamic analysis stage
 //! ([`slidestack::pipeline::ida`]), then its fragility table and optionally a figure of the
-//! first case's IDA curves.
+//! first case's IDA curves; with `--shard` only that shard's units (side by side with the other
+//! shards: it takes the output directory's lock shared).
 
 use super::{CliReporter, StudyArgs, print_outcome};
 use anyhow::Result;
@@ -15,6 +16,10 @@ pub struct Args {
     /// Also write the first case's IDA curves (each zone, stack and rigid load) as SVG here.
     #[arg(long)]
     pub figure: Option<PathBuf>,
+    /// Trace only shard K of N of the work units (1 ≤ K ≤ N ≤ units) into their unit files;
+    /// a later `slidestack ida` without it traces what is left and assembles ida.h5.
+    #[arg(long, value_parser = super::parse_shard, conflicts_with = "figure")]
+    pub shard: Option<(usize, usize)>,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -24,12 +29,17 @@ pub fn run(args: Args) -> Result<()> {
     let study = args.study.study()?;
     // Without an `ida` section: refused before the output directory is touched.
     study.fingerprint(StageId::Ida)?;
-    let session = Session::open(
-        study,
-        LockMode::Exclusive,
-        !args.study.no_wait,
-        &CliReporter,
-    )?;
+    // A shard shares the output directory with the other shards.
+    let mode = match args.shard {
+        Some(_) => LockMode::Shared,
+        None => LockMode::Exclusive,
+    };
+    let session = Session::open(study, mode, !args.study.no_wait, &CliReporter)?;
+    if let Some((k, n)) = args.shard {
+        let outcome = ida::run_shard(&session, k, n, args.study.options())?;
+        print_outcome(StageId::Ida, &outcome, &args.study.config);
+        return Ok(());
+    }
     let outcome = execute(&session, StageId::Ida, args.study.options())?;
     print_outcome(StageId::Ida, &outcome, &args.study.config);
     let rows = ida::fragility_table(&session.study)?;

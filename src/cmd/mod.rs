@@ -77,6 +77,22 @@ impl Reporter for CliReporter {
     }
 }
 
+/// `--shard K/N` of a stage that can be split: `1 ≤ K ≤ N` (the stage checks `N` against its
+/// work units).
+pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let (k, n) = s.split_once('/').ok_or("expected K/N, e.g. 2/8")?;
+    let num = |x: &str, what: &str| {
+        x.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("{what} in `{s}` is not a whole number"))
+    };
+    let (k, n) = (num(k, "K")?, num(n, "N")?);
+    if k == 0 || k > n {
+        return Err(format!("shard `{s}`: needs 1 ≤ K ≤ N"));
+    }
+    Ok((k, n))
+}
+
 /// One line saying what a stage did.
 pub fn print_outcome(stage: StageId, outcome: &StageOutcome, config: &std::path::Path) {
     match outcome {
@@ -85,10 +101,17 @@ pub fn print_outcome(stage: StageId, outcome: &StageOutcome, config: &std::path:
             let list: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
             println!("{stage}: wrote {}", list.join(" and "));
         }
-        StageOutcome::ShardDone { k, n } => println!(
-            "{stage}: shard {k}/{n} done; run `slidestack merge {}` when every shard is done",
-            config.display()
-        ),
+        StageOutcome::ShardDone { k, n } => {
+            let assemble = match stage {
+                StageId::Sweep => "merge",
+                _ => stage.name(),
+            };
+            println!(
+                "{stage}: shard {k}/{n} done; run `slidestack {assemble} {}` when every shard is \
+                 done",
+                config.display()
+            )
+        }
     }
 }
 

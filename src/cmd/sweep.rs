@@ -13,22 +13,8 @@ pub struct Args {
     #[command(flatten)]
     pub study: StudyArgs,
     /// Compute only shard K of N (1 ≤ K ≤ N ≤ work units) and leave the assembly to `merge`.
-    #[arg(long, value_parser = parse_shard)]
+    #[arg(long, value_parser = super::parse_shard)]
     pub shard: Option<(usize, usize)>,
-}
-
-fn parse_shard(s: &str) -> Result<(usize, usize), String> {
-    let (k, n) = s.split_once('/').ok_or("expected K/N, e.g. 2/8")?;
-    let num = |x: &str, what: &str| {
-        x.trim()
-            .parse::<usize>()
-            .map_err(|_| format!("{what} in `{s}` is not a whole number"))
-    };
-    let (k, n) = (num(k, "K")?, num(n, "N")?);
-    if k == 0 || k > n {
-        return Err(format!("shard `{s}`: needs 1 ≤ K ≤ N"));
-    }
-    Ok((k, n))
 }
 
 pub fn run(args: Args) -> Result<()> {

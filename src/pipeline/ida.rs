@@ -2,11 +2,13 @@
 //! structure, traced by hunt & fill → `ida.h5` (layout in [`crate::store::ida`]; the numerics of
 //! one unit in [`crate::study::ida`], the kernels in [`crate::ida`]).
 //!
-//! Work units (one zone, one motion, one case; both systems) run in parallel and are collected
-//! in their fixed order, so the file's bytes do not depend on the thread count. The file is
-//! written once, atomically, at the end: a run killed before that leaves nothing but a temporary
-//! (removed by the next session) and the rerun computes everything again (the quick config takes
-//! seconds).
+//! Work units (one zone, one motion, one case; both systems) run in parallel, each stored as a
+//! unit file in [`UNITS_DIR`] as it ends (identity and checksum, written atomically: the sweep's
+//! format, [`crate::store::units`]), so a run killed at any point resumes where it stopped, and
+//! `--shard K/N` traces only the units `i` with `i mod N = K − 1` beside the other shards. The
+//! unsharded stage traces what no unit file holds, reads every unit back in its fixed order and
+//! writes `ida.h5` once, atomically; its bytes depend neither on the thread count nor on the
+//! shards. The unit files go once `ida.h5` is written and verified.
 //!
 //! In a building study a unit is one zone, one motion, one case and one frame (`storeys`,
 //! `stack_floor`; docs/model.md, "Incremental dynamic analysis", "In a building").
@@ -16,14 +18,19 @@
 //! `grid.stack_floor`.
 
 use super::{PipelineError, Session, StageId, StageOutcome, Study};
+use crate::ground_motion::Record;
 use crate::ida::fragility::FIT_STATUS_FLAGS;
+use crate::ida::trace::{Run, Trace};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaAxes, IdaMeta, ZoneIda, read_zone_ida, write_ida};
+use crate::store::units::{Columns, Stored, UnitId, read_unit, unit_path, write_unit};
 use crate::study::config::StudyConfig;
-use crate::study::ida::{DemandLayout, IdaConfig, SYSTEMS};
-use crate::study::ida_zone::{FRACTILES, UnitPlan, UnitTraces, axes_of, trace_unit, zone_ida};
+use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS};
+use crate::study::ida_zone::{
+    FRACTILES, IdaUnit, UnitPlan, UnitTraces, axes_of, trace_unit, zone_ida,
+};
 use crate::study::physics::Physics;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -33,6 +40,19 @@ use thiserror::Error;
 pub enum IdaStageError {
     #[error("{}: the `ida` stage needs an `ida` section", config.display())]
     NoSection { config: PathBuf },
+    #[error("shard {k}/{n}: needs 1 ≤ K ≤ N ≤ {units} (the IDA traces {units} work units)")]
+    Shard { k: usize, n: usize, units: usize },
+    #[error(
+        "{} of the {total} units of the IDA are damaged, misplaced or missing in {}, first: \
+         {first}; rerun the IDA (or the shards that made them), which computes them again",
+        count, dir.display()
+    )]
+    BadUnits {
+        count: usize,
+        total: usize,
+        dir: PathBuf,
+        first: String,
+    },
     #[error("zone {zone}, motion {motion}, case {case}{frame} ({system}): {why}")]
     Simulation {
         zone: String,
@@ -72,8 +92,8 @@ fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
         })
 }
 
-/// Builds `ida.h5`.
-pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
+/// Builds `ida.h5`, or with `shard = Some((K, N))` only that shard's unit files.
+pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Ida;
     let cfg = section(study)?;
@@ -85,13 +105,29 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let nf = frames.len();
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
     let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
-    let units = &plan.traced;
+    let traced = plan.traced.len();
+    if let Some((k, n)) = shard
+        && !(1 <= k && k <= n && n <= traced)
+    {
+        return Err(IdaStageError::Shard {
+            k,
+            n,
+            units: traced,
+        }
+        .into());
+    }
+    let store = IdaUnits {
+        study,
+        cfg,
+        motions: &motions,
+        fingerprint: fp,
+    };
     s.reporter.info(
         me,
         &format!(
             "{} traces ({} motions over {} zones × {} cases{} × {} systems{}), at most {} runs \
              each",
-            units.len() * SYSTEMS.len(),
+            traced * SYSTEMS.len(),
             motions.iter().map(Vec::len).sum::<usize>(),
             motions.len(),
             cfg.cases.len(),
@@ -101,18 +137,44 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
                 String::new()
             },
             SYSTEMS.len(),
-            match plan.all.len() - units.len() {
+            match plan.all.len() - traced {
                 0 => String::new(),
                 n => format!("; {n} units of frames that repeat a building take its traces"),
             },
             cfg.tracing.max_runs()
         ),
     );
+    let mine: Vec<IdaUnit> = (plan.traced.iter().enumerate())
+        .filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1))
+        .map(|(_, u)| *u)
+        .collect();
+    let dir = study.path(UNITS_DIR);
+    std::fs::create_dir_all(&dir).map_err(|e| StoreError::io(&dir, "cannot create", e))?;
+    let mut todo = Vec::new();
+    for &u in &mine {
+        match store.read(u) {
+            Ok(Some(_)) => {}
+            Ok(None) => todo.push(u),
+            Err(e) => {
+                s.reporter.warn(me, &format!("{e}: computing it again"));
+                todo.push(u);
+            }
+        }
+    }
+    if todo.len() < mine.len() {
+        let line = format!(
+            "{} of {} units to trace ({} already done)",
+            todo.len(),
+            mine.len(),
+            mine.len() - todo.len()
+        );
+        s.reporter.info(me, &line);
+    }
     let start = std::time::Instant::now();
-    let bar = s.reporter.progress(me, units.len() as u64);
-    let outs: Vec<UnitTraces> = units
+    let bar = s.reporter.progress(me, todo.len() as u64);
+    let done = todo
         .par_iter()
-        .map(|&u| -> Result<UnitTraces, PipelineError> {
+        .map(|&u| -> Result<(usize, usize), PipelineError> {
             s.check_cancelled(me)?;
             let (record, frame) = (&motions[u.zone][u.motion], frames[u.frame].as_ref());
             let traced = trace_unit(
@@ -131,29 +193,33 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
                 system: f.system,
                 why: f.why,
             })?;
+            store.write(u, &traced)?;
             bar.inc();
             s.pass("ida.trace", me)?;
-            Ok(traced)
+            let runs = traced.traces.iter().map(|t| t.runs.len()).sum();
+            Ok((runs, traced.samples))
         })
         .collect::<Result<Vec<_>, _>>()?;
     bar.finish();
-    let samples: usize = outs.iter().map(|o| o.samples).sum();
-    let runs: usize = outs
-        .iter()
-        .flat_map(|o| o.traces.iter().map(|t| t.runs.len()))
-        .sum();
-    let secs = start.elapsed().as_secs_f64();
-    let threads = rayon::current_num_threads();
-    s.reporter.info(
-        me,
-        &format!(
-            "{runs} runs in {secs:.1} s ({:.0} runs/s); {:.0} ns per simulated record sample \
-             per thread ({threads} threads)",
-            runs as f64 / secs.max(1e-9),
-            secs * 1e9 * threads as f64 / samples.max(1) as f64
-        ),
-    );
-    let outs = plan.expand(&outs);
+    if !done.is_empty() {
+        let (runs, samples) = (done.iter()).fold((0, 0), |(r, n), &(a, b)| (r + a, n + b));
+        let secs = start.elapsed().as_secs_f64();
+        let threads = rayon::current_num_threads();
+        s.reporter.info(
+            me,
+            &format!(
+                "{runs} runs in {secs:.1} s ({:.0} runs/s); {:.0} ns per simulated record sample \
+                 per thread ({threads} threads)",
+                runs as f64 / secs.max(1e-9),
+                secs * 1e9 * threads as f64 / samples.max(1) as f64
+            ),
+        );
+    }
+    if let Some((k, n)) = shard {
+        return Ok(StageOutcome::ShardDone { k, n });
+    }
+    s.pass("ida.assemble", me)?;
+    let outs = plan.expand(&store.read_all(&plan.traced)?);
     let axes = axes_of(cfg, study.building());
     let mut zones = Vec::new();
     let mut at = 0;
@@ -178,8 +244,181 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     };
     let path = study.path(me.output());
     write_ida(&path, &meta, &axes, &zones)?;
+    remove_units(study)?;
     s.reporter.info(me, &format!("verified {}", path.display()));
     Ok(StageOutcome::Wrote(vec![path]))
+}
+
+/// Shard `K/N` of the IDA: nothing when `ida.h5` is already up to date (unless forced).
+pub fn run_shard(
+    s: &Session,
+    k: usize,
+    n: usize,
+    opts: super::StageOptions,
+) -> Result<StageOutcome, PipelineError> {
+    let me = StageId::Ida;
+    s.study.fingerprint(me)?;
+    s.study.require(StageId::Motions)?;
+    if !opts.force && s.study.state(me)? == super::StageState::UpToDate {
+        return Ok(StageOutcome::UpToDate(s.study.path(me.output())));
+    }
+    build(s, Some((k, n)))
+}
+
+/// The directory of the IDA's unit files.
+pub const UNITS_DIR: &str = "ida.units";
+
+/// Removes the IDA's unit files (after `ida.h5` was verified, or left over from an interrupted
+/// cleanup).
+pub fn remove_units(study: &Study) -> Result<(), StoreError> {
+    let dir = study.path(UNITS_DIR);
+    match std::fs::remove_dir_all(&dir) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(StoreError::io(&dir, "cannot remove", e)),
+    }
+}
+
+/// The IDA's unit files: a unit's traces as columns (the record's `Sa` first, then per system
+/// its runs' `Sa` and demands, `f64`; its runs' collapse and slip flags, `u8`), under an
+/// identity whose `period_index` and `period_s` are the `ida:` section's case and its `T_p`.
+struct IdaUnits<'a> {
+    study: &'a Study,
+    cfg: &'a IdaConfig,
+    motions: &'a [Vec<Record>],
+    fingerprint: &'a str,
+}
+
+impl IdaUnits<'_> {
+    fn path(&self, u: IdaUnit) -> PathBuf {
+        unit_path(
+            &self.study.path(UNITS_DIR),
+            &self.study.cfg.zones[u.zone].name,
+            u.motion,
+            self.study.building().map(|_| u.frame),
+            u.case,
+        )
+    }
+
+    fn id(&self, u: IdaUnit) -> UnitId {
+        let frame = self.study.building().map(|b| {
+            let (n, floor) = b.frame(u.frame);
+            (u.frame, format!("storeys {n}, stack_floor {floor}"))
+        });
+        UnitId {
+            frame,
+            fingerprint: self.fingerprint.to_string(),
+            zone: self.study.cfg.zones[u.zone].name.clone(),
+            motion_index: u.motion,
+            motion: self.motions[u.zone][u.motion].name.clone(),
+            period_index: u.case,
+            period_s: self.cfg.cases[u.case].period_s,
+        }
+    }
+
+    fn write(&self, u: IdaUnit, t: &UnitTraces) -> Result<(), StoreError> {
+        let mut c = Columns {
+            f64s: vec![vec![t.record_sa_g]],
+            u8s: Vec::new(),
+        };
+        for trace in &t.traces {
+            c.f64s.push(trace.runs.iter().map(|r| r.sa_g).collect());
+            (c.f64s).push(
+                trace
+                    .runs
+                    .iter()
+                    .flat_map(|r| r.demand.values.clone())
+                    .collect(),
+            );
+            c.u8s
+                .push(trace.runs.iter().map(|r| u8::from(r.collapsed)).collect());
+            (c.u8s).push(
+                (trace.runs.iter())
+                    .map(|r| u8::from(r.demand.slip_exceeded))
+                    .collect(),
+            );
+        }
+        write_unit(&self.path(u), &self.id(u), &c)
+    }
+
+    /// The unit's traces, `None` when no file holds them for this IDA (missing, or made with
+    /// other inputs); a file of the wrong shape is refused as damaged.
+    fn read(&self, u: IdaUnit) -> Result<Option<UnitTraces>, StoreError> {
+        let path = self.path(u);
+        let c = match read_unit(&path, &self.id(u))? {
+            Stored::Valid(c) => c,
+            Stored::Missing | Stored::Stale => return Ok(None),
+        };
+        let demands = self.cfg.demand_names(self.study.building().is_some()).len();
+        let max_runs = self.cfg.tracing.max_runs();
+        let shape_ok = c.f64s.len() == 1 + 2 * SYSTEMS.len()
+            && c.u8s.len() == 2 * SYSTEMS.len()
+            && c.f64s[0].len() == 1
+            && (0..SYSTEMS.len()).all(|k| {
+                let runs = c.f64s[1 + 2 * k].len();
+                runs <= max_runs
+                    && c.f64s[2 + 2 * k].len() == runs * demands
+                    && c.u8s[2 * k].len() == runs
+                    && c.u8s[2 * k + 1].len() == runs
+            });
+        if !shape_ok {
+            let found: Vec<usize> = (c.f64s.iter().map(Vec::len))
+                .chain(c.u8s.iter().map(Vec::len))
+                .collect();
+            let why = format!(
+                "holds columns of lengths {found:?}, not one unit of {} systems' runs of {demands} \
+                 demands",
+                SYSTEMS.len()
+            );
+            return Err(StoreError::corrupt(&path, why));
+        }
+        let traces = (0..SYSTEMS.len())
+            .map(|k| {
+                let (sa, values) = (&c.f64s[1 + 2 * k], &c.f64s[2 + 2 * k]);
+                let (collapsed, slip) = (&c.u8s[2 * k], &c.u8s[2 * k + 1]);
+                let runs = (0..sa.len())
+                    .map(|r| Run {
+                        sa_g: sa[r],
+                        demand: RunDemand {
+                            values: values[r * demands..(r + 1) * demands].to_vec(),
+                            slip_exceeded: slip[r] != 0,
+                        },
+                        collapsed: collapsed[r] != 0,
+                    })
+                    .collect();
+                Trace { runs }
+            })
+            .collect();
+        Ok(Some(UnitTraces {
+            record_sa_g: c.f64s[0][0],
+            traces,
+            samples: 0,
+        }))
+    }
+
+    /// Every unit of `units`, in their order; an error naming the directory unless each is
+    /// stored whole for this IDA.
+    fn read_all(&self, units: &[IdaUnit]) -> Result<Vec<UnitTraces>, PipelineError> {
+        let mut bad = Vec::new();
+        let mut read = Vec::with_capacity(units.len());
+        for &u in units {
+            match self.read(u) {
+                Ok(Some(t)) => read.push(t),
+                Ok(None) => bad.push(format!("{} is missing", self.path(u).display())),
+                Err(e) => bad.push(e.to_string()),
+            }
+        }
+        if bad.is_empty() {
+            return Ok(read);
+        }
+        Err(IdaStageError::BadUnits {
+            count: bad.len(),
+            total: units.len(),
+            dir: self.study.path(UNITS_DIR),
+            first: bad.swap_remove(0),
+        }
+        .into())
+    }
 }
 
 /// How the structure's strength is set, in words (in a building: the base-shear coefficient

@@ -665,8 +665,9 @@ impl<'r> Session<'r> {
             );
         }
         if mode == LockMode::Exclusive {
-            for dir in [study.out.clone(), study.path(sweep::UNITS_DIR)] {
-                atomic::remove_stale_temps(&dir)?;
+            let units = [sweep::UNITS_DIR, ida::UNITS_DIR].map(|d| study.path(d));
+            for dir in [study.out.clone()].iter().chain(&units) {
+                atomic::remove_stale_temps(dir)?;
             }
         }
         let session = Self {
@@ -713,7 +714,8 @@ pub enum StageOutcome {
     UpToDate(PathBuf),
     /// These files were written.
     Wrote(Vec<PathBuf>),
-    /// A sweep shard stored its units; `merge` assembles them.
+    /// A shard of the sweep or the IDA stored its units; `merge` (the sweep) or the unsharded
+    /// stage (the IDA) assembles them.
     ShardDone { k: usize, n: usize },
 }
 
@@ -732,8 +734,12 @@ pub fn execute(
     if !opts.force {
         match s.study.state(stage)? {
             StageState::UpToDate => {
-                if stage == StageId::Sweep && s.exclusive() {
-                    sweep::remove_units(&s.study)?;
+                if s.exclusive() {
+                    match stage {
+                        StageId::Sweep => sweep::remove_units(&s.study)?,
+                        StageId::Ida => ida::remove_units(&s.study)?,
+                        _ => {}
+                    }
                 }
                 return Ok(StageOutcome::UpToDate(path));
             }
@@ -747,7 +753,7 @@ pub fn execute(
         StageId::Tnew => tnew::build(s),
         StageId::Fit => fit::build(s),
         StageId::Report => report::build(s),
-        StageId::Ida => ida::build(s),
+        StageId::Ida => ida::build(s, None),
         StageId::Floors => floors::build(s),
     }?;
     // A Ctrl-C that came while the output was being finished is reported, the output kept.
