@@ -12,6 +12,7 @@ use crate::store::fit::{FitReport, read_fit};
 use crate::store::motions::{read_zone_motions, read_zone_target};
 use crate::store::sweep::{ZoneSweep, read_zone_sweep};
 use crate::store::tnew::{ZoneTnew, read_zone_tnew_in};
+use crate::store::units::{UnitId, unit_path};
 use crate::study::tnew::spectrum_periods_s;
 use std::path::Path;
 
@@ -81,4 +82,40 @@ pub fn fit(study: &Study) -> Result<FitReport, PipelineError> {
     let fit = read_fit(&path)?.ok_or_else(|| StoreError::corrupt(&path, "is missing"))?;
     fit.check_blocks(&path, study.grid(StageId::Fit)?.blocks())?;
     Ok(fit)
+}
+
+/// Where a unit of a stage that stores its work units (the sweep, the IDA) lives in `dir`, and
+/// the identity its file must hold: zone `zone`'s motion `motion` of `motions`, a building
+/// study's frame `frame`, and index `index` along the stage's own axis with its `period_s` (the
+/// sweep's `T_p`, the IDA's case).
+pub fn unit_place(
+    study: &Study,
+    (dir, fingerprint): (&str, &str),
+    motions: &[Vec<Record>],
+    (zone, motion, frame): (usize, usize, usize),
+    (index, period_s): (usize, f64),
+) -> (std::path::PathBuf, UnitId) {
+    let zone_name = &study.cfg.zones[zone].name;
+    let building = study.building();
+    let path = unit_path(
+        &study.path(dir),
+        zone_name,
+        motion,
+        building.map(|_| frame),
+        index,
+    );
+    let frame = building.map(|b| {
+        let (n, floor) = b.frame(frame);
+        (frame, format!("storeys {n}, stack_floor {floor}"))
+    });
+    let id = UnitId {
+        frame,
+        fingerprint: fingerprint.to_string(),
+        zone: zone_name.clone(),
+        motion_index: motion,
+        motion: motions[zone][motion].name.clone(),
+        period_index: index,
+        period_s,
+    };
+    (path, id)
 }

@@ -25,7 +25,7 @@ use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaAxes, IdaMeta, ZoneIda, read_zone_ida, write_ida};
-use crate::store::units::{Columns, Stored, UnitId, read_unit, unit_path, write_unit};
+use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
 use crate::study::config::StudyConfig;
 use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS};
 use crate::study::ida_zone::{
@@ -271,12 +271,7 @@ pub const UNITS_DIR: &str = "ida.units";
 /// Removes the IDA's unit files (after `ida.h5` was verified, or left over from an interrupted
 /// cleanup).
 pub fn remove_units(study: &Study) -> Result<(), StoreError> {
-    let dir = study.path(UNITS_DIR);
-    match std::fs::remove_dir_all(&dir) {
-        Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(StoreError::io(&dir, "cannot remove", e)),
-    }
+    crate::store::units::remove_units(&study.path(UNITS_DIR))
 }
 
 /// The IDA's unit files: a unit's traces as columns (the record's `Sa` first, then per system
@@ -290,30 +285,14 @@ struct IdaUnits<'a> {
 }
 
 impl IdaUnits<'_> {
-    fn path(&self, u: IdaUnit) -> PathBuf {
-        unit_path(
-            &self.study.path(UNITS_DIR),
-            &self.study.cfg.zones[u.zone].name,
-            u.motion,
-            self.study.building().map(|_| u.frame),
-            u.case,
+    fn place(&self, u: IdaUnit) -> (PathBuf, UnitId) {
+        super::files::unit_place(
+            self.study,
+            (UNITS_DIR, self.fingerprint),
+            self.motions,
+            (u.zone, u.motion, u.frame),
+            (u.case, self.cfg.cases[u.case].period_s),
         )
-    }
-
-    fn id(&self, u: IdaUnit) -> UnitId {
-        let frame = self.study.building().map(|b| {
-            let (n, floor) = b.frame(u.frame);
-            (u.frame, format!("storeys {n}, stack_floor {floor}"))
-        });
-        UnitId {
-            frame,
-            fingerprint: self.fingerprint.to_string(),
-            zone: self.study.cfg.zones[u.zone].name.clone(),
-            motion_index: u.motion,
-            motion: self.motions[u.zone][u.motion].name.clone(),
-            period_index: u.case,
-            period_s: self.cfg.cases[u.case].period_s,
-        }
     }
 
     fn write(&self, u: IdaUnit, t: &UnitTraces) -> Result<(), StoreError> {
@@ -338,14 +317,15 @@ impl IdaUnits<'_> {
                     .collect(),
             );
         }
-        write_unit(&self.path(u), &self.id(u), &c)
+        let (path, id) = self.place(u);
+        write_unit(&path, &id, &c)
     }
 
     /// The unit's traces, `None` when no file holds them for this IDA (missing, or made with
     /// other inputs); a file of the wrong shape is refused as damaged.
     fn read(&self, u: IdaUnit) -> Result<Option<UnitTraces>, StoreError> {
-        let path = self.path(u);
-        let c = match read_unit(&path, &self.id(u))? {
+        let (path, id) = self.place(u);
+        let c = match read_unit(&path, &id)? {
             Stored::Valid(c) => c,
             Stored::Missing | Stored::Stale => return Ok(None),
         };
@@ -404,7 +384,7 @@ impl IdaUnits<'_> {
         for &u in units {
             match self.read(u) {
                 Ok(Some(t)) => read.push(t),
-                Ok(None) => bad.push(format!("{} is missing", self.path(u).display())),
+                Ok(None) => bad.push(format!("{} is missing", self.place(u).0.display())),
                 Err(e) => bad.push(e.to_string()),
             }
         }

@@ -24,7 +24,7 @@ use crate::store::h5::Attr;
 use crate::store::sweep::{
     BuildingVars, SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep,
 };
-use crate::store::units::{Columns, Stored, UnitId, read_unit, unit_path, write_unit};
+use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
 use crate::study::config::{Seeds, StudyConfig};
 use crate::study::physics::{CaseError, Physics, SystemKind};
 use crate::study::sweep::{SKIP_RULE_CODES, SKIP_RULE_FLAGS, UnitOptions, UnitResult, run_unit};
@@ -131,37 +131,21 @@ struct Units<'a> {
 }
 
 impl Units<'_> {
-    fn path(&self, u: Unit) -> PathBuf {
-        unit_path(
-            &self.study.path(UNITS_DIR),
-            &self.study.cfg.zones[u.zone].name,
-            u.motion,
-            self.study.building().map(|_| u.frame),
-            u.period,
+    fn place(&self, u: Unit) -> (PathBuf, UnitId) {
+        super::files::unit_place(
+            self.study,
+            (UNITS_DIR, self.fingerprint),
+            self.motions,
+            (u.zone, u.motion, u.frame),
+            (u.period, self.grid.periods_s[u.period]),
         )
-    }
-
-    fn id(&self, u: Unit) -> UnitId {
-        let frame = self.study.building().map(|b| {
-            let (n, floor) = b.frame(u.frame);
-            (u.frame, format!("storeys {n}, stack_floor {floor}"))
-        });
-        UnitId {
-            frame,
-            fingerprint: self.fingerprint.to_string(),
-            zone: self.study.cfg.zones[u.zone].name.clone(),
-            motion_index: u.motion,
-            motion: self.motions[u.zone][u.motion].name.clone(),
-            period_index: u.period,
-            period_s: self.grid.periods_s[u.period],
-        }
     }
 
     /// The unit's file, refused (as damaged) unless its columns have the lengths the grid
     /// gives ([`column_lengths`]).
     fn read(&self, u: Unit) -> Result<Stored, StoreError> {
-        let path = self.path(u);
-        let stored = read_unit(&path, &self.id(u))?;
+        let (path, id) = self.place(u);
+        let stored = read_unit(&path, &id)?;
         if let Stored::Valid(c) = &stored {
             let found: Vec<usize> = (c.f64s.iter().map(Vec::len))
                 .chain(c.u8s.iter().map(Vec::len))
@@ -343,7 +327,8 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             sims.fetch_add(r.simulations, Ordering::Relaxed);
             samples.fetch_add(r.simulations * accel.len(), Ordering::Relaxed);
             let sizes = (study.building()).map(|b| (b.frame(u.frame).0, b.max_storeys()));
-            write_unit(&units.path(u), &units.id(u), &to_columns(&r, sizes))?;
+            let (path, id) = units.place(u);
+            write_unit(&path, &id, &to_columns(&r, sizes))?;
             bar.inc();
             s.pass("sweep.unit", me)
         })?;
@@ -599,12 +584,7 @@ fn same_bits(a: &ZoneSweep, b: &ZoneSweep) -> bool {
 /// Removes the unit files (after `sweep.h5` was verified, or left over from an interrupted
 /// cleanup).
 pub fn remove_units(study: &Study) -> Result<(), StoreError> {
-    let dir = study.path(UNITS_DIR);
-    match std::fs::remove_dir_all(&dir) {
-        Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(StoreError::io(&dir, "cannot remove", e)),
-    }
+    crate::store::units::remove_units(&study.path(UNITS_DIR))
 }
 
 /// `(work units, units stored for the current sweep, record samples per motion)`; before the

@@ -68,6 +68,16 @@ pub fn unit_path(
     }
 }
 
+/// Removes a stage's directory of unit files (once its output was verified, or left over from an
+/// interrupted cleanup); a directory that is not there is fine.
+pub fn remove_units(dir: &Path) -> Result<(), StoreError> {
+    match std::fs::remove_dir_all(dir) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(StoreError::io(dir, "cannot remove", e)),
+    }
+}
+
 /// Writes a unit atomically.
 pub fn write_unit(path: &Path, id: &UnitId, data: &Columns) -> Result<(), StoreError> {
     let header = serde_json::to_vec(id).expect("a UnitId serialises");
