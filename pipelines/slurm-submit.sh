@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Submits a slidestack study to Slurm from a login node, without computing anything there:
 #   1. `motions` as one job (only when motions.h5 is not up to date),
-#   2. the sweep as a job array, task K computing shard K of N (`sweep --shard K/N`),
+#   2. the sweep as a job array, task K computing shard K of N (`sweep --shard K/N`), and with an
+#      `ida:` section the IDA as a second array beside it (`ida --shard K/N`, N at most the IDA's
+#      work units), both after motions,
 #   3. one finishing job, started when every task has ended (`afterany`), that checks every work
-#      unit is there, merges them and runs the later stages the config configures (tnew, fit,
-#      ida with an `ida:` section, floors with a `floor_spectra:` section, report).
+#      unit of the sweep is there, merges them and runs the later stages the config configures
+#      (tnew, fit, ida with an `ida:` section: it traces what an IDA task left out and assembles
+#      ida.h5, floors with a `floor_spectra:` section, report).
 # Each part is left out when its file is already up to date (`slidestack status`), so submitting
 # a finished study submits nothing. Run with --help for the options; pipelines/README.md has the
 # walk-through.
@@ -152,13 +155,15 @@ status=$("$SLIDESTACK" status "$CONFIG" --out "$OUT" --format env) ||
 # shellcheck disable=SC2034 # TNEW, FIT, IDA and REPORT are read through ${!v} below
 MOTIONS="" SWEEP="" TNEW="" FIT="" IDA="" REPORT="" SWEEP_UNITS="" SWEEP_UNITS_DONE=""
 SWEEP_CASES_PER_UNIT="" SWEEP_SAMPLES_PER_MOTION="" SWEEP_SAMPLES_PER_UNIT="" STAGES=""
+IDA_UNITS="" IDA_UNITS_DONE=""
 # KEY=VALUE lines; the keys used here are checked below, others are left alone. A stage the
 # config does not configure has no line (STAGES lists the configured ones).
 while IFS= read -r line; do
   [[ $line =~ ^([A-Z_]+)=(.*)$ ]] || continue
   case ${BASH_REMATCH[1]} in
   MOTIONS | SWEEP | TNEW | FIT | IDA | REPORT | SWEEP_UNITS | SWEEP_UNITS_DONE | \
-    SWEEP_CASES_PER_UNIT | SWEEP_SAMPLES_PER_MOTION | SWEEP_SAMPLES_PER_UNIT | STAGES)
+    SWEEP_CASES_PER_UNIT | SWEEP_SAMPLES_PER_MOTION | SWEEP_SAMPLES_PER_UNIT | STAGES | \
+    IDA_UNITS | IDA_UNITS_DONE)
     printf -v "${BASH_REMATCH[1]}" '%s' "${BASH_REMATCH[2]}" ;;
   esac
 done <<<"$status"
@@ -174,10 +179,13 @@ for stage in "${stages[@]}"; do
   [ "${!v}" = up_to_date ] || all_done=0
   states="$states${states:+, }$stage ${!v}"
 done
-for v in SWEEP_UNITS SWEEP_UNITS_DONE SWEEP_CASES_PER_UNIT SWEEP_SAMPLES_PER_MOTION SWEEP_SAMPLES_PER_UNIT; do
+for v in SWEEP_UNITS SWEEP_UNITS_DONE SWEEP_CASES_PER_UNIT SWEEP_SAMPLES_PER_MOTION SWEEP_SAMPLES_PER_UNIT \
+  IDA_UNITS IDA_UNITS_DONE; do
   is_uint "${!v}" || die "slidestack status gave $v='${!v}'"
 done
-note "status: $states ($SWEEP_UNITS_DONE of $SWEEP_UNITS sweep units stored)"
+ida_units=""
+[ "$IDA_UNITS" = 0 ] || ida_units=", $IDA_UNITS_DONE of $IDA_UNITS ida units"
+note "status: $states ($SWEEP_UNITS_DONE of $SWEEP_UNITS sweep units$ida_units stored)"
 if [ $FORCE = 0 ] && [ $all_done = 1 ]; then
   note "the study in $OUT is up to date: nothing to submit ($OUT/report/index.html; --force recomputes it)"
   exit 0
@@ -191,6 +199,13 @@ NEED_MOTIONS=1 NEED_SWEEP=1
 if [ $FORCE = 1 ]; then
   NEED_SWEEP=1
   if [ -z "$ARRAY" ]; then NEED_MOTIONS=1; fi
+fi
+# The IDA array (a config with an `ida:` section whose ida.h5 is not up to date, or --force), not
+# when only some sweep shards are resubmitted (--array): the finishing job's `ida` traces what
+# is left. Its N is the sweep's, at most the IDA's work units.
+NEED_IDA=0
+if [[ ,$STAGES, == *,ida,* ]] && [ -z "$ARRAY" ] && { [ "$IDA" != up_to_date ] || [ $FORCE = 1 ]; }; then
+  NEED_IDA=1
 fi
 
 # --- What the cluster allows. ----------------------------------------------------------------
@@ -399,11 +414,20 @@ motions_cmd=(sbatch "${common[@]}" --job-name=slidestack-motions --time="$STAGE_
 sweep_cmd=(sbatch "${common[@]}" --job-name=slidestack-sweep --time="$TIME" --array="$ARRAY_SPEC"
   --output="$LOGS/sweep-%A_%a.out" "${EXTRA[@]}" "$HERE/sweep.slurm" "${FORCE_ARG[@]}" "$JOB_BIN" "$CONFIG" "$OUT"
   "$SHARDS")
+IDA_SHARDS=$SHARDS
+if [ "$IDA_UNITS" -lt "$IDA_SHARDS" ]; then IDA_SHARDS=$IDA_UNITS; fi
+[ "$IDA_SHARDS" -ge 1 ] || NEED_IDA=0
+IDA_SPEC="1-$IDA_SHARDS"
+[ -z "$MAX_RUNNING" ] || IDA_SPEC="$IDA_SPEC%$MAX_RUNNING"
+ida_cmd=(sbatch "${common[@]}" --job-name=slidestack-ida --time="$STAGE_TIME" --array="$IDA_SPEC"
+  --output="$LOGS/ida-%A_%a.out" "${EXTRA[@]}" "$HERE/ida.slurm" "${FORCE_ARG[@]}" "$JOB_BIN" "$CONFIG" "$OUT"
+  "$IDA_SHARDS")
 finish_cmd=(sbatch "${common[@]}" --job-name=slidestack-finish --time="$STAGE_TIME"
   --output="$LOGS/finish-%j.out" "${EXTRA[@]}" "$HERE/finish.slurm" "${FORCE_ARG[@]}" "$JOB_BIN" "$CONFIG" "$OUT"
   "$SHARDS" "$RESUBMIT_CMD" "$RESUBMIT_ARGS")
 
 parts="finishing job"
+[ $NEED_IDA = 0 ] || parts="ida array ($IDA_SHARDS shards of $IDA_UNITS units, $(show_time "$STAGE_TIME") each), $parts"
 [ $NEED_SWEEP = 0 ] || parts="sweep array (tasks $ARRAY_SPEC of N = $SHARDS shards, $CPUS CPUs and $(show_time "$TIME") each), $parts"
 [ $NEED_MOTIONS = 0 ] || parts="motions job, $parts"
 note "submitting: $parts"
@@ -421,6 +445,7 @@ $out"
 if [ $HAVE_SLURM = 1 ]; then
   [ $NEED_MOTIONS = 0 ] || test_only motions "${motions_cmd[@]}"
   [ $NEED_SWEEP = 0 ] || test_only sweep "${sweep_cmd[@]}"
+  [ $NEED_IDA = 0 ] || test_only ida "${ida_cmd[@]}"
   test_only finishing "${finish_cmd[@]}"
 fi
 
@@ -428,6 +453,7 @@ if [ $DRY_RUN = 1 ]; then
   note "dry run; would submit (each with its --dependency):"
   if [ $NEED_MOTIONS = 1 ]; then printf ' %q' "${motions_cmd[@]}"; echo; fi
   if [ $NEED_SWEEP = 1 ]; then printf ' %q' "${sweep_cmd[@]}"; echo; fi
+  if [ $NEED_IDA = 1 ]; then printf ' %q' "${ida_cmd[@]}"; echo; fi
   printf ' %q' "${finish_cmd[@]}"
   echo
   exit 0
@@ -462,6 +488,7 @@ if [ $NEED_MOTIONS = 1 ]; then
   note "motions job $motions_job"
   # The array waits for motions and is cancelled if motions fails, instead of pending forever.
   sweep_cmd=("${sweep_cmd[0]}" --dependency="afterok:$motions_job" --kill-on-invalid-dep=yes "${sweep_cmd[@]:1}")
+  ida_cmd=("${ida_cmd[0]}" --dependency="afterok:$motions_job" --kill-on-invalid-dep=yes "${ida_cmd[@]:1}")
   deps+=("$motions_job")
 fi
 if [ $NEED_SWEEP = 1 ]; then
@@ -469,6 +496,14 @@ if [ $NEED_SWEEP = 1 ]; then
   array_job=${array_job%%;*}
   note "sweep array $array_job: tasks $ARRAY_SPEC, shard K of N = $SHARDS in task K"
   deps=("$array_job")
+fi
+if [ $NEED_IDA = 1 ]; then
+  ida_job=$("${ida_cmd[@]}")
+  ida_job=${ida_job%%;*}
+  note "ida array $ida_job: tasks $IDA_SPEC, IDA shard K of N = $IDA_SHARDS in task K"
+  # The finishing job waits for the sweep array (or motions) and for the IDA array.
+  if [ $NEED_SWEEP = 0 ]; then deps=(); fi
+  deps+=("$ida_job")
 fi
 if [ ${#deps[@]} -gt 0 ]; then
   # afterany: starts however the tasks end, then checks that every unit is there.

@@ -46,6 +46,8 @@ pub fn run(args: Args) -> Result<()> {
             println!("SWEEP_CASES_PER_UNIT={}", st.cases_per_unit);
             println!("SWEEP_SAMPLES_PER_MOTION={}", st.samples_per_motion);
             println!("SWEEP_SAMPLES_PER_UNIT={}", st.samples_per_unit);
+            println!("IDA_UNITS={}", st.ida_units);
+            println!("IDA_UNITS_DONE={}", st.ida_units_done);
         }
         Format::Text => {
             println!("output directory {}", study.out.display());

@@ -265,6 +265,36 @@ pub fn run_shard(
     build(s, Some((k, n)))
 }
 
+/// `(units the IDA traces, units stored for the current IDA)`; before the motions stage ran
+/// the motion counts come from the config ([`super::sweep::motions_per_zone`]) and none is
+/// stored.
+pub fn unit_status(study: &Study) -> Result<(usize, usize), PipelineError> {
+    let cfg = section(study)?;
+    let frames = study.frames();
+    if study.state(StageId::Motions)? != super::StageState::UpToDate {
+        let counts = super::sweep::motions_per_zone(study);
+        let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
+        return Ok((plan.traced.len(), 0));
+    }
+    let motions = super::files::motions(study)?;
+    let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
+    let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
+    let done = if study.state(StageId::Ida)? == super::StageState::UpToDate {
+        plan.traced.len()
+    } else {
+        let store = IdaUnits {
+            study,
+            cfg,
+            motions: &motions,
+            fingerprint: study.fingerprint(StageId::Ida)?,
+        };
+        (plan.traced.iter())
+            .filter(|&&u| matches!(store.read(u), Ok(Some(_))))
+            .count()
+    };
+    Ok((plan.traced.len(), done))
+}
+
 /// The directory of the IDA's unit files.
 pub const UNITS_DIR: &str = "ida.units";
 

@@ -787,6 +787,10 @@ pub struct Status {
     pub sweep_units: usize,
     /// Units already stored for the current sweep.
     pub sweep_units_done: usize,
+    /// Work units the IDA traces (zones × motions × cases × distinct buildings; 0 without an
+    /// `ida:` section) and those already stored for the current IDA.
+    pub ida_units: usize,
+    pub ida_units_done: usize,
     pub cases_per_unit: usize,
     /// Record samples per motion, the mean over the stored motions (0 before `motions` ran).
     pub samples_per_motion: usize,
@@ -820,7 +824,13 @@ pub fn status(study: &Study) -> Result<Status, PipelineError> {
         None => (0, 0, 0),
     };
     let cases_per_unit = study.grid.as_ref().map_or(0, Grid::cases_per_unit);
+    let (ida_units, ida_units_done) = match study.configured(StageId::Ida) {
+        true => ida::unit_status(study)?,
+        false => (0, 0),
+    };
     Ok(Status {
+        ida_units,
+        ida_units_done,
         stages,
         made_with,
         sweep_units,

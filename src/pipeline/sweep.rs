@@ -587,20 +587,23 @@ pub fn remove_units(study: &Study) -> Result<(), StoreError> {
     crate::store::units::remove_units(&study.path(UNITS_DIR))
 }
 
+/// Each zone's motion count as the config gives it, before the motions stage ran (the seeds'
+/// count or the record files'; the stage may keep fewer).
+pub fn motions_per_zone(study: &Study) -> Vec<usize> {
+    let per_zone = match study.cfg.motions.seeds.kind() {
+        Seeds::Stochastic(s) => s.count,
+        Seeds::Records(r) => r.files.len(),
+    };
+    vec![per_zone; study.cfg.zones.len()]
+}
+
 /// `(work units, units stored for the current sweep, record samples per motion)`; before the
 /// motions stage ran the motion counts come from the config and the samples are 0.
 pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError> {
     let grid = study.grid(StageId::Sweep)?;
     if study.state(StageId::Motions)? != super::StageState::UpToDate {
-        let per_zone = match study.cfg.motions.seeds.kind() {
-            Seeds::Stochastic(s) => s.count,
-            Seeds::Records(r) => r.files.len(),
-        };
-        return Ok((
-            per_zone * study.cfg.zones.len() * frames(study) * grid.periods_s.len(),
-            0,
-            0,
-        ));
+        let motions: usize = motions_per_zone(study).iter().sum();
+        return Ok((motions * frames(study) * grid.periods_s.len(), 0, 0));
     }
     let motions = super::files::motions(study)?;
     let units = Units {
