@@ -17,8 +17,8 @@
 
 use super::StoreError;
 use super::h5::{
-    Attr, GroupReader, attach_all, attr_str, coordinate, set_scale, write_attrs, write_stage_file,
-    write_strings, write_var,
+    Attr, GroupReader, attach_all, attr_str, coordinate, string_coordinate, write_attrs,
+    write_stage_file, write_var,
 };
 use super::sweep::{building_coordinates, read_building_coordinates};
 use crate::grid::BuildingAxes;
@@ -89,8 +89,7 @@ pub fn write_floors(
 fn write_zone(f: &hdf5::File, axes: &FloorsAxes, z: &ZoneFloors) -> hdf5::Result<()> {
     let g = f.create_group(&format!("zone_{}", z.name))?;
     attr_str(&g, "target", &z.target)?;
-    let motion = write_strings(&g, "motion", &z.motions, "ground motion (see motions.h5)")?;
-    set_scale(&motion, "motion")?;
+    let motion = string_coordinate(&g, "motion", &z.motions, "ground motion (see motions.h5)")?;
     let count = |n: usize| (1..=n).map(|i| i as f64).collect::<Vec<_>>();
     let cases = axes.case_period_s.len();
     let case = coordinate(

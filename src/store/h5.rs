@@ -119,6 +119,18 @@ pub fn write_strings(
     Ok(ds)
 }
 
+/// A 1-D coordinate of strings (names, labels), made a dimension scale named after itself.
+pub fn string_coordinate(
+    g: &hdf5::Group,
+    name: &str,
+    values: &[String],
+    long_name: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let ds = write_strings(g, name, values, long_name)?;
+    set_scale(&ds, name)?;
+    Ok(ds)
+}
+
 pub fn read_strings(g: &hdf5::Group, name: &str) -> hdf5::Result<Vec<String>> {
     Ok(g.dataset(name)?
         .read_raw::<VarLenUnicode>()?

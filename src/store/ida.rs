@@ -34,8 +34,8 @@
 
 use super::StoreError;
 use super::h5::{
-    Attr, GroupReader, attach_scale, attr_str, coordinate, set_scale, write_attrs, write_flags,
-    write_stage_file, write_strings, write_var,
+    Attr, GroupReader, attach_scale, attr_str, coordinate, string_coordinate, write_attrs,
+    write_flags, write_stage_file, write_strings, write_var,
 };
 use super::sweep::{building_coordinates, read_building_coordinates};
 use crate::grid::BuildingAxes;
@@ -140,17 +140,6 @@ pub fn write_ida(
             Ok(())
         },
     )
-}
-
-fn strings_scale(
-    g: &hdf5::Group,
-    name: &str,
-    v: &[String],
-    long: &str,
-) -> hdf5::Result<hdf5::Dataset> {
-    let ds = write_strings(g, name, v, long)?;
-    set_scale(&ds, name)?;
-    Ok(ds)
 }
 
 fn indices(n: usize) -> Vec<f64> {
@@ -271,13 +260,13 @@ fn put_flags(
 }
 
 fn write_coordinates(g: &hdf5::Group, axes: &IdaAxes, z: &ZoneIda) -> hdf5::Result<Coordinates> {
-    let system = strings_scale(
+    let system = string_coordinate(
         g,
         "system",
         &axes.systems,
         "stack: the sliding stack; rigid: the same load rigidly attached",
     )?;
-    let record = strings_scale(
+    let record = string_coordinate(
         g,
         "record",
         &z.records,
@@ -316,13 +305,13 @@ fn write_coordinates(g: &hdf5::Group, axes: &IdaAxes, z: &ZoneIda) -> hdf5::Resu
             "Sa(T_p, 5 %) of the scaled motion: the common intensity grid"
         },
     )?;
-    let demand = strings_scale(
+    let demand = string_coordinate(
         g,
         "demand",
         &axes.demands,
         "engineering demand (units in the name; ductility = u_m/u_y)",
     )?;
-    let limit = strings_scale(
+    let limit = string_coordinate(
         g,
         "limit_state",
         &axes.limit_states,

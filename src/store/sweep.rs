@@ -37,8 +37,8 @@
 
 use super::StoreError;
 use super::h5::{
-    Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, set_scale, write_attrs,
-    write_flags, write_stage_file, write_strings, write_var,
+    Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, string_coordinate,
+    write_attrs, write_flags, write_stage_file, write_var,
 };
 use crate::grid::{BuildingAxes, Grid, StackFloor};
 use ndarray::ArrayD;
@@ -321,13 +321,12 @@ pub fn building_coordinates(
     let storeys: Vec<f64> = axes.storeys.iter().map(|&n| n as f64).collect();
     let s = coordinate(g, "storeys", &storeys, "1", "storeys N of the building")?;
     let floors: Vec<String> = axes.stack_floor.iter().map(|f| f.to_string()).collect();
-    let f = write_strings(
+    let f = string_coordinate(
         g,
         "stack_floor",
         &floors,
         "floor carrying the stack (1 the lowest; roof: floor N; all: a stack on every floor)",
     )?;
-    set_scale(&f, "stack_floor")?;
     Ok(vec![s, f])
 }
 
@@ -389,13 +388,12 @@ fn write_zone(
     let g = f.create_group(&format!("zone_{}", z.name))?;
     attr_str(&g, "target", &z.target)?;
     let n = grid.blocks();
-    let m = write_strings(
+    let m = string_coordinate(
         &g,
         "motion",
         &z.motions,
         "ground motion (matched, see motions.h5)",
     )?;
-    set_scale(&m, "motion")?;
     let mut scales = vec![m];
     if let Some(b) = building {
         scales.extend(building_coordinates(&g, b)?);
