@@ -150,23 +150,11 @@ fn study(dir: &Path, extra: &str) -> PathBuf {
     cfg
 }
 
-/// Every file of a study's output directory (the lock file aside), by relative path.
+/// Every file below `dir` with its bytes, by its path relative to `dir`, in order.
 fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.file_name().unwrap() != ".slidestack.lock" {
-                let rel = p.strip_prefix(dir).unwrap().display().to_string();
-                out.push((rel, std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
+    (common::output_files(dir, &[]).into_iter())
+        .map(|(p, f)| (p.display().to_string(), f.bytes))
+        .collect()
 }
 
 fn assert_same_files(a: &Path, b: &Path) {

@@ -9,7 +9,6 @@ mod common;
 use common::{ok, slidestack};
 use slidestack::fit::{FitError, Form, Sample, cross_validate, fit};
 use slidestack::study::equations::{FOLDS, cases_needed};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 fn config(name: &str) -> PathBuf {
@@ -24,30 +23,6 @@ fn s(p: &Path) -> &str {
 
 fn stdout(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-/// Every file under `dir` but the lock and make's own `make/`, by relative path: its bytes and
-/// inode (a rewrite is a new inode: every file is written under a temporary name and renamed).
-fn files(dir: &Path) -> BTreeMap<PathBuf, (Vec<u8>, u64)> {
-    use std::os::unix::fs::MetadataExt;
-    let mut out = BTreeMap::new();
-    let mut todo = vec![dir.to_path_buf()];
-    while let Some(d) = todo.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            let rel = p.strip_prefix(dir).unwrap().to_path_buf();
-            if rel == Path::new("make") || rel == Path::new(".slidestack.lock") {
-                continue;
-            }
-            if p.is_dir() {
-                todo.push(p);
-            } else {
-                let ino = std::fs::metadata(&p).unwrap().ino();
-                out.insert(rel, (std::fs::read(&p).unwrap(), ino));
-            }
-        }
-    }
-    out
 }
 
 #[test]
@@ -213,19 +188,25 @@ fn make_runs_the_configured_stages_with_the_bytes_of_run() {
         stages.contains("STAGES := motions ida report\n"),
         "{stages}"
     );
+    let files = |d: &Path| common::output_files(d, &["make"]);
     let (a, b) = (files(&by_run), files(&by_make));
     assert_eq!(
         a.keys().collect::<Vec<_>>(),
         b.keys().collect::<Vec<_>>(),
         "the same files"
     );
-    for (path, (bytes, _)) in &a {
-        assert!(bytes == &b[path].0, "{} differs", path.display());
+    for (path, f) in &a {
+        assert!(f.bytes == b[path].bytes, "{} differs", path.display());
     }
     make();
     let again = files(&by_make);
-    for (path, (_, ino)) in &b {
-        assert_eq!(*ino, again[path].1, "{} was rewritten", path.display());
+    for (path, f) in &b {
+        assert_eq!(
+            f.inode,
+            again[path].inode,
+            "{} was rewritten",
+            path.display()
+        );
     }
 }
 

@@ -339,3 +339,34 @@ pub fn test_python() -> PathBuf {
     );
     python
 }
+
+/// A file of an output directory: its bytes and its inode (a rewrite makes a new one).
+pub struct Stored {
+    pub bytes: Vec<u8>,
+    pub inode: u64,
+}
+
+/// Every file below the output directory `dir` by its path relative to `dir`, leaving out the
+/// lock and the top-level entries named in `skip` (e.g. make's `make/`).
+pub fn output_files(dir: &Path, skip: &[&str]) -> std::collections::BTreeMap<PathBuf, Stored> {
+    use std::os::unix::fs::MetadataExt;
+    let mut out = std::collections::BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let rel = p.strip_prefix(dir).unwrap().to_path_buf();
+            if rel == Path::new(".slidestack.lock") || skip.iter().any(|s| rel == Path::new(s)) {
+                continue;
+            }
+            if p.is_dir() {
+                todo.push(p);
+            } else {
+                let inode = std::fs::metadata(&p).unwrap().ino();
+                let bytes = std::fs::read(&p).unwrap();
+                out.insert(rel, Stored { bytes, inode });
+            }
+        }
+    }
+    out
+}
