@@ -16,7 +16,8 @@ use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::floors::{FloorsAxes, FloorsMeta, ZoneFloors, read_zone_floors, write_floors};
 use crate::store::h5::Attr;
-use crate::study::building::{Frame, first_of_building};
+use crate::study::building::Frame;
+use crate::study::case_units::{CaseUnit, UnitPlan};
 use crate::study::config::StudyConfig;
 use crate::study::floors::{FloorUnit, FloorsConfig, FloorsError, floor_unit};
 use ndarray::{ArrayD, IxDyn};
@@ -113,21 +114,9 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let physics = study.physics();
     let frames = study.frames();
     let nf = frames.len();
-    let first = first_of_building(&frames.iter().flatten().cloned().collect::<Vec<_>>());
-    let first = |f: usize| first.get(f).copied().unwrap_or(f);
-    // (zone, motion, case, frame) in stored order; only a building's first frame is run.
-    let all: Vec<[usize; 4]> = (motions.iter().enumerate())
-        .flat_map(|(z, ms)| {
-            (0..ms.len()).flat_map(move |m| {
-                (0..cfg.cases.len()).flat_map(move |c| (0..nf).map(move |f| [z, m, c, f]))
-            })
-        })
-        .collect();
-    let units: Vec<[usize; 4]> = all
-        .iter()
-        .filter(|u| first(u[3]) == u[3])
-        .copied()
-        .collect();
+    let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
+    let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
+    let units = &plan.run;
     s.reporter.info(
         me,
         &format!(
@@ -146,16 +135,16 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let bar = s.reporter.progress(me, units.len() as u64);
     let outs: Vec<FloorUnit> = units
         .par_iter()
-        .map(|&[z, m, c, f]| -> Result<FloorUnit, PipelineError> {
+        .map(|&u| -> Result<FloorUnit, PipelineError> {
             s.check_cancelled(me)?;
-            let rec = &motions[z][m];
-            let frame = frames[f].as_ref();
+            let rec = &motions[u.zone][u.motion];
+            let frame = frames[u.frame].as_ref();
             let unit =
-                floor_unit(&physics, &cfg.cases[c], frame, rec, &spec).map_err(|source| {
+                floor_unit(&physics, &cfg.cases[u.case], frame, rec, &spec).map_err(|source| {
                     FloorsStageError::Unit {
-                        zone: study.cfg.zones[z].name.clone(),
+                        zone: study.cfg.zones[u.zone].name.clone(),
                         motion: rec.name.clone(),
-                        case: c,
+                        case: u.case,
                         frame: frame.map_or(String::new(), |f| format!(", {f}")),
                         source: Box::new(source),
                     }
@@ -165,12 +154,19 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
         })
         .collect::<Result<_, _>>()?;
     bar.finish();
-    let done: std::collections::BTreeMap<[usize; 4], &FloorUnit> =
+    let done: std::collections::BTreeMap<CaseUnit, &FloorUnit> =
         units.iter().copied().zip(&outs).collect();
     let mut zones = Vec::new();
     for (z, zc) in study.cfg.zones.iter().enumerate() {
         let ms = &motions[z];
-        let unit = |m: usize, c: usize, f: usize| done[&[z, m, c, first(f)]];
+        let unit = |motion: usize, case: usize, frame: usize| {
+            done[&plan.source(CaseUnit {
+                zone: z,
+                motion,
+                case,
+                frame,
+            })]
+        };
         zones.push(zone_floors(
             &axes,
             ms.len(),

@@ -26,11 +26,10 @@ use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaAxes, IdaMeta, ZoneIda, read_zone_ida, write_ida};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
+use crate::study::case_units::{CaseUnit, UnitPlan};
 use crate::study::config::StudyConfig;
 use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS};
-use crate::study::ida_zone::{
-    FRACTILES, IdaUnit, UnitPlan, UnitTraces, axes_of, trace_unit, zone_ida,
-};
+use crate::study::ida_zone::{FRACTILES, UnitTraces, axes_of, trace_unit, zone_ida};
 use crate::study::physics::Physics;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -105,7 +104,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     let nf = frames.len();
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
     let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
-    let traced = plan.traced.len();
+    let traced = plan.run.len();
     if let Some((k, n)) = shard
         && !(1 <= k && k <= n && n <= traced)
     {
@@ -116,7 +115,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
         }
         .into());
     }
-    let store = IdaUnits {
+    let store = CaseUnits {
         study,
         cfg,
         motions: &motions,
@@ -144,7 +143,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             cfg.tracing.max_runs()
         ),
     );
-    let mine: Vec<IdaUnit> = (plan.traced.iter().enumerate())
+    let mine: Vec<CaseUnit> = (plan.run.iter().enumerate())
         .filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1))
         .map(|(_, u)| *u)
         .collect();
@@ -219,7 +218,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
         return Ok(StageOutcome::ShardDone { k, n });
     }
     s.pass("ida.assemble", me)?;
-    let outs = plan.expand(&store.read_all(&plan.traced)?);
+    let outs = plan.expand(&store.read_all(&plan.run)?);
     let axes = axes_of(cfg, study.building());
     let mut zones = Vec::new();
     let mut at = 0;
@@ -274,25 +273,25 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize), PipelineError> {
     if study.state(StageId::Motions)? != super::StageState::UpToDate {
         let counts = super::sweep::motions_per_zone(study);
         let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
-        return Ok((plan.traced.len(), 0));
+        return Ok((plan.run.len(), 0));
     }
     let motions = super::files::motions(study)?;
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
     let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
     let done = if study.state(StageId::Ida)? == super::StageState::UpToDate {
-        plan.traced.len()
+        plan.run.len()
     } else {
-        let store = IdaUnits {
+        let store = CaseUnits {
             study,
             cfg,
             motions: &motions,
             fingerprint: study.fingerprint(StageId::Ida)?,
         };
-        (plan.traced.iter())
+        (plan.run.iter())
             .filter(|&&u| matches!(store.read(u), Ok(Some(_))))
             .count()
     };
-    Ok((plan.traced.len(), done))
+    Ok((plan.run.len(), done))
 }
 
 /// The directory of the IDA's unit files.
@@ -307,15 +306,15 @@ pub fn remove_units(study: &Study) -> Result<(), StoreError> {
 /// The IDA's unit files: a unit's traces as columns (the record's `Sa` first, then per system
 /// its runs' `Sa` and demands, `f64`; its runs' collapse and slip flags, `u8`), under an
 /// identity whose `period_index` and `period_s` are the `ida:` section's case and its `T_p`.
-struct IdaUnits<'a> {
+struct CaseUnits<'a> {
     study: &'a Study,
     cfg: &'a IdaConfig,
     motions: &'a [Vec<Record>],
     fingerprint: &'a str,
 }
 
-impl IdaUnits<'_> {
-    fn place(&self, u: IdaUnit) -> (PathBuf, UnitId) {
+impl CaseUnits<'_> {
+    fn place(&self, u: CaseUnit) -> (PathBuf, UnitId) {
         super::files::unit_place(
             self.study,
             (UNITS_DIR, self.fingerprint),
@@ -325,7 +324,7 @@ impl IdaUnits<'_> {
         )
     }
 
-    fn write(&self, u: IdaUnit, t: &UnitTraces) -> Result<(), StoreError> {
+    fn write(&self, u: CaseUnit, t: &UnitTraces) -> Result<(), StoreError> {
         let mut c = Columns {
             f64s: vec![vec![t.record_sa_g]],
             u8s: Vec::new(),
@@ -353,7 +352,7 @@ impl IdaUnits<'_> {
 
     /// The unit's traces, `None` when no file holds them for this IDA (missing, or made with
     /// other inputs); a file of the wrong shape is refused as damaged.
-    fn read(&self, u: IdaUnit) -> Result<Option<UnitTraces>, StoreError> {
+    fn read(&self, u: CaseUnit) -> Result<Option<UnitTraces>, StoreError> {
         let (path, id) = self.place(u);
         let c = match read_unit(&path, &id)? {
             Stored::Valid(c) => c,
@@ -408,7 +407,7 @@ impl IdaUnits<'_> {
 
     /// Every unit of `units`, in their order; an error naming the directory unless each is
     /// stored whole for this IDA.
-    fn read_all(&self, units: &[IdaUnit]) -> Result<Vec<UnitTraces>, PipelineError> {
+    fn read_all(&self, units: &[CaseUnit]) -> Result<Vec<UnitTraces>, PipelineError> {
         let mut bad = Vec::new();
         let mut read = Vec::with_capacity(units.len());
         for &u in units {

@@ -4,7 +4,7 @@
 //! lognormal fragility, as `ida.h5` stores them ([`crate::store::ida`]). The kernels are in
 //! [`crate::ida`]; the systems and one trace in [`super::ida`].
 
-use super::building::{BuildingSection, Frame, first_of_building};
+use super::building::{BuildingSection, Frame};
 use super::ida::{IdaConfig, SYSTEMS, padded, sa_g, trace_system};
 use super::physics::Physics;
 use super::storey_strength::storey_strength_ratios;
@@ -22,73 +22,6 @@ use rayon::prelude::*;
 
 /// The fractiles of the summary curves (Vamvatsikos & Cornell 2002, Section 6).
 pub const FRACTILES: [f64; 3] = [0.16, 0.5, 0.84];
-
-/// One work unit: a case of the `ida:` section under a motion of a zone, on one frame of a
-/// building study (0 on one storey), both systems; indices in stored order.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub struct IdaUnit {
-    pub zone: usize,
-    pub motion: usize,
-    pub case: usize,
-    pub frame: usize,
-}
-
-/// Every unit of a study's IDA in stored order (zone, motion, case, frame; the frame fastest),
-/// and the ones traced: a frame that is an earlier one's building traces as it does, to the bit,
-/// so only the first of them is traced and the others take its traces.
-pub struct UnitPlan {
-    pub all: Vec<IdaUnit>,
-    pub traced: Vec<IdaUnit>,
-    /// Per frame, the first frame of its building.
-    first: Vec<usize>,
-}
-
-impl UnitPlan {
-    /// The units of `motions[z]` motions in each zone, `cases` cases and `frames` (`[None]` on
-    /// one storey).
-    pub fn new(motions: &[usize], cases: usize, frames: &[Option<Frame>]) -> Self {
-        let building: Vec<Frame> = frames.iter().flatten().cloned().collect();
-        let first = first_of_building(&building);
-        let first: Vec<usize> = (0..frames.len())
-            .map(|f| first.get(f).copied().unwrap_or(f))
-            .collect();
-        let mut all = Vec::new();
-        for (zone, &n) in motions.iter().enumerate() {
-            for motion in 0..n {
-                for case in 0..cases {
-                    for frame in 0..frames.len() {
-                        all.push(IdaUnit {
-                            zone,
-                            motion,
-                            case,
-                            frame,
-                        });
-                    }
-                }
-            }
-        }
-        let traced = (all.iter())
-            .filter(|u| first[u.frame] == u.frame)
-            .copied()
-            .collect();
-        Self { all, traced, first }
-    }
-
-    /// Every unit's traces in stored order from the traced units' (`traces`, in
-    /// [`Self::traced`]' order).
-    pub fn expand(&self, traces: &[UnitTraces]) -> Vec<UnitTraces> {
-        let traced: std::collections::BTreeMap<_, _> = self.traced.iter().zip(traces).collect();
-        (self.all.iter())
-            .map(|&u| {
-                traced[&IdaUnit {
-                    frame: self.first[u.frame],
-                    ..u
-                }]
-                    .clone()
-            })
-            .collect()
-    }
-}
 
 /// One zone of `ida.h5` from its units' traces (`units`: record-major, then case, then frame):
 /// the strengths of its cases from its `target` and, in a building study (`building`), each

@@ -4,6 +4,8 @@
 //! * [`attached`]: attached fractions: `λ` of the base shear, of each storey's shear and of the
 //!   overturning moment, the code-format `λ`, a building's `T_new` (the roof's).
 //! * [`building`]: a study over buildings: the `building:` section, `grid.stack_floor`, a frame.
+//! * [`case_units`]: the work units of a stage over listed cases (the IDA, the floor spectra),
+//!   a repeated building's taken from its first frame.
 //! * [`cases`]: the paper's named cases (Section 7.1, Table 2, Section 9).
 //! * [`config`]: the study file (YAML), validated before any work.
 //! * [`floors`]: floor response spectra of listed cases on every frame (`floor_spectra:`),
@@ -23,6 +25,7 @@
 
 pub mod attached;
 pub mod building;
+pub mod case_units;
 pub mod cases;
 pub mod config;
 pub mod design;
