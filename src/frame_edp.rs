@@ -1,11 +1,11 @@
 //! `slidestack export edp --study`'s entry point: one case of a finished building study, its
 //! FEMA P-58 demands under each of its zone's motions, read from `sweep.h5` (checked, and made
 //! from that `motions.h5`) and written as pelicun's demand sample
-//! ([`crate::simulation::edp::write_sample`]); docs/building.md, "FEMA P-58 demands through
+//! ([`crate::one_case::edp::write_sample`]); docs/building.md, "FEMA P-58 demands through
 //! pelicun".
 
 use crate::grid::StackFloor;
-use crate::simulation::edp::{Demands, Stacks, check_sample_path, write_sample};
+use crate::one_case::edp::{Demands, Stacks, check_sample_path, write_sample};
 use crate::store::StoreError;
 use crate::store::h5::stored_fingerprint;
 use crate::store::motions::read_zone_motions;

@@ -11,7 +11,7 @@
 //! * [`grid`]: the study's case grid (axes and indexing).
 //! * [`ida`]: incremental dynamic analysis kernels: hunt & fill, fractiles, fragility fits.
 //! * [`study`]: the study's numerics and configuration.
-//! * [`simulation`]: one case under one ground motion (`slidestack simulate`).
+//! * [`one_case`]: one case under one ground motion (`slidestack simulate`).
 //! * [`match_files`]: record files matched to a target and written (`slidestack match`).
 //! * [`design`]: `T_new` of one structure from a finished study (the designer's query).
 //! * [`pipeline`]: the study's stages as library code: one shape, the output lock, checks.
@@ -58,10 +58,10 @@ pub mod limits;
 pub mod match_files;
 pub mod methods;
 mod numeric;
+pub mod one_case;
 pub mod pipeline;
 pub mod render;
 pub mod sdof;
-pub mod simulation;
 pub mod spectrum;
 pub mod store;
 pub mod study;

@@ -8,8 +8,8 @@ mod common;
 
 use common::{apply, expm};
 use slidestack::dynamics::{G, Unwatched};
-use slidestack::simulation::floor_spectra::{FloorSpectra, REFINEMENT, floor_spectra};
-use slidestack::simulation::{Outcome, Settings, Simulation};
+use slidestack::one_case::floor_spectra::{FloorSpectra, REFINEMENT, floor_spectra};
+use slidestack::one_case::{Outcome, Settings, Simulation};
 
 fn case(yaml: &str) -> Simulation {
     let s: Settings = serde_yaml::from_str(yaml).unwrap();

@@ -10,7 +10,7 @@
 mod common;
 
 use common::{ok, slidestack};
-use slidestack::simulation::{Outcome, Settings};
+use slidestack::one_case::{Outcome, Settings};
 use slidestack::store::floors::read_zone_floors;
 use slidestack::store::motions::read_zone_motions;
 use slidestack::study::floors::{asce7_16_height_factor, asce7_22_h_f};

@@ -321,7 +321,7 @@ fn a_bad_aspect_is_refused_naming_it() {
 /// it is above 0. The same config without `aspect` stores neither and shows no section.
 #[test]
 fn a_study_stores_which_cases_rock_the_report_counts_them_and_design_warns() {
-    use slidestack::simulation::{Outcome, Settings};
+    use slidestack::one_case::{Outcome, Settings};
     use slidestack::store::motions::read_zone_motions;
     use slidestack::store::sweep::read_zone_sweep;
     let dir = tempfile::tempdir().unwrap();

@@ -1,5 +1,5 @@
 //! `simulate_many`'s compiled half: many cases (each a dict of `simulate`'s keywords) under one
-//! or more records, run by [`slidestack::simulation::batch::Batch`] on the library's threads with
+//! or more records, run by [`slidestack::one_case::batch::Batch`] on the library's threads with
 //! the GIL released. The answer is `simulate`'s dicts, `[case][record]`, each parsed from the
 //! same JSON (so bit for bit `simulate`'s numbers); python/slidestack/_batch.py labels them.
 
@@ -11,8 +11,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use slidestack::ground_motion::{Record, builtin};
-use slidestack::simulation::Settings;
-use slidestack::simulation::batch::{Batch, BatchError};
+use slidestack::one_case::Settings;
+use slidestack::one_case::batch::{Batch, BatchError};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;

@@ -7,7 +7,7 @@ use anyhow::Result;
 use slidestack::frame_edp::{self, FrameQuery};
 use slidestack::grid::StackFloor;
 use slidestack::ground_motion::Units;
-use slidestack::simulation::edp::{self, Stacks};
+use slidestack::one_case::edp::{self, Stacks};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Subcommand)]

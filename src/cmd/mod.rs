@@ -156,8 +156,8 @@ pub fn message(e: &anyhow::Error, command: &clap::Command) -> String {
 /// Whether `cause` is a YAML file's parser error, whose backticked names are the file's keys.
 fn names_file_keys(cause: &(dyn std::error::Error + 'static)) -> bool {
     matches!(
-        cause.downcast_ref::<slidestack::simulation::SimulationError>(),
-        Some(slidestack::simulation::SimulationError::Yaml { .. })
+        cause.downcast_ref::<slidestack::one_case::SimulationError>(),
+        Some(slidestack::one_case::SimulationError::Yaml { .. })
     ) || matches!(
         cause.downcast_ref::<slidestack::study::config::ConfigError>(),
         Some(slidestack::study::config::ConfigError::Yaml { .. })

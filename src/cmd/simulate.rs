@@ -6,12 +6,12 @@
 //! count and energy terms as a table or, with `--json`, one JSON object on stdout. Writes the full
 //! time history when `--history OUT.h5|OUT.csv` is given. `--structure epp|bilinear` makes the
 //! structure yield (docs/model.md, "Yielding structure") and adds its ductility, residual
-//! displacement and hysteretic energy. The case and its checks: `slidestack::simulation`.
+//! displacement and hysteretic energy. The case and its checks: `slidestack::one_case`.
 
 use anyhow::Result;
-use slidestack::simulation::building::{BuildingSummary, history_layout};
-use slidestack::simulation::floor_spectra::FloorSpectra;
-use slidestack::simulation::{Model, Outcome, Settings, Summary};
+use slidestack::one_case::building::{BuildingSummary, history_layout};
+use slidestack::one_case::floor_spectra::FloorSpectra;
+use slidestack::one_case::{Model, Outcome, Settings, Summary};
 use slidestack::store::{HistoryLayout, write_history};
 use std::path::PathBuf;
 

@@ -12,8 +12,8 @@ use crate::dynamics::{
     simulate_exact_watched, simulate_rk4_watched,
 };
 use crate::limits::MAX_STOREYS;
+use crate::one_case::{Integrator, StructureKind};
 use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
-use crate::simulation::{Integrator, StructureKind};
 use crate::store::HistoryLayout;
 use crate::study::building::{DEFAULT_STOREY_HEIGHT_M, OneOrList, STOREY_HEIGHT_RANGE_M};
 use serde::{Deserialize, Serialize};
