@@ -39,7 +39,7 @@ use super::building::Frame;
 use super::physics::{CaseError, Physics, SystemKind};
 use crate::case::Case;
 use crate::dynamics::building::{
-    Building, BuildingResponse, LinearBuilding, LinearPeaks, simulate_building,
+    Building, BuildingResponse, LinearBuilding, LinearOutput, simulate_building,
 };
 use crate::dynamics::{ExactOptions, G, Ground};
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
@@ -101,12 +101,54 @@ pub struct Means {
 }
 
 /// One of the mean peaks of [`Means`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Quantity {
     Roof,
     /// Storey `i`'s shear, 0 the base.
     StoreyShear(usize),
     Overturning,
+}
+
+impl Quantity {
+    /// The quantities of a building of `storeys`, in [`Means`]' order.
+    pub fn all(storeys: usize) -> Vec<Quantity> {
+        let shears = (0..storeys).map(Quantity::StoreyShear);
+        (std::iter::once(Quantity::Roof).chain(shears))
+            .chain([Quantity::Overturning])
+            .collect()
+    }
+
+    /// The linear kernel's output whose peaks this quantity's mean is over, in a building of
+    /// `storeys`.
+    fn output(self, storeys: usize) -> LinearOutput {
+        match self {
+            Quantity::Roof => LinearOutput::FloorDisplacement(storeys - 1),
+            Quantity::StoreyShear(i) => LinearOutput::StoreyShear(i),
+            Quantity::Overturning => LinearOutput::OverturningMoment,
+        }
+    }
+
+    /// This quantity's peak in one motion's response.
+    fn peak_of(self, r: &BuildingResponse) -> f64 {
+        match self {
+            Quantity::Roof => r.floor_peak_displacement_m[r.floor_peak_displacement_m.len() - 1],
+            Quantity::StoreyShear(i) => r.storey_peak_shear_n[i],
+            Quantity::Overturning => r.peak_overturning_n_m,
+        }
+    }
+
+    /// The mean of `peaks` (one per motion, in order: summed, then divided) of this quantity
+    /// in `frame`: the roof's displacement (m) as it is, a storey's shear (N) over the bare
+    /// building's weight, the overturning moment (N·m) over that weight times the height.
+    fn mean(self, frame: &Frame, peaks: impl ExactSizeIterator<Item = f64>) -> f64 {
+        let m = peaks.len() as f64;
+        let sum: f64 = match self {
+            Quantity::Roof => peaks.sum(),
+            Quantity::StoreyShear(_) => peaks.map(|p| frame.base_shear_ratio(p)).sum(),
+            Quantity::Overturning => peaks.map(|p| frame.overturning_ratio(p)).sum(),
+        };
+        sum / m
+    }
 }
 
 impl Means {
@@ -118,49 +160,24 @@ impl Means {
         }
     }
 
-    /// The means of the responses (one per motion, in order) of `frame`.
-    fn of(responses: &[BuildingResponse], frame: &Frame) -> Self {
-        let peaks: Vec<Peaks> = (responses.iter())
-            .map(|r| {
-                let roof = &r.floor_peak_displacement_m[..];
-                (roof, &r.storey_peak_shear_n[..], r.peak_overturning_n_m)
-            })
-            .collect();
-        Self::of_peaks(&peaks, frame)
-    }
-
-    /// The means of the linear kernel's peaks (one per motion, in order) of `frame`.
-    fn of_linear(peaks: &[LinearPeaks], frame: &Frame) -> Self {
-        let peaks: Vec<Peaks> = (peaks.iter())
-            .map(|p| {
-                let roof = &p.floor_peak_displacement_m[..];
-                (
-                    roof,
-                    &p.storey_peak_shear_n[..],
-                    p.peak_overturning_moment_nm,
-                )
-            })
-            .collect();
-        Self::of_peaks(&peaks, frame)
-    }
-
-    fn of_peaks(peaks: &[Peaks], frame: &Frame) -> Self {
-        let m = peaks.len() as f64;
+    /// The means of `frame`'s quantities, in [`Quantity::all`]'s order.
+    fn of_values(frame: &Frame, values: &[f64]) -> Self {
         let n = frame.storeys();
-        let mean = |get: &dyn Fn(&Peaks) -> f64| peaks.iter().map(get).sum::<f64>() / m;
         Self {
-            roof_m: mean(&|p| p.0[n - 1]),
-            storey_shear: (0..n)
-                .map(|i| mean(&|p| frame.base_shear_ratio(p.1[i])))
-                .collect(),
-            overturning: mean(&|p| frame.overturning_ratio(p.2)),
+            roof_m: values[0],
+            storey_shear: values[1..=n].to_vec(),
+            overturning: values[n + 1],
         }
     }
-}
 
-/// One motion's peaks: each floor's displacement (m), each storey's shear (N), the overturning
-/// moment (N·m).
-type Peaks<'a> = (&'a [f64], &'a [f64], f64);
+    /// The means of the responses (one per motion, in order) of `frame`.
+    fn of(responses: &[BuildingResponse], frame: &Frame) -> Self {
+        let values: Vec<f64> = (Quantity::all(frame.storeys()).into_iter())
+            .map(|q| q.mean(frame, responses.iter().map(|r| q.peak_of(r))))
+            .collect();
+        Self::of_values(frame, &values)
+    }
+}
 
 /// The lowest fraction of the family for `case`: every loaded floor keeps at least half its
 /// mass, and at most the whole stack is removed.
@@ -211,6 +228,33 @@ pub fn family_means(
     fraction: f64,
     grounds: &[Ground],
 ) -> Result<Means, CaseError> {
+    let all = Quantity::all(frame.storeys());
+    let values = family_values(physics, case, frame, fraction, grounds, &all)?;
+    Ok(Means::of_values(frame, &values))
+}
+
+/// The mean of one quantity of `B(fraction)`: [`family_means`]' value of `q`, to the bit (each
+/// of the kernel's outputs is computed on its own), at the cost of one output.
+pub fn family_mean(
+    physics: &Physics,
+    case: &Case,
+    frame: &Frame,
+    fraction: f64,
+    grounds: &[Ground],
+    q: Quantity,
+) -> Result<f64, CaseError> {
+    Ok(family_values(physics, case, frame, fraction, grounds, &[q])?[0])
+}
+
+/// The means of `quantities` of `B(fraction)`, in their order.
+fn family_values(
+    physics: &Physics,
+    case: &Case,
+    frame: &Frame,
+    fraction: f64,
+    grounds: &[Ground],
+    quantities: &[Quantity],
+) -> Result<Vec<f64>, CaseError> {
     let in_building = |e| CaseError::InBuilding {
         frame: frame.to_string(),
         source: Box::new(e),
@@ -233,11 +277,16 @@ pub fn family_means(
         })
     };
     let kernel = LinearBuilding::new(&b).map_err(linear)?;
+    let n = frame.storeys();
+    let outputs: Vec<LinearOutput> = quantities.iter().map(|q| q.output(n)).collect();
+    let selection = kernel.select(&outputs);
     let peaks = (grounds.iter())
-        .map(|g| kernel.run(g))
+        .map(|g| kernel.peaks_of(&selection, g))
         .collect::<Result<Vec<_>, _>>()
         .map_err(linear)?;
-    Ok(Means::of_linear(&peaks, frame))
+    Ok((quantities.iter().enumerate())
+        .map(|(k, q)| q.mean(frame, peaks.iter().map(|p| p[k])))
+        .collect())
 }
 
 /// [`Means`] of system `kind` of `case` in `frame` and its stuck mass share's mean over the
@@ -499,31 +548,39 @@ impl<F: FnMut(f64) -> Result<f64, E>, E> CostFunction for &Crossing<'_, F, E> {
     }
 }
 
-/// [`family_means`] remembered by fraction, seeded with a scan: every quantity of a case is
-/// solved on one memo, so a fraction is simulated once.
+/// [`family_mean`]s remembered by fraction and quantity, seeded with a scan's [`Means`]: a
+/// fraction a case's searches share (its stuck mass share) is simulated once per quantity, and
+/// each search runs only its own quantity.
 pub struct Memo<'a> {
-    known: BTreeMap<u64, Means>,
-    compute: Box<dyn FnMut(f64) -> Result<Means, CaseError> + 'a>,
+    known: BTreeMap<(u64, Quantity), f64>,
+    compute: Box<dyn FnMut(f64, Quantity) -> Result<f64, CaseError> + 'a>,
 }
 
 impl<'a> Memo<'a> {
     pub fn new(
         scan: &[(f64, Means)],
-        compute: impl FnMut(f64) -> Result<Means, CaseError> + 'a,
+        compute: impl FnMut(f64, Quantity) -> Result<f64, CaseError> + 'a,
     ) -> Self {
+        let known = (scan.iter())
+            .flat_map(|(f, m)| {
+                let all = Quantity::all(m.storey_shear.len());
+                all.into_iter().map(move |q| ((f.to_bits(), q), m.get(q)))
+            })
+            .collect();
         Self {
-            known: scan.iter().map(|(f, m)| (f.to_bits(), m.clone())).collect(),
+            known,
             compute: Box::new(compute),
         }
     }
 
-    pub fn get(&mut self, fraction: f64) -> Result<&Means, CaseError> {
-        let key = fraction.to_bits();
-        if !self.known.contains_key(&key) {
-            let m = (self.compute)(fraction)?;
-            self.known.insert(key, m);
+    pub fn get(&mut self, fraction: f64, q: Quantity) -> Result<f64, CaseError> {
+        let key = (fraction.to_bits(), q);
+        if let Some(&v) = self.known.get(&key) {
+            return Ok(v);
         }
-        Ok(&self.known[&key])
+        let v = (self.compute)(fraction, q)?;
+        self.known.insert(key, v);
+        Ok(v)
     }
 }
 
@@ -794,12 +851,12 @@ pub fn zone_fractions(
                 None if holds_everywhere(physics, &case, frame, grounds)? => (rigid.clone(), 1.0),
                 None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
             };
-            let mut memo = Memo::new(scan, |f| family_means(physics, &case, frame, f, grounds));
+            let mut memo = Memo::new(scan, |f, q| {
+                family_mean(physics, &case, frame, f, grounds, q)
+            });
             let mut solve_for = |q: Quantity| -> Result<(f64, FractionFlag), CaseError> {
                 let points: Vec<(f64, f64)> = scan.iter().map(|(f, m)| (*f, m.get(q))).collect();
-                let (f, flag) = solve(stack.get(q), share, &points, |f| {
-                    memo.get(f).map(|m| m.get(q))
-                })?;
+                let (f, flag) = solve(stack.get(q), share, &points, |f| memo.get(f, q))?;
                 Ok((
                     f,
                     if slides[c] {

@@ -102,9 +102,28 @@ pub struct LinearBuilding {
     /// Every output: floor displacements, floor absolute accelerations, storey drifts, storey
     /// shears, the overturning moment (`4N + 1`).
     all: Outputs,
-    /// The base shear alone (storey 1's shear row of `all`).
-    base: Outputs,
 }
+
+/// One peak response of a linear building ([`LinearBuilding::select`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinearOutput {
+    /// Floor `j`'s displacement relative to the ground (0 the lowest floor), m.
+    FloorDisplacement(usize),
+    /// Floor `j`'s absolute acceleration, m/s².
+    FloorAbsAccel(usize),
+    /// Storey `i`'s drift (0 the ground storey), m.
+    StoreyDrift(usize),
+    /// Storey `i`'s shear (0 the base shear), N.
+    StoreyShear(usize),
+    /// The overturning moment at the base, N·m.
+    OverturningMoment,
+}
+
+/// Some of a linear building's outputs, prepared for [`LinearBuilding::peaks_of`]: each output's
+/// peak is the bits [`LinearBuilding::run`] gives for it (the same row, sums and searches), at
+/// the cost of the outputs chosen.
+#[derive(Debug, Clone)]
+pub struct Selection(Outputs);
 
 /// A table of outputs, each a linear function of the modal state.
 #[derive(Debug, Clone)]
@@ -270,15 +289,49 @@ impl LinearBuilding {
         for r in 0..m {
             rows[Self::moment(n) * m + r] = combine(&mu, &mv, r);
         }
-        let base_row = rows[Self::shear(n, 0) * m..(Self::shear(n, 0) + 1) * m].to_vec();
-        let (all, base) = (Outputs::new(&modes, rows), Outputs::new(&modes, base_row));
+        let all = Outputs::new(&modes, rows);
         Ok(Self {
             n,
             modes,
             heights_m: storey_heights_m.to_vec(),
             all,
-            base,
         })
+    }
+
+    /// The outputs `which`, in that order (an index beyond the storeys panics).
+    pub fn select(&self, which: &[LinearOutput]) -> Selection {
+        let (n, m) = (self.n, self.modes());
+        let rows = (which.iter())
+            .flat_map(|&o| {
+                let at = match o {
+                    LinearOutput::FloorDisplacement(j) => Self::disp(j),
+                    LinearOutput::FloorAbsAccel(j) => Self::accel(n, j),
+                    LinearOutput::StoreyDrift(i) => Self::drift(n, i),
+                    LinearOutput::StoreyShear(i) => Self::shear(n, i),
+                    LinearOutput::OverturningMoment => Self::moment(n),
+                };
+                let within = match o {
+                    LinearOutput::OverturningMoment => 0,
+                    LinearOutput::FloorDisplacement(j)
+                    | LinearOutput::FloorAbsAccel(j)
+                    | LinearOutput::StoreyDrift(j)
+                    | LinearOutput::StoreyShear(j) => j,
+                };
+                assert!(within < n, "{o:?} of a building of {n} storeys");
+                self.all.rows[at * m..(at + 1) * m].iter().copied()
+            })
+            .collect();
+        Selection(Outputs::new(&self.modes, rows))
+    }
+
+    /// The peak `|f|` over `ground` of every output of `selection` (from
+    /// [`Self::select`] of this building), in its order.
+    pub fn peaks_of(
+        &self,
+        selection: &Selection,
+        ground: &Ground,
+    ) -> Result<Vec<f64>, LinearBuildingError> {
+        self.peaks(&selection.0, ground)
     }
 
     fn disp(j: usize) -> usize {
@@ -448,9 +501,10 @@ impl LinearBuilding {
 
     /// The peak `|V|` of the base shear over `ground`, N: [`Self::run`]'s
     /// [`LinearPeaks::peak_base_shear_n`] to the bit (the same row, sums and searches), at the
-    /// cost of one output instead of `4N + 1` (what a `λ` evaluation needs).
+    /// cost of one output instead of `4N + 1`.
     pub fn peak_base_shear_n(&self, ground: &Ground) -> Result<f64, LinearBuildingError> {
-        Ok(self.peaks(&self.base, ground)?[0])
+        let base = self.select(&[LinearOutput::StoreyShear(0)]);
+        Ok(self.peaks_of(&base, ground)?[0])
     }
 
     /// The peak `|f|` of every output of `out` over `ground` (module doc).

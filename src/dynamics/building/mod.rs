@@ -17,7 +17,7 @@ pub mod response;
 pub mod rk4;
 
 pub use exact::{simulate_building, simulate_building_watched};
-pub use linear::{LinearBuilding, LinearBuildingError, LinearPeaks};
+pub use linear::{LinearBuilding, LinearBuildingError, LinearOutput, LinearPeaks, Selection};
 pub use modal::ModalError;
 pub use model::{Building, BuildingError, BuildingSpec, DampingBasis, StackSpec, StoreyYielding};
 pub use response::BuildingResponse;
