@@ -172,6 +172,53 @@ fn a_selection_gives_the_full_runs_bits() {
     }
 }
 
+/// Records run side by side (`peaks_of_records`: four at a time in SIMD lanes, those of one
+/// sample interval together) give each record's peaks to the bit of its own run: seven records
+/// of one interval (a full batch and one a lane short, of lengths that end mid-block), one
+/// shorter than a block at another interval, the real records at theirs; one output and
+/// several, 1 and 6 storeys.
+#[test]
+fn records_side_by_side_give_each_records_bits() {
+    let wave = |n: usize, w: f64| -> Vec<f64> {
+        (0..n)
+            .map(|k| 3.0 * (k as f64 * w).sin() * (-(k as f64) / 900.0).exp())
+            .collect()
+    };
+    let accels: Vec<(f64, Vec<f64>)> = [1500, 1537, 999, 1203, 777, 640, 1100]
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| (0.01, wave(n, 0.07 + 0.01 * i as f64)))
+        .chain([(0.02, wave(20, 0.3))])
+        .chain(real_records().iter().map(|r| (r.dt_s, r.accel_mps2(1.0))))
+        .collect();
+    let grounds: Vec<Ground> = accels.iter().map(|(dt, a)| Ground::new(*dt, a)).collect();
+    for n in [1, 6] {
+        let b = Building::new(&loaded(n, DampingBasis::Rigid))
+            .unwrap()
+            .with_stacks_attached_fraction(0.3);
+        let lin = LinearBuilding::new(&b).unwrap();
+        let one = [LinearOutput::StoreyShear(0)];
+        let several = [
+            LinearOutput::FloorDisplacement(n - 1),
+            LinearOutput::OverturningMoment,
+            LinearOutput::FloorAbsAccel(0),
+        ];
+        for which in [&one[..], &several[..]] {
+            let selection = lin.select(which);
+            let together = lin.peaks_of_records(&selection, &grounds).unwrap();
+            for (i, g) in grounds.iter().enumerate() {
+                let alone = lin.peaks_of(&selection, g).unwrap();
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    bits(&together[i]),
+                    bits(&alone),
+                    "{n} storeys, record {i}, {which:?}"
+                );
+            }
+        }
+    }
+}
+
 /// The linear ODE `M·ü + C·u̇ + K·u = −M·1·a_g` stepped by classical RK4 with `substeps` per
 /// sample (`a_g` linear between samples, evaluated at each stage), and the peaks over the
 /// sub-steps of the storey shears and the overturning moment computed as Newton's sums of the

@@ -280,10 +280,7 @@ fn family_values(
     let n = frame.storeys();
     let outputs: Vec<LinearOutput> = quantities.iter().map(|q| q.output(n)).collect();
     let selection = kernel.select(&outputs);
-    let peaks = (grounds.iter())
-        .map(|g| kernel.peaks_of(&selection, g))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(linear)?;
+    let peaks = (kernel.peaks_of_records(&selection, grounds)).map_err(linear)?;
     Ok((quantities.iter().enumerate())
         .map(|(k, q)| q.mean(frame, peaks.iter().map(|p| p[k])))
         .collect())

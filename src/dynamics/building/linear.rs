@@ -190,6 +190,38 @@ impl Outputs {
         }
     }
 
+    /// [`Self::eval_all`] in every lane of `y` (`2·modes` components of `L` lanes): each lane's
+    /// sums in the same order, the same bits.
+    #[inline(always)]
+    fn lane_eval_all<const L: usize>(&self, y: &[[f64; L]], f: &mut [[[f64; LANE]; L]]) {
+        for (out, group) in f.iter_mut().zip(self.cols.chunks_exact(y.len())) {
+            let mut acc = [[0.0; LANE]; L];
+            for (col, s) in group.iter().zip(y) {
+                for l in 0..L {
+                    for i in 0..LANE {
+                        acc[l][i] += col[i] * s[l];
+                    }
+                }
+            }
+            *out = acc;
+        }
+    }
+
+    /// [`Self::lane_eval_all`] of a table of one output: its value in `f[0][l][0]`, the rest
+    /// of `f` left as it is (zero, as the other's padding), at `1/LANE` of the work.
+    #[inline(always)]
+    fn lane_eval_one<const L: usize>(&self, y: &[[f64; L]], f: &mut [[[f64; LANE]; L]]) {
+        let mut acc = [0.0; L];
+        for (w, s) in self.wrows.iter().zip(y) {
+            for l in 0..L {
+                acc[l] += w * s[l];
+            }
+        }
+        for l in 0..L {
+            f[0][l][0] = acc[l];
+        }
+    }
+
     /// Output `o` at modal state `y`: the same sum as [`Self::eval_all`]'s, the same bits.
     fn eval_one(&self, o: usize, y: &[f64]) -> f64 {
         let row = &self.wrows[o * y.len()..(o + 1) * y.len()];
@@ -209,6 +241,52 @@ struct FirstPass {
     block_q: Vec<f64>,
     best: Vec<[f64; LANE]>,
 }
+
+impl FirstPass {
+    /// Room for `intervals` sample intervals of `out` in `modes` modes.
+    fn new(out: &Outputs, modes: usize, intervals: usize) -> Self {
+        let (groups, blocks) = (out.count.div_ceil(LANE), intervals.div_ceil(BLOCK));
+        Self {
+            starts: vec![0.0; blocks * 2 * modes],
+            block_max: vec![[0.0; LANE]; blocks * groups],
+            block_q: vec![0.0; blocks * modes],
+            best: vec![[0.0; LANE]; groups],
+        }
+    }
+}
+
+/// The first pass's state between blocks: the modal state and each output's `|f|` at the
+/// latest sample (a block's maxima start from its first sample's).
+struct Carry {
+    y: Vec<f64>,
+    f_abs: Vec<[f64; LANE]>,
+}
+
+impl Carry {
+    /// At rest.
+    fn new(out: &Outputs, modes: usize) -> Self {
+        Self {
+            y: vec![0.0; 2 * modes],
+            f_abs: vec![[0.0; LANE]; out.count.div_ceil(LANE)],
+        }
+    }
+}
+
+/// Whether the processor runs the first pass's AVX2 copies.
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Records whose first passes run side by side, one per lane of four `f64` (one AVX2
+/// register).
+const MOTIONS: usize = 4;
 
 /// One mode's coefficients over a sample interval of `h`.
 #[derive(Debug, Clone, Copy)]
@@ -334,6 +412,16 @@ impl LinearBuilding {
         self.peaks(&selection.0, ground)
     }
 
+    /// [`Self::peaks_of`] of each of `grounds`, in their order, to the bit; records of one
+    /// sample interval run side by side, four at a time.
+    pub fn peaks_of_records(
+        &self,
+        selection: &Selection,
+        grounds: &[Ground],
+    ) -> Result<Vec<Vec<f64>>, LinearBuildingError> {
+        self.peaks_of_records_in(&selection.0, grounds)
+    }
+
     fn disp(j: usize) -> usize {
         j
     }
@@ -413,54 +501,119 @@ impl LinearBuilding {
     /// time where the processor has it) and for the baseline. Neither contracts a multiply and
     /// an add, so both give the same bits.
     fn first_pass(out: &Outputs, steps: &[ModeStep], accel: &[f64], inv_h: f64) -> FirstPass {
+        let mut pass = FirstPass::new(out, steps.len(), accel.len() - 1);
+        let mut carry = Carry::new(out, steps.len());
         #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the processor has AVX2 (checked just above).
-                return unsafe { Self::first_pass_avx2(out, steps, accel, inv_h) };
+        if has_avx2() {
+            // SAFETY: the processor has AVX2 (`has_avx2`).
+            unsafe { Self::blocks_avx2(out, steps, accel, inv_h, &mut pass, &mut carry, 0) };
+            return pass;
+        }
+        Self::blocks(out, steps, accel, inv_h, &mut pass, &mut carry, 0);
+        pass
+    }
+
+    /// The first pass over the samples of up to [`MOTIONS`] records of one sample interval side
+    /// by side, one per SIMD lane, over the blocks they all fill; each then finishes alone.
+    /// Every lane does the scalar pass's operations in its order: the same bits as
+    /// [`Self::first_pass`] of each record.
+    fn first_passes(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]],
+        inv_h: f64,
+    ) -> Vec<FirstPass> {
+        let m = steps.len();
+        let avx2 = has_avx2();
+        // Fewer records than lanes: the first fills the rest, its copies' passes dropped.
+        let lanes: [&[f64]; MOTIONS] =
+            std::array::from_fn(|l| *accels.get(l).unwrap_or(&accels[0]));
+        let mut passes: Vec<FirstPass> = (lanes.iter())
+            .map(|a| FirstPass::new(out, m, a.len() - 1))
+            .collect();
+        let mut carries: Vec<Carry> = lanes.iter().map(|_| Carry::new(out, m)).collect();
+        let common = accels
+            .iter()
+            .map(|a| (a.len() - 1) / BLOCK)
+            .min()
+            .unwrap_or(0);
+        let from = if accels.len() > 1 { common } else { 0 };
+        if from > 0 {
+            #[cfg(target_arch = "x86_64")]
+            if avx2 {
+                // SAFETY: the processor has AVX2 (`has_avx2`).
+                unsafe {
+                    Self::lane_blocks_avx2(
+                        out,
+                        steps,
+                        &lanes,
+                        inv_h,
+                        &mut passes,
+                        &mut carries,
+                        from,
+                    )
+                };
+            }
+            if !avx2 {
+                Self::lane_blocks(out, steps, &lanes, inv_h, &mut passes, &mut carries, from);
             }
         }
-        Self::first_pass_generic(out, steps, accel, inv_h)
+        passes.truncate(accels.len());
+        for ((pass, carry), accel) in passes.iter_mut().zip(&mut carries).zip(accels) {
+            #[cfg(target_arch = "x86_64")]
+            if avx2 {
+                // SAFETY: the processor has AVX2 (`has_avx2`).
+                unsafe { Self::blocks_avx2(out, steps, accel, inv_h, pass, carry, from) };
+                continue;
+            }
+            Self::blocks(out, steps, accel, inv_h, pass, carry, from);
+        }
+        passes
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn first_pass_avx2(
+    unsafe fn blocks_avx2(
         out: &Outputs,
         steps: &[ModeStep],
         accel: &[f64],
         inv_h: f64,
-    ) -> FirstPass {
-        Self::first_pass_generic(out, steps, accel, inv_h)
+        pass: &mut FirstPass,
+        carry: &mut Carry,
+        from: usize,
+    ) {
+        Self::blocks(out, steps, accel, inv_h, pass, carry, from)
     }
 
+    /// The first pass's blocks from `from` to the record's end, from the state `carry` holds
+    /// at block `from`'s start.
     #[inline(always)]
-    fn first_pass_generic(
+    fn blocks(
         out: &Outputs,
         steps: &[ModeStep],
         accel: &[f64],
         inv_h: f64,
-    ) -> FirstPass {
+        pass: &mut FirstPass,
+        carry: &mut Carry,
+        from: usize,
+    ) {
         let m = steps.len();
         let groups = out.count.div_ceil(LANE);
         let intervals = accel.len() - 1;
-        let blocks = intervals.div_ceil(BLOCK);
-        let mut starts = vec![0.0; blocks * 2 * m];
-        let mut block_max = vec![[0.0; LANE]; blocks * groups];
-        let mut block_q = vec![0.0; blocks * m];
-        let mut best = vec![[0.0; LANE]; groups];
-        let mut y = vec![0.0; 2 * m];
+        let Carry { y, f_abs } = carry;
         let mut f = vec![[0.0; LANE]; groups];
-        // |f| at the latest sample: the block's maxima start from its first sample's.
-        let mut f_abs = vec![[0.0; LANE]; groups];
-        for b in 0..blocks {
-            starts[b * 2 * m..(b + 1) * 2 * m].copy_from_slice(&y);
-            let bm = &mut block_max[b * groups..(b + 1) * groups];
-            bm.copy_from_slice(&f_abs);
-            let bq = &mut block_q[b * m..(b + 1) * m];
+        for b in from..intervals.div_ceil(BLOCK) {
+            pass.starts[b * 2 * m..(b + 1) * 2 * m].copy_from_slice(y);
+            let bm = &mut pass.block_max[b * groups..(b + 1) * groups];
+            bm.copy_from_slice(f_abs);
+            let bq = &mut pass.block_q[b * m..(b + 1) * m];
             for k in b * BLOCK..((b + 1) * BLOCK).min(intervals) {
-                Self::step(steps, &mut y, bq, accel[k], accel[k + 1], inv_h);
-                out.eval_all(&y, &mut f);
+                Self::step(steps, y, bq, accel[k], accel[k + 1], inv_h);
+                if out.count == 1 {
+                    f[0][0] = out.eval_one(0, y);
+                } else {
+                    out.eval_all(y, &mut f);
+                }
                 for ((bm, fa), fo) in bm.iter_mut().zip(f_abs.iter_mut()).zip(&f) {
                     for i in 0..LANE {
                         let a = fo[i].abs();
@@ -470,17 +623,137 @@ impl LinearBuilding {
                     }
                 }
             }
-            for (best, bm) in best.iter_mut().zip(bm.iter()) {
+            for (best, bm) in pass.best.iter_mut().zip(bm.iter()) {
                 for i in 0..LANE {
                     best[i] = if bm[i] > best[i] { bm[i] } else { best[i] };
                 }
             }
         }
-        FirstPass {
-            starts,
-            block_max,
-            block_q,
-            best,
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn lane_blocks_avx2(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]; MOTIONS],
+        inv_h: f64,
+        passes: &mut [FirstPass],
+        carries: &mut [Carry],
+        blocks: usize,
+    ) {
+        Self::lane_blocks(out, steps, accels, inv_h, passes, carries, blocks)
+    }
+
+    /// [`Self::blocks`] over the first `blocks` blocks of [`MOTIONS`] records at once, one per
+    /// lane (each lane the scalar operations in their order), leaving each record's state in
+    /// its `carries`.
+    #[inline(always)]
+    fn lane_blocks(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]; MOTIONS],
+        inv_h: f64,
+        passes: &mut [FirstPass],
+        carries: &mut [Carry],
+        blocks: usize,
+    ) {
+        const L: usize = MOTIONS;
+        let m = steps.len();
+        let groups = out.count.div_ceil(LANE);
+        let mut y = vec![[0.0; L]; 2 * m];
+        let mut q = vec![[0.0; L]; m];
+        let mut f = vec![[[0.0; LANE]; L]; groups];
+        let mut f_abs = vec![[[0.0; LANE]; L]; groups];
+        let mut bm = vec![[[0.0; LANE]; L]; groups];
+        for b in 0..blocks {
+            for (l, pass) in passes.iter_mut().enumerate() {
+                for (c, y) in y.iter().enumerate() {
+                    pass.starts[b * 2 * m + c] = y[l];
+                }
+            }
+            bm.copy_from_slice(&f_abs);
+            for q in q.iter_mut() {
+                *q = [0.0; L];
+            }
+            for k in b * BLOCK..(b + 1) * BLOCK {
+                let a0: [f64; L] = std::array::from_fn(|l| accels[l][k]);
+                let a1: [f64; L] = std::array::from_fn(|l| accels[l][k + 1]);
+                Self::lane_step(steps, &mut y, &mut q, a0, a1, inv_h);
+                if out.count == 1 {
+                    out.lane_eval_one(&y, &mut f);
+                } else {
+                    out.lane_eval_all(&y, &mut f);
+                }
+                for ((bm, fa), fo) in bm.iter_mut().zip(f_abs.iter_mut()).zip(&f) {
+                    for l in 0..L {
+                        for i in 0..LANE {
+                            let a = fo[l][i].abs();
+                            fa[l][i] = a;
+                            bm[l][i] = if a > bm[l][i] { a } else { bm[l][i] };
+                        }
+                    }
+                }
+            }
+            for (l, pass) in passes.iter_mut().enumerate() {
+                for (r, q) in q.iter().enumerate() {
+                    pass.block_q[b * m + r] = q[l];
+                }
+                for (g, bm) in bm.iter().enumerate() {
+                    pass.block_max[b * groups + g] = bm[l];
+                    let best = &mut pass.best[g];
+                    for i in 0..LANE {
+                        best[i] = if bm[l][i] > best[i] {
+                            bm[l][i]
+                        } else {
+                            best[i]
+                        };
+                    }
+                }
+            }
+        }
+        for (l, carry) in carries.iter_mut().enumerate() {
+            for (c, y) in y.iter().enumerate() {
+                carry.y[c] = y[l];
+            }
+            for (g, fa) in f_abs.iter().enumerate() {
+                carry.f_abs[g] = fa[l];
+            }
+        }
+    }
+
+    /// [`Self::step`] in every lane.
+    #[inline(always)]
+    fn lane_step<const L: usize>(
+        steps: &[ModeStep],
+        y: &mut [[f64; L]],
+        q_max: &mut [[f64; L]],
+        a0: [f64; L],
+        a1: [f64; L],
+        inv_h: f64,
+    ) {
+        let m = steps.len();
+        let (re, im) = y.split_at_mut(m);
+        let slope: [f64; L] = std::array::from_fn(|l| (a1[l] - a0[l]) * inv_h);
+        for (((s, yr), yi), q_max) in steps.iter().zip(re).zip(im).zip(q_max) {
+            let (y0r, y0i) = (*yr, *yi);
+            let qr: [f64; L] = std::array::from_fn(|l| {
+                s.l2.0 * y0r[l] - s.l2.1 * y0i[l] + s.lg.0 * a0[l] + s.ng.0 * slope[l]
+            });
+            let qi: [f64; L] = std::array::from_fn(|l| {
+                s.l2.0 * y0i[l] + s.l2.1 * y0r[l] + s.lg.1 * a0[l] + s.ng.1 * slope[l]
+            });
+            let qa: [f64; L] = std::array::from_fn(|l| qr[l].abs() + qi[l].abs());
+            // `f64::max` rather than a select, which the compiler makes a masked store (a
+            // store-forwarding stall on the next sample): the same value, `qa` never NaN-free
+            // below a NaN `q_max` (both start at 0 and `qa ≥ 0`).
+            *q_max = std::array::from_fn(|l| q_max[l].max(qa[l]));
+            *yr = std::array::from_fn(|l| {
+                s.e.0 * y0r[l] - s.e.1 * y0i[l] + s.fa0.0 * a0[l] + s.fa1.0 * a1[l]
+            });
+            *yi = std::array::from_fn(|l| {
+                s.e.0 * y0i[l] + s.e.1 * y0r[l] + s.fa0.1 * a0[l] + s.fa1.1 * a1[l]
+            });
         }
     }
 
@@ -510,10 +783,55 @@ impl LinearBuilding {
     /// The peak `|f|` of every output of `out` over `ground` (module doc).
     fn peaks(&self, out: &Outputs, ground: &Ground) -> Result<Vec<f64>, LinearBuildingError> {
         ground.validate()?;
+        let steps = self.mode_steps(ground.dt_s);
+        let first = Self::first_pass(out, &steps, ground.accel_mps2, 1.0 / ground.dt_s);
+        self.second_pass(out, &steps, ground, first)
+    }
+
+    /// [`Self::peaks`] of each of `grounds`, in their order: the records of one sample interval
+    /// run their first passes [`MOTIONS`] at a time ([`Self::first_passes`]), the same bits.
+    fn peaks_of_records_in(
+        &self,
+        out: &Outputs,
+        grounds: &[Ground],
+    ) -> Result<Vec<Vec<f64>>, LinearBuildingError> {
+        for g in grounds {
+            g.validate()?;
+        }
+        let mut by_step: Vec<(u64, Vec<usize>)> = Vec::new();
+        for (i, g) in grounds.iter().enumerate() {
+            let key = g.dt_s.to_bits();
+            match by_step.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, v)) => v.push(i),
+                None => by_step.push((key, vec![i])),
+            }
+        }
+        let mut peaks = vec![Vec::new(); grounds.len()];
+        for (_, records) in by_step {
+            let h = grounds[records[0]].dt_s;
+            let steps = self.mode_steps(h);
+            for batch in records.chunks(MOTIONS) {
+                let accels: Vec<&[f64]> = batch.iter().map(|&i| grounds[i].accel_mps2).collect();
+                let firsts = Self::first_passes(out, &steps, &accels, 1.0 / h);
+                for (&i, first) in batch.iter().zip(firsts) {
+                    peaks[i] = self.second_pass(out, &steps, &grounds[i], first)?;
+                }
+            }
+        }
+        Ok(peaks)
+    }
+
+    /// The peaks from a record's first pass `first` (module doc: the second pass).
+    fn second_pass(
+        &self,
+        out: &Outputs,
+        steps: &[ModeStep],
+        ground: &Ground,
+        first: FirstPass,
+    ) -> Result<Vec<f64>, LinearBuildingError> {
         let accel = ground.accel_mps2;
         let h = ground.dt_s;
         let inv_h = 1.0 / h;
-        let steps = self.mode_steps(h);
         let (m, outputs) = (self.modes(), out.count);
         // Curvature rows: h²/8 · w_r·|c_r| · max(1, e^{Re λ·h}), with the slack.
         let growth: Vec<f64> = (self.modes.lambda.iter())
@@ -530,7 +848,7 @@ impl LinearBuilding {
             block_max,
             block_q,
             best,
-        } = Self::first_pass(out, &steps, accel, inv_h);
+        } = first;
         let mut best: Vec<f64> = best.as_flattened()[..outputs].to_vec();
         if !best.iter().all(|x| x.is_finite()) {
             return Err(LinearBuildingError::NotFinite);
@@ -570,7 +888,7 @@ impl LinearBuilding {
                 let (a0, a1) = (accel[k], accel[k + 1]);
                 q.fill(0.0);
                 y1.copy_from_slice(&y);
-                Self::step(&steps, &mut y1, &mut q, a0, a1, inv_h);
+                Self::step(steps, &mut y1, &mut q, a0, a1, inv_h);
                 f1.clear();
                 f1.extend(candidates.iter().map(|&o| out.eval_one(o, &y1)));
                 let mut built = false;
