@@ -8,6 +8,8 @@
 #      unit of the sweep is there, merges them and runs the later stages the config configures
 #      (tnew, fit, ida with an `ida:` section: it traces what an IDA task left out and assembles
 #      ida.h5, floors with a `floor_spectra:` section, report).
+# A config without a grid but with an `ida:` section (configs/ida-quick.yaml) gets the motions job,
+# the IDA array (N defaults to its work units, one per task) and the finishing job.
 # Each part is left out when its file is already up to date (`slidestack status`), so submitting
 # a finished study submits nothing. Run with --help for the options; pipelines/README.md has the
 # walk-through.
@@ -169,8 +171,13 @@ while IFS= read -r line; do
 done <<<"$status"
 [ -n "$STAGES" ] || die "slidestack status gave no STAGES line: $SLIDESTACK is older than these
 scripts; build the current sources (see pipelines/README.md, \"Building\")"
-[ -n "$SWEEP" ] || die "$CONFIG has no grid, so there is no sweep to run on a cluster; its stages
-($STAGES) run on one machine: $SLIDESTACK run $CONFIG --out $OUT"
+# Without a grid the IDA is the only array; without either there is nothing to spread.
+HAS_SWEEP=1
+[ -n "$SWEEP" ] || HAS_SWEEP=0
+if [ $HAS_SWEEP = 0 ] && [[ ,$STAGES, != *,ida,* ]]; then
+  die "$CONFIG has neither a grid nor an ida: section, so there is nothing to run as an array; its
+stages ($STAGES) run on one machine: $SLIDESTACK run $CONFIG --out $OUT"
+fi
 IFS=, read -ra stages <<<"$STAGES"
 all_done=1 states=""
 for stage in "${stages[@]}"; do
@@ -183,9 +190,11 @@ for v in SWEEP_UNITS SWEEP_UNITS_DONE SWEEP_CASES_PER_UNIT SWEEP_SAMPLES_PER_MOT
   IDA_UNITS IDA_UNITS_DONE; do
   is_uint "${!v}" || die "slidestack status gave $v='${!v}'"
 done
-ida_units=""
-[ "$IDA_UNITS" = 0 ] || ida_units=", $IDA_UNITS_DONE of $IDA_UNITS ida units"
-note "status: $states ($SWEEP_UNITS_DONE of $SWEEP_UNITS sweep units$ida_units stored)"
+units=()
+[ $HAS_SWEEP = 0 ] || units+=("$SWEEP_UNITS_DONE of $SWEEP_UNITS sweep units")
+[ "$IDA_UNITS" = 0 ] || units+=("$IDA_UNITS_DONE of $IDA_UNITS ida units")
+stored=$(IFS=,; echo "${units[*]}")
+note "status: $states (${stored//,/, } stored)"
 if [ $FORCE = 0 ] && [ $all_done = 1 ]; then
   note "the study in $OUT is up to date: nothing to submit ($OUT/report/index.html; --force recomputes it)"
   exit 0
@@ -193,11 +202,11 @@ fi
 # What is submitted: the motions job when motions.h5 is not up to date, the sweep array when
 # sweep.h5 is not, the finishing job always. --force submits all three (without the motions job
 # when only some shards are resubmitted with --array) and passes --force to every stage.
-NEED_MOTIONS=1 NEED_SWEEP=1
+NEED_MOTIONS=1 NEED_SWEEP=$HAS_SWEEP
 [ "$MOTIONS" != up_to_date ] || NEED_MOTIONS=0
 [ "$SWEEP" != up_to_date ] || NEED_SWEEP=0
 if [ $FORCE = 1 ]; then
-  NEED_SWEEP=1
+  NEED_SWEEP=$HAS_SWEEP
   if [ -z "$ARRAY" ]; then NEED_MOTIONS=1; fi
 fi
 # The IDA array (a config with an `ida:` section whose ida.h5 is not up to date, or --force), not
@@ -262,6 +271,10 @@ if [ -n "$ARRAY" ] && [ -z "$SHARDS" ]; then
   is_uint "$SHARDS" || die "cannot read SHARDS from $LAST: give --shards N"
   note "--array: N = $SHARDS, from the last submission ($LAST)"
 fi
+if [ -n "$ARRAY" ] && [ $HAS_SWEEP = 0 ]; then
+  die "--array resubmits sweep shards, and $CONFIG has no grid: submit again without it (the IDA's
+units already stored are not traced again)"
+fi
 if [ -n "$ARRAY" ] && [ $NEED_MOTIONS = 1 ]; then
   die "motions.h5 is $MOTIONS, so every shard must run again: submit without --array"
 fi
@@ -284,7 +297,17 @@ else
   SAMPLES_PER_UNIT=$((3 * SWEEP_CASES_PER_UNIT * ASSUMED_SAMPLES_PER_MOTION))
   samples_from="$ASSUMED_SAMPLES_PER_MOTION samples per motion assumed, as motions.h5 is $MOTIONS"
 fi
-if [ "$SAMPLES_PER_UNIT" -gt 0 ] && [ "$SWEEP_UNITS" -gt 0 ]; then
+if [ $HAS_SWEEP = 0 ]; then
+  # No measured cost of an IDA unit to size from: one unit per task, as many tasks as the
+  # array allows.
+  if [ -z "$SHARDS" ]; then
+    SHARDS=$IDA_UNITS
+    if [ -n "$array_cap" ] && [ "$SHARDS" -gt "$array_cap" ]; then SHARDS=$array_cap; fi
+  fi
+  # No sweep task, so no sweep time limit: the IDA's tasks take the stage time.
+  TIME=${TIME:-30:00}
+  note "sizing: no grid, so no sweep; the IDA's $IDA_UNITS work units in $SHARDS array tasks"
+elif [ "$SAMPLES_PER_UNIT" -gt 0 ] && [ "$SWEEP_UNITS" -gt 0 ]; then
   # U: bound of one unit's CPU seconds; W: of all units. CPUs: enough for tasks of
   # TARGET_TASK_S with the shards given (1 if not), at most cpu_cap and no more than a shard's
   # units. Shards: enough for tasks of TARGET_TASK_S, at most the units and the array limit. Time
@@ -326,10 +349,17 @@ if [ -z "$STAGE_TIME" ]; then
   STAGE_TIME=30:00
   if [ -n "$plim" ] && [ "$plim" -lt 30 ]; then STAGE_TIME=$PART_LIMIT; fi
 fi
-note "jobs: shards $SHARDS, CPUs per job $CPUS, time limits $(show_time "$TIME") per sweep task and $(show_time "$STAGE_TIME") for motions and finishing${given:+ (given:$given)}"
+if [ $HAS_SWEEP = 1 ]; then
+  note "jobs: shards $SHARDS, CPUs per job $CPUS, time limits $(show_time "$TIME") per sweep task and $(show_time "$STAGE_TIME") for motions and finishing${given:+ (given:$given)}"
+else
+  note "jobs: IDA shards $SHARDS, CPUs per job $CPUS, time limit $(show_time "$STAGE_TIME") per job${given:+ (given:$given)}"
+fi
 
 # --- Checks before any work. ------------------------------------------------------------------
-if [ -n "$SWEEP_UNITS" ] && [ "$SHARDS" -gt "$SWEEP_UNITS" ]; then
+if [ $HAS_SWEEP = 0 ] && [ "$SHARDS" -gt "$IDA_UNITS" ]; then
+  die "--shards $SHARDS is more than the IDA's $IDA_UNITS work units: give at most $IDA_UNITS"
+fi
+if [ $HAS_SWEEP = 1 ] && [ "$SHARDS" -gt "$SWEEP_UNITS" ]; then
   die "--shards $SHARDS is more than the $SWEEP_UNITS work units of the grid: give at most $SWEEP_UNITS"
 fi
 if [ -n "$array_cap" ] && [ "$SHARDS" -gt "$array_cap" ]; then
@@ -516,4 +546,4 @@ finish_job=$("${finish_cmd[@]}")
 finish_job=${finish_job%%;*}
 note "finishing job $finish_job"
 note "logs in $LOGS; watch with: squeue --me; the report will be $OUT/report/index.html"
-note "if a sweep task fails, the finishing job's log ($LOGS/finish-$finish_job.out) gives the command that resubmits only the failed shards"
+[ $HAS_SWEEP = 0 ] || note "if a sweep task fails, the finishing job's log ($LOGS/finish-$finish_job.out) gives the command that resubmits only the failed shards"
