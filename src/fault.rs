@@ -224,7 +224,6 @@ impl Classify for PipelineError {
                     Fault::of(BadInput).file(config.display()).key("ida")
                 }
                 IdaStageError::Shard { .. } => Fault::of(BadInput).key("shard"),
-                IdaStageError::BadUnits { dir, .. } => Fault::of(DamagedFile).file(dir.display()),
                 IdaStageError::Simulation { .. } => Fault::of(Failed),
             },
             PipelineError::Floors(e) => match e {

@@ -41,17 +41,6 @@ pub enum IdaStageError {
     NoSection { config: PathBuf },
     #[error("shard {k}/{n}: needs 1 ≤ K ≤ N ≤ {units} (the IDA traces {units} work units)")]
     Shard { k: usize, n: usize, units: usize },
-    #[error(
-        "{} of the {total} units of the IDA are damaged, misplaced or missing in {}, first: \
-         {first}; rerun the IDA (or the shards that made them), which computes them again",
-        count, dir.display()
-    )]
-    BadUnits {
-        count: usize,
-        total: usize,
-        dir: PathBuf,
-        first: String,
-    },
     #[error("zone {zone}, motion {motion}, case {case}{frame} ({system}): {why}")]
     Simulation {
         zone: String,
@@ -149,16 +138,23 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
         .collect();
     let dir = study.path(UNITS_DIR);
     std::fs::create_dir_all(&dir).map_err(|e| StoreError::io(&dir, "cannot create", e))?;
+    // What the unit files hold, each read once: a shard only asks whether a unit is done; the
+    // whole stage keeps the traces for the assembly.
+    let mut held: Vec<Option<UnitTraces>> = Vec::with_capacity(mine.len());
     let mut todo = Vec::new();
-    for &u in &mine {
-        match store.read(u) {
-            Ok(Some(_)) => {}
-            Ok(None) => todo.push(u),
+    for (i, &u) in mine.iter().enumerate() {
+        let read = match store.read(u) {
+            Ok(Some(t)) => Some(t),
+            Ok(None) => None,
             Err(e) => {
                 s.reporter.warn(me, &format!("{e}: computing it again"));
-                todo.push(u);
+                None
             }
+        };
+        if read.is_none() {
+            todo.push((i, u));
         }
+        held.push(if shard.is_none() { read } else { None });
     }
     if todo.len() < mine.len() {
         let line = format!(
@@ -173,7 +169,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     let bar = s.reporter.progress(me, todo.len() as u64);
     let done = todo
         .par_iter()
-        .map(|&u| -> Result<(usize, usize), PipelineError> {
+        .map(|&(i, u)| -> Result<(usize, UnitTraces), PipelineError> {
             s.check_cancelled(me)?;
             let (record, frame) = (&motions[u.zone][u.motion], frames[u.frame].as_ref());
             let traced = trace_unit(
@@ -195,13 +191,16 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             store.write(u, &traced)?;
             bar.inc();
             s.pass("ida.trace", me)?;
-            let runs = traced.traces.iter().map(|t| t.runs.len()).sum();
-            Ok((runs, traced.samples))
+            Ok((i, traced))
         })
         .collect::<Result<Vec<_>, _>>()?;
     bar.finish();
     if !done.is_empty() {
-        let (runs, samples) = (done.iter()).fold((0, 0), |(r, n), &(a, b)| (r + a, n + b));
+        let runs: usize = (done.iter())
+            .flat_map(|(_, t)| &t.traces)
+            .map(|t| t.runs.len())
+            .sum();
+        let samples: usize = done.iter().map(|(_, t)| t.samples).sum();
         let secs = start.elapsed().as_secs_f64();
         let threads = rayon::current_num_threads();
         s.reporter.info(
@@ -218,7 +217,14 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
         return Ok(StageOutcome::ShardDone { k, n });
     }
     s.pass("ida.assemble", me)?;
-    let outs = plan.expand(&store.read_all(&plan.run)?);
+    for (i, traced) in done {
+        held[i] = Some(traced);
+    }
+    let held: Vec<UnitTraces> = held
+        .into_iter()
+        .map(|t| t.expect("read or traced"))
+        .collect();
+    let outs = plan.expand(&held);
     let axes = axes_of(cfg, study.building());
     let mut zones = Vec::new();
     let mut at = 0;
@@ -403,30 +409,6 @@ impl CaseUnits<'_> {
             traces,
             samples: 0,
         }))
-    }
-
-    /// Every unit of `units`, in their order; an error naming the directory unless each is
-    /// stored whole for this IDA.
-    fn read_all(&self, units: &[CaseUnit]) -> Result<Vec<UnitTraces>, PipelineError> {
-        let mut bad = Vec::new();
-        let mut read = Vec::with_capacity(units.len());
-        for &u in units {
-            match self.read(u) {
-                Ok(Some(t)) => read.push(t),
-                Ok(None) => bad.push(format!("{} is missing", self.place(u).0.display())),
-                Err(e) => bad.push(e.to_string()),
-            }
-        }
-        if bad.is_empty() {
-            return Ok(read);
-        }
-        Err(IdaStageError::BadUnits {
-            count: bad.len(),
-            total: units.len(),
-            dir: self.study.path(UNITS_DIR),
-            first: bad.swap_remove(0),
-        }
-        .into())
     }
 }
 
