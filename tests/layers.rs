@@ -74,11 +74,16 @@ fn product_lines(text: &str) -> Vec<(usize, String)> {
 
 /// The top-level modules a line names through `crate::` (`crate::a::…`, `crate::{a, b::…}`).
 fn named_modules(code: &str) -> Vec<String> {
+    named_after(code, "crate::")
+}
+
+/// The names a line takes right after `prefix` (`prefix a::…`, `prefix {a, b::…}`).
+fn named_after(code: &str, prefix: &str) -> Vec<String> {
     let mut names = Vec::new();
     let mut rest = code;
-    while let Some(at) = rest.find("crate::") {
+    while let Some(at) = rest.find(prefix) {
         let before = rest[..at].chars().last();
-        rest = &rest[at + "crate::".len()..];
+        rest = &rest[at + prefix.len()..];
         if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
             continue;
         }
@@ -225,4 +230,71 @@ fn the_check_finds_an_upward_name_and_only_that() {
     );
     assert!(found[1].starts_with("src/store/fit.rs:3: `store` (rank 2) names `crate::study`"));
     assert!(found[2].starts_with("src/store/fit.rs:10: `store` (rank 2) names `crate::pipeline`"));
+}
+
+/// The stage modules of `src/pipeline/` (one per `StageId`).
+const STAGES: [&str; 7] = ["motions", "sweep", "tnew", "fit", "ida", "floors", "report"];
+
+/// Every name of one stage module in another file of `pipeline/` (`mod.rs`, which declares and
+/// dispatches them, aside): a stage reads another stage's file through `files.rs` and shares
+/// nothing else with it.
+fn stage_to_stage(pipeline: &Path) -> Vec<String> {
+    let mut found = Vec::new();
+    for file in rust_files(pipeline) {
+        let rel = file.strip_prefix(pipeline).unwrap();
+        let parts: Vec<String> = (rel.components())
+            .map(|c| c.as_os_str().to_string_lossy().trim_end_matches(".rs").to_string())
+            .collect();
+        if parts == ["mod"] {
+            continue;
+        }
+        let own = &parts[0];
+        // `super::` from `pipeline/x.rs` and `pipeline/report/mod.rs`, `super::super::` from
+        // `pipeline/report/x.rs`, is the pipeline.
+        let depth = parts.len() - usize::from(parts.last().is_some_and(|p| p == "mod"));
+        let up = "super::".repeat(depth);
+        let text = std::fs::read_to_string(&file).unwrap();
+        for (line, code) in product_lines(&text) {
+            let named = [named_after(&code, &up), named_after(&code, "crate::pipeline::")];
+            for n in named.iter().flatten() {
+                if STAGES.contains(&n.as_str()) && n != own {
+                    found.push(format!(
+                        "src/pipeline/{}:{line}: names the stage module `{n}`",
+                        rel.display()
+                    ));
+                }
+            }
+        }
+    }
+    found
+}
+
+/// No stage module (nor `files.rs`, `lock.rs`, …) names another stage's module: what a stage
+/// or the report needs of another stage's results it reads through `files.rs`.
+#[test]
+fn no_stage_names_another_stage() {
+    let found = stage_to_stage(&root().join("src/pipeline"));
+    assert!(found.is_empty(), "{}", found.join("\n"));
+    // The check itself on a made-up tree.
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path();
+    std::fs::create_dir(p.join("report")).unwrap();
+    std::fs::write(p.join("mod.rs"), "pub mod sweep;\nuse sweep::x;\n").unwrap();
+    std::fs::write(p.join("report/mod.rs"), "use super::{Study, fit};\n").unwrap();
+    std::fs::write(
+        p.join("tnew.rs"),
+        "use super::{PipelineError, sweep::building_attr};\nuse super::tnew::x;\n",
+    )
+    .unwrap();
+    std::fs::write(
+        p.join("report/ida.rs"),
+        "use super::Files;\nuse crate::pipeline::ida::figure;\nfn f() { super::super::floors::g() }\n",
+    )
+    .unwrap();
+    let found = stage_to_stage(p);
+    assert_eq!(found.len(), 4, "{found:#?}");
+    assert!(found[0].starts_with("src/pipeline/report/ida.rs:2: names the stage module `ida`"));
+    assert!(found[1].starts_with("src/pipeline/report/ida.rs:3: names the stage module `floors`"));
+    assert!(found[2].starts_with("src/pipeline/report/mod.rs:1: names the stage module `fit`"));
+    assert!(found[3].starts_with("src/pipeline/tnew.rs:1: names the stage module `sweep`"));
 }

@@ -5,7 +5,7 @@
 use super::{CliReporter, StudyArgs, print_outcome};
 use anyhow::Result;
 use slidestack::pipeline::lock::LockMode;
-use slidestack::pipeline::{StageId, execute, floors};
+use slidestack::pipeline::{StageId, execute, report};
 
 pub fn run(args: StudyArgs) -> Result<()> {
     let session = args.session(LockMode::Exclusive, &CliReporter)?;
@@ -24,7 +24,7 @@ pub fn run(args: StudyArgs) -> Result<()> {
         "PSA/PFA slide",
         "PSA/PFA attach"
     );
-    for r in floors::amplification_table(&session.study)? {
+    for r in report::floors::amplification_table(&session.study)? {
         println!(
             "{:<5} {:>4} {:>5} {:>5.2} {:>14.3} {:>14.3} {:>10.3} {:>10.3} {:>14.3} {:>14.3}  {}",
             r.zone,

@@ -6,7 +6,7 @@
 use super::{CliReporter, StudyArgs, print_outcome};
 use anyhow::Result;
 use slidestack::pipeline::lock::LockMode;
-use slidestack::pipeline::{Session, StageId, execute, ida};
+use slidestack::pipeline::{Session, StageId, execute, ida, report};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -42,7 +42,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let outcome = execute(&session, StageId::Ida, args.study.options())?;
     print_outcome(StageId::Ida, &outcome, &args.study.config);
-    let rows = ida::fragility_table(&session.study)?;
+    let rows = report::ida::fragility_table(&session.study)?;
     println!(
         "{:<5} {:>4} {:<6} {:<10} {:>8} {:>17} {:>6} {:>15}  status",
         "zone", "case", "system", "limit", "θ (g)", "95 % CI θ", "β", "95 % CI β"
@@ -67,7 +67,7 @@ pub fn run(args: Args) -> Result<()> {
             r.status
         );
     }
-    let medians = ida::median_demand(&session.study)?;
+    let medians = report::ida::median_demand(&session.study)?;
     println!(
         "median {} at multiples of the zone's target Sa(T_p) (the matched motions' level):",
         medians.first().map_or("ductility", |m| m.demand.as_str())
@@ -91,7 +91,7 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     if let Some(path) = &args.figure {
-        let svg = ida::figure(&session.study)?;
+        let svg = report::ida::figure(&session.study)?;
         slidestack::store::atomic::write_bytes(path, svg.as_bytes())?;
         println!("ida: wrote {}", path.display());
     }

@@ -1,7 +1,6 @@
 //! The stage files as the later stages and the report read them: one reader per file kind, each
 //! refusing as damaged a file whose axes are not the config's, so that no stage reads another
-//! stage's file with checks of its own (`ida.h5`, which only its own stage reads for the report,
-//! is read in [`super::ida`]). It imports no stage. (The store layer, [`crate::store`], reads a file by its
+//! stage's file with checks of its own. It imports no stage. (The store layer, [`crate::store`], reads a file by its
 //! path; this layer knows the study it must belong to.)
 
 use super::{PipelineError, StageId, Study};
@@ -9,10 +8,13 @@ use crate::ground_motion::Record;
 use crate::spectrum::TargetSpectrum;
 use crate::store::StoreError;
 use crate::store::fit::{FitReport, read_fit};
+use crate::store::floors::{FloorsAxes, ZoneFloors, read_zone_floors};
+use crate::store::ida::{IdaAxes, ZoneIda, read_zone_ida};
 use crate::store::motions::{read_zone_motions, read_zone_target};
 use crate::store::sweep::{ZoneSweep, read_zone_sweep};
 use crate::store::tnew::{ZoneTnew, read_zone_tnew_in};
 use crate::store::units::{UnitId, unit_path};
+use crate::study::ida_zone::axes_of as ida_axes_of;
 use crate::study::tnew::spectrum_periods_s;
 use std::path::Path;
 
@@ -118,4 +120,47 @@ pub fn unit_place(
         period_s,
     };
     (path, id)
+}
+
+/// Zone `zone` of `ida.h5` (the caller has required it up to date), refused unless its axes
+/// are the ones the config's `ida:` section gives.
+pub fn ida_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
+    let path = study.path(StageId::Ida.output());
+    let (axes, z) = read_zone_ida(&path, zone)?;
+    if axes != ida_axes_of(study.ida_config()?, study.building()) {
+        let why = format!("zone_{zone}: its axes differ from the config's `ida:` section");
+        return Err(StoreError::corrupt(&path, why).into());
+    }
+    Ok((axes, z))
+}
+
+/// The axes the config gives every zone of `floors.h5`.
+pub fn floors_axes(study: &Study) -> Result<FloorsAxes, PipelineError> {
+    let cfg = study.floors_config()?;
+    let spec = cfg.spec().map_err(|(key, why)| PipelineError::BadInput {
+        file: study.config_path.clone(),
+        why: format!("`floor_spectra.{key}`: {why}"),
+    })?;
+    Ok(FloorsAxes {
+        case_period_s: cfg.cases.iter().map(|c| c.period_s).collect(),
+        case_alpha: cfg.cases.iter().map(|c| c.alpha.clone()).collect(),
+        case_mu: cfg.cases.iter().map(|c| c.mu.clone()).collect(),
+        damping: spec.damping,
+        periods_s: spec.periods_s,
+        floors: study.building().map_or(1, |b| b.max_storeys()),
+        building: study.building().cloned(),
+    })
+}
+
+/// Zone `zone` of `floors.h5` (the caller has required it up to date), refused unless its
+/// axes are the ones the config's `floor_spectra:` section gives.
+pub fn floors_zone(study: &Study, zone: &str) -> Result<(FloorsAxes, ZoneFloors), PipelineError> {
+    let path = study.path(StageId::Floors.output());
+    let (axes, z) = read_zone_floors(&path, zone, study.building().is_some())?;
+    if axes != floors_axes(study)? {
+        let why =
+            format!("zone_{zone}: its axes differ from the config's `floor_spectra:` section");
+        return Err(StoreError::corrupt(&path, why).into());
+    }
+    Ok((axes, z))
 }

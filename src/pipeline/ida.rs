@@ -24,12 +24,12 @@ use crate::ida::trace::{Run, Trace};
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
-use crate::store::ida::{IdaAxes, IdaMeta, ZoneIda, read_zone_ida, write_ida};
+use crate::store::ida::{IdaMeta, write_ida};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
 use crate::study::case_units::{CaseUnit, UnitPlan};
 use crate::study::config::StudyConfig;
-use crate::study::ida::{DemandLayout, IdaConfig, RunDemand, SYSTEMS};
-use crate::study::ida_zone::{FRACTILES, UnitTraces, axes_of, trace_unit, zone_ida};
+use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS};
+use crate::study::ida_zone::{UnitTraces, axes_of, trace_unit, zone_ida};
 use crate::study::physics::Physics;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -69,22 +69,11 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
     Some(StageId::Ida.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint])))
 }
 
-/// The config's `ida:` section, which the stage needs.
-fn section(study: &Study) -> Result<&IdaConfig, IdaStageError> {
-    study
-        .cfg
-        .ida
-        .as_ref()
-        .ok_or_else(|| IdaStageError::NoSection {
-            config: study.config_path.clone(),
-        })
-}
-
 /// Builds `ida.h5`, or with `shard = Some((K, N))` only that shard's unit files.
 pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Ida;
-    let cfg = section(study)?;
+    let cfg = study.ida_config()?;
     let fp = study.fingerprint(me)?;
     let motions = super::files::motions(study)?;
     let physics = study.physics();
@@ -238,7 +227,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
         at += count;
     }
     let c_y_rule = c_y_rule(cfg, study.building().is_some());
-    let building_json = super::sweep::building_attr(study);
+    let building_json = study.building_attr();
     let settings = settings_attrs(cfg, &physics, &c_y_rule, building_json.as_deref());
     let meta = IdaMeta {
         fingerprint: fp,
@@ -271,13 +260,13 @@ pub fn run_shard(
 }
 
 /// `(units the IDA traces, units stored for the current IDA)`; before the motions stage ran
-/// the motion counts come from the config ([`super::sweep::motions_per_zone`]) and none is
+/// the motion counts come from the config ([`Study::motions_per_zone`]) and none is
 /// stored.
 pub fn unit_status(study: &Study) -> Result<(usize, usize), PipelineError> {
-    let cfg = section(study)?;
+    let cfg = study.ida_config()?;
     let frames = study.frames();
     if study.state(StageId::Motions)? != super::StageState::UpToDate {
-        let counts = super::sweep::motions_per_zone(study);
+        let counts = study.motions_per_zone();
         let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
         return Ok((plan.run.len(), 0));
     }
@@ -442,7 +431,7 @@ fn settings_attrs<'a>(
     building_json: Option<&'a str>,
 ) -> Vec<(&'static str, Attr<'a>)> {
     let t = &cfg.tracing;
-    let mut settings: Vec<(&str, Attr)> = super::sweep::physics_attrs(physics).to_vec();
+    let mut settings: Vec<(&str, Attr)> = super::physics_attrs(physics).to_vec();
     settings.extend([
         ("mu_static_ratio", Attr::F64(physics.mu_static_ratio)),
         ("c_y_rule", Attr::Str(c_y_rule)),
@@ -489,269 +478,4 @@ fn settings_attrs<'a>(
         ),
     ]);
     settings
-}
-
-/// Zone `zone` of `ida.h5` (the caller has required it up to date), refused unless its axes
-/// are the ones the config's `ida:` section gives.
-fn read_zone(study: &Study, zone: &str) -> Result<(IdaAxes, ZoneIda), PipelineError> {
-    let path = study.path(StageId::Ida.output());
-    let (axes, z) = read_zone_ida(&path, zone)?;
-    if axes != axes_of(section(study)?, study.building()) {
-        let why = format!("zone_{zone}: its axes differ from the config's `ida:` section");
-        return Err(StoreError::corrupt(&path, why).into());
-    }
-    Ok((axes, z))
-}
-
-/// One row of the fragility table.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FragilityRow {
-    pub zone: String,
-    pub case: usize,
-    /// The frame of a building study (`3 storeys, stack on the roof`).
-    pub frame: Option<String>,
-    pub system: String,
-    pub limit_state: String,
-    pub theta_sa_g: f64,
-    pub theta_ci_sa_g: (f64, f64),
-    pub beta: f64,
-    pub beta_ci: (f64, f64),
-    /// The fit's status word.
-    pub status: &'static str,
-}
-
-/// Every fit of `ida.h5` (which must be up to date), zone, case, system, limit state in order.
-pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError> {
-    study.require(StageId::Ida)?;
-    let mut rows = Vec::new();
-    for zone in &study.cfg.zones {
-        let (axes, z) = read_zone(study, &zone.name)?;
-        let v = &z.vars;
-        let labels = frame_labels(study);
-        let nf = labels.len();
-        for c in 0..axes.case_period_s.len() * nf {
-            for (s, system) in axes.systems.iter().enumerate() {
-                for (l, limit) in axes.limit_states.iter().enumerate() {
-                    let at = [s, c, l];
-                    let code = v.fit_status[at];
-                    rows.push(FragilityRow {
-                        zone: zone.name.clone(),
-                        case: c / nf,
-                        frame: labels[c % nf].clone(),
-                        system: system.clone(),
-                        limit_state: limit.clone(),
-                        theta_sa_g: v.theta_sa_g[at],
-                        theta_ci_sa_g: (v.theta_ci_low_sa_g[at], v.theta_ci_high_sa_g[at]),
-                        beta: v.beta[at],
-                        beta_ci: (v.beta_ci_low[at], v.beta_ci_high[at]),
-                        status: FIT_STATUS_FLAGS
-                            .iter()
-                            .find(|f| f.0 == code)
-                            .map_or("unknown", |f| f.1),
-                    });
-                }
-            }
-        }
-    }
-    Ok(rows)
-}
-
-/// The frames' labels in stored order (`[None]` on one storey).
-fn frame_labels(study: &Study) -> Vec<Option<String>> {
-    study
-        .frames()
-        .into_iter()
-        .map(|f| f.map(|f| f.to_string()))
-        .collect()
-}
-
-/// The median primary demand (ductility on one storey, the peak interstorey drift ratio in a
-/// building) of the stack and of the rigidly attached load at one intensity.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MedianDemand {
-    pub zone: String,
-    pub case: usize,
-    /// The frame of a building study (`3 storeys, stack on the roof`).
-    pub frame: Option<String>,
-    /// The demand compared: `ductility` or `peak_drift_ratio`.
-    pub demand: String,
-    pub period_s: f64,
-    pub alpha: Vec<f64>,
-    pub mu: Vec<f64>,
-    /// The intensity is `factor × target_sa_g`.
-    pub factor: f64,
-    /// The zone's target `Sa(T_p)` (`Sa(T_1)` in a building), g: the level the motions are
-    /// matched to.
-    pub target_sa_g: f64,
-    pub stack: f64,
-    pub rigid: f64,
-    /// The stack's largest peak slip at any interface in any run of the case, m.
-    pub stack_max_slip_m: f64,
-}
-
-/// Multiples of the zone's target at which [`median_demand`] compares the systems.
-pub const TARGET_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
-
-/// `y` on the grid `x` at `at`, linearly (`+∞` where either neighbour is; NaN outside).
-fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
-    let j = x.partition_point(|&v| v < at);
-    if j == x.len() {
-        return f64::NAN;
-    }
-    if x[j] == at || j == 0 {
-        return if x[j] == at { y[j] } else { f64::NAN };
-    }
-    let w = (at - x[j - 1]) / (x[j] - x[j - 1]);
-    if y[j - 1].is_infinite() || y[j].is_infinite() {
-        return f64::INFINITY;
-    }
-    y[j - 1] + w * (y[j] - y[j - 1])
-}
-
-/// The median ductility of both systems at [`TARGET_FACTORS`] × the zone's target `Sa(T_p)`,
-/// read off the median curves of `ida.h5` (NaN above the grid).
-pub fn median_demand(study: &Study) -> Result<Vec<MedianDemand>, PipelineError> {
-    study.require(StageId::Motions)?;
-    study.require(StageId::Ida)?;
-    let targets = super::files::targets(study)?;
-    let mut rows = Vec::new();
-    let labels = frame_labels(study);
-    let nf = labels.len();
-    for (zone, target) in study.cfg.zones.iter().zip(&targets) {
-        let (axes, z) = read_zone(study, &zone.name)?;
-        let median = FRACTILES.iter().position(|&p| p == 0.5).unwrap_or(1);
-        for cf in 0..axes.case_period_s.len() * nf {
-            let c = cf / nf;
-            let curve = |s: usize| -> Vec<f64> {
-                (0..axes.sa_grid_g.len())
-                    .map(|j| z.vars.fractile_curve[[s, cf, median, j, DemandLayout::PRIMARY]])
-                    .collect()
-            };
-            let (stack, rigid) = (curve(0), curve(1));
-            let target_sa_g = target.sa_g(axes.case_period_s[c]);
-            let n = axes.case_alpha[c].len();
-            let slip = DemandLayout {
-                building: axes.building.is_some(),
-                blocks: n,
-            }
-            .first_slip();
-            let stack_max_slip_m = z
-                .vars
-                .run_demand
-                .slice(ndarray::s![0, .., cf, .., slip..slip + n])
-                .iter()
-                .copied()
-                .filter(|v| !v.is_nan())
-                .fold(0.0, f64::max);
-            for factor in TARGET_FACTORS {
-                let at = factor * target_sa_g;
-                rows.push(MedianDemand {
-                    zone: zone.name.clone(),
-                    case: c,
-                    frame: labels[cf % nf].clone(),
-                    demand: axes.demands[DemandLayout::PRIMARY].clone(),
-                    period_s: axes.case_period_s[c],
-                    alpha: axes.case_alpha[c].clone(),
-                    mu: axes.case_mu[c].clone(),
-                    factor,
-                    target_sa_g,
-                    stack: interpolate(&axes.sa_grid_g, &stack, at),
-                    rigid: interpolate(&axes.sa_grid_g, &rigid, at),
-                    stack_max_slip_m,
-                });
-            }
-        }
-    }
-    Ok(rows)
-}
-
-/// SVG of [`figure_of`].
-pub fn figure(study: &Study) -> Result<String, PipelineError> {
-    let fig = figure_of(study)?;
-    crate::render::chart::render(&fig).map_err(|e| {
-        let path = study.path(StageId::Ida.output());
-        PipelineError::Store(crate::store::StoreError::corrupt(&path, e.to_string()))
-    })
-}
-
-/// The first case's ductility (in a building: peak interstorey drift ratio) against intensity,
-/// one panel per zone (and frame): every record's curve (faint) and the 16–50–84 % fractiles
-/// of the stack and of the rigidly attached load. Collapsed values (`+∞`) are drawn at the
-/// collapse ductility (drift ratio).
-pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, PipelineError> {
-    use crate::render::chart::{Axis, Figure, Panel, Series, Stroke};
-    study.require(StageId::Ida)?;
-    let cfg = section(study)?;
-    let building = study.building().is_some();
-    let (cap, y_label) = if building {
-        let cap = cfg.collapse_drift_ratio.unwrap_or(f64::NAN);
-        (cap, "peak interstorey drift ratio")
-    } else {
-        let cap = cfg.collapse_ductility.unwrap_or(f64::NAN);
-        (cap, "ductility u_m/u_y")
-    };
-    let clip = |v: f64| if v.is_infinite() { cap } else { v };
-    let labels = frame_labels(study);
-    // Each building once (on one storey every stack floor is the first's).
-    let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
-    let d = DemandLayout::PRIMARY;
-    let mut panels = Vec::new();
-    for zone in &study.cfg.zones {
-        let (axes, z) = read_zone(study, &zone.name)?;
-        let x = axes.sa_grid_g.clone();
-        // The first case in every frame: folded index `f` (crate::store::ida).
-        for (f, label) in labels.iter().enumerate() {
-            if building && !distinct.contains(&f) {
-                continue;
-            }
-            let mut series = Vec::new();
-            for s in 0..axes.systems.len() {
-                for r in 0..z.records.len() {
-                    let y: Vec<f64> = (0..x.len())
-                        .map(|j| clip(z.vars.curve[[s, r, f, j, d]]))
-                        .collect();
-                    series.push(Series::faint(x.clone(), y));
-                }
-            }
-            for (s, name) in axes.systems.iter().enumerate() {
-                let q = |k: usize| -> Vec<f64> {
-                    (0..x.len())
-                        .map(|j| clip(z.vars.fractile_curve[[s, f, k, j, d]]))
-                        .collect()
-                };
-                series.push(Series::band(
-                    format!("{name}: 16–84 %"),
-                    x.clone(),
-                    q(0),
-                    q(2),
-                ));
-                let line = Series::line(format!("{name}: median"), x.clone(), q(1));
-                series.push(if s == 0 {
-                    line
-                } else {
-                    line.stroke(Stroke::Dashed, 2)
-                });
-            }
-            let a = &axes;
-            let at = label.as_ref().map_or(String::new(), |l| format!(", {l}"));
-            panels.push(Panel::xy(
-                format!(
-                    "zone {}{at}: T_p = {} s, α = {:?}, μ = {:?}, C_y = {:.3}",
-                    zone.name,
-                    a.case_period_s[0],
-                    a.case_alpha[0],
-                    a.case_mu[0],
-                    z.vars.c_y[[0]]
-                ),
-                Axis::new("Sa(T_p, 5 %), g"),
-                Axis::new(y_label).range(0.0, cap),
-                series,
-            ));
-        }
-    }
-    Ok(Figure::grid(
-        "IDA curves: sliding stack vs rigidly attached load",
-        panels,
-        labels.len().min(3),
-    ))
 }

@@ -41,7 +41,9 @@ use crate::grid::{BuildingAxes, Grid};
 use crate::methods::Method;
 use crate::store::{StoreError, atomic};
 use crate::study::building::Frame;
-use crate::study::config::{ConfigError, StudyConfig};
+use crate::study::config::{ConfigError, Seeds, StudyConfig};
+use crate::study::floors::FloorsConfig;
+use crate::study::ida::IdaConfig;
 use crate::study::physics::{Physics, SystemKind};
 use lock::{LockError, LockMode, OutputLock};
 use std::path::{Path, PathBuf};
@@ -351,6 +353,15 @@ fn frames_of(cfg: &StudyConfig, building: Option<&BuildingAxes>) -> Vec<Frame> {
     })
 }
 
+/// The physics settings every stage file after the motions' stores as file attributes.
+pub fn physics_attrs(p: &Physics) -> [(&'static str, crate::store::h5::Attr<'static>); 2] {
+    use crate::store::h5::Attr;
+    [
+        ("damping", Attr::F64(p.damping)),
+        ("damping_basis", Attr::Str(p.basis.name())),
+    ]
+}
+
 impl Study {
     /// Reads and validates the config (every limit is checked here, before any work) and
     /// computes every stage's expected fingerprint.
@@ -484,6 +495,44 @@ impl Study {
         self.grid.as_ref().ok_or_else(|| PipelineError::NoGrid {
             config: self.config_path.clone(),
             stage,
+        })
+    }
+
+    /// A building study's `building:` section as JSON (the file attribute `building` of every
+    /// stage file after the motions').
+    pub fn building_attr(&self) -> Option<String> {
+        let b = self.cfg.building.as_ref()?;
+        Some(serde_json::to_string(b).expect("the building section serialises"))
+    }
+
+    /// Each zone's motion count as the config gives it, before the motions stage ran (the
+    /// seeds' count or the record files'; the stage may keep fewer).
+    pub fn motions_per_zone(&self) -> Vec<usize> {
+        let per_zone = match self.cfg.motions.seeds.kind() {
+            Seeds::Stochastic(s) => s.count,
+            Seeds::Records(r) => r.files.len(),
+        };
+        vec![per_zone; self.cfg.zones.len()]
+    }
+
+    /// The config's `ida:` section, which the `ida` stage and what reads `ida.h5` need.
+    pub fn ida_config(&self) -> Result<&IdaConfig, PipelineError> {
+        (self.cfg.ida.as_ref()).ok_or_else(|| {
+            ida::IdaStageError::NoSection {
+                config: self.config_path.clone(),
+            }
+            .into()
+        })
+    }
+
+    /// The config's `floor_spectra:` section, which the `floors` stage and what reads
+    /// `floors.h5` need.
+    pub fn floors_config(&self) -> Result<&FloorsConfig, PipelineError> {
+        (self.cfg.floor_spectra.as_ref()).ok_or_else(|| {
+            floors::FloorsStageError::NoSection {
+                config: self.config_path.clone(),
+            }
+            .into()
         })
     }
 

@@ -25,8 +25,8 @@ use crate::store::sweep::{
     BuildingVars, SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep,
 };
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
-use crate::study::config::{Seeds, StudyConfig};
-use crate::study::physics::{CaseError, Physics, SystemKind};
+use crate::study::config::StudyConfig;
+use crate::study::physics::{CaseError, SystemKind};
 use crate::study::sweep::{SKIP_RULE_CODES, SKIP_RULE_FLAGS, UnitOptions, UnitResult, run_unit};
 use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
@@ -483,8 +483,8 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
     let fp = study.fingerprint(me)?;
     let motions_fp = study.fingerprint(StageId::Motions)?;
     let physics = study.physics();
-    let building_json = building_attr(study);
-    let mut settings = physics_attrs(&physics).to_vec();
+    let building_json = study.building_attr();
+    let mut settings = super::physics_attrs(&physics).to_vec();
     if let Some(b) = &building_json {
         settings.push(("building", Attr::Str(b)));
     }
@@ -541,21 +541,6 @@ fn array<T>(
     })
 }
 
-/// A building study's `building:` section as JSON (the file attribute `building` of `sweep.h5`
-/// and `tnew.h5`).
-pub fn building_attr(study: &Study) -> Option<String> {
-    let b = study.cfg.building.as_ref()?;
-    Some(serde_json::to_string(b).expect("the building section serialises"))
-}
-
-/// The physics settings stored as file attributes of `sweep.h5` and `tnew.h5`.
-pub fn physics_attrs(p: &Physics) -> [(&'static str, Attr<'static>); 2] {
-    [
-        ("damping", Attr::F64(p.damping)),
-        ("damping_basis", Attr::Str(p.basis.name())),
-    ]
-}
-
 /// Equal to the bit (NaN fill included).
 fn same_bits(a: &ZoneSweep, b: &ZoneSweep) -> bool {
     let f = |x: &ArrayD<f64>, y: &ArrayD<f64>| {
@@ -587,22 +572,12 @@ pub fn remove_units(study: &Study) -> Result<(), StoreError> {
     crate::store::units::remove_units(&study.path(UNITS_DIR))
 }
 
-/// Each zone's motion count as the config gives it, before the motions stage ran (the seeds'
-/// count or the record files'; the stage may keep fewer).
-pub fn motions_per_zone(study: &Study) -> Vec<usize> {
-    let per_zone = match study.cfg.motions.seeds.kind() {
-        Seeds::Stochastic(s) => s.count,
-        Seeds::Records(r) => r.files.len(),
-    };
-    vec![per_zone; study.cfg.zones.len()]
-}
-
 /// `(work units, units stored for the current sweep, record samples per motion)`; before the
 /// motions stage ran the motion counts come from the config and the samples are 0.
 pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError> {
     let grid = study.grid(StageId::Sweep)?;
     if study.state(StageId::Motions)? != super::StageState::UpToDate {
-        let motions: usize = motions_per_zone(study).iter().sum();
+        let motions: usize = study.motions_per_zone().iter().sum();
         return Ok((motions * frames(study) * grid.periods_s.len(), 0, 0));
     }
     let motions = super::files::motions(study)?;

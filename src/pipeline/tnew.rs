@@ -68,8 +68,8 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
         zones.push(out.tnew);
         s.pass("tnew.zone", me)?;
     }
-    let building_json = super::sweep::building_attr(study);
-    let mut settings = super::sweep::physics_attrs(&physics).to_vec();
+    let building_json = study.building_attr();
+    let mut settings = super::physics_attrs(&physics).to_vec();
     if let Some(b) = &building_json {
         settings.push(("building", crate::store::h5::Attr::Str(b)));
     }

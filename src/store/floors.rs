@@ -256,3 +256,40 @@ pub fn read_zone_floors(
     };
     Ok((axes, zone))
 }
+
+/// Where a value of a zone's variables lies in their flat row-major arrays
+/// (this module's layout: `[motion, case, frame, …]`, the frame axis `storeys ×
+/// stack_floor` folded into one).
+pub struct Offsets {
+    pub cases: usize,
+    pub frames: usize,
+    pub damping: usize,
+    pub floors: usize,
+    pub periods: usize,
+}
+
+impl Offsets {
+    pub fn of(axes: &FloorsAxes, frames: usize) -> Self {
+        Self {
+            cases: axes.case_period_s.len(),
+            frames,
+            damping: axes.damping.len(),
+            floors: axes.floors,
+            periods: axes.periods_s.len(),
+        }
+    }
+
+    pub fn unit(&self, m: usize, c: usize, f: usize) -> usize {
+        (m * self.cases + c) * self.frames + f
+    }
+
+    /// Floor `j`'s peak of `pfa_*`.
+    pub fn pfa(&self, m: usize, c: usize, f: usize, j: usize) -> usize {
+        self.unit(m, c, f) * self.floors + j
+    }
+
+    /// The first period of floor `j`'s spectrum at damping ratio `d` in `psa_*`.
+    pub fn psa(&self, m: usize, c: usize, f: usize, d: usize, j: usize) -> usize {
+        ((self.unit(m, c, f) * self.damping + d) * self.floors + j) * self.periods
+    }
+}
