@@ -243,7 +243,12 @@ fn stage_to_stage(pipeline: &Path) -> Vec<String> {
     for file in rust_files(pipeline) {
         let rel = file.strip_prefix(pipeline).unwrap();
         let parts: Vec<String> = (rel.components())
-            .map(|c| c.as_os_str().to_string_lossy().trim_end_matches(".rs").to_string())
+            .map(|c| {
+                c.as_os_str()
+                    .to_string_lossy()
+                    .trim_end_matches(".rs")
+                    .to_string()
+            })
             .collect();
         if parts == ["mod"] {
             continue;
@@ -255,7 +260,10 @@ fn stage_to_stage(pipeline: &Path) -> Vec<String> {
         let up = "super::".repeat(depth);
         let text = std::fs::read_to_string(&file).unwrap();
         for (line, code) in product_lines(&text) {
-            let named = [named_after(&code, &up), named_after(&code, "crate::pipeline::")];
+            let named = [
+                named_after(&code, &up),
+                named_after(&code, "crate::pipeline::"),
+            ];
             for n in named.iter().flatten() {
                 if STAGES.contains(&n.as_str()) && n != own {
                     found.push(format!(

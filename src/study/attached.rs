@@ -365,12 +365,7 @@ pub fn solve<E>(
     mut value: impl FnMut(f64) -> Result<f64, E>,
 ) -> Result<(f64, FractionFlag), E> {
     let tol = MATCH_TOL * target.abs();
-    let (lo, hi) = (scan[0].0, scan[scan.len() - 1].0);
-    let prior = if prior.is_finite() {
-        prior.clamp(lo, hi)
-    } else {
-        hi
-    };
+    let prior = prior_fraction(prior, scan);
     let mut points = scan.to_vec();
     if !points.iter().any(|p| p.0 == prior) {
         let at = points.partition_point(|p| p.0 < prior);
@@ -470,6 +465,17 @@ pub fn solve<E>(
     Ok((best.expect("a band was entered"), flag))
 }
 
+/// The fraction [`solve`] evaluates for the prior `share` over `scan` (ascending `(f, value)`):
+/// the share clamped to the scan's range, its top (1) when the share is not finite.
+pub fn prior_fraction<T>(share: f64, scan: &[(f64, T)]) -> f64 {
+    let (lo, hi) = (scan[0].0, scan[scan.len() - 1].0);
+    if share.is_finite() {
+        share.clamp(lo, hi)
+    } else {
+        hi
+    }
+}
+
 /// The scan intervals whose ends straddle `target` (a point on it counts once, in the interval
 /// it ends, or the first interval it starts).
 fn crossings(target: f64, points: &[(f64, f64)]) -> Vec<usize> {
@@ -545,9 +551,9 @@ impl<F: FnMut(f64) -> Result<f64, E>, E> CostFunction for &Crossing<'_, F, E> {
     }
 }
 
-/// [`family_mean`]s remembered by fraction and quantity, seeded with a scan's [`Means`]: a
-/// fraction a case's searches share (its stuck mass share) is simulated once per quantity, and
-/// each search runs only its own quantity.
+/// [`family_mean`]s remembered by fraction and quantity, seeded with [`Means`] already known
+/// (the scan's, and the prior's, which every quantity's search evaluates: one run for them
+/// all); each search runs only its own quantity beyond them.
 pub struct Memo<'a> {
     known: BTreeMap<(u64, Quantity), f64>,
     compute: Box<dyn FnMut(f64, Quantity) -> Result<f64, CaseError> + 'a>,
@@ -848,7 +854,13 @@ pub fn zone_fractions(
                 None if holds_everywhere(physics, &case, frame, grounds)? => (rigid.clone(), 1.0),
                 None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
             };
-            let mut memo = Memo::new(scan, |f, q| {
+            // Every quantity's search evaluates the prior: one run gives them all.
+            let prior = prior_fraction(share, scan);
+            let mut known = scan.clone();
+            if !scan.iter().any(|(f, _)| *f == prior) {
+                known.push((prior, family_means(physics, &case, frame, prior, grounds)?));
+            }
+            let mut memo = Memo::new(&known, |f, q| {
                 family_mean(physics, &case, frame, f, grounds, q)
             });
             let mut solve_for = |q: Quantity| -> Result<(f64, FractionFlag), CaseError> {
