@@ -21,11 +21,13 @@ use super::{PipelineError, Session, StageId, StageOutcome, Study};
 use crate::ground_motion::Record;
 use crate::ida::fragility::FIT_STATUS_FLAGS;
 use crate::ida::trace::{Run, Trace};
+use crate::spectrum::TargetSpectrum;
 use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaMeta, write_ida};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
+use crate::study::building::Frame;
 use crate::study::case_units::{CaseUnit, UnitPlan};
 use crate::study::config::StudyConfig;
 use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS};
@@ -69,107 +71,121 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
     Some(StageId::Ida.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint])))
 }
 
-/// Builds `ida.h5`, or with `shard = Some((K, N))` only that shard's unit files.
+/// Builds `ida.h5`, or with `shard = Some((K, N))` only that shard's unit files: reads the
+/// unit files there are, traces the rest (each stored as it ends) and, unsharded, assembles
+/// and writes `ida.h5`.
 pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Ida;
     let cfg = study.ida_config()?;
-    let fp = study.fingerprint(me)?;
     let motions = super::files::motions(study)?;
-    let physics = study.physics();
     let targets = super::files::targets(study)?;
     let frames = study.frames();
-    let nf = frames.len();
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
     let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
-    let traced = plan.run.len();
+    let units = plan.run.len();
     if let Some((k, n)) = shard
-        && !(1 <= k && k <= n && n <= traced)
+        && !(1 <= k && k <= n && n <= units)
     {
-        return Err(IdaStageError::Shard {
-            k,
-            n,
-            units: traced,
-        }
-        .into());
+        return Err(IdaStageError::Shard { k, n, units }.into());
     }
     let store = CaseUnits {
         study,
         cfg,
         motions: &motions,
-        fingerprint: fp,
+        fingerprint: study.fingerprint(me)?,
     };
-    s.reporter.info(
-        me,
-        &format!(
-            "{} traces ({} motions over {} zones × {} cases{} × {} systems{}), at most {} runs \
-             each",
-            traced * SYSTEMS.len(),
-            motions.iter().map(Vec::len).sum::<usize>(),
-            motions.len(),
-            cfg.cases.len(),
-            if nf > 1 || study.building().is_some() {
-                format!(" × {nf} frames")
-            } else {
-                String::new()
-            },
-            SYSTEMS.len(),
-            match plan.all.len() - traced {
-                0 => String::new(),
-                n => format!("; {n} units of frames that repeat a building take its traces"),
-            },
-            cfg.tracing.max_runs()
-        ),
-    );
+    s.reporter
+        .info(me, &plan_line(study, cfg, &counts, &plan, frames.len()));
     let mine: Vec<CaseUnit> = (plan.run.iter().enumerate())
         .filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1))
         .map(|(_, u)| *u)
         .collect();
     let dir = study.path(UNITS_DIR);
     std::fs::create_dir_all(&dir).map_err(|e| StoreError::io(&dir, "cannot create", e))?;
-    // What the unit files hold, each read once: a shard only asks whether a unit is done; the
-    // whole stage keeps the traces for the assembly.
-    let mut held: Vec<Option<UnitTraces>> = Vec::with_capacity(mine.len());
-    let mut todo = Vec::new();
-    for (i, &u) in mine.iter().enumerate() {
-        let read = match store.read(u) {
-            Ok(Some(t)) => Some(t),
-            Ok(None) => None,
-            Err(e) => {
-                s.reporter.warn(me, &format!("{e}: computing it again"));
-                None
-            }
-        };
-        if read.is_none() {
-            todo.push((i, u));
-        }
-        held.push(if shard.is_none() { read } else { None });
+    // Each unit file read once: a shard only asks whether a unit is done; the whole stage
+    // keeps the traces for the assembly.
+    let (mut held, todo) = store.scan(s, &mine, shard.is_none());
+    let inputs = TraceInputs {
+        physics: study.physics(),
+        targets: &targets,
+        frames: &frames,
+    };
+    for (i, traced) in trace_units(s, &store, &inputs, &todo)? {
+        held[i] = Some(traced);
     }
-    if todo.len() < mine.len() {
-        let line = format!(
-            "{} of {} units to trace ({} already done)",
-            todo.len(),
-            mine.len(),
-            mine.len() - todo.len()
-        );
-        s.reporter.info(me, &line);
+    if let Some((k, n)) = shard {
+        return Ok(StageOutcome::ShardDone { k, n });
     }
+    s.pass("ida.assemble", me)?;
+    let held: Vec<UnitTraces> = (held.into_iter())
+        .map(|t| t.expect("read or traced"))
+        .collect();
+    let path = write_stage_file(study, &store, &inputs, &plan.expand(&held))?;
+    remove_units(study)?;
+    s.reporter.info(me, &format!("verified {}", path.display()));
+    Ok(StageOutcome::Wrote(vec![path]))
+}
+
+/// The stage's first line: the traces, what they run over, and the runs a trace may take.
+fn plan_line(
+    study: &Study,
+    cfg: &IdaConfig,
+    motions: &[usize],
+    plan: &UnitPlan,
+    nf: usize,
+) -> String {
+    let traced = plan.run.len();
+    format!(
+        "{} traces ({} motions over {} zones × {} cases{} × {} systems{}), at most {} runs each",
+        traced * SYSTEMS.len(),
+        motions.iter().sum::<usize>(),
+        motions.len(),
+        cfg.cases.len(),
+        if nf > 1 || study.building().is_some() {
+            format!(" × {nf} frames")
+        } else {
+            String::new()
+        },
+        SYSTEMS.len(),
+        match plan.all.len() - traced {
+            0 => String::new(),
+            n => format!("; {n} units of frames that repeat a building take its traces"),
+        },
+        cfg.tracing.max_runs()
+    )
+}
+
+/// What tracing a unit needs besides the config and its record.
+struct TraceInputs<'a> {
+    physics: Physics,
+    /// Each zone's target spectrum (as `motions.h5` stores it).
+    targets: &'a [TargetSpectrum],
+    frames: &'a [Option<Frame>],
+}
+
+/// Traces the units `todo` (`(index, unit)`) in parallel, each stored as it ends, and reports
+/// the rate; `(index, traces)` in `todo`'s order.
+fn trace_units(
+    s: &Session,
+    store: &CaseUnits,
+    inp: &TraceInputs,
+    todo: &[(usize, CaseUnit)],
+) -> Result<Vec<(usize, UnitTraces)>, PipelineError> {
+    let (me, cfg, study) = (StageId::Ida, store.cfg, store.study);
     let start = std::time::Instant::now();
     let bar = s.reporter.progress(me, todo.len() as u64);
     let done = todo
         .par_iter()
         .map(|&(i, u)| -> Result<(usize, UnitTraces), PipelineError> {
             s.check_cancelled(me)?;
-            let (record, frame) = (&motions[u.zone][u.motion], frames[u.frame].as_ref());
-            let traced = trace_unit(
-                cfg,
-                &physics,
-                &targets[u.zone],
-                &cfg.cases[u.case],
-                frame,
-                record,
-            )
-            .map_err(|f| IdaStageError::Simulation {
+            let (record, frame) = (
+                &store.motions[u.zone][u.motion],
+                inp.frames[u.frame].as_ref(),
+            );
+            let case = &cfg.cases[u.case];
+            let traced = trace_unit(cfg, &inp.physics, &inp.targets[u.zone], case, frame, record)
+                .map_err(|f| IdaStageError::Simulation {
                 zone: study.cfg.zones[u.zone].name.clone(),
                 motion: record.name.clone(),
                 case: u.case,
@@ -202,25 +218,26 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             ),
         );
     }
-    if let Some((k, n)) = shard {
-        return Ok(StageOutcome::ShardDone { k, n });
-    }
-    s.pass("ida.assemble", me)?;
-    for (i, traced) in done {
-        held[i] = Some(traced);
-    }
-    let held: Vec<UnitTraces> = held
-        .into_iter()
-        .map(|t| t.expect("read or traced"))
-        .collect();
-    let outs = plan.expand(&held);
+    Ok(done)
+}
+
+/// Writes `ida.h5` from every unit's traces (`outs`, over every zone, motion, case and frame in
+/// stored order), zone by zone ([`zone_ida`]); its path.
+fn write_stage_file(
+    study: &Study,
+    store: &CaseUnits,
+    inp: &TraceInputs,
+    outs: &[UnitTraces],
+) -> Result<PathBuf, PipelineError> {
+    let cfg = store.cfg;
     let axes = axes_of(cfg, study.building());
     let mut zones = Vec::new();
     let mut at = 0;
     for (z, zc) in study.cfg.zones.iter().enumerate() {
-        let count = motions[z].len() * cfg.cases.len() * nf;
-        let names = motions[z].iter().map(|m| m.name.clone()).collect();
-        let (zone, target) = ((zc.name.as_str(), zc.target.as_str()), &targets[z]);
+        let motions = &store.motions[z];
+        let count = motions.len() * cfg.cases.len() * inp.frames.len();
+        let names = motions.iter().map(|m| m.name.clone()).collect();
+        let (zone, target) = ((zc.name.as_str(), zc.target.as_str()), &inp.targets[z]);
         let building = study.cfg.building.as_ref();
         let units = &outs[at..at + count];
         zones.push(zone_ida(cfg, &axes, building, zone, target, names, units));
@@ -228,19 +245,17 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     }
     let c_y_rule = c_y_rule(cfg, study.building().is_some());
     let building_json = study.building_attr();
-    let settings = settings_attrs(cfg, &physics, &c_y_rule, building_json.as_deref());
+    let settings = settings_attrs(cfg, &inp.physics, &c_y_rule, building_json.as_deref());
     let meta = IdaMeta {
-        fingerprint: fp,
+        fingerprint: store.fingerprint,
         motions_fingerprint: study.fingerprint(StageId::Motions)?,
         config_sha256: &study.config_sha256,
         fit_flags: FIT_STATUS_FLAGS,
         settings: &settings,
     };
-    let path = study.path(me.output());
+    let path = study.path(StageId::Ida.output());
     write_ida(&path, &meta, &axes, &zones)?;
-    remove_units(study)?;
-    s.reporter.info(me, &format!("verified {}", path.display()));
-    Ok(StageOutcome::Wrote(vec![path]))
+    Ok(path)
 }
 
 /// Shard `K/N` of the IDA: nothing when `ida.h5` is already up to date (unless forced).
@@ -317,6 +332,42 @@ impl CaseUnits<'_> {
             (u.zone, u.motion, u.frame),
             (u.case, self.cfg.cases[u.case].period_s),
         )
+    }
+
+    /// Reads each of `units` (in order): what a unit file holds when `keep` (else nothing),
+    /// and `(index, unit)` of those to trace, a damaged file among them with a warning.
+    fn scan(
+        &self,
+        s: &Session,
+        units: &[CaseUnit],
+        keep: bool,
+    ) -> (Vec<Option<UnitTraces>>, Vec<(usize, CaseUnit)>) {
+        let me = StageId::Ida;
+        let mut held = Vec::with_capacity(units.len());
+        let mut todo = Vec::new();
+        for (i, &u) in units.iter().enumerate() {
+            let read = match self.read(u) {
+                Ok(t) => t,
+                Err(e) => {
+                    s.reporter.warn(me, &format!("{e}: computing it again"));
+                    None
+                }
+            };
+            if read.is_none() {
+                todo.push((i, u));
+            }
+            held.push(if keep { read } else { None });
+        }
+        if todo.len() < units.len() {
+            let line = format!(
+                "{} of {} units to trace ({} already done)",
+                todo.len(),
+                units.len(),
+                units.len() - todo.len()
+            );
+            s.reporter.info(me, &line);
+        }
+        (held, todo)
     }
 
     fn write(&self, u: CaseUnit, t: &UnitTraces) -> Result<(), StoreError> {
