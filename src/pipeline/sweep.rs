@@ -378,49 +378,70 @@ pub fn merge(s: &Session) -> Result<StageOutcome, PipelineError> {
     assemble(s, &units, &all)
 }
 
+/// `sweep.h5` from the unit files of `all` (every unit of the grid): read, per zone its
+/// variables, written and verified; then the units go.
 fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, PipelineError> {
     let study = units.study;
-    let grid = units.grid;
-    let dir = study.path(UNITS_DIR);
-    let mut missing = 0;
-    let mut bad = Vec::new();
-    let mut read: Vec<Columns> = Vec::with_capacity(all.len());
-    for &u in all {
-        match units.read(u) {
-            Ok(Stored::Valid(c)) => read.push(c),
-            Ok(Stored::Missing | Stored::Stale) => missing += 1,
-            Err(e) => bad.push(e.to_string()),
-        }
-    }
-    if !bad.is_empty() {
-        return Err(SweepStageError::BadUnits {
-            count: bad.len(),
-            dir,
-            first: bad.swap_remove(0),
-        }
-        .into());
-    }
-    if missing > 0 {
-        return Err(SweepStageError::MissingUnits {
-            missing,
-            total: all.len(),
-            dir,
-        }
-        .into());
-    }
-    let n = grid.blocks();
-    let building = study.building();
+    let read = units.read_all(all)?;
+    let count = |z: usize| units.motions[z].len() * frames(study) * units.grid.periods_s.len();
     let mut zones = Vec::new();
     let mut at = 0;
-    for (z, zc) in study.cfg.zones.iter().enumerate() {
-        let count = units.motions[z].len() * frames(study) * grid.periods_s.len();
-        let cols = &read[at..at + count];
-        at += count;
-        let mut shape = vec![units.motions[z].len()];
+    for z in 0..study.cfg.zones.len() {
+        zones.push(units.zone_of(z, &read[at..at + count(z)])?);
+        at += count(z);
+    }
+    let path = write_verified(study, units.grid, &zones)?;
+    remove_units(study)?;
+    s.reporter
+        .info(StageId::Sweep, &format!("verified {}", path.display()));
+    Ok(StageOutcome::Wrote(vec![path]))
+}
+
+impl Units<'_> {
+    /// Every unit of `all` in order, refused naming the directory unless each is stored whole
+    /// for the current sweep.
+    fn read_all(&self, all: &[Unit]) -> Result<Vec<Columns>, PipelineError> {
+        let dir = self.study.path(UNITS_DIR);
+        let mut missing = 0;
+        let mut bad = Vec::new();
+        let mut read: Vec<Columns> = Vec::with_capacity(all.len());
+        for &u in all {
+            match self.read(u) {
+                Ok(Stored::Valid(c)) => read.push(c),
+                Ok(Stored::Missing | Stored::Stale) => missing += 1,
+                Err(e) => bad.push(e.to_string()),
+            }
+        }
+        if !bad.is_empty() {
+            return Err(SweepStageError::BadUnits {
+                count: bad.len(),
+                dir,
+                first: bad.swap_remove(0),
+            }
+            .into());
+        }
+        if missing > 0 {
+            return Err(SweepStageError::MissingUnits {
+                missing,
+                total: all.len(),
+                dir,
+            }
+            .into());
+        }
+        Ok(read)
+    }
+
+    /// Zone `z`'s variables from its units' columns `cols` (motion, frame, `T_p` in stored
+    /// order; the columns' layout is `column_lengths`').
+    fn zone_of(&self, z: usize, cols: &[Columns]) -> Result<ZoneSweep, PipelineError> {
+        let (study, grid) = (self.study, self.grid);
+        let dir = study.path(UNITS_DIR);
+        let building = study.building();
+        let mut shape = vec![self.motions[z].len()];
         shape.extend(building.iter().flat_map(|b| b.shape()));
         shape.extend(grid.shape());
         let mut shape_i = shape.clone();
-        shape_i.push(n);
+        shape_i.push(grid.blocks());
         let f = |i: usize, shape: &[usize]| -> Result<ArrayD<f64>, PipelineError> {
             let flat: Vec<f64> = cols
                 .iter()
@@ -458,10 +479,11 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
             let flat: Vec<u8> = cols.iter().flat_map(|c| c.u8s[i].iter().copied()).collect();
             array(flat, &shape, &dir)
         };
-        zones.push(ZoneSweep {
+        let zc = &study.cfg.zones[z];
+        Ok(ZoneSweep {
             name: zc.name.clone(),
             target: zc.target.clone(),
-            motions: units.motions[z].iter().map(|m| m.name.clone()).collect(),
+            motions: self.motions[z].iter().map(|m| m.name.clone()).collect(),
             vars: SweepVars {
                 u_stack: f(0, &shape)?,
                 u_single: f(1, &shape)?,
@@ -477,12 +499,21 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
                 rocks_stack: study.aspect().map(|_| codes(2)).transpose()?,
                 building: building_vars,
             },
-        });
+        })
     }
+}
+
+/// Writes `sweep.h5` of `zones` and reads it back: its fingerprint and every zone bit for bit
+/// what was meant, before the units go; its path.
+fn write_verified(
+    study: &Study,
+    grid: &Grid,
+    zones: &[ZoneSweep],
+) -> Result<PathBuf, PipelineError> {
     let me = StageId::Sweep;
     let fp = study.fingerprint(me)?;
-    let motions_fp = study.fingerprint(StageId::Motions)?;
     let physics = study.physics();
+    let building = study.building();
     let building_json = study.building_attr();
     let mut settings = super::physics_attrs(&physics).to_vec();
     if let Some(b) = &building_json {
@@ -495,15 +526,14 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
     let meta = SweepMeta {
         fingerprint: fp,
         config_sha256: &study.config_sha256,
-        motions_fingerprint: motions_fp,
+        motions_fingerprint: study.fingerprint(StageId::Motions)?,
         skip_rule_codes: SKIP_RULE_CODES,
         skip_rule_flags: SKIP_RULE_FLAGS,
         mu_static_ratio: physics.mu_static_ratio,
         settings: &settings,
     };
     let path = study.path(me.output());
-    write_sweep(&path, &meta, grid, building, &zones)?;
-    // Verified on disk before the units go: what reads back is bit for bit what was meant.
+    write_sweep(&path, &meta, grid, building, zones)?;
     if study.stored(me)?.as_deref() != Some(fp) {
         return Err(SweepStageError::Verify {
             file: path,
@@ -511,8 +541,8 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
         }
         .into());
     }
-    for z in &zones {
-        let (_, _, back) = read_zone_sweep(&path, &z.name, n, building.is_some())?;
+    for z in zones {
+        let (_, _, back) = read_zone_sweep(&path, &z.name, grid.blocks(), building.is_some())?;
         if !same_bits(&back, z) {
             return Err(SweepStageError::Verify {
                 file: path,
@@ -521,9 +551,7 @@ fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, Pi
             .into());
         }
     }
-    remove_units(study)?;
-    s.reporter.info(me, &format!("verified {}", path.display()));
-    Ok(StageOutcome::Wrote(vec![path]))
+    Ok(path)
 }
 
 fn array<T>(
