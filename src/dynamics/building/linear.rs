@@ -497,26 +497,12 @@ impl LinearBuilding {
         }
     }
 
-    /// The first pass over the samples (module doc), compiled twice: for AVX2 (chosen at run
-    /// time where the processor has it) and for the baseline. Neither contracts a multiply and
-    /// an add, so both give the same bits.
-    fn first_pass(out: &Outputs, steps: &[ModeStep], accel: &[f64], inv_h: f64) -> FirstPass {
-        let mut pass = FirstPass::new(out, steps.len(), accel.len() - 1);
-        let mut carry = Carry::new(out, steps.len());
-        #[cfg(target_arch = "x86_64")]
-        if has_avx2() {
-            // SAFETY: the processor has AVX2 (`has_avx2`).
-            unsafe { Self::blocks_avx2(out, steps, accel, inv_h, &mut pass, &mut carry, 0) };
-            return pass;
-        }
-        Self::blocks(out, steps, accel, inv_h, &mut pass, &mut carry, 0);
-        pass
-    }
-
-    /// The first pass over the samples of up to [`MOTIONS`] records of one sample interval side
-    /// by side, one per SIMD lane, over the blocks they all fill; each then finishes alone.
-    /// Every lane does the scalar pass's operations in its order: the same bits as
-    /// [`Self::first_pass`] of each record.
+    /// The first pass over the samples (module doc) of up to [`MOTIONS`] records of one sample
+    /// interval: side by side, one per SIMD lane, over the blocks they all fill, then each alone
+    /// (one record: alone throughout). Every lane does the scalar pass's operations in its
+    /// order, so each record's pass has the same bits as its own. Compiled twice: for AVX2
+    /// (chosen at run time where the processor has it) and for the baseline; neither contracts a
+    /// multiply and an add, so both give the same bits.
     fn first_passes(
         out: &Outputs,
         steps: &[ModeStep],
@@ -525,20 +511,23 @@ impl LinearBuilding {
     ) -> Vec<FirstPass> {
         let m = steps.len();
         let avx2 = has_avx2();
-        // Fewer records than lanes: the first fills the rest, its copies' passes dropped.
-        let lanes: [&[f64]; MOTIONS] =
-            std::array::from_fn(|l| *accels.get(l).unwrap_or(&accels[0]));
-        let mut passes: Vec<FirstPass> = (lanes.iter())
+        let mut passes: Vec<FirstPass> = (accels.iter())
             .map(|a| FirstPass::new(out, m, a.len() - 1))
             .collect();
-        let mut carries: Vec<Carry> = lanes.iter().map(|_| Carry::new(out, m)).collect();
-        let common = accels
-            .iter()
+        let mut carries: Vec<Carry> = accels.iter().map(|_| Carry::new(out, m)).collect();
+        let common = (accels.iter())
             .map(|a| (a.len() - 1) / BLOCK)
             .min()
             .unwrap_or(0);
         let from = if accels.len() > 1 { common } else { 0 };
         if from > 0 {
+            // Fewer records than lanes: the first fills the rest, its copies' passes dropped.
+            let lanes: [&[f64]; MOTIONS] =
+                std::array::from_fn(|l| *accels.get(l).unwrap_or(&accels[0]));
+            for a in &lanes[accels.len()..] {
+                passes.push(FirstPass::new(out, m, a.len() - 1));
+                carries.push(Carry::new(out, m));
+            }
             #[cfg(target_arch = "x86_64")]
             if avx2 {
                 // SAFETY: the processor has AVX2 (`has_avx2`).
@@ -784,7 +773,9 @@ impl LinearBuilding {
     fn peaks(&self, out: &Outputs, ground: &Ground) -> Result<Vec<f64>, LinearBuildingError> {
         ground.validate()?;
         let steps = self.mode_steps(ground.dt_s);
-        let first = Self::first_pass(out, &steps, ground.accel_mps2, 1.0 / ground.dt_s);
+        let first = Self::first_passes(out, &steps, &[ground.accel_mps2], 1.0 / ground.dt_s)
+            .pop()
+            .expect("one record, one pass");
         self.second_pass(out, &steps, ground, first)
     }
 
