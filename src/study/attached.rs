@@ -560,11 +560,11 @@ pub struct Memo<'a> {
 }
 
 impl<'a> Memo<'a> {
-    pub fn new(
-        scan: &[(f64, Means)],
+    pub fn new<'k>(
+        known: impl IntoIterator<Item = &'k (f64, Means)>,
         compute: impl FnMut(f64, Quantity) -> Result<f64, CaseError> + 'a,
     ) -> Self {
-        let known = (scan.iter())
+        let known = (known.into_iter())
             .flat_map(|(f, m)| {
                 let all = Quantity::all(m.storey_shear.len());
                 all.into_iter().map(move |q| ((f.to_bits(), q), m.get(q)))
@@ -856,11 +856,11 @@ pub fn zone_fractions(
             };
             // Every quantity's search evaluates the prior: one run gives them all.
             let prior = prior_fraction(share, scan);
-            let mut known = scan.clone();
-            if !scan.iter().any(|(f, _)| *f == prior) {
-                known.push((prior, family_means(physics, &case, frame, prior, grounds)?));
-            }
-            let mut memo = Memo::new(&known, |f, q| {
+            let at_prior = match scan.iter().any(|(f, _)| *f == prior) {
+                true => None,
+                false => Some((prior, family_means(physics, &case, frame, prior, grounds)?)),
+            };
+            let mut memo = Memo::new(scan.iter().chain(&at_prior), |f, q| {
                 family_mean(physics, &case, frame, f, grounds, q)
             });
             let mut solve_for = |q: Quantity| -> Result<(f64, FractionFlag), CaseError> {
