@@ -42,6 +42,17 @@ macro_rules! flag_enum {
 
         $(#[$table_meta])*
         $table_vis const $table: &[(u8, &str)] = &[$(($name::$variant as u8, $word),)+];
+
+        impl $name {
+            /// The flag stored as `code`, if it is one.
+            #[allow(dead_code)]
+            $vis fn from_code(code: u8) -> Option<Self> {
+                match code {
+                    $($code => Some(Self::$variant),)+
+                    _ => None,
+                }
+            }
+        }
     };
 }
 

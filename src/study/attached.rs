@@ -756,161 +756,205 @@ pub enum AttachedError {
     Stopped,
 }
 
-/// The attached fractions of every case of a zone, flat over `[frame][case]` (`grid`'s cases in
-/// each of `frames`): `swept` per case, `slides` whether any interface slipped under any motion.
-/// The scans depend on the frame, `T_p` and `α` (through the damping matrix) but not on `μ`:
-/// each is made once for the first case of its key; frames that are one building
-/// ([`super::building::first_of_building`]) are computed once. Keys and cases run in
-/// parallel, each on its own, so the numbers do not depend on the threads. `keep_going` is
-/// asked before each case (Ctrl-C).
-pub fn zone_fractions(
-    physics: &Physics,
-    grid: &crate::grid::Grid,
-    frames: &[Frame],
-    grounds: &[Ground],
-    swept: &[Swept],
-    slides: &[bool],
-    keep_going: &(dyn Fn() -> bool + Sync),
-) -> Result<Vec<CaseFractions>, AttachedError> {
-    use rayon::prelude::*;
+/// One unit of a zone's attached fractions, the work that `tnew --shard` splits: a scan key (a
+/// distinct building's frame, `T_p` and total `α`: the scan depends on them, through the
+/// damping matrix, but not on `μ`) and the cases of that frame that share it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FractionUnit {
+    pub frame: usize,
+    pub period_s: f64,
+    pub alpha_total: f64,
+    /// Its cases, flat over `[frame][case]` and ascending; the first makes the scan.
+    pub cases: Vec<usize>,
+}
+
+/// The units of a zone's attached fractions over `grid`'s cases in each of `frames`, in the
+/// order of their keys (frame, `T_p`, total `α`); frames that are one building
+/// ([`super::building::first_of_building`]) give units for the first only.
+pub fn fraction_units(grid: &crate::grid::Grid, frames: &[Frame]) -> Vec<FractionUnit> {
     let per_frame = grid.cases();
-    let cases = frames.len() * per_frame;
     let first = super::building::first_of_building(frames);
-    let own: Vec<usize> = (0..cases)
-        .filter(|&c| first[c / per_frame] == c / per_frame)
-        .collect();
-    let case_of = |c: usize| grid.case(c % per_frame);
-    let key = |c: usize| {
-        let case = case_of(c);
-        (
-            c / per_frame,
-            case.period_s.to_bits(),
-            case.alpha_total().to_bits(),
-        )
-    };
-    // The stack's and the rigid system's means and the share of every own case: the sweep's,
-    // or on one storey simulated here (the rigid system once per key; the sweep's no-slip rule
-    // for the stack, whose argument holds whatever the integrator).
-    let mut firsts = BTreeMap::new();
-    for &c in &own {
-        firsts.entry(key(c)).or_insert(c);
+    let mut units: BTreeMap<(usize, u64, u64), FractionUnit> = BTreeMap::new();
+    for c in (0..frames.len() * per_frame).filter(|&c| first[c / per_frame] == c / per_frame) {
+        let case = grid.case(c % per_frame);
+        let (period_s, alpha_total) = (case.period_s, case.alpha_total());
+        let key = (c / per_frame, period_s.to_bits(), alpha_total.to_bits());
+        (units.entry(key))
+            .or_insert_with(|| FractionUnit {
+                frame: c / per_frame,
+                period_s,
+                alpha_total,
+                cases: Vec::new(),
+            })
+            .cases
+            .push(c);
     }
-    let firsts: Vec<((usize, u64, u64), usize)> = firsts.into_iter().collect();
-    type Scan = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64);
-    let scans: BTreeMap<(usize, u64, u64), Scan> = firsts
-        .par_iter()
-        .map(|&(k, c)| -> Result<_, AttachedError> {
-            if !keep_going() {
-                return Err(AttachedError::Stopped);
-            }
-            let (case, frame) = (case_of(c), &frames[c / per_frame]);
-            let rigid = match &swept[c] {
-                Some((_, rigid, _)) => rigid.clone(),
-                None => system_means(physics, SystemKind::Rigid, &case, frame, grounds)?.0,
+    units.into_values().collect()
+}
+
+/// What a zone's attached fractions are made from: `swept` per case (flat over `[frame][case]`,
+/// `grid`'s cases in each of `frames`), `slides` whether any interface slipped under any motion.
+/// `keep_going` is asked before each case (Ctrl-C).
+pub struct ZoneFamily<'a> {
+    pub physics: &'a Physics,
+    pub grid: &'a crate::grid::Grid,
+    pub frames: &'a [Frame],
+    pub grounds: &'a [Ground<'a>],
+    pub swept: &'a [Swept],
+    pub slides: &'a [bool],
+    pub keep_going: &'a (dyn Fn() -> bool + Sync),
+}
+
+/// A unit's scan: the family's means at the scan's fractions, the code-format ratio at each and
+/// the rigid system's mean spectral acceleration at `T_1`, g.
+type Scan = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64);
+
+impl ZoneFamily<'_> {
+    /// The attached fractions of every case of `unit`, in its order: the scan once, then each
+    /// case on its own (in parallel: the numbers do not depend on the threads).
+    pub fn unit(&self, unit: &FractionUnit) -> Result<Vec<CaseFractions>, AttachedError> {
+        use rayon::prelude::*;
+        let scan = self.scan(unit.cases[0])?;
+        (unit.cases.par_iter())
+            .map(|&c| self.case(c, &scan))
+            .collect()
+    }
+
+    /// The scan of the key of case `c`.
+    fn scan(&self, c: usize) -> Result<Scan, AttachedError> {
+        let (physics, grounds) = (self.physics, self.grounds);
+        if !(self.keep_going)() {
+            return Err(AttachedError::Stopped);
+        }
+        let per_frame = self.grid.cases();
+        let (case, frame) = (self.grid.case(c % per_frame), &self.frames[c / per_frame]);
+        // The rigid system's means: the sweep's, or on one storey simulated here.
+        let rigid = match &self.swept[c] {
+            Some((_, rigid, _)) => rigid.clone(),
+            None => system_means(physics, SystemKind::Rigid, &case, frame, grounds)?.0,
+        };
+        let mut scan = Vec::new();
+        for f in scan_fractions(&case) {
+            let m = if f == 1.0 {
+                rigid.clone()
+            } else {
+                family_means(physics, &case, frame, f, grounds)?
             };
-            let mut scan = Vec::new();
-            for f in scan_fractions(&case) {
-                let m = if f == 1.0 {
-                    rigid.clone()
-                } else {
-                    family_means(physics, &case, frame, f, grounds)?
-                };
-                scan.push((f, m));
-            }
-            let t_rigid = frame.t1_attached_s(&case, 1.0);
-            let psa_rigid =
-                mean_psa_g(grounds, t_rigid).map_err(|source| AttachedError::Spectrum {
-                    period_s: t_rigid,
-                    source,
-                })?;
-            let code = (scan.iter().map(|(f, _)| *f))
-                .map(|f| {
-                    code_shear_ratio(&case, frame, grounds, f, psa_rigid)
-                        .map(|g| (f, g))
-                        .map_err(|source| AttachedError::Spectrum {
-                            period_s: frame.t1_attached_s(&case, f),
-                            source,
-                        })
-                })
-                .collect::<Result<Vec<_>, _>>()?;
-            Ok((k, (scan, code, psa_rigid)))
-        })
-        .collect::<Result<_, _>>()?;
-    let computed: Vec<CaseFractions> = own
-        .par_iter()
-        .map(|&c| -> Result<CaseFractions, AttachedError> {
-            if !keep_going() {
-                return Err(AttachedError::Stopped);
-            }
-            let (case, frame) = (case_of(c), &frames[c / per_frame]);
-            let (scan, code_scan, psa_rigid) = &scans[&key(c)];
-            let rigid = scan[scan.len() - 1].1.clone();
-            let bare = (scan.iter().find(|(f, _)| *f == 0.0))
-                .expect("the scan holds 0")
-                .1
-                .clone();
-            let (stack, share) = match &swept[c] {
-                Some((stack, _, share)) => (stack.clone(), *share),
-                None if holds_everywhere(physics, &case, frame, grounds)? => (rigid.clone(), 1.0),
-                None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
-            };
-            // Every quantity's search evaluates the prior: one run gives them all.
-            let prior = prior_fraction(share, scan);
-            let at_prior = match scan.iter().any(|(f, _)| *f == prior) {
-                true => None,
-                false => Some((prior, family_means(physics, &case, frame, prior, grounds)?)),
-            };
-            let mut memo = Memo::new(scan.iter().chain(&at_prior), |f, q| {
-                family_mean(physics, &case, frame, f, grounds, q)
-            });
-            let mut solve_for = |q: Quantity| -> Result<(f64, FractionFlag), CaseError> {
-                let points: Vec<(f64, f64)> = scan.iter().map(|(f, m)| (*f, m.get(q))).collect();
-                let (f, flag) = solve(stack.get(q), share, &points, |f| memo.get(f, q))?;
-                Ok((
-                    f,
-                    if slides[c] {
-                        flag
-                    } else {
-                        FractionFlag::NoSlide
-                    },
-                ))
-            };
-            let roof = solve_for(Quantity::Roof)?;
-            let storey = (0..frame.storeys())
-                .map(|i| solve_for(Quantity::StoreyShear(i)))
-                .collect::<Result<Vec<_>, _>>()?;
-            let overturning = solve_for(Quantity::Overturning)?;
-            let target = stack.storey_shear[0] / rigid.storey_shear[0];
-            let code = solve(target, share, code_scan, |f| {
-                code_shear_ratio(&case, frame, grounds, f, *psa_rigid).map_err(|source| {
-                    AttachedError::Spectrum {
+            scan.push((f, m));
+        }
+        let t_rigid = frame.t1_attached_s(&case, 1.0);
+        let psa_rigid = mean_psa_g(grounds, t_rigid).map_err(|source| AttachedError::Spectrum {
+            period_s: t_rigid,
+            source,
+        })?;
+        let code = (scan.iter().map(|(f, _)| *f))
+            .map(|f| {
+                code_shear_ratio(&case, frame, grounds, f, psa_rigid)
+                    .map(|g| (f, g))
+                    .map_err(|source| AttachedError::Spectrum {
                         period_s: frame.t1_attached_s(&case, f),
                         source,
-                    }
-                })
-            })?;
-            let code = (
-                code.0,
-                if slides[c] {
-                    code.1
-                } else {
-                    FractionFlag::NoSlide
-                },
-            );
-            Ok(CaseFractions {
-                stack,
-                rigid,
-                bare,
-                share,
-                roof,
-                storey,
-                overturning,
-                code,
+                    })
             })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((scan, code, psa_rigid))
+    }
+
+    /// Case `c`'s attached fractions from its key's scan.
+    fn case(
+        &self,
+        c: usize,
+        (scan, code_scan, psa_rigid): &Scan,
+    ) -> Result<CaseFractions, AttachedError> {
+        let (physics, grounds) = (self.physics, self.grounds);
+        if !(self.keep_going)() {
+            return Err(AttachedError::Stopped);
+        }
+        let per_frame = self.grid.cases();
+        let (case, frame) = (self.grid.case(c % per_frame), &self.frames[c / per_frame]);
+        let rigid = scan[scan.len() - 1].1.clone();
+        let bare = (scan.iter().find(|(f, _)| *f == 0.0))
+            .expect("the scan holds 0")
+            .1
+            .clone();
+        // The stack's means and share: the sweep's, or on one storey simulated here (the
+        // sweep's no-slip rule, whose argument holds whatever the integrator).
+        let (stack, share) = match &self.swept[c] {
+            Some((stack, _, share)) => (stack.clone(), *share),
+            None if holds_everywhere(physics, &case, frame, grounds)? => (rigid.clone(), 1.0),
+            None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
+        };
+        let slid = |flag| match self.slides[c] {
+            true => flag,
+            false => FractionFlag::NoSlide,
+        };
+        // Every quantity's search evaluates the prior: one run gives them all.
+        let prior = prior_fraction(share, scan);
+        let at_prior = match scan.iter().any(|(f, _)| *f == prior) {
+            true => None,
+            false => Some((prior, family_means(physics, &case, frame, prior, grounds)?)),
+        };
+        let mut memo = Memo::new(scan.iter().chain(&at_prior), |f, q| {
+            family_mean(physics, &case, frame, f, grounds, q)
+        });
+        let mut solve_for = |q: Quantity| -> Result<(f64, FractionFlag), CaseError> {
+            let points: Vec<(f64, f64)> = scan.iter().map(|(f, m)| (*f, m.get(q))).collect();
+            let (f, flag) = solve(stack.get(q), share, &points, |f| memo.get(f, q))?;
+            Ok((f, slid(flag)))
+        };
+        let roof = solve_for(Quantity::Roof)?;
+        let storey = (0..frame.storeys())
+            .map(|i| solve_for(Quantity::StoreyShear(i)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let overturning = solve_for(Quantity::Overturning)?;
+        let target = stack.storey_shear[0] / rigid.storey_shear[0];
+        let code = solve(target, share, code_scan, |f| {
+            code_shear_ratio(&case, frame, grounds, f, *psa_rigid).map_err(|source| {
+                AttachedError::Spectrum {
+                    period_s: frame.t1_attached_s(&case, f),
+                    source,
+                }
+            })
+        })?;
+        Ok(CaseFractions {
+            stack,
+            rigid,
+            bare,
+            share,
+            roof,
+            storey,
+            overturning,
+            code: (code.0, slid(code.1)),
         })
+    }
+}
+
+/// The attached fractions of every case of a zone, flat over `[frame][case]` (`grid`'s cases in
+/// each of `frames`; a frame that repeats a building takes its first frame's), from each unit's
+/// (`of_units`, in `units`' order, [`fraction_units`]).
+pub fn spread(
+    grid: &crate::grid::Grid,
+    frames: &[Frame],
+    units: &[FractionUnit],
+    of_units: &[Vec<CaseFractions>],
+) -> Vec<CaseFractions> {
+    let per_frame = grid.cases();
+    let first = super::building::first_of_building(frames);
+    let at: BTreeMap<usize, &CaseFractions> = (units.iter().zip(of_units))
+        .flat_map(|(u, l)| u.cases.iter().copied().zip(l))
+        .collect();
+    (0..frames.len() * per_frame)
+        .map(|c| at[&(first[c / per_frame] * per_frame + c % per_frame)].clone())
+        .collect()
+}
+
+/// The attached fractions of every case of a zone, flat over `[frame][case]`
+/// ([`spread`] of every unit's, the units in parallel).
+pub fn zone_fractions(family: &ZoneFamily) -> Result<Vec<CaseFractions>, AttachedError> {
+    use rayon::prelude::*;
+    let units = fraction_units(family.grid, family.frames);
+    let of_units: Vec<Vec<CaseFractions>> = (units.par_iter())
+        .map(|u| family.unit(u))
         .collect::<Result<_, _>>()?;
-    let at: BTreeMap<usize, usize> = own.iter().enumerate().map(|(i, &c)| (c, i)).collect();
-    Ok((0..cases)
-        .map(|c| computed[at[&(first[c / per_frame] * per_frame + c % per_frame)]].clone())
-        .collect())
+    Ok(spread(family.grid, family.frames, &units, &of_units))
 }

@@ -28,7 +28,9 @@ use crate::ground_motion::Record;
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
 use crate::store::sweep::{BuildingVars, SweepVars};
 use crate::store::tnew::{AttachedVars, TnewVars, ZoneTnew};
-use crate::study::attached::{self, AttachedError, CaseFractions, FRACTION_FLAGS, FractionFlag};
+use crate::study::attached::{
+    self, AttachedError, CaseFractions, FRACTION_FLAGS, FractionFlag, FractionUnit, ZoneFamily,
+};
 use crate::study::building::{Frame, repeats};
 use crate::study::physics::Physics;
 use ndarray::{ArrayD, Axis};
@@ -373,86 +375,176 @@ impl FractionCounts {
 
 /// A zone's `T_new` (paper Section 7.1; a building of several storeys: `T_1` of the attached
 /// fraction of its roof's mean peak displacement, docs/model.md, "A study over buildings"),
-/// its `DRR`s and, in a building study, its attached fractions.
+/// its `DRR`s and, in a building study, its attached fractions: [`ZoneWork`] with every unit
+/// computed here (the units in parallel).
 pub fn zone(inp: &ZoneInputs) -> Result<ZoneOutcome, TnewError> {
-    let (grid, v) = (inp.grid, inp.sweep);
-    let period_sd_s = spectrum_periods_s(grid);
-    let sd_mean_m = mean_displacement_spectrum(inp.name, inp.motions, &period_sd_s)?;
-    let m = inp.motions.len();
-    // Means over the motion axis (summed in motion order, then divided).
-    let mean = |v: &ArrayD<f64>| v.sum_axis(Axis(0)) / m as f64;
-    let (u_stack, u_single, u_rigid) = (mean(&v.u_stack), mean(&v.u_single), mean(&v.u_rigid));
-    let per_frame = grid.cases();
-    let cases = inp.frames.len() * per_frame;
-    let slides = slides(&v.slip_peak, m, cases, grid.blocks());
-    let mut shape: Vec<usize> = inp.building.iter().flat_map(|b| b.shape()).collect();
-    shape.extend(grid.shape());
-    let shaped = |v: Vec<f64>| {
-        ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
-    };
-    let frames: Vec<Frame> = inp.frames.iter().flatten().cloned().collect();
-    let fractions = match (&v.building, inp.building) {
-        (Some(bv), Some(_)) => Some(attached_fractions(
-            inp, &frames, bv, &u_stack, &u_rigid, &slides,
-        )?),
-        _ => None,
-    };
-    let participation: Vec<f64> = (inp.frames.iter())
-        .map(|f| f.as_ref().map_or(1.0, Frame::roof_participation))
-        .collect();
-    let p = CasePeriods::of(
-        grid,
-        inp.frames,
-        &participation,
-        (&period_sd_s, &sd_mean_m),
-        &u_stack,
-        &slides,
-        fractions.as_deref(),
-    );
-    let bands = BandCounts::new(&p.band, &p.t_new, &p.t_rigid);
-    let lambda = match (&fractions, inp.building) {
-        (Some(l), Some(axes)) => Some(attached_vars(
-            l,
-            &shape,
-            axes.max_storeys(),
-            shaped(p.t_first_mode.clone()),
-        )),
-        _ => None,
-    };
-    let vars = TnewVars {
-        drr_1: &u_stack / &u_rigid,
-        drr_2: &u_single / &u_rigid,
-        u_stack_mean: u_stack,
-        u_single_mean: u_single,
-        u_rigid_mean: u_rigid,
-        t_rigid: shaped(p.t_rigid),
-        t_new: shaped(p.t_new),
-        slides: shaped(slides.iter().map(|&b| f64::from(u8::from(b))).collect()),
-        flag: shaped(p.flag),
-        band: ArrayD::from_shape_vec(shape.clone(), p.band).expect("one code per case"),
-    };
-    // Γ_1·φ_1,N per storey count (stored).
-    let roof_participation = match inp.building {
-        None => Vec::new(),
-        Some(b) => (0..b.storeys.len())
-            .map(|s| participation[s * b.stack_floor.len()])
-            .collect(),
-    };
-    Ok(ZoneOutcome {
-        fractions: (fractions.as_deref()).map(|l| FractionCounts::new(l, &frames, per_frame)),
-        tnew: ZoneTnew {
-            name: inp.name.to_string(),
-            target: inp.target.to_string(),
-            vars,
-            period_sd_s,
-            sd_mean_m,
-            roof_participation,
-            lambda,
-            rocks_share: (v.rocks_stack.as_ref()).map(|r| mean(&r.mapv(f64::from))),
-        },
-        cases,
-        bands,
-    })
+    let work = ZoneWork::new(inp);
+    let of_units = (work.units().par_iter())
+        .map(|u| work.fractions_of(u))
+        .collect::<Result<Vec<_>, _>>()?;
+    work.finish(of_units)
+}
+
+/// A zone's `T_new` in two parts, so that its costly part can be split (`tnew --shard`): the
+/// attached fractions' units ([`attached::fraction_units`]: none on one storey), each computed
+/// on its own by [`Self::fractions_of`], and [`Self::finish`] with every unit's fractions.
+pub struct ZoneWork<'a> {
+    inp: &'a ZoneInputs<'a>,
+    /// The motions' accelerations, m/s².
+    accels: Vec<Vec<f64>>,
+    /// The means over the motions (summed in motion order, then divided), `[(frame,) case…]`.
+    u_stack: ArrayD<f64>,
+    u_single: ArrayD<f64>,
+    u_rigid: ArrayD<f64>,
+    /// Per case (flat over `[frame][case]`): whether any interface slipped under any motion.
+    slides: Vec<bool>,
+    frames: Vec<Frame>,
+    /// A building study's sweep means per case and its units; empty on one storey.
+    swept: Vec<attached::Swept>,
+    units: Vec<FractionUnit>,
+}
+
+impl<'a> ZoneWork<'a> {
+    /// The zone's means over the motions and its units, from the sweep (no simulation).
+    pub fn new(inp: &'a ZoneInputs<'a>) -> Self {
+        let (grid, v) = (inp.grid, inp.sweep);
+        let m = inp.motions.len();
+        let mean = |v: &ArrayD<f64>| v.sum_axis(Axis(0)) / m as f64;
+        let (u_stack, u_single, u_rigid) = (mean(&v.u_stack), mean(&v.u_single), mean(&v.u_rigid));
+        let per_frame = grid.cases();
+        let cases = inp.frames.len() * per_frame;
+        let slides = slides(&v.slip_peak, m, cases, grid.blocks());
+        let frames: Vec<Frame> = inp.frames.iter().flatten().cloned().collect();
+        let (swept, units) = match (&v.building, inp.building) {
+            (Some(bv), Some(_)) => (
+                swept(bv, &u_stack, &u_rigid, &frames, per_frame, m),
+                attached::fraction_units(grid, &frames),
+            ),
+            _ => (Vec::new(), Vec::new()),
+        };
+        Self {
+            inp,
+            accels: inp.motions.iter().map(|r| r.accel_mps2(1.0)).collect(),
+            u_stack,
+            u_single,
+            u_rigid,
+            slides,
+            frames,
+            swept,
+            units,
+        }
+    }
+
+    /// The units of the zone's attached fractions (none on one storey).
+    pub fn units(&self) -> &[FractionUnit] {
+        &self.units
+    }
+
+    /// The attached fractions of `unit`'s cases, in its order.
+    pub fn fractions_of(&self, unit: &FractionUnit) -> Result<Vec<CaseFractions>, TnewError> {
+        let grounds: Vec<Ground> = (self.inp.motions.iter().zip(&self.accels))
+            .map(|(r, a)| Ground::new(r.dt_s, a))
+            .collect();
+        let family = ZoneFamily {
+            physics: self.inp.physics,
+            grid: self.inp.grid,
+            frames: &self.frames,
+            grounds: &grounds,
+            swept: &self.swept,
+            slides: &self.slides,
+            keep_going: self.inp.keep_going,
+        };
+        family.unit(unit).map_err(|e| TnewError::Attached {
+            zone: self.inp.name.to_string(),
+            source: Box::new(e),
+        })
+    }
+
+    /// The zone's `T_new`, `DRR`s and attached fractions from every unit's fractions
+    /// (`of_units`, in [`Self::units`]' order).
+    pub fn finish(self, of_units: Vec<Vec<CaseFractions>>) -> Result<ZoneOutcome, TnewError> {
+        let (inp, grid) = (self.inp, self.inp.grid);
+        let period_sd_s = spectrum_periods_s(grid);
+        let sd_mean_m = mean_displacement_spectrum(inp.name, inp.motions, &period_sd_s)?;
+        let per_frame = grid.cases();
+        let cases = inp.frames.len() * per_frame;
+        let mut shape: Vec<usize> = inp.building.iter().flat_map(|b| b.shape()).collect();
+        shape.extend(grid.shape());
+        let shaped = |v: Vec<f64>| {
+            ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
+        };
+        let fractions = match (&inp.sweep.building, inp.building) {
+            (Some(_), Some(_)) => {
+                Some(attached::spread(grid, &self.frames, &self.units, &of_units))
+            }
+            _ => None,
+        };
+        let participation: Vec<f64> = (inp.frames.iter())
+            .map(|f| f.as_ref().map_or(1.0, Frame::roof_participation))
+            .collect();
+        let p = CasePeriods::of(
+            grid,
+            inp.frames,
+            &participation,
+            (&period_sd_s, &sd_mean_m),
+            &self.u_stack,
+            &self.slides,
+            fractions.as_deref(),
+        );
+        let bands = BandCounts::new(&p.band, &p.t_new, &p.t_rigid);
+        let lambda = match (&fractions, inp.building) {
+            (Some(l), Some(axes)) => Some(attached_vars(
+                l,
+                &shape,
+                axes.max_storeys(),
+                shaped(p.t_first_mode.clone()),
+            )),
+            _ => None,
+        };
+        let (u_stack, u_single, u_rigid) = (self.u_stack, self.u_single, self.u_rigid);
+        let vars = TnewVars {
+            drr_1: &u_stack / &u_rigid,
+            drr_2: &u_single / &u_rigid,
+            u_stack_mean: u_stack,
+            u_single_mean: u_single,
+            u_rigid_mean: u_rigid,
+            t_rigid: shaped(p.t_rigid),
+            t_new: shaped(p.t_new),
+            slides: shaped(
+                self.slides
+                    .iter()
+                    .map(|&b| f64::from(u8::from(b)))
+                    .collect(),
+            ),
+            flag: shaped(p.flag),
+            band: ArrayD::from_shape_vec(shape.clone(), p.band).expect("one code per case"),
+        };
+        // Γ_1·φ_1,N per storey count (stored).
+        let roof_participation = match inp.building {
+            None => Vec::new(),
+            Some(b) => (0..b.storeys.len())
+                .map(|s| participation[s * b.stack_floor.len()])
+                .collect(),
+        };
+        let m = inp.motions.len();
+        Ok(ZoneOutcome {
+            fractions: (fractions.as_deref())
+                .map(|l| FractionCounts::new(l, &self.frames, per_frame)),
+            tnew: ZoneTnew {
+                name: inp.name.to_string(),
+                target: inp.target.to_string(),
+                vars,
+                period_sd_s,
+                sd_mean_m,
+                roof_participation,
+                lambda,
+                rocks_share: (inp.sweep.rocks_stack.as_ref())
+                    .map(|r| r.mapv(f64::from).sum_axis(Axis(0)) / m as f64),
+            },
+            cases,
+            bands,
+        })
+    }
 }
 
 /// The zone's mean 5 %-damped displacement spectrum at `periods_s`, m (summed in motion order,
@@ -545,38 +637,8 @@ impl CasePeriods {
     }
 }
 
-/// The building's attached fractions of every case (docs/model.md, "The attached fraction").
-fn attached_fractions(
-    inp: &ZoneInputs,
-    frames: &[Frame],
-    bv: &BuildingVars,
-    u_stack: &ArrayD<f64>,
-    u_rigid: &ArrayD<f64>,
-    slides: &[bool],
-) -> Result<Vec<CaseFractions>, TnewError> {
-    let accels: Vec<Vec<f64>> = inp.motions.iter().map(|r| r.accel_mps2(1.0)).collect();
-    let grounds: Vec<Ground> = (inp.motions.iter().zip(&accels))
-        .map(|(r, a)| Ground::new(r.dt_s, a))
-        .collect();
-    let per_frame = inp.grid.cases();
-    let swept = swept(bv, u_stack, u_rigid, frames, per_frame, inp.motions.len());
-    attached::zone_fractions(
-        inp.physics,
-        inp.grid,
-        frames,
-        &grounds,
-        &swept,
-        slides,
-        inp.keep_going,
-    )
-    .map_err(|e| TnewError::Attached {
-        zone: inp.name.to_string(),
-        source: Box::new(e),
-    })
-}
-
 /// The sweep's means over the motions (summed in motion order, then divided) of every case of
-/// a building study's zone that [`attached::zone_fractions`] needs: per case (flat over
+/// a building study's zone that the attached fractions need ([`ZoneFamily`]): per case (flat over
 /// `[frame][case]`) the stack's and the rigid system's mean peaks and the mean stuck share,
 /// `None` in a building of one storey (its integrator gives neither the shears nor the share).
 fn swept(
