@@ -211,7 +211,6 @@ impl Classify for PipelineError {
                 | MotionsError::Changed { .. } => Fault::of(Failed),
             },
             PipelineError::Sweep(e) => match e {
-                SweepStageError::Shard { .. } => Fault::of(BadInput).key("shard"),
                 SweepStageError::MissingUnits { dir, .. } => {
                     Fault::of(MissingFile).file(dir.display())
                 }
@@ -223,7 +222,6 @@ impl Classify for PipelineError {
                 IdaStageError::NoSection { config } => {
                     Fault::of(BadInput).file(config.display()).key("ida")
                 }
-                IdaStageError::Shard { .. } => Fault::of(BadInput).key("shard"),
                 IdaStageError::Simulation { .. } => Fault::of(Failed),
             },
             PipelineError::Floors(e) => match e {
@@ -237,6 +235,7 @@ impl Classify for PipelineError {
             PipelineError::Tnew(_) | PipelineError::Fit(_) | PipelineError::Report(_) => {
                 Fault::of(Failed)
             }
+            PipelineError::Shard { .. } => Fault::of(BadInput).key("shard"),
             PipelineError::Cancelled(_) => Fault::of(Interrupted),
         }
     }

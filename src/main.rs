@@ -24,11 +24,12 @@ enum Command {
     /// Study stage 1: seed motions matched to every zone's target → motions.h5.
     Motions(cmd::StudyArgs),
     /// Study stage 2: every case of the grid under every motion → sweep.h5 (resumable, shards).
-    Sweep(cmd::sweep::Args),
+    Sweep(cmd::stage::ShardArgs),
     /// Join the units of a sharded sweep into sweep.h5.
     Merge(cmd::StudyArgs),
-    /// Study stage 3: T_new and the displacement response ratios → tnew.h5.
-    Tnew(cmd::StudyArgs),
+    /// Study stage 3: T_new and the displacement response ratios → tnew.h5 (resumable; in a
+    /// building study shards of the attached fractions).
+    Tnew(cmd::stage::ShardArgs),
     /// Study stage 4: fit the design equation for T_new (argmin) → fit.h5, fit.yaml.
     Fit(cmd::StudyArgs),
     /// Study stage 5: figures and tables → report/index.html.
@@ -72,9 +73,9 @@ fn main() -> std::process::ExitCode {
         Command::Spectrum(args) => cmd::spectrum::run(args),
         Command::Match(args) => cmd::matching::run(args),
         Command::Motions(args) => cmd::stage::run(args, StageId::Motions),
-        Command::Sweep(args) => cmd::sweep::run(args),
-        Command::Merge(args) => cmd::sweep::merge(args),
-        Command::Tnew(args) => cmd::stage::run(args, StageId::Tnew),
+        Command::Sweep(args) => cmd::stage::run_sharded(args, StageId::Sweep),
+        Command::Merge(args) => cmd::merge::run(args),
+        Command::Tnew(args) => cmd::stage::run_sharded(args, StageId::Tnew),
         Command::Fit(args) => cmd::stage::run(args, StageId::Fit),
         Command::Report(args) => cmd::stage::run(args, StageId::Report),
         Command::Ida(args) => cmd::ida::run(args),

@@ -22,6 +22,10 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
 fn repo(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
 }
@@ -389,6 +393,7 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
     let two = std::fs::read(out.join("tnew.h5")).unwrap();
     ok(slidestack(&["tnew", cfg_s, "--out", out_s, "--force"], "1"));
     assert_eq!(std::fs::read(out.join("tnew.h5")).unwrap(), two);
+    tnew_shards_a_kill_and_a_damaged_unit_give_the_unsharded_bytes(dir.path(), &out, &two);
     // λ: 1 where nothing slid, between the family's ends otherwise (unclamped: below 0 where
     // the stack lowers the base shear below the bare building's), the same on one storey's
     // three floors; labelled.
@@ -427,6 +432,98 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
     );
 
     several_frames_are_fitted_and_designed_for(&out);
+}
+
+/// `tnew` of `configs/mdof-quick.yaml` (motions and sweep done in `out`, whose unsharded
+/// `tnew.h5` is `want`) split in three shards, one of them killed with SIGKILL after its first
+/// unit file and rerun, then a stored unit damaged: the unsharded stage recomputes that unit,
+/// assembles the same bytes and removes the unit files. A split into more shards than units is
+/// bad input (exit 2).
+fn tnew_shards_a_kill_and_a_damaged_unit_give_the_unsharded_bytes(
+    tmp: &Path,
+    out: &Path,
+    want: &[u8],
+) {
+    let cfg = repo("configs/mdof-quick.yaml");
+    let split = tmp.join("tnew-split");
+    std::fs::create_dir_all(&split).unwrap();
+    for f in [
+        "motions.h5",
+        "motions.h5.sha256",
+        "sweep.h5",
+        "sweep.h5.sha256",
+    ] {
+        std::fs::copy(out.join(f), split.join(f)).unwrap();
+    }
+    // 2 zones × 2 distinct buildings (one storey, and 3 storeys ×3 floors: 4) × 3 periods × 2
+    // total α.
+    let o = ok(slidestack(
+        &["status", s(&cfg), "--out", s(&split), "--format", "env"],
+        "1",
+    ));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("TNEW_UNITS=48\n") && text.contains("TNEW_UNITS_DONE=0\n"),
+        "{text}"
+    );
+    let shard = |k: &str, threads: &str| {
+        let o = ok(slidestack(
+            &["tnew", s(&cfg), "--out", s(&split), "--shard", k],
+            threads,
+        ));
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(text.contains(&format!("shard {k} done")), "{text}");
+    };
+    shard("3/3", "1");
+    common::kill_at(
+        &["tnew", s(&cfg), "--out", s(&split), "--shard", "1/3"],
+        "tnew.unit:1",
+        tmp,
+    );
+    let units = split.join("tnew.units");
+    assert_eq!(std::fs::read_dir(&units).unwrap().count(), 16 + 1);
+    shard("1/3", "2");
+    shard("2/3", "2");
+    assert!(!split.join("tnew.h5").exists());
+    let mut files: Vec<PathBuf> = (std::fs::read_dir(&units).unwrap())
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 48);
+    let o = ok(slidestack(&["status", s(&cfg), "--out", s(&split)], "1"));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("tnew units: 48 of 48 stored"), "{text}");
+    // One byte of a stored unit flipped: refused by its checksum, computed again.
+    let mut bytes = std::fs::read(&files[5]).unwrap();
+    bytes[40] ^= 1;
+    std::fs::write(&files[5], bytes).unwrap();
+    let o = ok(slidestack(&["tnew", s(&cfg), "--out", s(&split)], "1"));
+    let (text, err) = (String::from_utf8_lossy(&o.stdout), stderr(&o));
+    assert!(
+        err.contains("fails its checksum") && err.contains("computing it again"),
+        "{err}"
+    );
+    assert!(text.contains("1 of 24 units"), "{text}");
+    assert_eq!(std::fs::read(split.join("tnew.h5")).unwrap(), want);
+    assert!(!units.exists());
+    let o = slidestack(
+        &[
+            "tnew",
+            s(&cfg),
+            "--out",
+            s(&split),
+            "--shard",
+            "1/49",
+            "--force",
+        ],
+        "1",
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("shard 1/49: needs 1 ≤ K ≤ N ≤ 48"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// The fit over the six frames of `configs/mdof-quick.yaml` (finished through `tnew` in `out`)
@@ -605,6 +702,15 @@ fn one_storey_buildings_are_the_one_storey_study() {
         ok(slidestack(&["tnew", c, "--out", o], "2"));
         ok(slidestack(&["fit", c, "--out", o], "2"));
     }
+    // A one-storey study's tnew has no units to split.
+    let args = ["tnew", s(&plain), "--out", s(&a), "--shard", "1/2", "--force"];
+    let o = slidestack(&args, "1");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("has nothing to split"),
+        "{}",
+        stderr(&o)
+    );
     // The fit: every number the same; fit.yaml names the frame and carries its own fingerprint.
     let fit = |out: &Path| -> serde_yaml::Value {
         let text = std::fs::read_to_string(out.join("fit.yaml")).unwrap();

@@ -15,7 +15,7 @@ use pyo3::types::{PyDict, PyList, PyString};
 use slidestack::pipeline::lock::LockMode;
 use slidestack::pipeline::{
     PipelineError, Progress, Reporter, Session, StageId, StageOptions, StageOutcome, StageState,
-    Study, execute, ida, run_all, status as study_status, sweep, terminal_progress,
+    Study, execute, execute_shard, run_all, status as study_status, sweep, terminal_progress,
 };
 use slidestack::study::config::{ConfigError, StudyConfig};
 use std::io::IsTerminal;
@@ -233,7 +233,21 @@ stage_fn!(
     StageId::Motions,
     "The motions stage (`slidestack motions`)."
 );
-stage_fn!(tnew, StageId::Tnew, "The tnew stage (`slidestack tnew`).");
+/// The tnew stage (`slidestack tnew`); with `shard=(k, n)` only that shard's units of a building
+/// study's attached fractions, which a later call without it assembles.
+#[pyfunction]
+#[pyo3(name = "tnew", signature = (config, out=None, force=false, wait=true, shard=None))]
+fn tnew_<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    out: Option<PathBuf>,
+    force: bool,
+    wait: bool,
+    shard: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let args = (config, out, force, wait);
+    sharded_stage(py, StageId::Tnew, args, shard)
+}
 stage_fn!(fit, StageId::Fit, "The fit stage (`slidestack fit`).");
 stage_fn!(
     floors,
@@ -268,11 +282,10 @@ fn shard_pair(shard: Option<&Bound<'_, PyAny>>) -> PyResult<Option<(usize, usize
 }
 
 /// A stage that can be split: the whole stage, or with `shard=(k, n)` only that shard's units
-/// (`run_shard`), in a session shared with the other shards.
+/// (`execute_shard`), in a session shared with the other shards.
 fn sharded_stage<'py>(
     py: Python<'py>,
     stage: StageId,
-    run_shard: fn(&Session, usize, usize, StageOptions) -> Result<StageOutcome, PipelineError>,
     (config, out, force, wait): (&Bound<'py, PyAny>, Option<PathBuf>, bool, bool),
     shard: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -281,7 +294,7 @@ fn sharded_stage<'py>(
     };
     let config = ConfigArg::from_py(config)?;
     let outcome = in_session(py, config, out, LockMode::Shared, wait, move |s| {
-        run_shard(s, k, n, StageOptions { force })
+        execute_shard(s, stage, (k, n), StageOptions { force })
     })?;
     outcome_dict(py, stage, &outcome, None)
 }
@@ -298,7 +311,7 @@ fn sweep_<'py>(
     shard: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let args = (config, out, force, wait);
-    sharded_stage(py, StageId::Sweep, sweep::run_shard, args, shard)
+    sharded_stage(py, StageId::Sweep, args, shard)
 }
 
 /// The ida stage (`slidestack ida`); with `shard=(k, n)` only that shard's units, which a later
@@ -314,7 +327,7 @@ fn ida_<'py>(
     shard: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let args = (config, out, force, wait);
-    sharded_stage(py, StageId::Ida, ida::run_shard, args, shard)
+    sharded_stage(py, StageId::Ida, args, shard)
 }
 
 /// Assembles `sweep.h5` when every shard is done (`slidestack merge`).
@@ -377,7 +390,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(motions, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_, m)?)?;
-    m.add_function(wrap_pyfunction!(tnew, m)?)?;
+    m.add_function(wrap_pyfunction!(tnew_, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(ida_, m)?)?;
     m.add_function(wrap_pyfunction!(floors, m)?)?;

@@ -6,7 +6,7 @@
 use super::{CliReporter, StudyArgs, print_outcome};
 use anyhow::Result;
 use slidestack::pipeline::lock::LockMode;
-use slidestack::pipeline::{Session, StageId, execute, ida, report};
+use slidestack::pipeline::{Session, StageId, execute, execute_shard, report};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -36,7 +36,7 @@ pub fn run(args: Args) -> Result<()> {
     };
     let session = Session::open(study, mode, !args.study.no_wait, &CliReporter)?;
     if let Some((k, n)) = args.shard {
-        let outcome = ida::run_shard(&session, k, n, args.study.options())?;
+        let outcome = execute_shard(&session, StageId::Ida, (k, n), args.study.options())?;
         print_outcome(StageId::Ida, &outcome, &args.study.config);
         return Ok(());
     }

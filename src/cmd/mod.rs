@@ -7,12 +7,12 @@ pub mod floors;
 pub mod ida;
 pub mod interrupt;
 pub mod matching;
+pub mod merge;
 pub mod run;
 pub mod simulate;
 pub mod spectrum;
 pub mod stage;
 pub mod status;
-pub mod sweep;
 
 use anyhow::{Context, Result};
 pub use slidestack::fault::BadInput;

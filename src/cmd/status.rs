@@ -46,6 +46,8 @@ pub fn run(args: Args) -> Result<()> {
             println!("SWEEP_CASES_PER_UNIT={}", st.cases_per_unit);
             println!("SWEEP_SAMPLES_PER_MOTION={}", st.samples_per_motion);
             println!("SWEEP_SAMPLES_PER_UNIT={}", st.samples_per_unit);
+            println!("TNEW_UNITS={}", st.tnew_units);
+            println!("TNEW_UNITS_DONE={}", st.tnew_units_done);
             println!("IDA_UNITS={}", st.ida_units);
             println!("IDA_UNITS_DONE={}", st.ida_units_done);
         }
@@ -68,6 +70,12 @@ pub fn run(args: Args) -> Result<()> {
                 println!(
                     "sweep units: {} of {} stored ({} cases each)",
                     st.sweep_units_done, st.sweep_units, st.cases_per_unit
+                );
+            }
+            if st.tnew_units > 0 {
+                println!(
+                    "tnew units: {} of {} stored (the attached fractions' scans)",
+                    st.tnew_units_done, st.tnew_units
                 );
             }
         }

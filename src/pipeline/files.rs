@@ -106,20 +106,27 @@ pub fn unit_place(
         building.map(|_| frame),
         index,
     );
-    let frame = building.map(|b| {
-        let (n, floor) = b.frame(frame);
-        (frame, format!("storeys {n}, stack_floor {floor}"))
-    });
+    let frame = frame_label(study, frame);
     let id = UnitId {
         frame,
         fingerprint: fingerprint.to_string(),
         zone: zone_name.clone(),
-        motion_index: motion,
-        motion: motions[zone][motion].name.clone(),
+        motion_index: Some(motion),
+        motion: Some(motions[zone][motion].name.clone()),
         period_index: index,
         period_s,
+        alpha_total: None,
     };
     (path, id)
+}
+
+/// A building study's frame `frame` as a unit file names it: its index and `storeys`/
+/// `stack_floor` (`None` on one storey).
+pub fn frame_label(study: &Study, frame: usize) -> Option<(usize, String)> {
+    study.building().map(|b| {
+        let (n, floor) = b.frame(frame);
+        (frame, format!("storeys {n}, stack_floor {floor}"))
+    })
 }
 
 /// Zone `zone` of `ida.h5` (the caller has required it up to date), refused unless its axes

@@ -41,8 +41,6 @@ use thiserror::Error;
 pub enum IdaStageError {
     #[error("{}: the `ida` stage needs an `ida` section", config.display())]
     NoSection { config: PathBuf },
-    #[error("shard {k}/{n}: needs 1 ≤ K ≤ N ≤ {units} (the IDA traces {units} work units)")]
-    Shard { k: usize, n: usize, units: usize },
     #[error("zone {zone}, motion {motion}, case {case}{frame} ({system}): {why}")]
     Simulation {
         zone: String,
@@ -84,11 +82,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
     let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
     let units = plan.run.len();
-    if let Some((k, n)) = shard
-        && !(1 <= k && k <= n && n <= units)
-    {
-        return Err(IdaStageError::Shard { k, n, units }.into());
-    }
+    let in_shard = super::shard_filter(me, shard, units)?;
     let store = CaseUnits {
         study,
         cfg,
@@ -98,7 +92,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     s.reporter
         .info(me, &plan_line(study, cfg, &counts, &plan, frames.len()));
     let mine: Vec<CaseUnit> = (plan.run.iter().enumerate())
-        .filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1))
+        .filter(|&(i, _)| in_shard(i))
         .map(|(_, u)| *u)
         .collect();
     let dir = study.path(UNITS_DIR);
@@ -256,22 +250,6 @@ fn write_stage_file(
     let path = study.path(StageId::Ida.output());
     write_ida(&path, &meta, &axes, &zones)?;
     Ok(path)
-}
-
-/// Shard `K/N` of the IDA: nothing when `ida.h5` is already up to date (unless forced).
-pub fn run_shard(
-    s: &Session,
-    k: usize,
-    n: usize,
-    opts: super::StageOptions,
-) -> Result<StageOutcome, PipelineError> {
-    let me = StageId::Ida;
-    s.study.fingerprint(me)?;
-    s.study.require(StageId::Motions)?;
-    if !opts.force && s.study.state(me)? == super::StageState::UpToDate {
-        return Ok(StageOutcome::UpToDate(s.study.path(me.output())));
-    }
-    build(s, Some((k, n)))
 }
 
 /// `(units the IDA traces, units stored for the current IDA)`; before the motions stage ran

@@ -194,6 +194,13 @@ pub enum PipelineError {
     Ida(#[from] ida::IdaStageError),
     #[error(transparent)]
     Floors(#[from] floors::FloorsStageError),
+    #[error("shard {k}/{n}: needs 1 ≤ K ≤ N ≤ {units} (the {stage} stage has {units} work units)")]
+    Shard {
+        stage: StageId,
+        k: usize,
+        n: usize,
+        units: usize,
+    },
     /// The reporter asked the run to stop ([`Reporter::cancelled`]).
     #[error("{0}: interrupted; what it stored is kept and the next run resumes from there")]
     Cancelled(StageId),
@@ -763,9 +770,54 @@ pub enum StageOutcome {
     UpToDate(PathBuf),
     /// These files were written.
     Wrote(Vec<PathBuf>),
-    /// A shard of the sweep or the IDA stored its units; `merge` (the sweep) or the unsharded
-    /// stage (the IDA) assembles them.
+    /// A shard of the sweep, `tnew` or the IDA stored its units; `merge` (the sweep) or the
+    /// unsharded stage (`tnew`, the IDA) assembles them.
     ShardDone { k: usize, n: usize },
+}
+
+/// Which of a stage's `units` work units `--shard K/N` computes (`i mod N = K − 1`; every unit
+/// without a shard): refused unless `1 ≤ K ≤ N ≤ units`.
+pub fn shard_filter(
+    stage: StageId,
+    shard: Option<(usize, usize)>,
+    units: usize,
+) -> Result<impl Fn(usize) -> bool, PipelineError> {
+    if let Some((k, n)) = shard
+        && !(1 <= k && k <= n && n <= units)
+    {
+        return Err(PipelineError::Shard { stage, k, n, units });
+    }
+    Ok(move |i: usize| shard.is_none_or(|(k, n)| i % n == k - 1))
+}
+
+/// Runs shard `K/N` of a stage that can be split (the sweep, `tnew`, the IDA: ):
+/// checks its inputs, does nothing when its output is up to date (unless forced), else
+/// computes and stores that shard's units; the unsharded stage (`merge` for the sweep)
+/// assembles them.
+pub fn execute_shard(
+    s: &Session,
+    stage: StageId,
+    (k, n): (usize, usize),
+    opts: StageOptions,
+) -> Result<StageOutcome, PipelineError> {
+    s.check_cancelled(stage)?;
+    s.study.fingerprint(stage)?;
+    for up in s.study.upstream(stage) {
+        s.study.require(up)?;
+    }
+    if !opts.force && s.study.state(stage)? == StageState::UpToDate {
+        return Ok(StageOutcome::UpToDate(s.study.path(stage.output())));
+    }
+    let shard = Some((k, n));
+    match stage {
+        StageId::Sweep => sweep::build(s, shard),
+        StageId::Tnew => tnew::build(s, shard),
+        StageId::Ida => ida::build(s, shard),
+        _ => Err(PipelineError::Setting {
+            setting: "shard",
+            why: format!("is not an option of the {stage} stage: it has no work units to split"),
+        }),
+    }
 }
 
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
@@ -786,6 +838,7 @@ pub fn execute(
                 if s.exclusive() {
                     match stage {
                         StageId::Sweep => sweep::remove_units(&s.study)?,
+                        StageId::Tnew => tnew::remove_units(&s.study)?,
                         StageId::Ida => ida::remove_units(&s.study)?,
                         _ => {}
                     }
@@ -799,7 +852,7 @@ pub fn execute(
     let outcome = match stage {
         StageId::Motions => motions::build(s),
         StageId::Sweep => sweep::build(s, None),
-        StageId::Tnew => tnew::build(s),
+        StageId::Tnew => tnew::build(s, None),
         StageId::Fit => fit::build(s),
         StageId::Report => report::build(s),
         StageId::Ida => ida::build(s, None),
@@ -840,6 +893,10 @@ pub struct Status {
     /// `ida:` section) and those already stored for the current IDA.
     pub ida_units: usize,
     pub ida_units_done: usize,
+    /// `tnew`'s work units (the attached fractions' of a building study; 0 on one storey) and
+    /// those stored for the current `tnew`.
+    pub tnew_units: usize,
+    pub tnew_units_done: usize,
     pub cases_per_unit: usize,
     /// Record samples per motion, the mean over the stored motions (0 before `motions` ran).
     pub samples_per_motion: usize,
@@ -873,6 +930,10 @@ pub fn status(study: &Study) -> Result<Status, PipelineError> {
         None => (0, 0, 0),
     };
     let cases_per_unit = study.grid.as_ref().map_or(0, Grid::cases_per_unit);
+    let (tnew_units, tnew_units_done) = match study.configured(StageId::Tnew) {
+        true => tnew::unit_status(study)?,
+        false => (0, 0),
+    };
     let (ida_units, ida_units_done) = match study.configured(StageId::Ida) {
         true => ida::unit_status(study)?,
         false => (0, 0),
@@ -880,6 +941,8 @@ pub fn status(study: &Study) -> Result<Status, PipelineError> {
     Ok(Status {
         ida_units,
         ida_units_done,
+        tnew_units,
+        tnew_units_done,
         stages,
         made_with,
         sweep_units,

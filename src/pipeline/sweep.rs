@@ -39,8 +39,6 @@ pub const UNITS_DIR: &str = "sweep.units";
 
 #[derive(Debug, Error)]
 pub enum SweepStageError {
-    #[error("shard {k}/{n}: needs 1 ≤ K ≤ N ≤ {units} (the sweep has {units} work units)")]
-    Shard { k: usize, n: usize, units: usize },
     #[error("zone {zone}, motion {motion}: {source}")]
     Simulation {
         zone: String,
@@ -255,20 +253,11 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
         fingerprint: fp,
     };
     let all = all_units(study, grid, &motions);
-    if let Some((k, n)) = shard
-        && !(1 <= k && k <= n && n <= all.len())
-    {
-        return Err(SweepStageError::Shard {
-            k,
-            n,
-            units: all.len(),
-        }
-        .into());
-    }
+    let in_shard = super::shard_filter(StageId::Sweep, shard, all.len())?;
     let mine: Vec<Unit> = all
         .iter()
         .enumerate()
-        .filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1))
+        .filter(|&(i, _)| in_shard(i))
         .map(|(_, u)| *u)
         .collect();
     let dir = study.path(UNITS_DIR);
@@ -628,19 +617,4 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError
         .flatten()
         .fold((0, 0), |(c, n), m| (c + 1, n + m.accel_g.len()));
     Ok((all.len(), done, samples / count.max(1)))
-}
-
-/// Shard `K/N` of the sweep: nothing when `sweep.h5` is already up to date (unless forced).
-pub fn run_shard(
-    s: &Session,
-    k: usize,
-    n: usize,
-    opts: super::StageOptions,
-) -> Result<StageOutcome, PipelineError> {
-    let me = StageId::Sweep;
-    s.study.require(StageId::Motions)?;
-    if !opts.force && s.study.state(me)? == super::StageState::UpToDate {
-        return Ok(StageOutcome::UpToDate(s.study.path(me.output())));
-    }
-    build(s, Some((k, n)))
 }

@@ -1,8 +1,9 @@
-//! The sweep's unit files: one small file per finished work unit (one zone, one motion, one
-//! `T_p`), so that an interrupted or sharded sweep resumes where it stopped.
+//! The unit files of the stages that can be split (the sweep, `tnew`, the IDA): one small file
+//! per finished work unit (the sweep's: one zone, one motion, one `T_p`), so that an interrupted
+//! or sharded stage resumes where it stopped.
 //!
-//! A unit file records which unit it is (its [`UnitId`]: the sweep's fingerprint, the zone, the
-//! motion's index and name, the period's index and value) and ends with the SHA-256 of everything
+//! A unit file records which unit it is (its [`UnitId`]: the stage's fingerprint, the zone, the
+//! motion's index and name, the period's index and value, …) and ends with the SHA-256 of everything
 //! before it. It is written atomically ([`super::atomic`]), so it is either whole or absent;
 //! reading it checks the checksum and the identity, so a damaged unit, or one swapped with
 //! another's, is refused instead of merged.
@@ -24,16 +25,39 @@ const MAGIC: &[u8; 8] = b"SLUNIT02";
 /// Which unit a file holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct UnitId {
-    /// Fingerprint of the sweep that made it.
+    /// Fingerprint of the stage that made it.
     pub fingerprint: String,
     pub zone: String,
-    pub motion_index: usize,
-    pub motion: String,
+    /// The motion's index and name (absent for a unit over every motion of its zone: `tnew`'s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion_index: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<String>,
     pub period_index: usize,
     pub period_s: f64,
     /// A building study's frame: its index and `storeys`/`stack_floor` (absent on one storey).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frame: Option<(usize, String)>,
+    /// The total `α` of a unit over the cases sharing it (`tnew`'s), absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha_total: Option<f64>,
+}
+
+impl std::fmt::Display for UnitId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "zone {}", self.zone)?;
+        if let (Some(i), Some(name)) = (self.motion_index, &self.motion) {
+            write!(f, ", motion {} `{name}`", i + 1)?;
+        }
+        if let Some((_, frame)) = &self.frame {
+            write!(f, ", frame `{frame}`")?;
+        }
+        write!(f, ", T_p {} s", self.period_s)?;
+        if let Some(a) = self.alpha_total {
+            write!(f, ", total α {a}")?;
+        }
+        Ok(())
+    }
 }
 
 /// A unit's values, as columns.
@@ -136,21 +160,8 @@ pub fn read_unit(path: &Path, want: &UnitId) -> Result<Stored, StoreError> {
         return Ok(Stored::Stale);
     }
     if id != *want {
-        let frame = |u: &UnitId| {
-            (u.frame.as_ref()).map_or(String::new(), |(_, f)| format!(", frame `{f}`"))
-        };
         return Err(bad(&format!(
-            "holds unit (zone {}, motion {} `{}`{}, T_p {} s) where unit (zone {}, motion {} `{}`{}, T_p {} s) belongs",
-            id.zone,
-            id.motion_index + 1,
-            id.motion,
-            frame(&id),
-            id.period_s,
-            want.zone,
-            want.motion_index + 1,
-            want.motion,
-            frame(want),
-            want.period_s
+            "holds unit ({id}) where unit ({want}) belongs"
         )));
     }
     let nf = u32_at(take(4)?);
@@ -184,11 +195,12 @@ mod tests {
         UnitId {
             fingerprint: "fp".into(),
             zone: "III".into(),
-            motion_index: motion,
-            motion: format!("m{motion}"),
+            motion_index: Some(motion),
+            motion: Some(format!("m{motion}")),
             period_index: 4,
             period_s: 0.5,
             frame: None,
+            alpha_total: None,
         }
     }
 
