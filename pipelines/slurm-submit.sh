@@ -8,6 +8,10 @@
 #      unit of the sweep is there, merges them and runs the later stages the config configures
 #      (tnew, fit, ida with an `ida:` section: it traces what an IDA task left out and assembles
 #      ida.h5, floors with a `floor_spectra:` section, report).
+# In a building study `tnew` has work units too (the attached fractions'): the finishing job is
+# then split in a merge job (after the sweep array: checks and merges the sweep) and the rest,
+# and between them runs a `tnew` array (`tnew --shard K/N`, N at most its work units) that the
+# rest waits for (the finishing job's `tnew` computes what a task left out and assembles tnew.h5).
 # A config without a grid but with an `ida:` section (configs/ida-quick.yaml) gets the motions job,
 # the IDA array (N defaults to its work units, one per task) and the finishing job.
 # Each part is left out when its file is already up to date (`slidestack status`), so submitting
@@ -157,7 +161,7 @@ status=$("$SLIDESTACK" status "$CONFIG" --out "$OUT" --format env) ||
 # shellcheck disable=SC2034 # TNEW, FIT, IDA and REPORT are read through ${!v} below
 MOTIONS="" SWEEP="" TNEW="" FIT="" IDA="" REPORT="" SWEEP_UNITS="" SWEEP_UNITS_DONE=""
 SWEEP_CASES_PER_UNIT="" SWEEP_SAMPLES_PER_MOTION="" SWEEP_SAMPLES_PER_UNIT="" STAGES=""
-IDA_UNITS="" IDA_UNITS_DONE=""
+IDA_UNITS="" IDA_UNITS_DONE="" TNEW_UNITS="" TNEW_UNITS_DONE=""
 # KEY=VALUE lines; the keys used here are checked below, others are left alone. A stage the
 # config does not configure has no line (STAGES lists the configured ones).
 while IFS= read -r line; do
@@ -165,7 +169,7 @@ while IFS= read -r line; do
   case ${BASH_REMATCH[1]} in
   MOTIONS | SWEEP | TNEW | FIT | IDA | REPORT | SWEEP_UNITS | SWEEP_UNITS_DONE | \
     SWEEP_CASES_PER_UNIT | SWEEP_SAMPLES_PER_MOTION | SWEEP_SAMPLES_PER_UNIT | STAGES | \
-    IDA_UNITS | IDA_UNITS_DONE)
+    IDA_UNITS | IDA_UNITS_DONE | TNEW_UNITS | TNEW_UNITS_DONE)
     printf -v "${BASH_REMATCH[1]}" '%s' "${BASH_REMATCH[2]}" ;;
   esac
 done <<<"$status"
@@ -187,11 +191,12 @@ for stage in "${stages[@]}"; do
   states="$states${states:+, }$stage ${!v}"
 done
 for v in SWEEP_UNITS SWEEP_UNITS_DONE SWEEP_CASES_PER_UNIT SWEEP_SAMPLES_PER_MOTION SWEEP_SAMPLES_PER_UNIT \
-  IDA_UNITS IDA_UNITS_DONE; do
+  IDA_UNITS IDA_UNITS_DONE TNEW_UNITS TNEW_UNITS_DONE; do
   is_uint "${!v}" || die "slidestack status gave $v='${!v}'"
 done
 units=()
 [ $HAS_SWEEP = 0 ] || units+=("$SWEEP_UNITS_DONE of $SWEEP_UNITS sweep units")
+[ "$TNEW_UNITS" = 0 ] || units+=("$TNEW_UNITS_DONE of $TNEW_UNITS tnew units")
 [ "$IDA_UNITS" = 0 ] || units+=("$IDA_UNITS_DONE of $IDA_UNITS ida units")
 stored=$(IFS=,; echo "${units[*]}")
 note "status: $states (${stored//,/, } stored)"
@@ -215,6 +220,15 @@ fi
 NEED_IDA=0
 if [[ ,$STAGES, == *,ida,* ]] && [ -z "$ARRAY" ] && { [ "$IDA" != up_to_date ] || [ $FORCE = 1 ]; }; then
   NEED_IDA=1
+fi
+
+# The tnew array (a building study, whose attached fractions are tnew's work units, when tnew.h5
+# is not up to date or --force), not when only some sweep shards are resubmitted (--array): the
+# finishing job's `tnew` computes them. Its N is the sweep's, at most tnew's work units; with the
+# sweep to run, a merge job goes between the two arrays.
+NEED_TNEW=0
+if [ "$TNEW_UNITS" -gt 0 ] && [ -z "$ARRAY" ] && { [ "$TNEW" != up_to_date ] || [ $FORCE = 1 ]; }; then
+  NEED_TNEW=1
 fi
 
 # --- What the cluster allows. ----------------------------------------------------------------
@@ -450,14 +464,30 @@ if [ "$IDA_UNITS" -lt "$IDA_SHARDS" ]; then IDA_SHARDS=$IDA_UNITS; fi
 IDA_SPEC="1-$IDA_SHARDS"
 [ -z "$MAX_RUNNING" ] || IDA_SPEC="$IDA_SPEC%$MAX_RUNNING"
 ida_cmd=(sbatch "${common[@]}" --job-name=slidestack-ida --time="$STAGE_TIME" --array="$IDA_SPEC"
-  --output="$LOGS/ida-%A_%a.out" "${EXTRA[@]}" "$HERE/ida.slurm" "${FORCE_ARG[@]}" "$JOB_BIN" "$CONFIG" "$OUT"
-  "$IDA_SHARDS")
+  --output="$LOGS/ida-%A_%a.out" "${EXTRA[@]}" "$HERE/shard.slurm" "${FORCE_ARG[@]}" ida "$JOB_BIN" "$CONFIG"
+  "$OUT" "$IDA_SHARDS")
+TNEW_SHARDS=$SHARDS
+if [ "$TNEW_UNITS" -lt "$TNEW_SHARDS" ]; then TNEW_SHARDS=$TNEW_UNITS; fi
+TNEW_SPEC="1-$TNEW_SHARDS"
+[ -z "$MAX_RUNNING" ] || TNEW_SPEC="$TNEW_SPEC%$MAX_RUNNING"
+tnew_cmd=(sbatch "${common[@]}" --job-name=slidestack-tnew --time="$STAGE_TIME" --array="$TNEW_SPEC"
+  --output="$LOGS/tnew-%A_%a.out" "${EXTRA[@]}" "$HERE/shard.slurm" "${FORCE_ARG[@]}" tnew "$JOB_BIN" "$CONFIG"
+  "$OUT" "$TNEW_SHARDS")
+# With the sweep and tnew both as arrays, the finishing job is split: the merge job between them
+# and the rest after tnew's.
+NEED_MERGE=0 FINISH_PART=()
+if [ $NEED_TNEW = 1 ] && [ $NEED_SWEEP = 1 ]; then NEED_MERGE=1 FINISH_PART=(--after-merge); fi
+merge_cmd=(sbatch "${common[@]}" --job-name=slidestack-merge --time="$STAGE_TIME"
+  --output="$LOGS/merge-%j.out" "${EXTRA[@]}" "$HERE/finish.slurm" "${FORCE_ARG[@]}" --sweep-only "$JOB_BIN"
+  "$CONFIG" "$OUT" "$SHARDS" "$RESUBMIT_CMD" "$RESUBMIT_ARGS")
 finish_cmd=(sbatch "${common[@]}" --job-name=slidestack-finish --time="$STAGE_TIME"
-  --output="$LOGS/finish-%j.out" "${EXTRA[@]}" "$HERE/finish.slurm" "${FORCE_ARG[@]}" "$JOB_BIN" "$CONFIG" "$OUT"
-  "$SHARDS" "$RESUBMIT_CMD" "$RESUBMIT_ARGS")
+  --output="$LOGS/finish-%j.out" "${EXTRA[@]}" "$HERE/finish.slurm" "${FORCE_ARG[@]}" "${FINISH_PART[@]}"
+  "$JOB_BIN" "$CONFIG" "$OUT" "$SHARDS" "$RESUBMIT_CMD" "$RESUBMIT_ARGS")
 
 parts="finishing job"
 [ $NEED_IDA = 0 ] || parts="ida array ($IDA_SHARDS shards of $IDA_UNITS units, $(show_time "$STAGE_TIME") each), $parts"
+[ $NEED_TNEW = 0 ] || parts="tnew array ($TNEW_SHARDS shards of $TNEW_UNITS units, $(show_time "$STAGE_TIME") each), $parts"
+[ $NEED_MERGE = 0 ] || parts="merge job, $parts"
 [ $NEED_SWEEP = 0 ] || parts="sweep array (tasks $ARRAY_SPEC of N = $SHARDS shards, $CPUS CPUs and $(show_time "$TIME") each), $parts"
 [ $NEED_MOTIONS = 0 ] || parts="motions job, $parts"
 note "submitting: $parts"
@@ -475,6 +505,8 @@ $out"
 if [ $HAVE_SLURM = 1 ]; then
   [ $NEED_MOTIONS = 0 ] || test_only motions "${motions_cmd[@]}"
   [ $NEED_SWEEP = 0 ] || test_only sweep "${sweep_cmd[@]}"
+  [ $NEED_MERGE = 0 ] || test_only merge "${merge_cmd[@]}"
+  [ $NEED_TNEW = 0 ] || test_only tnew "${tnew_cmd[@]}"
   [ $NEED_IDA = 0 ] || test_only ida "${ida_cmd[@]}"
   test_only finishing "${finish_cmd[@]}"
 fi
@@ -483,6 +515,8 @@ if [ $DRY_RUN = 1 ]; then
   note "dry run; would submit (each with its --dependency):"
   if [ $NEED_MOTIONS = 1 ]; then printf ' %q' "${motions_cmd[@]}"; echo; fi
   if [ $NEED_SWEEP = 1 ]; then printf ' %q' "${sweep_cmd[@]}"; echo; fi
+  if [ $NEED_MERGE = 1 ]; then printf ' %q' "${merge_cmd[@]}"; echo; fi
+  if [ $NEED_TNEW = 1 ]; then printf ' %q' "${tnew_cmd[@]}"; echo; fi
   if [ $NEED_IDA = 1 ]; then printf ' %q' "${ida_cmd[@]}"; echo; fi
   printf ' %q' "${finish_cmd[@]}"
   echo
@@ -527,12 +561,26 @@ if [ $NEED_SWEEP = 1 ]; then
   note "sweep array $array_job: tasks $ARRAY_SPEC, shard K of N = $SHARDS in task K"
   deps=("$array_job")
 fi
+if [ $NEED_TNEW = 1 ]; then
+  if [ $NEED_MERGE = 1 ]; then
+    merge_cmd=("${merge_cmd[0]}" --dependency="afterany:$array_job" "${merge_cmd[@]:1}")
+    merge_job=$("${merge_cmd[@]}")
+    merge_job=${merge_job%%;*}
+    note "merge job $merge_job: checks and merges the sweep's units"
+    # The tnew array needs sweep.h5: cancelled if the merge fails, instead of pending forever.
+    tnew_cmd=("${tnew_cmd[0]}" --dependency="afterok:$merge_job" --kill-on-invalid-dep=yes "${tnew_cmd[@]:1}")
+  fi
+  tnew_job=$("${tnew_cmd[@]}")
+  tnew_job=${tnew_job%%;*}
+  note "tnew array $tnew_job: tasks $TNEW_SPEC, tnew shard K of N = $TNEW_SHARDS in task K"
+  deps=("$tnew_job")
+fi
 if [ $NEED_IDA = 1 ]; then
   ida_job=$("${ida_cmd[@]}")
   ida_job=${ida_job%%;*}
   note "ida array $ida_job: tasks $IDA_SPEC, IDA shard K of N = $IDA_SHARDS in task K"
   # The finishing job waits for the sweep array (or motions) and for the IDA array.
-  if [ $NEED_SWEEP = 0 ]; then deps=(); fi
+  if [ $NEED_SWEEP = 0 ] && [ $NEED_TNEW = 0 ]; then deps=(); fi
   deps+=("$ida_job")
 fi
 if [ ${#deps[@]} -gt 0 ]; then
@@ -546,4 +594,6 @@ finish_job=$("${finish_cmd[@]}")
 finish_job=${finish_job%%;*}
 note "finishing job $finish_job"
 note "logs in $LOGS; watch with: squeue --me; the report will be $OUT/report/index.html"
-[ $HAS_SWEEP = 0 ] || note "if a sweep task fails, the finishing job's log ($LOGS/finish-$finish_job.out) gives the command that resubmits only the failed shards"
+checker="the finishing job's log ($LOGS/finish-$finish_job.out)"
+[ $NEED_MERGE = 0 ] || checker="the merge job's log ($LOGS/merge-$merge_job.out)"
+[ $HAS_SWEEP = 0 ] || note "if a sweep task fails, $checker gives the command that resubmits only the failed shards"

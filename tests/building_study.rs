@@ -703,7 +703,15 @@ fn one_storey_buildings_are_the_one_storey_study() {
         ok(slidestack(&["fit", c, "--out", o], "2"));
     }
     // A one-storey study's tnew has no units to split.
-    let args = ["tnew", s(&plain), "--out", s(&a), "--shard", "1/2", "--force"];
+    let args = [
+        "tnew",
+        s(&plain),
+        "--out",
+        s(&a),
+        "--shard",
+        "1/2",
+        "--force",
+    ];
     let o = slidestack(&args, "1");
     assert_eq!(o.status.code(), Some(2));
     assert!(

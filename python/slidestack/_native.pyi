@@ -148,7 +148,11 @@ def sweep(
     shard: Optional[Tuple[int, int]] = None,
 ) -> Dict[str, Any]: ...
 def tnew(
-    config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True
+    config: _Config,
+    out: Optional[_Path] = None,
+    force: bool = False,
+    wait: bool = True,
+    shard: Optional[Tuple[int, int]] = None,
 ) -> Dict[str, Any]: ...
 def fit(
     config: _Config, out: Optional[_Path] = None, force: bool = False, wait: bool = True

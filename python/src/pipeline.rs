@@ -378,6 +378,8 @@ fn status<'py>(
     d.set_item("made_with", made_with)?;
     d.set_item("sweep_units", st.sweep_units)?;
     d.set_item("sweep_units_done", st.sweep_units_done)?;
+    d.set_item("tnew_units", st.tnew_units)?;
+    d.set_item("tnew_units_done", st.tnew_units_done)?;
     d.set_item("ida_units", st.ida_units)?;
     d.set_item("ida_units_done", st.ida_units_done)?;
     d.set_item("sweep_cases_per_unit", st.cases_per_unit)?;

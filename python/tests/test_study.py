@@ -1,6 +1,7 @@
 """The study's stages from Python: the CLI's files, open_study, h5py beside the module, Ctrl-C."""
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -300,6 +301,26 @@ def test_ida_shards_make_the_unsharded_ida(tmp_path):
     assert (split / "ida.h5").read_bytes() == (whole / "ida.h5").read_bytes()
     with pytest.raises(ValueError, match="shard 1/99: needs 1 ≤ K ≤ N ≤ 6"):
         slidestack.ida(cfg, out=split, shard=(1, 99), force=True)
+
+
+def test_tnew_shards_make_the_unsharded_tnew(tmp_path):
+    """slidestack.tnew(shard=(k, n)) computes its share of a building study's attached fractions;
+    a call without it assembles the bytes of an unsharded run."""
+    cfg = ROOT / "configs/mdof-quick.yaml"
+    whole, split = tmp_path / "whole", tmp_path / "split"
+    slidestack.motions(cfg, out=whole)
+    slidestack.sweep(cfg, out=whole)
+    split.mkdir()
+    for f in ("motions.h5", "motions.h5.sha256", "sweep.h5", "sweep.h5.sha256"):
+        shutil.copy(whole / f, split / f)
+    assert slidestack.tnew(cfg, out=whole)["outcome"] == "wrote"
+    status = slidestack.status(cfg, out=split)
+    assert (status["tnew_units"], status["tnew_units_done"]) == (48, 0)
+    for k in (2, 1):
+        assert slidestack.tnew(cfg, out=split, shard=(k, 2))["shard"] == (k, 2)
+    assert slidestack.tnew(cfg, out=split)["outcome"] == "wrote"
+    assert (split / "tnew.h5").read_bytes() == (whole / "tnew.h5").read_bytes()
+    assert not (split / "tnew.units").exists()
 
 
 def test_design_in_a_building_study_is_the_clis(tmp_path, cli):
