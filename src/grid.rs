@@ -128,27 +128,35 @@ pub enum StackFloor {
     Floor(usize),
     /// The top floor `N`, whatever `N` is.
     Roof,
+    /// The floor at mid-height, `⌈N/2⌉` (floor 2 of 3, 3 of 6, 5 of 10, 10 of 20; floor 1 of 1),
+    /// whatever `N` is.
+    Mid,
     /// Every floor its own stack, each with the case's `α`, `μ` (the warehouse case).
     All,
 }
 
 impl StackFloor {
+    /// The floors named by a word rather than a number, in the order the page offers them.
+    pub const NAMED: [StackFloor; 3] = [StackFloor::Roof, StackFloor::Mid, StackFloor::All];
+
     /// The floors (1-based, lowest first) carrying a stack in a building of `storeys` storeys.
     pub fn floors(self, storeys: usize) -> Vec<usize> {
         match self {
             StackFloor::Floor(f) => vec![f],
             StackFloor::Roof => vec![storeys],
+            StackFloor::Mid => vec![storeys.div_ceil(2)],
             StackFloor::All => (1..=storeys).collect(),
         }
     }
 }
 
-/// `3`, `roof`, `all`: as the config writes it and the `stack_floor` coordinate stores it.
+/// `3`, `roof`, `mid`, `all`: as the config writes it and the `stack_floor` coordinate stores it.
 impl std::fmt::Display for StackFloor {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             StackFloor::Floor(j) => write!(f, "{j}"),
             StackFloor::Roof => f.write_str("roof"),
+            StackFloor::Mid => f.write_str("mid"),
             StackFloor::All => f.write_str("all"),
         }
     }
@@ -161,11 +169,12 @@ impl std::str::FromStr for StackFloor {
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "roof" => Ok(StackFloor::Roof),
+            "mid" => Ok(StackFloor::Mid),
             "all" => Ok(StackFloor::All),
             _ => (s.parse().ok())
                 .filter(|&j| j >= 1)
                 .map(StackFloor::Floor)
-                .ok_or_else(|| format!("`{s}` is not a floor, `roof` or `all`")),
+                .ok_or_else(|| format!("`{s}` is not a floor, `roof`, `mid` or `all`")),
         }
     }
 }

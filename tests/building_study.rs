@@ -842,7 +842,7 @@ fn a_building_study_refuses_what_it_cannot_do_naming_the_key() {
         (
             "building: { storeys: 2 }\n",
             "  stack_floor: cellar\n",
-            "`grid.stack_floor`: `cellar`: a floor number, `roof` or `all`",
+            "`grid.stack_floor`: `cellar`: a floor number, `roof`, `mid` or `all`",
         ),
     ];
     for (i, (top, grid, want)) in cases.iter().enumerate() {
@@ -863,6 +863,55 @@ fn a_building_study_refuses_what_it_cannot_do_naming_the_key() {
         "{}",
         stderr(&o)
     );
+}
+
+/// `stack_floor: mid` is the floor at mid-height, `⌈N/2⌉`: a five-storey study with the stack
+/// at mid-height sweeps to the same bits as one with it on floor 3 (each simulated: two
+/// studies), labelled `mid` in `sweep.h5` and by its floor in words.
+#[test]
+fn a_stack_at_mid_height_is_the_floor_at_half_the_height() {
+    let dir = tempfile::tempdir().unwrap();
+    let top = "building: { storeys: 5 }\n";
+    let mid = quick_with(dir.path(), "mid.yaml", top, "  stack_floor: mid\n");
+    let third = quick_with(dir.path(), "third.yaml", top, "  stack_floor: 3\n");
+    let (a, b) = (dir.path().join("mid"), dir.path().join("third"));
+    for (cfg, out) in [(&mid, &a), (&third, &b)] {
+        ok(slidestack(&["motions", s(cfg), "--out", s(out)], "2"));
+        ok(slidestack(&["sweep", s(cfg), "--out", s(out)], "2"));
+    }
+    let read = |out: &Path| read_zone_sweep(&out.join("sweep.h5"), "V", 2, true).unwrap();
+    let ((_, axes_a, za), (_, axes_b, zb)) = (read(&a), read(&b));
+    assert_eq!(axes_a.unwrap().stack_floor, [StackFloor::Mid]);
+    assert_eq!(axes_b.unwrap().stack_floor, [StackFloor::Floor(3)]);
+    assert!(za.vars.u_stack.iter().any(|&u| u > 0.0));
+    assert_eq!(za.vars.u_stack, zb.vars.u_stack);
+    assert_eq!(za.vars.slip_peak, zb.vars.slip_peak);
+    let (ba, bb) = (za.vars.building.unwrap(), zb.vars.building.unwrap());
+    assert_eq!(ba.storey_shear_stack, bb.storey_shear_stack);
+    assert_eq!(ba.floor_accel_stack, bb.floor_accel_stack);
+    for n in 1..=20 {
+        assert_eq!(StackFloor::Mid.floors(n), [n.div_ceil(2)]);
+        assert_eq!(StackFloor::Mid.floors(n), [(n + 1) / 2]);
+    }
+    let frame = Frame {
+        floor_masses: vec![1.0; 5],
+        storey_stiffnesses: vec![1.0; 5],
+        storey_heights_m: vec![3.0; 5],
+        stack_floor: StackFloor::Mid,
+    };
+    assert_eq!(frame.floors(), [3]);
+    assert_eq!(
+        frame.to_string(),
+        "5 storeys, stack at mid-height (floor 3)"
+    );
+    for f in [
+        StackFloor::Floor(4),
+        StackFloor::Roof,
+        StackFloor::Mid,
+        StackFloor::All,
+    ] {
+        assert_eq!(f.to_string().parse::<StackFloor>(), Ok(f));
+    }
 }
 
 #[test]

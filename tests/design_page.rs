@@ -517,7 +517,7 @@ fn a_building_studys_design_page_answers_as_the_command_does() {
     let design = file_url(&report.join("design.html"));
     // The grid: T_1 0.3, 0.6, 1 s; α_1 0.25, 0.5; α_2 0.5; μ_1 0.1, 0.3; μ_2 0.05, 0.2; one
     // and three storeys; the stack on floor 1, the roof, every floor.
-    let questions: [FrameQuestion; 17] = [
+    let questions: [FrameQuestion; 19] = [
         // A grid point of each kind of frame of three storeys.
         ("III", "0.6", "0.25,0.5", "0.1,0.05", false, "3", "roof"),
         ("V", "0.6", "0.5,0.5", "0.3,0.2", false, "3", "1"),
@@ -531,6 +531,10 @@ fn a_building_studys_design_page_answers_as_the_command_does() {
         ("V", "0.45", "0.3,0.5", "0.2,0.1", false, "1", "1"),
         ("V", "0.45", "0.3,0.5", "0.2,0.1", false, "1", "roof"),
         ("III", "0.3", "0.25,0.5", "0.1,0.05", false, "1", "all"),
+        // The floor at mid-height: of one storey floor 1, which the study holds; of three floor
+        // 2, which it lacks.
+        ("V", "0.45", "0.3,0.5", "0.2,0.1", false, "1", "mid"),
+        ("V", "0.6", "0.25,0.5", "0.1,0.05", false, "3", "mid"),
         // Outside the grid: refused, then extrapolated inside the box 25 % beyond it, refused
         // beyond.
         ("III", "1.2", "0.25,0.5", "0.1,0.05", false, "3", "roof"),
@@ -595,9 +599,9 @@ fn a_building_studys_design_page_answers_as_the_command_does() {
         check_frame_page(q, page, &cli);
         check_quiet(page);
     }
-    // The refusals: outside the grid, beyond the box the fit was checked on, three frames the
-    // study lacks, a floor that is none.
-    assert_eq!(refused, 6);
+    // The refusals: outside the grid, beyond the box the fit was checked on, four frames the
+    // study lacks (one the floor at mid-height), a floor that is none.
+    assert_eq!(refused, 7);
 
     let typed_page = &seen[questions.len()];
     check_frame_page(&typed, typed_page, &frame_command(&study, &typed));

@@ -224,7 +224,7 @@ fn a_study_config_is_refused_in_plain_words_with_the_key_and_line() {
         ),
         (
             format!("{head}building:\n  storeys: 3\n{grid}  stack_floor: [1, 1.5]\n"),
-            "line 12: `grid.stack_floor`: expected a floor number, `roof` or `all`, or a list \
+            "line 12: `grid.stack_floor`: expected a floor number, `roof`, `mid` or `all`, or a list \
              of them, got 1.5",
         ),
         (

@@ -105,7 +105,7 @@ def design(
     floor: Union[int, str, None] = None,
 ) -> Dict[str, Any]:
     """T_new of one structure from a finished study: the dict ``slidestack design --json``
-    prints. In a building study, ``storeys`` and ``floor`` (a number, ``"roof"`` or ``"all"``)
+    prints. In a building study, ``storeys`` and ``floor`` (a number, ``"roof"``, ``"mid"`` or ``"all"``)
     name the building, and ``period`` is its bare first-mode period T_1."""
 
 def export_edp(

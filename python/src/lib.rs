@@ -469,9 +469,10 @@ fn design<'py>(
         None => None,
         Some(f) => {
             let text = f.str()?.to_string();
-            Some(text.parse::<StackFloor>().map_err(|_| {
-                PyValueError::new_err(format!("floor `{text}`: a floor number, `roof` or `all`"))
-            })?)
+            Some(
+                (text.parse::<StackFloor>())
+                    .map_err(|why| PyValueError::new_err(format!("floor: {why}")))?,
+            )
         }
     };
     let building = match (storeys, floor) {
@@ -545,11 +546,8 @@ fn export_frame_edp<'py>(
     let q = FrameQuery {
         zone,
         storeys: convert::whole(storeys, "storeys", 1)?,
-        stack_floor: text.parse::<StackFloor>().map_err(|_| {
-            PyValueError::new_err(format!(
-                "stack_floor `{text}`: a floor number, `roof` or `all`"
-            ))
-        })?,
+        stack_floor: (text.parse::<StackFloor>())
+            .map_err(|why| PyValueError::new_err(format!("stack_floor: {why}")))?,
         period_s: period,
         alpha: convert::float_vec(alpha, "alpha")?,
         mu: convert::float_vec(mu, "mu")?,

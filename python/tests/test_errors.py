@@ -208,7 +208,7 @@ def test_a_whole_number_keyword_is_a_value_error_naming_it(tmp_path):
         with pytest.raises(ValueError, match="^`storeys` must be a whole number ≥ 1, got "):
             slidestack.design(*question, storeys=storeys, floor="roof")
     for floor in (-1, 0, 1.5, "top"):
-        with pytest.raises(ValueError, match="a floor number, `roof` or `all`"):
+        with pytest.raises(ValueError, match="is not a floor, `roof`, `mid` or `all`"):
             slidestack.design(*question, storeys=3, floor=floor)
     for shard in ((-1, 2), (1, 2**70), (1.5, 2)):
         with pytest.raises(ValueError, match="^`shard` must be a whole number ≥ 1, got "):

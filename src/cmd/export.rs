@@ -45,7 +45,7 @@ pub struct EdpArgs {
     /// The building's storeys.
     #[arg(long, requires = "study")]
     storeys: Option<usize>,
-    /// The floor the stacks stand on: a number, `roof` or `all`.
+    /// The floor the stacks stand on: a number, `roof`, `mid` or `all`.
     #[arg(long, requires = "study")]
     stack_floor: Option<StackFloor>,
     /// The bare building's first-mode period, s.

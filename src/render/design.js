@@ -170,17 +170,19 @@ const fin = (v) => (v !== null && Number.isFinite(v) ? v : null);
 
 // ---- a building study's frame ----
 
-// grid.rs, StackFloor: parsed from its text (`3`, `roof`, `all`), and StackFloor::floors.
+// grid.rs, StackFloor: parsed from its text (`3`, `roof`, `mid`, `all`), and StackFloor::floors.
 function parseFloor(s) {
-  if (s === "roof" || s === "all") return { floor: s };
+  if (s === "roof" || s === "mid" || s === "all") return { floor: s };
   if (/^\+?[0-9]+$/.test(s) && Number(s) >= 1) return { floor: Number(s) };
-  return { error: "`" + s + "` is not a floor, `roof` or `all`" };
+  return { error: "`" + s + "` is not a floor, `roof`, `mid` or `all`" };
 }
 
 function floorsOf(floor, storeys) {
   if (floor === "roof") return [storeys];
+  if (floor === "mid") return [Math.ceil(storeys / 2)];
   if (floor === "all") return Array.from({ length: storeys }, (_, i) => i + 1);
-  return [floor];
+  if (typeof floor === "number") return [floor];
+  throw new Error("design.js: unknown stack floor `" + floor + "`");
 }
 
 const sameList = (a, b) => a.length === b.length && a.every((v, i) => v === b[i]);

@@ -120,7 +120,7 @@ pub struct PageForm<'a> {
 /// distinct frames (`3 storeys, stack on the roof`) for the explorer, in stored order.
 pub struct FrameInputs {
     pub storeys: Vec<usize>,
-    /// `1` … `N_max`, `roof`, `all`.
+    /// `1` … `N_max`, `roof`, `mid`, `all`.
     pub floors: Vec<String>,
     pub frames: Vec<String>,
 }

@@ -118,7 +118,7 @@ pub struct FrameFit {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FrameSpec {
     pub storeys: usize,
-    /// `3`, `roof` or `all`.
+    /// `3`, `roof`, `mid` or `all`.
     pub stack_floor: String,
     /// Relative floor masses, floor 1 first.
     pub floor_masses: Vec<f64>,

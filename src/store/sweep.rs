@@ -12,7 +12,7 @@
 //!     rocks_stack                                  [motion, T_p, …] (with grid.aspect only)
 //! ```
 //! A building study (docs/model.md, "A study over buildings") has two more coordinates,
-//! `storeys` (numbers) and `stack_floor` (strings: a floor number, `roof`, `all`), as dimensions
+//! `storeys` (numbers) and `stack_floor` (strings: a floor number, `roof`, `mid`, `all`), as dimensions
 //! after `motion`: `[motion, storeys, stack_floor, T_p, …]`; the structure's peaks are then the
 //! roof's. It also stores, with and without sliding (`_stack`, `_rigid`: the stack rigidly
 //! attached), each floor's and storey's peaks over the coordinates `floor` and `storey`

@@ -10,7 +10,7 @@
 //!                                  # (a list only with one `storeys` value) [default: 3.0]
 //! grid:
 //!   period_s: [0.3, 0.6]           # the bare building's first-mode period
-//!   stack_floor: [1, roof, all]    # a floor number, `roof`, `all`, or a list (an axis)
+//!   stack_floor: [1, roof, all]    # a floor number, `roof`, `mid`, `all`, or a list (an axis)
 //! ```
 //!
 //! The building's damping is the grid's (`damping`, `damping_basis`: modal, `ζ` in every mode
@@ -114,7 +114,7 @@ pub fn stack_floors<'de, D: serde::Deserializer<'de>>(
     };
     optional_one_or_list(
         d,
-        "a floor number, `roof` or `all`, or a list of them",
+        "a floor number, `roof`, `mid` or `all`, or a list of them",
         floor,
     )
 }
@@ -128,7 +128,7 @@ impl<T: Clone> OneOrList<T> {
     }
 }
 
-/// A floor as the config writes it: a number, `roof` or `all` (read by [`stack_floors`]).
+/// A floor as the config writes it: a number, `roof`, `mid` or `all` (read by [`stack_floors`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum FloorKey {
@@ -333,7 +333,7 @@ pub fn fit_features(blocks: usize, frames: &[Frame]) -> Option<BuildingFeatures>
     })
 }
 
-/// `3 storeys, stack on floor 2` (or `on the roof`, `on every floor`).
+/// `3 storeys, stack on floor 2` (or `on the roof`, `at mid-height (floor 2)`, `on every floor`).
 impl fmt::Display for Frame {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let n = self.storeys();
@@ -341,6 +341,11 @@ impl fmt::Display for Frame {
         match self.stack_floor {
             StackFloor::Floor(j) => write!(f, "{n} storey{s}, stack on floor {j}"),
             StackFloor::Roof => write!(f, "{n} storey{s}, stack on the roof"),
+            StackFloor::Mid => write!(
+                f,
+                "{n} storey{s}, stack at mid-height (floor {})",
+                n.div_ceil(2)
+            ),
             StackFloor::All => write!(f, "{n} storey{s}, a stack on every floor"),
         }
     }
@@ -449,12 +454,13 @@ impl BuildingSection {
                     );
                 }
                 FloorKey::Name(s) if s == "roof" => StackFloor::Roof,
+                FloorKey::Name(s) if s == "mid" => StackFloor::Mid,
                 FloorKey::Name(s) if s == "all" => StackFloor::All,
                 FloorKey::Name(s) => {
                     return err(
                         "grid.stack_floor",
                         format!(
-                            "`{}`: a floor number, `roof` or `all` (or a list of them)",
+                            "`{}`: a floor number, `roof`, `mid` or `all` (or a list of them)",
                             excerpt(&s)
                         ),
                     );

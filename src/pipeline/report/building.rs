@@ -263,6 +263,7 @@ fn floor_name(s: StackFloor) -> String {
     match s {
         StackFloor::Floor(j) => format!("floor {j}"),
         StackFloor::Roof => "roof".into(),
+        StackFloor::Mid => "mid-height".into(),
         StackFloor::All => "every floor".into(),
     }
 }

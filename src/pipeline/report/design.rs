@@ -8,6 +8,7 @@ use super::text::num;
 use super::{Files, Inputs, ReportError};
 use crate::fit::extrapolation::{LOWER_T_P, UPPER_T_RIGID};
 use crate::fit::forms::DAMPING_DEPTH;
+use crate::grid::StackFloor;
 use crate::limits::STRUCTURE_PERIOD_RANGE_S;
 use crate::pipeline::{PipelineError, files};
 use crate::render::design::{FrameInputs, PageForm, design_page};
@@ -134,7 +135,7 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
     });
     let frame_inputs = inp.study.building().map(|axes| {
         let mut floors: Vec<String> = (1..=axes.max_storeys()).map(|j| j.to_string()).collect();
-        floors.extend(["roof".into(), "all".into()]);
+        floors.extend(StackFloor::NAMED.map(|f| f.to_string()));
         let per_zone = labels.len() / inp.zones.len().max(1);
         FrameInputs {
             storeys: axes.storeys.clone(),
