@@ -48,7 +48,7 @@ options (defaults in brackets; "sized" = from the grid's work units and their me
   -p, --partition NAME      submit to this partition [the site's default]
   -n, --shards N            sweep array tasks [sized]; 1 <= N <= work units, N < MaxArraySize
   -c, --cpus-per-task C     CPUs (threads) of every job [sized, at most $MAX_DEFAULT_CPUS]
-  -t, --time TIME           time limit of each sweep task, any sbatch form [sized]
+  -t, --time TIME           time limit of each sweep task (and tnew task), any sbatch form [sized]
       --stage-time TIME     time limit of the motions job and the finishing job [30:00]
       --mem SIZE            memory of every job, e.g. 2G [the site's default]
       --array LIST          submit only these shard indices, e.g. 3 or 2,5-7: to rerun failed
@@ -224,8 +224,9 @@ fi
 
 # The tnew array (a building study, whose attached fractions are tnew's work units, when tnew.h5
 # is not up to date or --force), not when only some sweep shards are resubmitted (--array): the
-# finishing job's `tnew` computes them. Its N is the sweep's, at most tnew's work units; with the
-# sweep to run, a merge job goes between the two arrays.
+# finishing job's `tnew` computes them. Its N is the sweep's, at most tnew's work units, and its
+# time limit the sweep task's (its units cost about as much as the sweep's); with the sweep to
+# run, a merge job goes between the two arrays.
 NEED_TNEW=0
 if [ "$TNEW_UNITS" -gt 0 ] && [ -z "$ARRAY" ] && { [ "$TNEW" != up_to_date ] || [ $FORCE = 1 ]; }; then
   NEED_TNEW=1
@@ -350,6 +351,9 @@ elif [ "$SAMPLES_PER_UNIT" -gt 0 ] && [ "$SWEEP_UNITS" -gt 0 ]; then
 elif [ -n "$sized" ]; then
   note "warning: the grid has no work to size from: default 1 shard, 1 CPU, 4 hours where not given"
 fi
+if [ "$TNEW_UNITS" -gt 0 ] && [[ $sized == *time* ]] && [ -z "${SLIDESTACK_NS_PER_SAMPLE:-}" ]; then
+  note "warning: a building study's simulated sample costs far more than the one-storey sweep's $NS_PER_SAMPLE ns the sizing assumes (16.5 µs at 20 storeys: pipelines/README.md, \"A research-sized building study\"), so the time limit sized here is too short: give --time, or SLIDESTACK_NS_PER_SAMPLE"
+fi
 CPUS=${CPUS:-1}
 SHARDS=${SHARDS:-1}
 TIME=${TIME:-4:00:00}
@@ -470,7 +474,7 @@ TNEW_SHARDS=$SHARDS
 if [ "$TNEW_UNITS" -lt "$TNEW_SHARDS" ]; then TNEW_SHARDS=$TNEW_UNITS; fi
 TNEW_SPEC="1-$TNEW_SHARDS"
 [ -z "$MAX_RUNNING" ] || TNEW_SPEC="$TNEW_SPEC%$MAX_RUNNING"
-tnew_cmd=(sbatch "${common[@]}" --job-name=slidestack-tnew --time="$STAGE_TIME" --array="$TNEW_SPEC"
+tnew_cmd=(sbatch "${common[@]}" --job-name=slidestack-tnew --time="$TIME" --array="$TNEW_SPEC"
   --output="$LOGS/tnew-%A_%a.out" "${EXTRA[@]}" "$HERE/shard.slurm" "${FORCE_ARG[@]}" tnew "$JOB_BIN" "$CONFIG"
   "$OUT" "$TNEW_SHARDS")
 # With the sweep and tnew both as arrays, the finishing job is split: the merge job between them
@@ -486,7 +490,7 @@ finish_cmd=(sbatch "${common[@]}" --job-name=slidestack-finish --time="$STAGE_TI
 
 parts="finishing job"
 [ $NEED_IDA = 0 ] || parts="ida array ($IDA_SHARDS shards of $IDA_UNITS units, $(show_time "$STAGE_TIME") each), $parts"
-[ $NEED_TNEW = 0 ] || parts="tnew array ($TNEW_SHARDS shards of $TNEW_UNITS units, $(show_time "$STAGE_TIME") each), $parts"
+[ $NEED_TNEW = 0 ] || parts="tnew array ($TNEW_SHARDS shards of $TNEW_UNITS units, $(show_time "$TIME") each), $parts"
 [ $NEED_MERGE = 0 ] || parts="merge job, $parts"
 [ $NEED_SWEEP = 0 ] || parts="sweep array (tasks $ARRAY_SPEC of N = $SHARDS shards, $CPUS CPUs and $(show_time "$TIME") each), $parts"
 [ $NEED_MOTIONS = 0 ] || parts="motions job, $parts"

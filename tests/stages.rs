@@ -126,6 +126,7 @@ fn every_shipped_study_config_configures_its_stages() {
         ("mdof-floors-quick.yaml", "motions sweep tnew floors report"),
         ("mdof-ida-quick.yaml", "motions sweep tnew ida report"),
         ("mdof-quick.yaml", "motions sweep tnew fit report"),
+        ("mdof-research.yaml", "motions sweep tnew fit report"),
         ("mdof-structure.yaml", "motions sweep tnew fit report"),
         ("mdof.yaml", "motions sweep tnew fit report"),
         ("paper.yaml", "motions sweep tnew fit report"),

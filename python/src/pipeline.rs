@@ -233,21 +233,6 @@ stage_fn!(
     StageId::Motions,
     "The motions stage (`slidestack motions`)."
 );
-/// The tnew stage (`slidestack tnew`); with `shard=(k, n)` only that shard's units of a building
-/// study's attached fractions, which a later call without it assembles.
-#[pyfunction]
-#[pyo3(name = "tnew", signature = (config, out=None, force=false, wait=true, shard=None))]
-fn tnew_<'py>(
-    py: Python<'py>,
-    config: &Bound<'py, PyAny>,
-    out: Option<PathBuf>,
-    force: bool,
-    wait: bool,
-    shard: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let args = (config, out, force, wait);
-    sharded_stage(py, StageId::Tnew, args, shard)
-}
 stage_fn!(fit, StageId::Fit, "The fit stage (`slidestack fit`).");
 stage_fn!(
     floors,
@@ -299,36 +284,46 @@ fn sharded_stage<'py>(
     outcome_dict(py, stage, &outcome, None)
 }
 
-/// The sweep stage (`slidestack sweep`); with `shard=(k, n)` only that shard's units.
-#[pyfunction]
-#[pyo3(name = "sweep", signature = (config, out=None, force=false, wait=true, shard=None))]
-fn sweep_<'py>(
-    py: Python<'py>,
-    config: &Bound<'py, PyAny>,
-    out: Option<PathBuf>,
-    force: bool,
-    wait: bool,
-    shard: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let args = (config, out, force, wait);
-    sharded_stage(py, StageId::Sweep, args, shard)
+/// A stage that can be split (`slidestack STAGE [--shard K/N]`): its function with the
+/// `shard=(k, n)` keyword ([`sharded_stage`]).
+macro_rules! sharded_fn {
+    ($name:ident, $py_name:literal, $id:expr, $doc:literal) => {
+        #[doc = $doc]
+        #[pyfunction]
+        #[pyo3(name = $py_name, signature = (config, out=None, force=false, wait=true, shard=None))]
+        fn $name<'py>(
+            py: Python<'py>,
+            config: &Bound<'py, PyAny>,
+            out: Option<PathBuf>,
+            force: bool,
+            wait: bool,
+            shard: Option<&Bound<'py, PyAny>>,
+        ) -> PyResult<Bound<'py, PyDict>> {
+            sharded_stage(py, $id, (config, out, force, wait), shard)
+        }
+    };
 }
 
-/// The ida stage (`slidestack ida`); with `shard=(k, n)` only that shard's units, which a later
-/// call without it assembles.
-#[pyfunction]
-#[pyo3(name = "ida", signature = (config, out=None, force=false, wait=true, shard=None))]
-fn ida_<'py>(
-    py: Python<'py>,
-    config: &Bound<'py, PyAny>,
-    out: Option<PathBuf>,
-    force: bool,
-    wait: bool,
-    shard: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let args = (config, out, force, wait);
-    sharded_stage(py, StageId::Ida, args, shard)
-}
+sharded_fn!(
+    sweep_,
+    "sweep",
+    StageId::Sweep,
+    "The sweep stage (`slidestack sweep`); with `shard=(k, n)` only that shard's units."
+);
+sharded_fn!(
+    tnew_,
+    "tnew",
+    StageId::Tnew,
+    "The tnew stage (`slidestack tnew`); with `shard=(k, n)` only that shard's units of a \
+     building study's attached fractions, which a later call without it assembles."
+);
+sharded_fn!(
+    ida_,
+    "ida",
+    StageId::Ida,
+    "The ida stage (`slidestack ida`); with `shard=(k, n)` only that shard's units, which a \
+     later call without it assembles."
+);
 
 /// Assembles `sweep.h5` when every shard is done (`slidestack merge`).
 #[pyfunction]

@@ -790,21 +790,16 @@ pub fn shard_filter(
     Ok(move |i: usize| shard.is_none_or(|(k, n)| i % n == k - 1))
 }
 
-/// Runs shard `K/N` of a stage that can be split (the sweep, `tnew`, the IDA: ):
-/// checks its inputs, does nothing when its output is up to date (unless forced), else
-/// computes and stores that shard's units; the unsharded stage (`merge` for the sweep)
-/// assembles them.
+/// Runs shard `K/N` of a stage that can be split (the sweep, `tnew`, the IDA): checks its
+/// inputs, does nothing when its output is up to date (unless forced), else computes and stores
+/// that shard's units; the unsharded stage (`merge` for the sweep) assembles them.
 pub fn execute_shard(
     s: &Session,
     stage: StageId,
     (k, n): (usize, usize),
     opts: StageOptions,
 ) -> Result<StageOutcome, PipelineError> {
-    s.check_cancelled(stage)?;
-    s.study.fingerprint(stage)?;
-    for up in s.study.upstream(stage) {
-        s.study.require(up)?;
-    }
+    check_inputs(s, stage)?;
     if !opts.force && s.study.state(stage)? == StageState::UpToDate {
         return Ok(StageOutcome::UpToDate(s.study.path(stage.output())));
     }
@@ -820,17 +815,23 @@ pub fn execute_shard(
     }
 }
 
+/// `Err` unless `stage` can run: not cancelled, configured, every upstream file up to date.
+fn check_inputs(s: &Session, stage: StageId) -> Result<(), PipelineError> {
+    s.check_cancelled(stage)?;
+    s.study.fingerprint(stage)?;
+    for up in s.study.upstream(stage) {
+        s.study.require(up)?;
+    }
+    Ok(())
+}
+
 /// Runs one stage (module doc): checks its inputs, skips it when up to date, else builds it.
 pub fn execute(
     s: &Session,
     stage: StageId,
     opts: StageOptions,
 ) -> Result<StageOutcome, PipelineError> {
-    s.check_cancelled(stage)?;
-    s.study.fingerprint(stage)?;
-    for up in s.study.upstream(stage) {
-        s.study.require(up)?;
-    }
+    check_inputs(s, stage)?;
     let path = s.study.path(stage.output());
     if !opts.force {
         match s.study.state(stage)? {

@@ -390,7 +390,7 @@ pub fn zone(inp: &ZoneInputs) -> Result<ZoneOutcome, TnewError> {
 /// on its own by [`Self::fractions_of`], and [`Self::finish`] with every unit's fractions.
 pub struct ZoneWork<'a> {
     inp: &'a ZoneInputs<'a>,
-    /// The motions' accelerations, m/s².
+    /// The motions' accelerations, m/s² (empty without units).
     accels: Vec<Vec<f64>>,
     /// The means over the motions (summed in motion order, then divided), `[(frame,) case…]`.
     u_stack: ArrayD<f64>,
@@ -422,9 +422,14 @@ impl<'a> ZoneWork<'a> {
             ),
             _ => (Vec::new(), Vec::new()),
         };
+        // The motions' accelerations, for the units' simulations only.
+        let accels = match units.is_empty() {
+            true => Vec::new(),
+            false => inp.motions.iter().map(|r| r.accel_mps2(1.0)).collect(),
+        };
         Self {
             inp,
-            accels: inp.motions.iter().map(|r| r.accel_mps2(1.0)).collect(),
+            accels,
             u_stack,
             u_single,
             u_rigid,
