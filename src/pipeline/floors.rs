@@ -10,14 +10,17 @@
 //! Fingerprint: the `zones` and `floor_spectra` sections, the grid's physics, in a building
 //! study the `building` section and `grid.stack_floor`, and the motions' fingerprint.
 
-use super::{PipelineError, Session, StageId, StageOutcome};
+use super::{PipelineError, Session, StageId, StageOutcome, Study};
+use crate::ground_motion::Record;
 use crate::spectrum::floor::{FloorSpectraSpec, REFINEMENT};
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::floors::{FloorsAxes, FloorsMeta, Offsets, ZoneFloors, write_floors};
 use crate::store::h5::Attr;
+use crate::study::building::Frame;
 use crate::study::case_units::{CaseUnit, UnitPlan};
 use crate::study::config::StudyConfig;
-use crate::study::floors::{FloorUnit, FloorsError, floor_unit};
+use crate::study::floors::{FloorUnit, FloorsConfig, FloorsError, floor_unit};
+use crate::study::physics::Physics;
 use ndarray::{ArrayD, IxDyn};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -60,7 +63,8 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
     Some(StageId::Floors.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint])))
 }
 
-/// Builds `floors.h5`.
+/// Builds `floors.h5`: checks every record, runs the units ([`run_units`]: a repeated
+/// building's taken from its first frame), assembles each zone ([`zone_floors`]) and writes.
 pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Floors;
@@ -72,63 +76,21 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
         damping: axes.damping.clone(),
     };
     let motions = super::files::motions(study)?;
-    // Every record refined before any run: one whose history the spectrum cannot take is
-    // refused here, naming it.
-    for (z, ms) in motions.iter().enumerate() {
-        for m in ms {
-            m.check_refinable(REFINEMENT)
-                .map_err(|why| FloorsStageError::Record {
-                    zone: study.cfg.zones[z].name.clone(),
-                    motion: m.name.clone(),
-                    why,
-                })?;
-        }
-    }
+    check_records(study, &motions)?;
     let physics = study.physics();
     let frames = study.frames();
-    let nf = frames.len();
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
     let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
-    let units = &plan.run;
-    s.reporter.info(
-        me,
-        &format!(
-            "{} units (motions × cases{}), each two runs on the record refined {REFINEMENT} \
-             times and {} spectra of {} periods per floor",
-            units.len(),
-            if study.building().is_some() {
-                " × distinct buildings"
-            } else {
-                ""
-            },
-            spec.damping.len(),
-            spec.periods_s.len()
-        ),
-    );
-    let bar = s.reporter.progress(me, units.len() as u64);
-    let outs: Vec<FloorUnit> = units
-        .par_iter()
-        .map(|&u| -> Result<FloorUnit, PipelineError> {
-            s.check_cancelled(me)?;
-            let rec = &motions[u.zone][u.motion];
-            let frame = frames[u.frame].as_ref();
-            let unit =
-                floor_unit(&physics, &cfg.cases[u.case], frame, rec, &spec).map_err(|source| {
-                    FloorsStageError::Unit {
-                        zone: study.cfg.zones[u.zone].name.clone(),
-                        motion: rec.name.clone(),
-                        case: u.case,
-                        frame: frame.map_or(String::new(), |f| format!(", {f}")),
-                        source: Box::new(source),
-                    }
-                })?;
-            bar.inc();
-            Ok(unit)
-        })
-        .collect::<Result<_, _>>()?;
-    bar.finish();
+    let inp = UnitInputs {
+        physics: &physics,
+        cfg,
+        frames: &frames,
+        motions: &motions,
+        spec: &spec,
+    };
+    let outs = run_units(s, &inp, &plan.run)?;
     let done: std::collections::BTreeMap<CaseUnit, &FloorUnit> =
-        units.iter().copied().zip(&outs).collect();
+        plan.run.iter().copied().zip(&outs).collect();
     let mut zones = Vec::new();
     for (z, zc) in study.cfg.zones.iter().enumerate() {
         let ms = &motions[z];
@@ -143,7 +105,7 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
         zones.push(zone_floors(
             &axes,
             ms.len(),
-            nf,
+            frames.len(),
             unit,
             ZoneNames {
                 name: zc.name.clone(),
@@ -170,6 +132,78 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     write_floors(&path, &meta, &axes, &zones)?;
     s.reporter.info(me, &format!("verified {}", path.display()));
     Ok(StageOutcome::Wrote(vec![path]))
+}
+
+/// `Err` naming the first record whose history the floor spectra cannot refine: every record
+/// is checked before any run.
+fn check_records(study: &Study, motions: &[Vec<Record>]) -> Result<(), FloorsStageError> {
+    for (z, ms) in motions.iter().enumerate() {
+        for m in ms {
+            m.check_refinable(REFINEMENT)
+                .map_err(|why| FloorsStageError::Record {
+                    zone: study.cfg.zones[z].name.clone(),
+                    motion: m.name.clone(),
+                    why,
+                })?;
+        }
+    }
+    Ok(())
+}
+
+/// What running a unit needs besides the unit.
+struct UnitInputs<'a> {
+    physics: &'a Physics,
+    cfg: &'a FloorsConfig,
+    frames: &'a [Option<Frame>],
+    motions: &'a [Vec<Record>],
+    spec: &'a FloorSpectraSpec,
+}
+
+/// Runs `units` in parallel, reporting what they are and a bar; their results in order.
+fn run_units(
+    s: &Session,
+    inp: &UnitInputs,
+    units: &[CaseUnit],
+) -> Result<Vec<FloorUnit>, PipelineError> {
+    let (me, study) = (StageId::Floors, &s.study);
+    s.reporter.info(
+        me,
+        &format!(
+            "{} units (motions × cases{}), each two runs on the record refined {REFINEMENT} \
+             times and {} spectra of {} periods per floor",
+            units.len(),
+            if study.building().is_some() {
+                " × distinct buildings"
+            } else {
+                ""
+            },
+            inp.spec.damping.len(),
+            inp.spec.periods_s.len()
+        ),
+    );
+    let bar = s.reporter.progress(me, units.len() as u64);
+    let outs = units
+        .par_iter()
+        .map(|&u| -> Result<FloorUnit, PipelineError> {
+            s.check_cancelled(me)?;
+            let rec = &inp.motions[u.zone][u.motion];
+            let frame = inp.frames[u.frame].as_ref();
+            let case = &inp.cfg.cases[u.case];
+            let unit = floor_unit(inp.physics, case, frame, rec, inp.spec).map_err(|source| {
+                FloorsStageError::Unit {
+                    zone: study.cfg.zones[u.zone].name.clone(),
+                    motion: rec.name.clone(),
+                    case: u.case,
+                    frame: frame.map_or(String::new(), |f| format!(", {f}")),
+                    source: Box::new(source),
+                }
+            })?;
+            bar.inc();
+            Ok(unit)
+        })
+        .collect::<Result<_, _>>()?;
+    bar.finish();
+    Ok(outs)
 }
 
 /// A zone's names, and its motions' peak ground accelerations, g.
