@@ -253,7 +253,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
         fingerprint: fp,
     };
     let all = all_units(study, grid, &motions);
-    let in_shard = super::shard_filter(StageId::Sweep, shard, all.len())?;
+    let in_shard = super::shard_filter(me, shard, all.len())?;
     let mine: Vec<Unit> = all
         .iter()
         .enumerate()
@@ -262,8 +262,21 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
         .collect();
     let dir = study.path(UNITS_DIR);
     std::fs::create_dir_all(&dir).map_err(|e| StoreError::io(&dir, "cannot create", e))?;
+    let todo = todo_units(s, &units, &mine);
+    compute_units(s, &units, &todo)?;
+    if let Some((k, n)) = shard {
+        return Ok(StageOutcome::ShardDone { k, n });
+    }
+    s.pass("sweep.assemble", me)?;
+    assemble(s, &units, &all)
+}
+
+/// Of `mine`, the units no valid unit file holds (a damaged one with a warning), and a line
+/// saying how many.
+fn todo_units(s: &Session, units: &Units, mine: &[Unit]) -> Vec<Unit> {
+    let me = StageId::Sweep;
     let mut todo = Vec::new();
-    for &u in &mine {
+    for &u in mine {
         match units.read(u) {
             Ok(Stored::Valid(_)) => {}
             Ok(Stored::Missing | Stored::Stale) => todo.push(u),
@@ -273,7 +286,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             }
         }
     }
-    let cases = todo.len() * grid.cases_per_unit();
+    let cases = todo.len() * units.grid.cases_per_unit();
     s.reporter.info(
         me,
         &format!(
@@ -284,6 +297,13 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             mine.len() - todo.len()
         ),
     );
+    todo
+}
+
+/// Computes `todo` in parallel, each unit's file written as it ends, and reports the rate.
+fn compute_units(s: &Session, units: &Units, todo: &[Unit]) -> Result<(), PipelineError> {
+    let (me, study, grid) = (StageId::Sweep, units.study, units.grid);
+    let cases = todo.len() * grid.cases_per_unit();
     let bar = s.reporter.progress(me, todo.len() as u64);
     let start = std::time::Instant::now();
     let sims = AtomicUsize::new(0);
@@ -293,7 +313,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     todo.par_iter()
         .try_for_each(|&u| -> Result<(), PipelineError> {
             s.check_cancelled(me)?;
-            let rec = &motions[u.zone][u.motion];
+            let rec = &units.motions[u.zone][u.motion];
             let accel = rec.accel_mps2(1.0);
             let ground = Ground::new(rec.dt_s, &accel);
             let frame = (study.building()).and_then(|b| study.cfg.frame(b, u.frame));
@@ -339,11 +359,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             ),
         );
     }
-    if let Some((k, n)) = shard {
-        return Ok(StageOutcome::ShardDone { k, n });
-    }
-    s.pass("sweep.assemble", me)?;
-    assemble(s, &units, &all)
+    Ok(())
 }
 
 /// Assembles `sweep.h5` from the stored units of every shard (`merge`).
