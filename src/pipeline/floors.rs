@@ -63,8 +63,8 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> Option<Strin
     Some(StageId::Floors.fingerprint(&hash_parts(&[&section.to_string(), motions_fingerprint])))
 }
 
-/// Builds `floors.h5`: checks every record, runs the units ([`run_units`]: a repeated
-/// building's taken from its first frame), assembles each zone ([`zone_floors`]) and writes.
+/// Builds `floors.h5`: checks every record, runs the units (`run_units`: a repeated
+/// building's taken from its first frame), assembles each zone (`zone_floors`) and writes.
 pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Floors;
