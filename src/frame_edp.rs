@@ -130,7 +130,6 @@ pub fn frame_demands(
         return Err(FrameEdpError::OtherMotions { file: sweep });
     }
     let b = zone
-        .vars
         .building
         .expect("a building study's zone has its building variables");
     let (accel, velocity, drift, residual) = match stacks {

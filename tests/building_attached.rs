@@ -164,7 +164,7 @@ fn the_code_format_lambda_meets_its_definition_from_the_files() {
     let l = t.lambda.as_ref().unwrap();
     let (_, _, sw) = read_zone_sweep(&out.join("sweep.h5"), "V", 1, true).unwrap();
     let motions = read_zone_motions(&out.join("motions.h5"), "V").unwrap();
-    let bv = sw.vars.building.as_ref().unwrap();
+    let bv = sw.building.as_ref().unwrap();
     let m = motions.len();
     let mean = |v: &ndarray::ArrayD<f64>, c: usize| {
         let flat = v.as_slice().unwrap();

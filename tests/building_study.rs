@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{ok, slidestack};
+use common::{ok, shards, slidestack};
 
 use slidestack::dynamics::{ExactOptions, G, Ground};
 use slidestack::grid::StackFloor;
@@ -161,7 +161,7 @@ print([int(f) for f in ds['floor']], bool(a.sel(storeys=1, stack_floor='roof', f
 
     // The profiles are a direct run's: every case of one motion, three storeys, stack on the
     // roof, against `Physics::simulate_building` of the system the skip rule names.
-    let bv = z.vars.building.as_ref().unwrap();
+    let bv = z.building.as_ref().unwrap();
     let recs = read_zone_motions(&out.join("motions.h5"), "V").unwrap();
     let accel = recs[1].accel_mps2(1.0);
     let ground = Ground::new(recs[1].dt_s, &accel);
@@ -466,15 +466,7 @@ fn tnew_shards_a_kill_and_a_damaged_unit_give_the_unsharded_bytes(
         text.contains("TNEW_UNITS=48\n") && text.contains("TNEW_UNITS_DONE=0\n"),
         "{text}"
     );
-    let shard = |k: &str, threads: &str| {
-        let o = ok(slidestack(
-            &["tnew", s(&cfg), "--out", s(&split), "--shard", k],
-            threads,
-        ));
-        let text = String::from_utf8_lossy(&o.stdout);
-        assert!(text.contains(&format!("shard {k} done")), "{text}");
-    };
-    shard("3/3", "1");
+    shards::run("tnew", &cfg, &split, "3/3", "1");
     common::kill_at(
         &["tnew", s(&cfg), "--out", s(&split), "--shard", "1/3"],
         "tnew.unit:1",
@@ -482,48 +474,20 @@ fn tnew_shards_a_kill_and_a_damaged_unit_give_the_unsharded_bytes(
     );
     let units = split.join("tnew.units");
     assert_eq!(std::fs::read_dir(&units).unwrap().count(), 16 + 1);
-    shard("1/3", "2");
-    shard("2/3", "2");
+    shards::run("tnew", &cfg, &split, "1/3", "2");
+    shards::run("tnew", &cfg, &split, "2/3", "2");
     assert!(!split.join("tnew.h5").exists());
-    let mut files: Vec<PathBuf> = (std::fs::read_dir(&units).unwrap())
-        .map(|e| e.unwrap().path())
-        .collect();
-    files.sort();
+    let files = shards::unit_files(&units);
     assert_eq!(files.len(), 48);
     let o = ok(slidestack(&["status", s(&cfg), "--out", s(&split)], "1"));
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("tnew units: 48 of 48 stored"), "{text}");
-    // One byte of a stored unit flipped: refused by its checksum, computed again.
-    let mut bytes = std::fs::read(&files[5]).unwrap();
-    bytes[40] ^= 1;
-    std::fs::write(&files[5], bytes).unwrap();
-    let o = ok(slidestack(&["tnew", s(&cfg), "--out", s(&split)], "1"));
-    let (text, err) = (String::from_utf8_lossy(&o.stdout), stderr(&o));
-    assert!(
-        err.contains("fails its checksum") && err.contains("computing it again"),
-        "{err}"
-    );
+    let o = shards::rerun_with_a_damaged_unit("tnew", &cfg, &split, &files[5]);
+    let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("1 of 24 units"), "{text}");
     assert_eq!(std::fs::read(split.join("tnew.h5")).unwrap(), want);
     assert!(!units.exists());
-    let o = slidestack(
-        &[
-            "tnew",
-            s(&cfg),
-            "--out",
-            s(&split),
-            "--shard",
-            "1/49",
-            "--force",
-        ],
-        "1",
-    );
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).contains("shard 1/49: needs 1 ≤ K ≤ N ≤ 48"),
-        "{}",
-        stderr(&o)
-    );
+    shards::refuses_more_shards_than_units("tnew", &cfg, &split, 49, "1 ≤ K ≤ N ≤ 48");
 }
 
 /// The fit over the six frames of `configs/mdof-quick.yaml` (finished through `tnew` in `out`)
@@ -886,7 +850,7 @@ fn a_stack_at_mid_height_is_the_floor_at_half_the_height() {
     assert!(za.vars.u_stack.iter().any(|&u| u > 0.0));
     assert_eq!(za.vars.u_stack, zb.vars.u_stack);
     assert_eq!(za.vars.slip_peak, zb.vars.slip_peak);
-    let (ba, bb) = (za.vars.building.unwrap(), zb.vars.building.unwrap());
+    let (ba, bb) = (za.building.unwrap(), zb.building.unwrap());
     assert_eq!(ba.storey_shear_stack, bb.storey_shear_stack);
     assert_eq!(ba.floor_accel_stack, bb.floor_accel_stack);
     let mid_height = [1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8, 9, 9, 10, 10];

@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{ok, slidestack};
+use common::{ok, shards, slidestack};
 
 use slidestack::dynamics::{ExactOptions, Ground, System, SystemSpec, Yielding, simulate_exact};
 use slidestack::ida::trace::{HuntFill, hunt_fill};
@@ -117,59 +117,26 @@ fn shards_a_kill_and_a_damaged_unit_give_the_unsharded_bytes() {
         ok(slidestack(&["ida", s(&cfg), "--out", s(&whole)], "2"));
         let want = std::fs::read(whole.join("ida.h5")).unwrap();
 
-        let shard = |k: &str, threads: &str| {
-            let o = ok(slidestack(
-                &["ida", s(&cfg), "--out", s(&split), "--shard", k],
-                threads,
-            ));
-            assert!(String::from_utf8_lossy(&o.stdout).contains(&format!("shard {k} done")));
-        };
-        shard("3/3", "1");
+        shards::run("ida", &cfg, &split, "3/3", "1");
         common::kill_at(
             &["ida", s(&cfg), "--out", s(&split), "--shard", "1/3"],
             "ida.trace:1",
             dir.path(),
         );
-        shard("1/3", "2");
-        shard("2/3", "2");
+        shards::run("ida", &cfg, &split, "1/3", "2");
+        shards::run("ida", &cfg, &split, "2/3", "2");
         assert!(!split.join("ida.h5").exists());
         let units = split.join("ida.units");
-        let mut files: Vec<PathBuf> = (std::fs::read_dir(&units).unwrap())
-            .map(|e| e.unwrap().path())
-            .collect();
-        files.sort();
+        let files = shards::unit_files(&units);
         assert!(files.len() >= 3, "{files:?}");
-        // One byte of a stored unit flipped: refused by its checksum, traced again.
-        let mut bytes = std::fs::read(&files[1]).unwrap();
-        bytes[40] ^= 1;
-        std::fs::write(&files[1], bytes).unwrap();
-        let o = ok(slidestack(&["ida", s(&cfg), "--out", s(&split)], "1"));
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            err.contains("fails its checksum") && err.contains("computing it again"),
-            "{err}"
-        );
+        shards::rerun_with_a_damaged_unit("ida", &cfg, &split, &files[1]);
         assert_eq!(
             std::fs::read(split.join("ida.h5")).unwrap(),
             want,
             "{config}"
         );
         assert!(!units.exists());
-
-        let o = slidestack(
-            &[
-                "ida",
-                s(&cfg),
-                "--out",
-                s(&split),
-                "--shard",
-                "1/999",
-                "--force",
-            ],
-            "1",
-        );
-        assert_eq!(o.status.code(), Some(2));
-        assert!(String::from_utf8_lossy(&o.stderr).contains("shard 1/999: needs 1 ≤ K ≤ N ≤"));
+        shards::refuses_more_shards_than_units("ida", &cfg, &split, 999, "1 ≤ K ≤ N ≤");
     }
 }
 

@@ -432,7 +432,7 @@ fn a_building_studys_report_shows_the_files_numbers() {
         let (_, axes, sw) = read_zone_sweep(&out.join("sweep.h5"), zone, 2, true).unwrap();
         let (grid, _, t) = read_zone_tnew_in(&out.join("tnew.h5"), zone, 2, true).unwrap();
         let axes = axes.unwrap();
-        let b = sw.vars.building.as_ref().unwrap();
+        let b = sw.building.as_ref().unwrap();
         let l = t.lambda.as_ref().unwrap();
         for (si, &n) in axes.storeys.iter().enumerate() {
             for (fi, floor) in axes.stack_floor.iter().enumerate() {

@@ -351,7 +351,7 @@ fn a_study_stores_which_cases_rock_the_report_counts_them_and_design_warns() {
     for zone in ["III", "V"] {
         let (grid, _, sweep) = read_zone_sweep(&out.join("sweep.h5"), zone, 2, false).unwrap();
         let motions = read_zone_motions(&out.join("motions.h5"), zone).unwrap();
-        let rocks = sweep.vars.rocks_stack.expect("stored with grid.aspect");
+        let rocks = sweep.rocks_stack.expect("stored with grid.aspect");
         let mut count = 0;
         for (idx, &flag) in rocks.indexed_iter() {
             let settings = Settings {
@@ -416,7 +416,7 @@ fn a_study_stores_which_cases_rock_the_report_counts_them_and_design_warns() {
     // tnew.h5's rocks_share is the flags' mean over the motions, and `design` warns where it
     // is above 0 (at a grid case, its share exactly).
     let (grid, _, sweep) = read_zone_sweep(&out.join("sweep.h5"), "V", 2, false).unwrap();
-    let rocks = sweep.vars.rocks_stack.unwrap().mapv(f64::from);
+    let rocks = sweep.rocks_stack.unwrap().mapv(f64::from);
     let share = rocks.mean_axis(ndarray::Axis(0)).unwrap();
     let (_, _, t) =
         slidestack::store::tnew::read_zone_tnew_in(&out.join("tnew.h5"), "V", 2, false).unwrap();
@@ -440,7 +440,7 @@ fn a_study_stores_which_cases_rock_the_report_counts_them_and_design_warns() {
     assert_eq!(warned, [true, true]);
     let plain = config("plain", "");
     let (_, _, sweep) = read_zone_sweep(&plain.join("sweep.h5"), "III", 2, false).unwrap();
-    assert!(sweep.vars.rocks_stack.is_none());
+    assert!(sweep.rocks_stack.is_none());
     let report = std::fs::read_to_string(plain.join("report/index.html")).unwrap();
     assert!(!report.contains("Where the stacks would rock"));
     let (_, _, t) =

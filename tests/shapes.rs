@@ -84,9 +84,9 @@ fn write_sweep_file(path: &Path) {
             block_velocity_stack: zeros(&[2, 2, 1, 2, 1]),
             skip_rule: zeros(&shape),
             single_rule: zeros(&shape),
-            rocks_stack: None,
-            building: None,
         },
+        rocks_stack: None,
+        building: None,
     };
     let meta = SweepMeta {
         fingerprint: "f",
@@ -102,27 +102,12 @@ fn write_sweep_file(path: &Path) {
 
 #[test]
 fn sweep_h5() {
-    each_variable(
-        &[
-            "motion",
-            "T_p",
-            "alpha_1",
-            "mu_1",
-            "u_stack",
-            "u_single",
-            "u_rigid",
-            "a_stack",
-            "friction_energy",
-            "slip_peak",
-            "slip_residual",
-            "block_accel_stack",
-            "block_velocity_stack",
-            "skip_rule",
-            "single_rule",
-        ],
-        write_sweep_file,
-        |p, _| read_zone_sweep(p, "III", 1, false),
-    );
+    // The coordinates, then every declared variable.
+    let mut variables = vec!["motion", "T_p", "alpha_1", "mu_1"];
+    variables.extend(SweepVars::VARS.iter().map(|v| v.name));
+    each_variable(&variables, write_sweep_file, |p, _| {
+        read_zone_sweep(p, "III", 1, false)
+    });
 }
 
 const BAND_FLAGS: [(u8, &str); 2] = [(0, "band"), (5, "no_slide")];
@@ -168,24 +153,11 @@ fn write_tnew_with(path: &Path, zone: ZoneTnew, flags: &[(u8, &str)]) {
 
 #[test]
 fn tnew_h5() {
+    let mut variables = vec!["T_p", "alpha_1", "mu_1"];
+    variables.extend(TnewVars::VARS.iter().map(|v| v.name));
+    variables.extend(["period_sd", "sd_mean"]);
     each_variable(
-        &[
-            "T_p",
-            "alpha_1",
-            "mu_1",
-            "u_stack_mean",
-            "u_single_mean",
-            "u_rigid_mean",
-            "T_rigid",
-            "T_new",
-            "DRR_1",
-            "DRR_2",
-            "slides",
-            "T_new_flag",
-            "T_new_band",
-            "period_sd",
-            "sd_mean",
-        ],
+        &variables,
         |p| write_tnew_with(p, tnew_zone(0), &BAND_FLAGS),
         |p, _| read_zone_tnew(p, "III", 1),
     );

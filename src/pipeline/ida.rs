@@ -321,21 +321,7 @@ impl CaseUnits<'_> {
         keep: bool,
     ) -> (Vec<Option<UnitTraces>>, Vec<(usize, CaseUnit)>) {
         let me = StageId::Ida;
-        let mut held = Vec::with_capacity(units.len());
-        let mut todo = Vec::new();
-        for (i, &u) in units.iter().enumerate() {
-            let read = match self.read(u) {
-                Ok(t) => t,
-                Err(e) => {
-                    s.reporter.warn(me, &format!("{e}: computing it again"));
-                    None
-                }
-            };
-            if read.is_none() {
-                todo.push((i, u));
-            }
-            held.push(if keep { read } else { None });
-        }
+        let (held, todo) = super::scan_units(s, me, units, keep, |u| self.read(u));
         if todo.len() < units.len() {
             let line = format!(
                 "{} of {} units to trace ({} already done)",

@@ -790,6 +790,31 @@ pub fn shard_filter(
     Ok(move |i: usize| shard.is_none_or(|(k, n)| i % n == k - 1))
 }
 
+/// A stage's stored work units, read back: what each of `units` holds (in order; only when
+/// `keep`, else `None`), and `(index, unit)` of those to compute again: missing, stale, or
+/// damaged (with a warning naming the file). The sweep, `tnew` and the IDA resume through it.
+pub(crate) fn scan_units<U: Copy, T, E: std::fmt::Display>(
+    s: &Session,
+    stage: StageId,
+    units: &[U],
+    keep: bool,
+    read: impl Fn(U) -> Result<Option<T>, E>,
+) -> (Vec<Option<T>>, Vec<(usize, U)>) {
+    let mut held = Vec::with_capacity(units.len());
+    let mut todo = Vec::new();
+    for (i, &u) in units.iter().enumerate() {
+        let stored = read(u).unwrap_or_else(|e| {
+            s.reporter.warn(stage, &format!("{e}: computing it again"));
+            None
+        });
+        if stored.is_none() {
+            todo.push((i, u));
+        }
+        held.push(if keep { stored } else { None });
+    }
+    (held, todo)
+}
+
 /// Runs shard `K/N` of a stage that can be split (the sweep, `tnew`, the IDA): checks its
 /// inputs, does nothing when its output is up to date (unless forced), else computes and stores
 /// that shard's units; the unsharded stage (`merge` for the sweep) assembles them.

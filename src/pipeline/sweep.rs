@@ -25,6 +25,7 @@ use crate::store::sweep::{
     BuildingVars, SweepMeta, SweepVars, ZoneSweep, read_zone_sweep, write_sweep,
 };
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
+use crate::store::vars;
 use crate::study::config::StudyConfig;
 use crate::study::physics::{CaseError, SystemKind};
 use crate::study::sweep::{SKIP_RULE_CODES, SKIP_RULE_FLAGS, UnitOptions, UnitResult, run_unit};
@@ -275,17 +276,13 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
 /// saying how many.
 fn todo_units(s: &Session, units: &Units, mine: &[Unit]) -> Vec<Unit> {
     let me = StageId::Sweep;
-    let mut todo = Vec::new();
-    for &u in mine {
-        match units.read(u) {
-            Ok(Stored::Valid(_)) => {}
-            Ok(Stored::Missing | Stored::Stale) => todo.push(u),
-            Err(e) => {
-                s.reporter.warn(me, &format!("{e}: computing it again"));
-                todo.push(u);
-            }
-        }
-    }
+    let valid = |u| {
+        units
+            .read(u)
+            .map(|r| matches!(r, Stored::Valid(_)).then_some(()))
+    };
+    let (_, todo) = super::scan_units(s, me, mine, false, valid);
+    let todo: Vec<Unit> = todo.into_iter().map(|(_, u)| u).collect();
     let cases = todo.len() * units.grid.cases_per_unit();
     s.reporter.info(
         me,
@@ -501,9 +498,9 @@ impl Units<'_> {
                 block_velocity_stack: f(goods + 2, &shape_i)?,
                 skip_rule: codes(0)?,
                 single_rule: codes(1)?,
-                rocks_stack: study.aspect().map(|_| codes(2)).transpose()?,
-                building: building_vars,
             },
+            rocks_stack: study.aspect().map(|_| codes(2)).transpose()?,
+            building: building_vars,
         })
     }
 }
@@ -576,25 +573,12 @@ fn array<T>(
 
 /// Equal to the bit (NaN fill included).
 fn same_bits(a: &ZoneSweep, b: &ZoneSweep) -> bool {
-    let f = |x: &ArrayD<f64>, y: &ArrayD<f64>| {
-        x.shape() == y.shape() && x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())
-    };
-    let (va, vb) = (&a.vars, &b.vars);
     a.motions == b.motions
-        && f(&va.u_stack, &vb.u_stack)
-        && f(&va.u_single, &vb.u_single)
-        && f(&va.u_rigid, &vb.u_rigid)
-        && f(&va.a_stack, &vb.a_stack)
-        && f(&va.friction_energy, &vb.friction_energy)
-        && f(&va.slip_peak, &vb.slip_peak)
-        && va.skip_rule == vb.skip_rule
-        && va.single_rule == vb.single_rule
-        && va.rocks_stack == vb.rocks_stack
-        && match (&va.building, &vb.building) {
+        && vars::same_bits(&a.vars.data(), &b.vars.data())
+        && a.rocks_stack == b.rocks_stack
+        && match (&a.building, &b.building) {
             (None, None) => true,
-            (Some(x), Some(y)) => {
-                (x.vars().iter().zip(y.vars())).all(|(p, q)| p.0 == q.0 && f(p.1, q.1))
-            }
+            (Some(x), Some(y)) => vars::same_bits(&x.data(), &y.data()),
             _ => false,
         }
 }

@@ -85,11 +85,10 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             building,
             frames: &frames,
             motions: &motions[z],
-            sweep: &sw.vars,
+            sweep: &sw,
             keep_going: &keep_going,
         };
-        let work = tnew::ZoneWork::new(&inp);
-        debug_assert_eq!(work.units(), store.units.as_slice());
+        let work = tnew::ZoneWork::new(&inp, &store.units);
         let of_units =
             zone_units(s, &store, z, &work, &mine, shard.is_none()).map_err(|e| match e {
                 PipelineError::Tnew(e) => stopped(e),
@@ -153,18 +152,7 @@ fn zone_units(
     keep: bool,
 ) -> Result<Vec<Vec<CaseFractions>>, PipelineError> {
     let me = StageId::Tnew;
-    let mut held: Vec<Option<Vec<CaseFractions>>> = Vec::with_capacity(mine.len());
-    let mut todo = Vec::new();
-    for (i, &u) in mine.iter().enumerate() {
-        let read = store.read(z, u).unwrap_or_else(|e| {
-            s.reporter.warn(me, &format!("{e}: computing it again"));
-            None
-        });
-        if read.is_none() {
-            todo.push((i, u));
-        }
-        held.push(if keep { read } else { None });
-    }
+    let (mut held, todo) = super::scan_units(s, me, mine, keep, |u| store.read(z, u));
     if todo.is_empty() {
         return Ok(held.into_iter().flatten().collect());
     }

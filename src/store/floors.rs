@@ -21,6 +21,7 @@ use super::h5::{
     write_stage_file, write_var,
 };
 use super::sweep::{building_coordinates, read_building_coordinates};
+use super::vars::{Codes, Trailing, Var};
 use crate::grid::BuildingAxes;
 use ndarray::ArrayD;
 use std::path::Path;
@@ -86,6 +87,88 @@ pub fn write_floors(
     )
 }
 
+/// Each motion's peaks, `[motion, case, (storeys, stack_floor,) floor]`.
+pub const PEAKS: [Var; 2] = [
+    floor_var(
+        "pfa_stack",
+        Trailing::Floor,
+        "peak absolute acceleration of the floor, stacks sliding",
+    ),
+    floor_var(
+        "pfa_rigid",
+        Trailing::Floor,
+        "peak absolute acceleration of the floor, stacks rigidly attached",
+    ),
+];
+
+/// Each motion's floor spectra, `[motion, case, (storeys, stack_floor,) damping, floor, period]`
+/// (their trailing axes `damping, floor, period` written by this module, not by
+/// [`super::vars::write_declared`]: `Case` here).
+pub const SPECTRA: [Var; 2] = [
+    floor_var(
+        "psa_stack",
+        Trailing::Case,
+        "floor response spectrum (pseudo-acceleration of an oscillator on the floor), stacks \
+         sliding",
+    ),
+    floor_var(
+        "psa_rigid",
+        Trailing::Case,
+        "floor response spectrum (pseudo-acceleration of an oscillator on the floor), stacks \
+         rigidly attached",
+    ),
+];
+
+const fn floor_var(name: &'static str, trailing: Trailing, long_name: &'static str) -> Var {
+    Var {
+        name,
+        trailing,
+        units: "g",
+        long_name,
+        building_long_name: None,
+        codes: Codes::Value,
+    }
+}
+
+/// The listed cases: each one's period `[case]` and its mass ratios and friction coefficients
+/// `[case, block]`.
+fn write_cases(
+    g: &hdf5::Group,
+    axes: &FloorsAxes,
+    case: &hdf5::Dataset,
+    block: &hdf5::Dataset,
+) -> hdf5::Result<()> {
+    let cases = axes.case_period_s.len();
+    let blocks = axes.case_alpha.first().map_or(0, Vec::len);
+    let ds = write_var(
+        g,
+        "case_period_s",
+        ndarray::arr1(&axes.case_period_s).into_dyn().view(),
+        &[cases],
+        "s",
+        "the case's bare period T_p (a building: its first-mode period T_1)",
+    )?;
+    attach_all(&ds, std::slice::from_ref(case))?;
+    for (name, values, long) in [
+        (
+            "case_alpha",
+            &axes.case_alpha,
+            "the case's mass ratios, block 1 first",
+        ),
+        (
+            "case_mu",
+            &axes.case_mu,
+            "the case's kinetic friction coefficients, interface 1 first",
+        ),
+    ] {
+        let flat: Vec<f64> = values.iter().flatten().copied().collect();
+        let a = ArrayD::from_shape_vec(vec![cases, blocks], flat).expect("one per block");
+        let ds = write_var(g, name, a.view(), &[cases, blocks], "1", long)?;
+        attach_all(&ds, &[case.clone(), block.clone()])?;
+    }
+    Ok(())
+}
+
 fn write_zone(f: &hdf5::File, axes: &FloorsAxes, z: &ZoneFloors) -> hdf5::Result<()> {
     let g = f.create_group(&format!("zone_{}", z.name))?;
     attr_str(&g, "target", &z.target)?;
@@ -120,32 +203,7 @@ fn write_zone(f: &hdf5::File, axes: &FloorsAxes, z: &ZoneFloors) -> hdf5::Result
         "floor (1 the lowest; one storey: the structure)",
     )?;
     let period = coordinate(&g, "period", &axes.periods_s, "s", "oscillator period")?;
-    let ds = write_var(
-        &g,
-        "case_period_s",
-        ndarray::arr1(&axes.case_period_s).into_dyn().view(),
-        &[cases],
-        "s",
-        "the case's bare period T_p (a building: its first-mode period T_1)",
-    )?;
-    attach_all(&ds, std::slice::from_ref(&case))?;
-    for (name, values, long) in [
-        (
-            "case_alpha",
-            &axes.case_alpha,
-            "the case's mass ratios, block 1 first",
-        ),
-        (
-            "case_mu",
-            &axes.case_mu,
-            "the case's kinetic friction coefficients, interface 1 first",
-        ),
-    ] {
-        let flat: Vec<f64> = values.iter().flatten().copied().collect();
-        let a = ArrayD::from_shape_vec(vec![cases, blocks], flat).expect("one per block");
-        let ds = write_var(&g, name, a.view(), &[cases, blocks], "1", long)?;
-        attach_all(&ds, &[case.clone(), block.clone()])?;
-    }
+    write_cases(&g, axes, &case, &block)?;
     let ds = write_var(
         &g,
         "pga",
@@ -162,42 +220,18 @@ fn write_zone(f: &hdf5::File, axes: &FloorsAxes, z: &ZoneFloors) -> hdf5::Result
         v.extend(tail.iter().map(|d| (*d).clone()));
         v
     };
-    for (name, data, long) in [
-        (
-            "pfa_stack",
-            &z.pfa_stack,
-            "peak absolute acceleration of the floor, stacks sliding",
-        ),
-        (
-            "pfa_rigid",
-            &z.pfa_rigid,
-            "peak absolute acceleration of the floor, stacks rigidly attached",
-        ),
-    ] {
+    for (var, data) in PEAKS.iter().zip([&z.pfa_stack, &z.pfa_rigid]) {
         let mut chunk = vec![1; data.ndim()];
         chunk[data.ndim() - 1] = axes.floors;
-        let ds = write_var(&g, name, data.view(), &chunk, "g", long)?;
+        let ds = write_var(&g, var.name, data.view(), &chunk, var.units, var.long_name)?;
         attach_all(&ds, &with(&[&floor]))?;
     }
-    for (name, data, long) in [
-        (
-            "psa_stack",
-            &z.psa_stack,
-            "floor response spectrum (pseudo-acceleration of an oscillator on the floor), \
-             stacks sliding",
-        ),
-        (
-            "psa_rigid",
-            &z.psa_rigid,
-            "floor response spectrum (pseudo-acceleration of an oscillator on the floor), \
-             stacks rigidly attached",
-        ),
-    ] {
+    for (var, data) in SPECTRA.iter().zip([&z.psa_stack, &z.psa_rigid]) {
         let n = data.ndim();
         let mut chunk = vec![1; n];
         chunk[n - 1] = axes.periods_s.len();
         chunk[n - 2] = axes.floors;
-        let ds = write_var(&g, name, data.view(), &chunk, "g", long)?;
+        let ds = write_var(&g, var.name, data.view(), &chunk, var.units, var.long_name)?;
         attach_all(&ds, &with(&[&damping, &floor, &period]))?;
     }
     Ok(())
@@ -248,10 +282,10 @@ pub fn read_zone_floors(
             .iter()
             .copied()
             .collect(),
-        pfa_stack: g.array("pfa_stack", &per_floor)?,
-        pfa_rigid: g.array("pfa_rigid", &per_floor)?,
-        psa_stack: g.array("psa_stack", &spectra)?,
-        psa_rigid: g.array("psa_rigid", &spectra)?,
+        pfa_stack: g.array(PEAKS[0].name, &per_floor)?,
+        pfa_rigid: g.array(PEAKS[1].name, &per_floor)?,
+        psa_stack: g.array(SPECTRA[0].name, &spectra)?,
+        psa_rigid: g.array(SPECTRA[1].name, &spectra)?,
         motions,
     };
     Ok((axes, zone))

@@ -23,6 +23,7 @@ pub mod report;
 pub mod sweep;
 pub mod tnew;
 pub mod units;
+pub mod vars;
 
 pub use history::{HistoryFormat, HistoryLayout, write_history};
 
@@ -136,4 +137,84 @@ impl<T> H5Context<T> for hdf5::Result<T> {
     fn at(self, file: &Path) -> Result<T, StoreError> {
         self.map_err(|e| StoreError::hdf5(file, e))
     }
+}
+
+/// `docs/variables.md`: the table of every declared stage-file variable, made from the
+/// declarations themselves ([`vars`]); `tests/variables_doc.rs` holds the file to it.
+pub fn variables_doc() -> String {
+    let one = "motion, T_p, alpha_1 … alpha_n, mu_1 … mu_n";
+    let building = "motion, storeys, stack_floor, T_p, …";
+    let mut s = String::from(
+        "# Stored variables\n\n\
+         Made by `slidestack::store::variables_doc()` from the declarations in `src/store/` \
+         (`stored_vars!`), which also drive the writers and the readers' shape checks; \
+         `SLIDESTACK_BLESS=1 cargo test --release --test variables_doc` rewrites it \
+         (`ida.h5` and `fit.h5` are described in their modules, `src/store/ida.rs` and \
+         `src/store/fit.rs`). \
+         \"codes\" are `u8` CF flags (`flag_values`, `flag_meanings` on the variable, 255 the \
+         fill); every other variable is `f64` with NaN as fill. A building study's variables \
+         have the dimensions `storeys, stack_floor` after `motion` (`sweep.h5`) or in front \
+         (`tnew.h5`); their layouts are described in [model.md](model.md).\n",
+    );
+    let mut section = |title: &str, note: &str, case: &str, vars: &[vars::Var]| {
+        s.push_str(&format!("\n## {title}\n\n{note}\n\n"));
+        s.push_str(&vars::table(case, vars));
+    };
+    section(
+        "`sweep.h5`: every case under every motion",
+        "Per zone; `rocks_stack` only with `grid.aspect`.",
+        one,
+        &[sweep::SweepVars::VARS, &[sweep::ROCKS_STACK]].concat(),
+    );
+    section(
+        "`sweep.h5`: a building study's floors and storeys",
+        "Over the building's floors or storeys up to the largest `storeys` (NaN above a \
+         building's roof).",
+        building,
+        sweep::BuildingVars::VARS,
+    );
+    let case = "T_p, alpha_1 … alpha_n, mu_1 … mu_n";
+    section(
+        "`tnew.h5`: per case, over the motions",
+        "Per zone; `rocks_share` only with `grid.aspect`.",
+        case,
+        &[tnew::TnewVars::VARS, &[tnew::ROCKS_SHARE]].concat(),
+    );
+    section(
+        "`tnew.h5`: a building study's attached fractions",
+        "Every flag's codes are the file's `lambda_flag` codes.",
+        "storeys, stack_floor, T_p, …",
+        tnew::AttachedVars::VARS,
+    );
+    section(
+        "`motions.h5`: each zone's spectra",
+        "Over the check periods; `psa_g` is over `motion, period`.",
+        "period",
+        &motions::SPECTRA,
+    );
+    section(
+        "`motions.h5`: each seed's matching",
+        "Per zone, over every seed (kept or not).",
+        "seed",
+        &motions::SEED_REPORT,
+    );
+    section(
+        "`motions.h5`: a table target's rows",
+        "Only for a `table:FILE` target.",
+        "target_row",
+        &motions::TARGET_TABLE,
+    );
+    section(
+        "`floors.h5`: the floors' peaks",
+        "Per zone, over the listed cases (`floor_spectra.cases`).",
+        "motion, case, (storeys, stack_floor)",
+        &floors::PEAKS,
+    );
+    section(
+        "`floors.h5`: the floor response spectra",
+        "Per zone, over the oscillators' damping ratios and periods.",
+        "motion, case, (storeys, stack_floor,) damping, floor, period",
+        &floors::SPECTRA,
+    );
+    s
 }

@@ -23,6 +23,7 @@ use super::h5::{
     GroupReader, attr_f64, attr_str, open, read_attr_f64, read_attr_str, write_1d, write_small,
     write_stage_file, write_strings,
 };
+use super::vars::{Codes, Trailing, Var};
 use super::{H5Context, StoreError};
 use crate::ground_motion::Record;
 use crate::ground_motion::matching::MatchReport;
@@ -100,123 +101,13 @@ fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Resul
         periods_s, sa_g, ..
     } = &z.target
     {
-        for (name, values, units, long) in [
-            (
-                TABLE_PERIOD,
-                periods_s,
-                "s",
-                "period of a row of the target table",
-            ),
-            (
-                TABLE_SA,
-                sa_g,
-                "g",
-                "target pseudo-spectral acceleration of a row",
-            ),
-        ] {
-            let ds = write_1d(&g, name, values, units, long)?;
+        for (var, values) in TARGET_TABLE.iter().zip([periods_s, sa_g]) {
+            let ds = write_1d(&g, var.name, values, var.units, var.long_name)?;
             attr_str(&ds, "dims", "target_row")?;
         }
     }
-    write_1d(&g, "period", &z.periods_s, "s", "oscillator period")?;
-    write_1d(
-        &g,
-        "target_psa_g",
-        &z.target_psa_g,
-        "g",
-        "target pseudo-spectral acceleration",
-    )?;
-    write_1d(
-        &g,
-        "mean_psa_g",
-        &z.mean_psa_g,
-        "g",
-        "mean PSA of the kept motions (5 % damping)",
-    )?;
-    let names: Vec<String> = z.motions.iter().map(|m| m.name.clone()).collect();
-    write_strings(&g, "motion", &names, "kept (matched and accepted) motions")?;
-    let flat: Vec<f64> = z.psa_g.iter().flatten().copied().collect();
-    let psa = ndarray::Array2::from_shape_vec((z.psa_g.len(), z.periods_s.len()), flat)
-        .map_err(|e| hdf5::Error::from(e.to_string()))?;
-    let ds = write_small(
-        &g,
-        "psa_g",
-        psa.view().into_dyn(),
-        "g",
-        "pseudo-spectral acceleration of each kept motion (5 % damping)",
-    )?;
-    attr_str(&ds, "dims", "motion, period")?;
-    write_strings(&g, "seed", &z.seeds, "all seed motions")?;
-    let col = |f: &dyn Fn(&MatchReport) -> f64| z.reports.iter().map(f).collect::<Vec<f64>>();
-    let kept: Vec<f64> = (0..z.seeds.len())
-        .map(|i| f64::from(u8::from(z.kept.contains(&i))))
-        .collect();
-    let report: [(&str, Vec<f64>, &str, &str); 10] = [
-        (
-            "kept",
-            kept,
-            "1",
-            "1 when the motion is one of the zone's motions",
-        ),
-        (
-            "converged",
-            col(&|r| f64::from(u8::from(r.converged))),
-            "1",
-            "1 when every check period is within the band",
-        ),
-        (
-            "iterations",
-            col(&|r| r.iterations as f64),
-            "1",
-            "matching iterations",
-        ),
-        (
-            "worst_misfit",
-            col(&|r| r.worst_misfit),
-            "1",
-            "largest |PSA/target − 1| on the check grid",
-        ),
-        (
-            "scale",
-            col(&|r| r.scale),
-            "1",
-            "pre-scale factor before matching",
-        ),
-        (
-            "pga_before_g",
-            col(&|r| r.pga_before_g),
-            "g",
-            "peak ground acceleration of the seed",
-        ),
-        (
-            "pga_after_g",
-            col(&|r| r.pga_after_g),
-            "g",
-            "peak ground acceleration after matching",
-        ),
-        (
-            "final_velocity_mps",
-            col(&|r| r.final_velocity_mps),
-            "m/s",
-            "ground velocity at the end (drift)",
-        ),
-        (
-            "final_displacement_m",
-            col(&|r| r.final_displacement_m),
-            "m",
-            "ground displacement at the end (drift)",
-        ),
-        (
-            "arias_ratio",
-            col(&|r| r.arias_ratio),
-            "1",
-            "Arias intensity after / before matching",
-        ),
-    ];
-    for (name, data, units, long) in &report {
-        let ds = write_1d(&g, name, data, units, long)?;
-        attr_str(&ds, "dims", "seed")?;
-    }
+    write_spectra(&g, z)?;
+    write_seed_report(&g, z)?;
     let acc = g.create_group("accel")?;
     for (i, m) in z.motions.iter().enumerate() {
         write_record(
@@ -225,6 +116,143 @@ fn write_zone(f: &hdf5::File, z: &ZoneMotions, fingerprint: &str) -> hdf5::Resul
             m,
             "matched ground acceleration",
         )?;
+    }
+    Ok(())
+}
+
+/// The rows of a `table:FILE` target, `[target_row]`.
+pub const TARGET_TABLE: [Var; 2] = [
+    value(TABLE_PERIOD, "s", "period of a row of the target table"),
+    value(
+        TABLE_SA,
+        "g",
+        "target pseudo-spectral acceleration of a row",
+    ),
+];
+
+/// The spectra over the check periods, `[period]` (`psa_g`: `[motion, period]`).
+pub const SPECTRA: [Var; 4] = [
+    value("period", "s", "oscillator period"),
+    value("target_psa_g", "g", "target pseudo-spectral acceleration"),
+    value(
+        "mean_psa_g",
+        "g",
+        "mean PSA of the kept motions (5 % damping)",
+    ),
+    value(
+        "psa_g",
+        "g",
+        "pseudo-spectral acceleration of each kept motion (5 % damping)",
+    ),
+];
+
+/// The matching report of every seed, `[seed]`: whether it was kept, then each column of its
+/// [`MatchReport`] ([`SEED_REPORT_OF`] in the same order).
+pub const SEED_REPORT: [Var; 10] = [
+    value(
+        "kept",
+        "1",
+        "1 when the motion is one of the zone's motions",
+    ),
+    value(
+        "converged",
+        "1",
+        "1 when every check period is within the band",
+    ),
+    value("iterations", "1", "matching iterations"),
+    value(
+        "worst_misfit",
+        "1",
+        "largest |PSA/target − 1| on the check grid",
+    ),
+    value("scale", "1", "pre-scale factor before matching"),
+    value("pga_before_g", "g", "peak ground acceleration of the seed"),
+    value(
+        "pga_after_g",
+        "g",
+        "peak ground acceleration after matching",
+    ),
+    value(
+        "final_velocity_mps",
+        "m/s",
+        "ground velocity at the end (drift)",
+    ),
+    value(
+        "final_displacement_m",
+        "m",
+        "ground displacement at the end (drift)",
+    ),
+    value(
+        "arias_ratio",
+        "1",
+        "Arias intensity after / before matching",
+    ),
+];
+
+/// The columns of [`SEED_REPORT`] after `kept`, from a seed's report.
+const SEED_REPORT_OF: [fn(&MatchReport) -> f64; 9] = [
+    |r| f64::from(u8::from(r.converged)),
+    |r| r.iterations as f64,
+    |r| r.worst_misfit,
+    |r| r.scale,
+    |r| r.pga_before_g,
+    |r| r.pga_after_g,
+    |r| r.final_velocity_mps,
+    |r| r.final_displacement_m,
+    |r| r.arias_ratio,
+];
+
+const fn value(name: &'static str, units: &'static str, long_name: &'static str) -> Var {
+    Var {
+        name,
+        trailing: Trailing::Case,
+        units,
+        long_name,
+        building_long_name: None,
+        codes: Codes::Value,
+    }
+}
+
+/// The check periods, the target and mean spectra and each kept motion's ([`SPECTRA`]) and the
+/// kept motions' names.
+fn write_spectra(g: &hdf5::Group, z: &ZoneMotions) -> hdf5::Result<()> {
+    let [period, target, mean, psa_var] = &SPECTRA;
+    for (var, values) in [
+        (period, &z.periods_s),
+        (target, &z.target_psa_g),
+        (mean, &z.mean_psa_g),
+    ] {
+        write_1d(g, var.name, values, var.units, var.long_name)?;
+    }
+    let names: Vec<String> = z.motions.iter().map(|m| m.name.clone()).collect();
+    write_strings(g, "motion", &names, "kept (matched and accepted) motions")?;
+    let flat: Vec<f64> = z.psa_g.iter().flatten().copied().collect();
+    let psa = ndarray::Array2::from_shape_vec((z.psa_g.len(), z.periods_s.len()), flat)
+        .map_err(|e| hdf5::Error::from(e.to_string()))?;
+    let ds = write_small(
+        g,
+        psa_var.name,
+        psa.view().into_dyn(),
+        psa_var.units,
+        psa_var.long_name,
+    )?;
+    attr_str(&ds, "dims", "motion, period")
+}
+
+/// The seeds' names and their matching report ([`SEED_REPORT`]).
+fn write_seed_report(g: &hdf5::Group, z: &ZoneMotions) -> hdf5::Result<()> {
+    write_strings(g, "seed", &z.seeds, "all seed motions")?;
+    let kept: Vec<f64> = (0..z.seeds.len())
+        .map(|i| f64::from(u8::from(z.kept.contains(&i))))
+        .collect();
+    let columns = std::iter::once(kept).chain(
+        SEED_REPORT_OF
+            .iter()
+            .map(|of| z.reports.iter().map(of).collect()),
+    );
+    for (var, data) in SEED_REPORT.iter().zip(columns) {
+        let ds = write_1d(g, var.name, &data, var.units, var.long_name)?;
+        attr_str(&ds, "dims", "seed")?;
     }
     Ok(())
 }
@@ -301,13 +329,14 @@ pub fn read_zone_spectra(path: &Path, zone: &str) -> Result<ZoneSpectra, StoreEr
     let periods_s = g.vector("period")?;
     let n = periods_s.len();
     let motions = g.strings("motion")?.len();
-    let list = |name: &str| -> Result<Vec<f64>, StoreError> {
-        Ok(g.array(name, &[n])?.into_iter().collect())
+    let list = |var: &Var| -> Result<Vec<f64>, StoreError> {
+        Ok(g.array(var.name, &[n])?.into_iter().collect())
     };
-    let psa_g = g.array::<f64>("psa_g", &[motions, n])?;
+    let [_, target, mean, psa] = &SPECTRA;
+    let psa_g = g.array::<f64>(psa.name, &[motions, n])?;
     Ok(ZoneSpectra {
-        target_psa_g: list("target_psa_g")?,
-        mean_psa_g: list("mean_psa_g")?,
+        target_psa_g: list(target)?,
+        mean_psa_g: list(mean)?,
         psa_g: psa_g
             .into_dimensionality()
             .map_err(|e| StoreError::corrupt(path, e.to_string()))?,

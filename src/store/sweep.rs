@@ -37,9 +37,9 @@
 
 use super::StoreError;
 use super::h5::{
-    Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, string_coordinate,
-    write_attrs, write_flags, write_stage_file, write_var,
+    Attr, GroupReader, attr_str, coordinate, string_coordinate, write_attrs, write_stage_file,
 };
+use super::vars::{Codes, Data, Target, Trailing, Var, read_optional, write_declared};
 use crate::grid::{BuildingAxes, Grid, StackFloor};
 use ndarray::ArrayD;
 use std::path::Path;
@@ -60,203 +60,129 @@ pub struct SweepMeta<'a> {
     pub settings: &'a [(&'a str, Attr<'a>)],
 }
 
-/// One zone's variables, each shaped `[motion, T_p, alpha…, mu…]` (`slip_peak` with a trailing
-/// interface axis).
-#[derive(Debug, Clone, PartialEq)]
-pub struct SweepVars {
-    pub u_stack: ArrayD<f64>,
-    pub u_single: ArrayD<f64>,
-    pub u_rigid: ArrayD<f64>,
-    pub a_stack: ArrayD<f64>,
-    pub friction_energy: ArrayD<f64>,
-    pub slip_peak: ArrayD<f64>,
-    /// Slip of each interface at the record's end, m (signed; a building with a stack on
-    /// several floors: the one of the largest magnitude).
-    pub slip_residual: ArrayD<f64>,
-    /// The goods' own demands: each block's peak absolute acceleration, g, and velocity, m/s
-    /// (a building with a stack on several floors: the largest over them).
-    pub block_accel_stack: ArrayD<f64>,
-    pub block_velocity_stack: ArrayD<f64>,
-    pub skip_rule: ArrayD<u8>,
-    pub single_rule: ArrayD<u8>,
-    /// With `grid.aspect`: 1 where the stack would start to rock (docs/model.md, "Rocking:
-    /// when a case leaves the model"); `None` when not checked.
-    pub rocks_stack: Option<ArrayD<u8>>,
-    /// A building study's per-floor peaks and base shear (`None` on one storey).
-    pub building: Option<BuildingVars>,
+crate::stored_vars! {
+    /// One zone's variables, each shaped `[motion, T_p, alpha…, mu…]` (in a building study
+    /// `[motion, storeys, stack_floor, T_p, …]`), some with a trailing `interface` or `block`
+    /// axis.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SweepVars {
+        u_stack: f64 => "u_stack", Case, "m",
+            "peak structure displacement with the sliding stack",
+            building "peak structure displacement with the sliding stack (a building: its roof's)";
+        u_single: f64 => "u_single", Case, "m",
+            "peak structure displacement with the stack as one sliding block on interface 1",
+            building "peak structure displacement with the stack as one sliding block on \
+                      interface 1 (a building: its roof's)";
+        u_rigid: f64 => "u_rigid", Case, "m",
+            "peak structure displacement with the stack rigidly attached",
+            building "peak structure displacement with the stack rigidly attached (a building: \
+                      its roof's)";
+        a_stack: f64 => "a_stack", Case, "g",
+            "peak absolute structure acceleration with the sliding stack",
+            building "peak absolute structure acceleration with the sliding stack (a building: \
+                      its roof's)";
+        friction_energy: f64 => "friction_energy", Case, "J/kg",
+            "energy dissipated by friction in the stack, per kg of structure mass",
+            building "energy dissipated by friction in the stack, per kg of structure mass (a \
+                      building: of every stack, per kg of all its floors)";
+        slip_peak: f64 => "slip_peak", Interface, "m",
+            "peak slip of each interface",
+            building "peak slip of each interface (with a stack on every floor: the largest over \
+                      them)";
+        /// Slip of each interface at the record's end, m (signed; a building with a stack on
+        /// several floors: the one of the largest magnitude).
+        slip_residual: f64 => "slip_residual", Interface, "m",
+            "slip of each interface at the record's end, signed",
+            building "slip of each interface at the record's end, signed (with a stack on every \
+                      floor: the one of the largest magnitude)";
+        /// The goods' own demands: each block's peak absolute acceleration, g, and velocity, m/s
+        /// (a building with a stack on several floors: the largest over them).
+        block_accel_stack: f64 => "block_accel_stack", Block, "g",
+            "peak absolute acceleration of each block",
+            building "peak absolute acceleration of each block (with a stack on every floor: the \
+                      largest over them)";
+        block_velocity_stack: f64 => "block_velocity_stack", Block, "m s-1",
+            "peak absolute velocity of each block",
+            building "peak absolute velocity of each block (with a stack on every floor: the \
+                      largest over them)";
+        /// The rule that gave each case's stack result (codes: the study's skip rules).
+        skip_rule: u8 => "skip_rule", Case, "",
+            "rule that gave the stack result (file attribute skip_rule_codes)";
+        single_rule: u8 => "single_rule", Case, "",
+            "1 when the single block cannot slip and equals the rigid system",
+            codes &[(0, "simulated"), (1, "equals_rigid")];
+    }
 }
 
-/// A building study's per-floor and per-storey peaks (a trailing `floor` or `storey` axis of
-/// length `N_max`, NaN above a building's roof) and base shear, with the stack (`_stack`) and
-/// with it rigidly attached (`_rigid`); docs/model.md, "Base shear, drift ratio, floor
-/// acceleration".
-#[derive(Debug, Clone, PartialEq)]
-pub struct BuildingVars {
-    /// Peak absolute acceleration of each floor, g.
-    pub floor_accel_stack: ArrayD<f64>,
-    pub floor_accel_rigid: ArrayD<f64>,
-    /// Peak interstorey drift over the storey's height, per storey.
-    pub drift_ratio_stack: ArrayD<f64>,
-    pub drift_ratio_rigid: ArrayD<f64>,
-    /// Peak base shear over the bare building's weight (NaN in a building of one storey).
-    pub base_shear_stack: ArrayD<f64>,
-    pub base_shear_rigid: ArrayD<f64>,
-    /// Peak shear of each storey over the bare building's weight (storey 1's is the base
-    /// shear; NaN in a building of one storey).
-    pub storey_shear_stack: ArrayD<f64>,
-    pub storey_shear_rigid: ArrayD<f64>,
-    /// Peak overturning moment at the base over the bare building's weight times its height
-    /// (NaN in a building of one storey).
-    pub overturning_stack: ArrayD<f64>,
-    pub overturning_rigid: ArrayD<f64>,
-    /// The stack's stuck mass share: the time average of its mass moving with its floor, over
-    /// its mass (NaN in a building of one storey).
-    pub stuck_share_stack: ArrayD<f64>,
-    /// Peak absolute velocity of each floor, m/s (FEMA P-58's PFV).
-    pub floor_velocity_stack: ArrayD<f64>,
-    pub floor_velocity_rigid: ArrayD<f64>,
-    /// Each storey's drift at the record's end over its height, signed.
-    pub residual_drift_ratio_stack: ArrayD<f64>,
-    pub residual_drift_ratio_rigid: ArrayD<f64>,
-}
+/// With `grid.aspect`: 1 where the stack would start to rock (docs/model.md, "Rocking: when a
+/// case leaves the model"), `[motion, …]` as [`SweepVars`]' case variables.
+pub const ROCKS_STACK: Var = Var {
+    name: "rocks_stack",
+    trailing: Trailing::Case,
+    units: "",
+    long_name: "1 when the stack (in a building, any of its stacks) would start to rock: the \
+                sliding-only model does not hold (blocks' width over height: file attribute aspect)",
+    building_long_name: None,
+    codes: Codes::Fixed(&[(0, "slides_only"), (1, "rocks")]),
+};
 
-/// The trailing level axis of a building variable.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Level {
-    /// None: the case dimensions alone.
-    Case,
-    Floor,
-    Storey,
-}
-
-impl BuildingVars {
-    /// `(name, data, units, long name, level axis)` of every variable, in the order they are
-    /// written and read.
-    pub fn vars(
-        &self,
-    ) -> [(
-        &'static str,
-        &ArrayD<f64>,
-        &'static str,
-        &'static str,
-        Level,
-    ); 15] {
-        [
-            (
-                "floor_accel_stack",
-                &self.floor_accel_stack,
-                "g",
-                "peak absolute acceleration of each floor with the sliding stack",
-                Level::Floor,
-            ),
-            (
-                "floor_accel_rigid",
-                &self.floor_accel_rigid,
-                "g",
-                "peak absolute acceleration of each floor with the stack rigidly attached",
-                Level::Floor,
-            ),
-            (
-                "drift_ratio_stack",
-                &self.drift_ratio_stack,
-                "1",
-                "peak interstorey drift over the storey height, with the sliding stack",
-                Level::Storey,
-            ),
-            (
-                "drift_ratio_rigid",
-                &self.drift_ratio_rigid,
-                "1",
-                "peak interstorey drift over the storey height, with the stack rigidly attached",
-                Level::Storey,
-            ),
-            (
-                "base_shear_stack",
-                &self.base_shear_stack,
-                "1",
-                "peak base shear over the bare building's weight, with the sliding stack \
-                 (NaN on one storey: its integrator does not give it)",
-                Level::Case,
-            ),
-            (
-                "base_shear_rigid",
-                &self.base_shear_rigid,
-                "1",
-                "peak base shear over the bare building's weight, with the stack rigidly \
-                 attached (NaN on one storey: its integrator does not give it)",
-                Level::Case,
-            ),
-            (
-                "storey_shear_stack",
-                &self.storey_shear_stack,
-                "1",
-                "peak shear of each storey over the bare building's weight, with the sliding \
-                 stack (NaN on one storey)",
-                Level::Storey,
-            ),
-            (
-                "storey_shear_rigid",
-                &self.storey_shear_rigid,
-                "1",
-                "peak shear of each storey over the bare building's weight, with the stack \
-                 rigidly attached (NaN on one storey)",
-                Level::Storey,
-            ),
-            (
-                "overturning_stack",
-                &self.overturning_stack,
-                "1",
-                "peak overturning moment at the base over the bare building's weight times its \
-                 height, with the sliding stack (NaN on one storey)",
-                Level::Case,
-            ),
-            (
-                "overturning_rigid",
-                &self.overturning_rigid,
-                "1",
-                "peak overturning moment at the base over the bare building's weight times its \
-                 height, with the stack rigidly attached (NaN on one storey)",
-                Level::Case,
-            ),
-            (
-                "stuck_share_stack",
-                &self.stuck_share_stack,
-                "1",
-                "time average of the stack's mass moving with its floor over its mass (1: it \
-                 never slid; NaN on one storey)",
-                Level::Case,
-            ),
-            (
-                "floor_velocity_stack",
-                &self.floor_velocity_stack,
-                "m s-1",
-                "peak absolute velocity of each floor with the sliding stack",
-                Level::Floor,
-            ),
-            (
-                "floor_velocity_rigid",
-                &self.floor_velocity_rigid,
-                "m s-1",
-                "peak absolute velocity of each floor with the stack rigidly attached",
-                Level::Floor,
-            ),
-            (
-                "residual_drift_ratio_stack",
-                &self.residual_drift_ratio_stack,
-                "1",
-                "interstorey drift at the record's end over the storey height, signed, with \
-                 the sliding stack",
-                Level::Storey,
-            ),
-            (
-                "residual_drift_ratio_rigid",
-                &self.residual_drift_ratio_rigid,
-                "1",
-                "interstorey drift at the record's end over the storey height, signed, with \
-                 the stack rigidly attached",
-                Level::Storey,
-            ),
-        ]
+crate::stored_vars! {
+    /// A building study's per-floor and per-storey peaks (a trailing `floor` or `storey` axis of
+    /// length `N_max`, NaN above a building's roof) and base shear, with the stack (`_stack`) and
+    /// with it rigidly attached (`_rigid`); docs/model.md, "Base shear, drift ratio, floor
+    /// acceleration".
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct BuildingVars {
+        /// Peak absolute acceleration of each floor, g.
+        floor_accel_stack: f64 => "floor_accel_stack", Floor, "g",
+            "peak absolute acceleration of each floor with the sliding stack";
+        floor_accel_rigid: f64 => "floor_accel_rigid", Floor, "g",
+            "peak absolute acceleration of each floor with the stack rigidly attached";
+        /// Peak interstorey drift over the storey's height, per storey.
+        drift_ratio_stack: f64 => "drift_ratio_stack", Storey, "1",
+            "peak interstorey drift over the storey height, with the sliding stack";
+        drift_ratio_rigid: f64 => "drift_ratio_rigid", Storey, "1",
+            "peak interstorey drift over the storey height, with the stack rigidly attached";
+        /// Peak base shear over the bare building's weight (NaN in a building of one storey).
+        base_shear_stack: f64 => "base_shear_stack", Case, "1",
+            "peak base shear over the bare building's weight, with the sliding stack (NaN on one \
+             storey: its integrator does not give it)";
+        base_shear_rigid: f64 => "base_shear_rigid", Case, "1",
+            "peak base shear over the bare building's weight, with the stack rigidly attached \
+             (NaN on one storey: its integrator does not give it)";
+        /// Peak shear of each storey over the bare building's weight (storey 1's is the base
+        /// shear; NaN in a building of one storey).
+        storey_shear_stack: f64 => "storey_shear_stack", Storey, "1",
+            "peak shear of each storey over the bare building's weight, with the sliding stack \
+             (NaN on one storey)";
+        storey_shear_rigid: f64 => "storey_shear_rigid", Storey, "1",
+            "peak shear of each storey over the bare building's weight, with the stack rigidly \
+             attached (NaN on one storey)";
+        /// Peak overturning moment at the base over the bare building's weight times its height
+        /// (NaN in a building of one storey).
+        overturning_stack: f64 => "overturning_stack", Case, "1",
+            "peak overturning moment at the base over the bare building's weight times its \
+             height, with the sliding stack (NaN on one storey)";
+        overturning_rigid: f64 => "overturning_rigid", Case, "1",
+            "peak overturning moment at the base over the bare building's weight times its \
+             height, with the stack rigidly attached (NaN on one storey)";
+        /// The stack's stuck mass share: the time average of its mass moving with its floor, over
+        /// its mass (NaN in a building of one storey).
+        stuck_share_stack: f64 => "stuck_share_stack", Case, "1",
+            "time average of the stack's mass moving with its floor over its mass (1: it never \
+             slid; NaN on one storey)";
+        /// Peak absolute velocity of each floor, m/s (FEMA P-58's PFV).
+        floor_velocity_stack: f64 => "floor_velocity_stack", Floor, "m s-1",
+            "peak absolute velocity of each floor with the sliding stack";
+        floor_velocity_rigid: f64 => "floor_velocity_rigid", Floor, "m s-1",
+            "peak absolute velocity of each floor with the stack rigidly attached";
+        /// Each storey's drift at the record's end over its height, signed.
+        residual_drift_ratio_stack: f64 => "residual_drift_ratio_stack", Storey, "1",
+            "interstorey drift at the record's end over the storey height, signed, with the \
+             sliding stack";
+        residual_drift_ratio_rigid: f64 => "residual_drift_ratio_rigid", Storey, "1",
+            "interstorey drift at the record's end over the storey height, signed, with the \
+             stack rigidly attached";
     }
 }
 
@@ -267,6 +193,10 @@ pub struct ZoneSweep {
     pub target: String,
     pub motions: Vec<String>,
     pub vars: SweepVars,
+    /// With `grid.aspect`: [`ROCKS_STACK`]; `None` when not checked.
+    pub rocks_stack: Option<ArrayD<u8>>,
+    /// A building study's per-floor peaks and base shear (`None` on one storey).
+    pub building: Option<BuildingVars>,
 }
 
 /// The coordinates of the case dimensions `T_p, alpha_1 … alpha_n, mu_1 … mu_n` of `grid` in
@@ -399,188 +329,68 @@ fn write_zone(
         scales.extend(building_coordinates(&g, b)?);
     }
     scales.extend(case_coordinates(&g, grid, meta.mu_static_ratio)?);
-    let iface: Vec<f64> = (1..=n).map(|i| i as f64).collect();
-    let iface = coordinate(
+    let blocks: Vec<f64> = (1..=n).map(|i| i as f64).collect();
+    let interface = coordinate(
         &g,
         "interface",
-        &iface,
+        &blocks,
         "1",
         "interface (1 = structure–block 1)",
     )?;
-    // One chunk per work unit: one motion (one frame), one T_p.
-    let mut chunk = vec![1; if building.is_some() { 4 } else { 2 }];
-    chunk.extend(grid.case_shape());
-    let v = &z.vars;
-    let vars: [(&str, &ArrayD<f64>, &str, &str); 5] = [
-        (
-            "u_stack",
-            &v.u_stack,
-            "m",
-            "peak structure displacement with the sliding stack",
-        ),
-        (
-            "u_single",
-            &v.u_single,
-            "m",
-            "peak structure displacement with the stack as one sliding block on interface 1",
-        ),
-        (
-            "u_rigid",
-            &v.u_rigid,
-            "m",
-            "peak structure displacement with the stack rigidly attached",
-        ),
-        (
-            "a_stack",
-            &v.a_stack,
-            "g",
-            "peak absolute structure acceleration with the sliding stack",
-        ),
-        (
-            "friction_energy",
-            &v.friction_energy,
-            "J/kg",
-            "energy dissipated by friction in the stack, per kg of structure mass",
-        ),
-    ];
-    for (name, data, units, long) in vars {
-        // In a building the structure's peaks are the roof's.
-        let long = match name {
-            "u_stack" | "u_single" | "u_rigid" | "a_stack" if building.is_some() => {
-                format!("{long} (a building: its roof's)")
-            }
-            "friction_energy" if building.is_some() => {
-                format!("{long} (a building: of every stack, per kg of all its floors)")
-            }
-            _ => long.to_string(),
-        };
-        let ds = write_var(&g, name, data.view(), &chunk, units, &long)?;
-        attach_all(&ds, &scales)?;
-    }
-    let mut chunk_i = chunk.clone();
-    chunk_i.push(n);
-    let ds = write_var(
-        &g,
-        "slip_peak",
-        v.slip_peak.view(),
-        &chunk_i,
-        "m",
-        if building.is_some() {
-            "peak slip of each interface (with a stack on every floor: the largest over them)"
-        } else {
-            "peak slip of each interface"
-        },
-    )?;
-    attach_all(&ds, &scales)?;
-    attach_scale(&ds, &iface, scales.len())?;
-    let several = building.is_some();
-    let ds = write_var(
-        &g,
-        "slip_residual",
-        v.slip_residual.view(),
-        &chunk_i,
-        "m",
-        if several {
-            "slip of each interface at the record's end, signed (with a stack on every floor: \
-             the one of the largest magnitude)"
-        } else {
-            "slip of each interface at the record's end, signed"
-        },
-    )?;
-    attach_all(&ds, &scales)?;
-    attach_scale(&ds, &iface, scales.len())?;
-    let block: Vec<f64> = (1..=n).map(|i| i as f64).collect();
     let block = coordinate(
         &g,
         "block",
-        &block,
+        &blocks,
         "1",
         "block (1 = the lowest, resting on interface 1)",
     )?;
-    for (name, data, units, long) in [
-        (
-            "block_accel_stack",
-            &v.block_accel_stack,
-            "g",
-            "peak absolute acceleration of each block",
-        ),
-        (
-            "block_velocity_stack",
-            &v.block_velocity_stack,
-            "m s-1",
-            "peak absolute velocity of each block",
-        ),
-    ] {
-        let long = if several {
-            format!("{long} (with a stack on every floor: the largest over them)")
-        } else {
-            long.to_string()
-        };
-        let ds = write_var(&g, name, data.view(), &chunk_i, units, &long)?;
-        attach_all(&ds, &scales)?;
-        attach_scale(&ds, &block, scales.len())?;
-    }
-    let ds = write_flags(
-        &g,
-        "skip_rule",
-        v.skip_rule.view(),
-        &chunk,
-        "rule that gave the stack result (file attribute skip_rule_codes)",
-        meta.skip_rule_flags,
-    )?;
-    attach_all(&ds, &scales)?;
-    let ds = write_flags(
-        &g,
-        "single_rule",
-        v.single_rule.view(),
-        &chunk,
-        "1 when the single block cannot slip and equals the rigid system",
-        &[(0, "simulated"), (1, "equals_rigid")],
-    )?;
-    attach_all(&ds, &scales)?;
-    if let Some(rocks) = &v.rocks_stack {
-        let ds = write_flags(
-            &g,
-            "rocks_stack",
-            rocks.view(),
-            &chunk,
-            "1 when the stack (in a building, any of its stacks) would start to rock: the \
-             sliding-only model does not hold (blocks' width over height: file attribute aspect)",
-            &[(0, "slides_only"), (1, "rocks")],
-        )?;
-        attach_all(&ds, &scales)?;
-    }
-    if let (Some(b), Some(bv)) = (building, &v.building) {
-        let levels: Vec<f64> = (1..=b.max_storeys()).map(|j| j as f64).collect();
-        let floor = coordinate(&g, "floor", &levels, "1", "floor (1 the lowest)")?;
-        let storey = coordinate(
-            &g,
-            "storey",
-            &levels,
-            "1",
-            "storey (1 the lowest: between the ground and floor 1)",
-        )?;
-        let mut chunk_f = chunk.clone();
-        chunk_f.push(levels.len());
-        for (name, data, units, long, level) in bv.vars() {
-            let per = match level {
-                Level::Floor => Some(&floor),
-                Level::Storey => Some(&storey),
-                Level::Case => None,
-            };
-            let ds = write_var(
+    let levels: Vec<f64> = (1..=building.map_or(0, |b| b.max_storeys()))
+        .map(|j| j as f64)
+        .collect();
+    let (floor, storey) = match building {
+        Some(_) => (
+            Some(coordinate(
                 &g,
-                name,
-                data.view(),
-                if per.is_some() { &chunk_f } else { &chunk },
-                units,
-                long,
-            )?;
-            attach_all(&ds, &scales)?;
-            if let Some(p) = per {
-                attach_scale(&ds, p, scales.len())?;
-            }
-        }
+                "floor",
+                &levels,
+                "1",
+                "floor (1 the lowest)",
+            )?),
+            Some(coordinate(
+                &g,
+                "storey",
+                &levels,
+                "1",
+                "storey (1 the lowest: between the ground and floor 1)",
+            )?),
+        ),
+        None => (None, None),
+    };
+    // One chunk per work unit: one motion (one frame), one T_p.
+    let mut chunk = vec![1; if building.is_some() { 4 } else { 2 }];
+    chunk.extend(grid.case_shape());
+    let trailing = |t: Trailing| match t {
+        Trailing::Case => None,
+        Trailing::Interface => Some(&interface),
+        Trailing::Block => Some(&block),
+        Trailing::Floor => floor.as_ref(),
+        Trailing::Storey => storey.as_ref(),
+    };
+    let given = |_: &str| meta.skip_rule_flags;
+    let to = Target {
+        group: &g,
+        building: building.is_some(),
+        chunk: &chunk,
+        scales: &scales,
+        trailing: &trailing,
+        given: &given,
+    };
+    write_declared(&to, &z.vars.data())?;
+    if let Some(rocks) = &z.rocks_stack {
+        write_declared(&to, &[(&ROCKS_STACK, Data::Codes(rocks))])?;
+    }
+    if let Some(bv) = &z.building {
+        write_declared(&to, &bv.data())?;
     }
     Ok(())
 }
@@ -602,54 +412,26 @@ pub fn read_zone_sweep(
     let mut shape = vec![motions.len()];
     shape.extend(axes.iter().flat_map(BuildingAxes::shape));
     shape.extend(grid.shape());
-    let mut per_interface = shape.clone();
-    per_interface.push(blocks);
-    let building_vars = match &axes {
-        None => None,
-        Some(a) => {
-            let mut per_floor = shape.clone();
-            per_floor.push(a.max_storeys());
-            Some(BuildingVars {
-                floor_accel_stack: g.array("floor_accel_stack", &per_floor)?,
-                floor_accel_rigid: g.array("floor_accel_rigid", &per_floor)?,
-                drift_ratio_stack: g.array("drift_ratio_stack", &per_floor)?,
-                drift_ratio_rigid: g.array("drift_ratio_rigid", &per_floor)?,
-                base_shear_stack: g.array("base_shear_stack", &shape)?,
-                base_shear_rigid: g.array("base_shear_rigid", &shape)?,
-                storey_shear_stack: g.array("storey_shear_stack", &per_floor)?,
-                storey_shear_rigid: g.array("storey_shear_rigid", &per_floor)?,
-                overturning_stack: g.array("overturning_stack", &shape)?,
-                overturning_rigid: g.array("overturning_rigid", &shape)?,
-                stuck_share_stack: g.array("stuck_share_stack", &shape)?,
-                floor_velocity_stack: g.array("floor_velocity_stack", &per_floor)?,
-                floor_velocity_rigid: g.array("floor_velocity_rigid", &per_floor)?,
-                residual_drift_ratio_stack: g.array("residual_drift_ratio_stack", &per_floor)?,
-                residual_drift_ratio_rigid: g.array("residual_drift_ratio_rigid", &per_floor)?,
-            })
+    let levels = axes.as_ref().map_or(0, BuildingAxes::max_storeys);
+    let shape_of = |t: Trailing| {
+        let mut s = shape.clone();
+        match t {
+            Trailing::Case => {}
+            Trailing::Interface | Trailing::Block => s.push(blocks),
+            Trailing::Floor | Trailing::Storey => s.push(levels),
         }
-    };
-    let vars = SweepVars {
-        building: building_vars,
-        u_stack: g.array("u_stack", &shape)?,
-        u_single: g.array("u_single", &shape)?,
-        u_rigid: g.array("u_rigid", &shape)?,
-        a_stack: g.array("a_stack", &shape)?,
-        friction_energy: g.array("friction_energy", &shape)?,
-        slip_peak: g.array("slip_peak", &per_interface)?,
-        slip_residual: g.array("slip_residual", &per_interface)?,
-        block_accel_stack: g.array("block_accel_stack", &per_interface)?,
-        block_velocity_stack: g.array("block_velocity_stack", &per_interface)?,
-        skip_rule: g.array("skip_rule", &shape)?,
-        single_rule: g.array("single_rule", &shape)?,
-        rocks_stack: (g.has("rocks_stack"))
-            .then(|| g.array("rocks_stack", &shape))
-            .transpose()?,
+        s
     };
     let zone = ZoneSweep {
         name: zone.to_string(),
         target: g.attr_str("target").unwrap_or_default(),
         motions,
-        vars,
+        vars: SweepVars::read(&g, shape_of)?,
+        rocks_stack: read_optional(&g, ROCKS_STACK.name, &shape)?,
+        building: axes
+            .is_some()
+            .then(|| BuildingVars::read(&g, shape_of))
+            .transpose()?,
     };
     Ok((grid, axes, zone))
 }

@@ -20,32 +20,63 @@
 //! ```
 
 use super::h5::{
-    Attr, GroupReader, attach_all, attach_scale, attr_str, coordinate, group, open, write_attrs,
-    write_flags, write_small, write_stage_file, write_var,
+    Attr, GroupReader, attach_scale, attr_str, coordinate, group, open, write_attrs, write_small,
+    write_stage_file,
 };
 use super::sweep::{
     building_coordinates, case_coordinates, read_building_coordinates, read_case_coordinates,
 };
+use super::vars::{Codes, Data, Target, Trailing, Var, read_optional, write_declared};
 use super::{H5Context, StoreError};
 use crate::grid::{BuildingAxes, Grid};
 use ndarray::ArrayD;
 use std::path::Path;
 
-/// One zone's derived quantities, each shaped `[T_p, alpha…, mu…]`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TnewVars {
-    pub u_stack_mean: ArrayD<f64>,
-    pub u_single_mean: ArrayD<f64>,
-    pub u_rigid_mean: ArrayD<f64>,
-    pub t_rigid: ArrayD<f64>,
-    pub t_new: ArrayD<f64>,
-    pub drr_1: ArrayD<f64>,
-    pub drr_2: ArrayD<f64>,
-    pub slides: ArrayD<f64>,
-    pub flag: ArrayD<f64>,
-    /// Where `T_new` lies against `[T_p, T_rigid]` (codes in [`TnewMeta::band_flags`]).
-    pub band: ArrayD<u8>,
+crate::stored_vars! {
+    /// One zone's derived quantities, each shaped `[T_p, alpha…, mu…]` (in a building study
+    /// `[storeys, stack_floor, T_p, …]`).
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct TnewVars {
+        u_stack_mean: f64 => "u_stack_mean", Case, "m",
+            "mean over the motions of the peak structure displacement with the sliding stack",
+            building "mean over the motions of the peak structure displacement with the sliding \
+                      stack (a building: its roof's)";
+        u_single_mean: f64 => "u_single_mean", Case, "m",
+            "mean peak structure displacement with the stack as one block",
+            building "mean peak structure displacement with the stack as one block (a building: \
+                      its roof's)";
+        u_rigid_mean: f64 => "u_rigid_mean", Case, "m",
+            "mean peak structure displacement with the stack rigidly attached",
+            building "mean peak structure displacement with the stack rigidly attached (a \
+                      building: its roof's)";
+        t_rigid: f64 => "T_rigid", Case, "s",
+            "period with the stack rigidly attached, T_p·sqrt(1+α)",
+            building "first-mode period with the stack rigidly attached";
+        t_new: f64 => "T_new", Case, "s",
+            "period whose mean 5 %-damped spectral displacement equals u_stack_mean (Section 7.1)",
+            building "period whose mean 5 %-damped spectral displacement equals u_stack_mean / \
+                      roof_participation (the first mode's equivalent SDOF)";
+        drr_1: f64 => "DRR_1", Case, "1", "u_stack_mean / u_rigid_mean (Eq. 7)";
+        drr_2: f64 => "DRR_2", Case, "1", "u_single_mean / u_rigid_mean (Eq. 8)";
+        slides: f64 => "slides", Case, "1", "1 when some interface slips under some motion";
+        flag: f64 => "T_new_flag", Case, "1",
+            "how T_new was found (file attribute T_new_flag_codes)";
+        /// Where `T_new` lies against `[T_p, T_rigid]` (codes in [`TnewMeta::band_flags`]).
+        band: u8 => "T_new_band", Case, "", "where T_new lies against [T_p, T_rigid]";
+    }
 }
+
+/// With `grid.aspect`: per case, the share of the motions under which the stack would start to
+/// rock, shaped as [`TnewVars`]' variables.
+pub const ROCKS_SHARE: Var = Var {
+    name: "rocks_share",
+    trailing: Trailing::Case,
+    units: "1",
+    long_name: "share of the motions under which the stack would start to rock (sweep.h5's \
+                rocks_stack averaged): outside the sliding-only model where > 0",
+    building_long_name: None,
+    codes: Codes::Value,
+};
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct ZoneTnew {
@@ -64,173 +95,70 @@ pub struct ZoneTnew {
     pub rocks_share: Option<ArrayD<f64>>,
 }
 
-/// A building study's attached fractions of every case (docs/model.md, "The attached
-/// fraction") and the mean peaks they come from, each over the bare building; shaped as
-/// [`TnewVars`]' variables, the per-storey ones with a trailing `storey` axis of length `N_max`
-/// (NaN, and 255 for flags, above a building's roof).
-#[derive(Debug, Clone, PartialEq)]
-pub struct AttachedVars {
-    /// `V̄_stack`: with the sliding stack, over the bare building's weight.
-    pub base_shear_stack_mean: ArrayD<f64>,
-    /// `V̄(1)`: with the whole stack rigidly attached.
-    pub base_shear_rigid_mean: ArrayD<f64>,
-    /// `V̄(0)`: with the stack's mass absent (the building's own damping matrix).
-    pub base_shear_bare_mean: ArrayD<f64>,
-    /// `V̄_stack/V̄(0)` and `V̄_stack/V̄(1)`, unclamped.
-    pub base_shear_ratio_bare: ArrayD<f64>,
-    pub base_shear_ratio_rigid: ArrayD<f64>,
-    /// The stuck mass share's mean over the motions.
-    pub stuck_share_mean: ArrayD<f64>,
-    /// `λ`: the attached fraction of the base shear, unclamped.
-    pub lambda: ArrayD<f64>,
-    pub flag: ArrayD<u8>,
-    /// The attached fraction of each storey's shear (storey 1's is `λ`).
-    pub lambda_storey: ArrayD<f64>,
-    pub lambda_storey_flag: ArrayD<u8>,
-    /// The attached fraction of the overturning moment at the base.
-    pub lambda_overturning: ArrayD<f64>,
-    pub lambda_overturning_flag: ArrayD<u8>,
-    /// The code-format fraction.
-    pub lambda_code: ArrayD<f64>,
-    pub lambda_code_flag: ArrayD<u8>,
-    /// The attached fraction of the roof's mean peak displacement (a building's `T_new` is the
-    /// first-mode period with it attached).
-    pub attached_fraction_roof: ArrayD<f64>,
-    pub attached_fraction_roof_flag: ArrayD<u8>,
-    /// The earlier definition of a building's `T_new` (the roof's mean peak over the bare
-    /// building's `Γ_1·φ_1,N`, read off the mean displacement spectrum), kept for one release.
-    pub t_new_first_mode: ArrayD<f64>,
-}
+/// The long name of every attached fraction's flag variable.
+const FRACTION_FLAG: &str = "how the fraction was found: the root of its mean peak on a 0.1 \
+                             scan (the one nearest the stuck share of several), the scan point \
+                             nearest when none, no_slide when nothing slid";
 
-/// Whether a variable has a trailing `storey` axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum PerStorey {
-    No,
-    Yes,
-}
-
-impl AttachedVars {
-    /// `(name, data, units, long name, per storey)` of every value variable.
-    fn vars(
-        &self,
-    ) -> [(
-        &'static str,
-        &ArrayD<f64>,
-        &'static str,
-        &'static str,
-        PerStorey,
-    ); 12] {
-        use PerStorey::*;
-        [
-            (
-                "base_shear_stack_mean",
-                &self.base_shear_stack_mean,
-                "1",
-                "mean over the motions of the peak base shear over the bare building's weight, \
-                 with the sliding stack",
-                No,
-            ),
-            (
-                "base_shear_rigid_mean",
-                &self.base_shear_rigid_mean,
-                "1",
-                "the same with the stack rigidly attached (fraction 1)",
-                No,
-            ),
-            (
-                "base_shear_bare_mean",
-                &self.base_shear_bare_mean,
-                "1",
-                "the same with the stack's mass absent (fraction 0)",
-                No,
-            ),
-            (
-                "base_shear_ratio_bare",
-                &self.base_shear_ratio_bare,
-                "1",
-                "base_shear_stack_mean / base_shear_bare_mean (below 1: the sliding stack lowers \
-                 the base shear below the bare building's)",
-                No,
-            ),
-            (
-                "base_shear_ratio_rigid",
-                &self.base_shear_ratio_rigid,
-                "1",
-                "base_shear_stack_mean / base_shear_rigid_mean",
-                No,
-            ),
-            (
-                "stuck_share_mean",
-                &self.stuck_share_mean,
-                "1",
-                "mean over the motions of the time average of the stack's mass moving with its \
-                 floor, over its mass (1: it never slid)",
-                No,
-            ),
-            (
-                "lambda",
-                &self.lambda,
-                "1",
-                "effective live-load fraction: the fraction of the stack which, rigidly attached \
-                 (below 0: removed), gives base_shear_stack_mean; unclamped (lambda_flag)",
-                No,
-            ),
-            (
-                "lambda_storey",
-                &self.lambda_storey,
-                "1",
-                "the same for each storey's mean peak shear (storey 1: lambda)",
-                Yes,
-            ),
-            (
-                "lambda_overturning",
-                &self.lambda_overturning,
-                "1",
-                "the same for the mean peak overturning moment at the base",
-                No,
-            ),
-            (
-                "lambda_code",
-                &self.lambda_code,
-                "1",
-                "code-format fraction: (W + lambda·W_L)·Sa(T_1(lambda)) / ((W + W_L)·Sa(T_1,rigid)) \
-                 = base_shear_ratio_rigid, Sa the zone's mean 5 %-damped spectrum exactly at the \
-                 period",
-                No,
-            ),
-            (
-                "attached_fraction_roof",
-                &self.attached_fraction_roof,
-                "1",
-                "the fraction of the stack which, rigidly attached, gives the mean peak roof \
-                 displacement (a building of several storeys: T_new is T_1 with it attached)",
-                No,
-            ),
-            (
-                "T_new_first_mode",
-                &self.t_new_first_mode,
-                "s",
-                "the earlier T_new of a building (kept for one release): the period whose mean \
-                 5 %-damped spectral displacement equals u_stack_mean / roof_participation",
-                No,
-            ),
-        ]
-    }
-
-    /// `(name, codes, per storey)` of every flag variable (codes: `lambda_flag`'s).
-    fn flags(&self) -> [(&'static str, &ArrayD<u8>, PerStorey); 5] {
-        use PerStorey::*;
-        [
-            ("lambda_flag", &self.flag, No),
-            ("lambda_storey_flag", &self.lambda_storey_flag, Yes),
-            ("lambda_overturning_flag", &self.lambda_overturning_flag, No),
-            ("lambda_code_flag", &self.lambda_code_flag, No),
-            (
-                "attached_fraction_roof_flag",
-                &self.attached_fraction_roof_flag,
-                No,
-            ),
-        ]
+crate::stored_vars! {
+    /// A building study's attached fractions of every case (docs/model.md, "The attached
+    /// fraction") and the mean peaks they come from, each over the bare building; shaped as
+    /// [`TnewVars`]' variables, the per-storey ones with a trailing `storey` axis of length
+    /// `N_max` (NaN, and 255 for flags, above a building's roof). Each flag's codes are
+    /// [`TnewMeta::lambda_flags`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct AttachedVars {
+        /// `V̄_stack`: with the sliding stack, over the bare building's weight.
+        base_shear_stack_mean: f64 => "base_shear_stack_mean", Case, "1",
+            "mean over the motions of the peak base shear over the bare building's weight, with \
+             the sliding stack";
+        /// `V̄(1)`: with the whole stack rigidly attached.
+        base_shear_rigid_mean: f64 => "base_shear_rigid_mean", Case, "1",
+            "the same with the stack rigidly attached (fraction 1)";
+        /// `V̄(0)`: with the stack's mass absent (the building's own damping matrix).
+        base_shear_bare_mean: f64 => "base_shear_bare_mean", Case, "1",
+            "the same with the stack's mass absent (fraction 0)";
+        /// `V̄_stack/V̄(0)` and `V̄_stack/V̄(1)`, unclamped.
+        base_shear_ratio_bare: f64 => "base_shear_ratio_bare", Case, "1",
+            "base_shear_stack_mean / base_shear_bare_mean (below 1: the sliding stack lowers the \
+             base shear below the bare building's)";
+        base_shear_ratio_rigid: f64 => "base_shear_ratio_rigid", Case, "1",
+            "base_shear_stack_mean / base_shear_rigid_mean";
+        /// The stuck mass share's mean over the motions.
+        stuck_share_mean: f64 => "stuck_share_mean", Case, "1",
+            "mean over the motions of the time average of the stack's mass moving with its floor, \
+             over its mass (1: it never slid)";
+        /// `λ`: the attached fraction of the base shear, unclamped.
+        lambda: f64 => "lambda", Case, "1",
+            "effective live-load fraction: the fraction of the stack which, rigidly attached \
+             (below 0: removed), gives base_shear_stack_mean; unclamped (lambda_flag)";
+        flag: u8 => "lambda_flag", Case, "", FRACTION_FLAG;
+        /// The attached fraction of each storey's shear (storey 1's is `λ`).
+        lambda_storey: f64 => "lambda_storey", Storey, "1",
+            "the same for each storey's mean peak shear (storey 1: lambda)";
+        lambda_storey_flag: u8 => "lambda_storey_flag", Storey, "", FRACTION_FLAG;
+        /// The attached fraction of the overturning moment at the base.
+        lambda_overturning: f64 => "lambda_overturning", Case, "1",
+            "the same for the mean peak overturning moment at the base";
+        lambda_overturning_flag: u8 => "lambda_overturning_flag", Case, "", FRACTION_FLAG;
+        /// The code-format fraction.
+        lambda_code: f64 => "lambda_code", Case, "1",
+            "code-format fraction: (W + lambda·W_L)·Sa(T_1(lambda)) / ((W + W_L)·Sa(T_1,rigid)) \
+             = base_shear_ratio_rigid, Sa the zone's mean 5 %-damped spectrum exactly at the \
+             period";
+        lambda_code_flag: u8 => "lambda_code_flag", Case, "", FRACTION_FLAG;
+        /// The attached fraction of the roof's mean peak displacement (a building's `T_new` is
+        /// the first-mode period with it attached).
+        attached_fraction_roof: f64 => "attached_fraction_roof", Case, "1",
+            "the fraction of the stack which, rigidly attached, gives the mean peak roof \
+             displacement (a building of several storeys: T_new is T_1 with it attached)";
+        attached_fraction_roof_flag: u8 => "attached_fraction_roof_flag", Case, "", FRACTION_FLAG;
+        /// The earlier definition of a building's `T_new` (the roof's mean peak over the bare
+        /// building's `Γ_1·φ_1,N`, read off the mean displacement spectrum), kept for one
+        /// release.
+        t_new_first_mode: f64 => "T_new_first_mode", Case, "s",
+            "the earlier T_new of a building (kept for one release): the period whose mean \
+             5 %-damped spectral displacement equals u_stack_mean / roof_participation";
     }
 }
 
@@ -301,141 +229,36 @@ fn write_zone(
         attach_scale(&ds, &scales[0], 0)?;
     }
     scales.extend(case_coordinates(&g, grid, meta.mu_static_ratio)?);
+    let levels: Vec<f64> = (1..=building.map_or(0, |b| b.max_storeys()))
+        .map(|j| j as f64)
+        .collect();
+    let storey = (z.lambda.is_some())
+        .then(|| coordinate(&g, "storey", &levels, "1", "storey (1 the lowest)"))
+        .transpose()?;
     let mut chunk = vec![1; if building.is_some() { 3 } else { 1 }];
     chunk.extend(grid.case_shape());
-    let v = &z.vars;
-    let vars: [(&str, &ArrayD<f64>, &str, &str); 9] = [
-        (
-            "u_stack_mean",
-            &v.u_stack_mean,
-            "m",
-            "mean over the motions of the peak structure displacement with the sliding stack",
-        ),
-        (
-            "u_single_mean",
-            &v.u_single_mean,
-            "m",
-            "mean peak structure displacement with the stack as one block",
-        ),
-        (
-            "u_rigid_mean",
-            &v.u_rigid_mean,
-            "m",
-            "mean peak structure displacement with the stack rigidly attached",
-        ),
-        (
-            "T_rigid",
-            &v.t_rigid,
-            "s",
-            if building.is_some() {
-                "first-mode period with the stack rigidly attached"
-            } else {
-                "period with the stack rigidly attached, T_p·sqrt(1+α)"
-            },
-        ),
-        (
-            "T_new",
-            &v.t_new,
-            "s",
-            if building.is_some() {
-                "period whose mean 5 %-damped spectral displacement equals u_stack_mean / \
-                 roof_participation (the first mode's equivalent SDOF)"
-            } else {
-                "period whose mean 5 %-damped spectral displacement equals u_stack_mean (Section 7.1)"
-            },
-        ),
-        (
-            "DRR_1",
-            &v.drr_1,
-            "1",
-            "u_stack_mean / u_rigid_mean (Eq. 7)",
-        ),
-        (
-            "DRR_2",
-            &v.drr_2,
-            "1",
-            "u_single_mean / u_rigid_mean (Eq. 8)",
-        ),
-        (
-            "slides",
-            &v.slides,
-            "1",
-            "1 when some interface slips under some motion",
-        ),
-        (
-            "T_new_flag",
-            &v.flag,
-            "1",
-            "how T_new was found (file attribute T_new_flag_codes)",
-        ),
-    ];
-    for (name, data, units, long) in vars {
-        // In a building the structure's peaks are the roof's.
-        let long = match name {
-            "u_stack_mean" | "u_single_mean" | "u_rigid_mean" if building.is_some() => {
-                format!("{long} (a building: its roof's)")
-            }
-            _ => long.to_string(),
-        };
-        let ds = write_var(&g, name, data.view(), &chunk, units, &long)?;
-        attach_all(&ds, &scales)?;
-    }
-    let ds = write_flags(
-        &g,
-        "T_new_band",
-        v.band.view(),
-        &chunk,
-        "where T_new lies against [T_p, T_rigid]",
-        meta.band_flags,
-    )?;
-    attach_all(&ds, &scales)?;
+    let trailing = |t: Trailing| match t {
+        Trailing::Storey => storey.as_ref(),
+        _ => None,
+    };
+    let given = |name: &str| match name {
+        "T_new_band" => meta.band_flags,
+        _ => meta.lambda_flags,
+    };
+    let to = Target {
+        group: &g,
+        building: building.is_some(),
+        chunk: &chunk,
+        scales: &scales,
+        trailing: &trailing,
+        given: &given,
+    };
+    write_declared(&to, &z.vars.data())?;
     if let Some(share) = &z.rocks_share {
-        let ds = write_var(
-            &g,
-            "rocks_share",
-            share.view(),
-            &chunk,
-            "1",
-            "share of the motions under which the stack would start to rock (sweep.h5's \
-             rocks_stack averaged): outside the sliding-only model where > 0",
-        )?;
-        attach_all(&ds, &scales)?;
+        write_declared(&to, &[(&ROCKS_SHARE, Data::Values(share))])?;
     }
-    if let (Some(l), Some(b)) = (&z.lambda, building) {
-        let levels: Vec<f64> = (1..=b.max_storeys()).map(|j| j as f64).collect();
-        let storey = coordinate(&g, "storey", &levels, "1", "storey (1 the lowest)")?;
-        let mut chunk_s = chunk.clone();
-        chunk_s.push(levels.len());
-        let per = |p: PerStorey| {
-            if p == PerStorey::Yes {
-                &chunk_s
-            } else {
-                &chunk
-            }
-        };
-        for (name, data, units, long, p) in l.vars() {
-            let ds = write_var(&g, name, data.view(), per(p), units, long)?;
-            attach_all(&ds, &scales)?;
-            if p == PerStorey::Yes {
-                attach_scale(&ds, &storey, scales.len())?;
-            }
-        }
-        for (name, codes, p) in l.flags() {
-            let ds = write_flags(
-                &g,
-                name,
-                codes.view(),
-                per(p),
-                "how the fraction was found: the root of its mean peak on a 0.1 scan (the one \
-                 nearest the stuck share of several), the scan point nearest when none, \
-                 no_slide when nothing slid",
-                meta.lambda_flags,
-            )?;
-            attach_all(&ds, &scales)?;
-            if p == PerStorey::Yes {
-                attach_scale(&ds, &storey, scales.len())?;
-            }
-        }
+    if let Some(l) = &z.lambda {
+        write_declared(&to, &l.data())?;
     }
     let p = coordinate(
         &g,
@@ -487,18 +310,15 @@ pub fn read_zone_tnew_in(
             .collect(),
         None => Vec::new(),
     };
-    let vars = TnewVars {
-        u_stack_mean: g.array("u_stack_mean", &shape)?,
-        u_single_mean: g.array("u_single_mean", &shape)?,
-        u_rigid_mean: g.array("u_rigid_mean", &shape)?,
-        t_rigid: g.array("T_rigid", &shape)?,
-        t_new: g.array("T_new", &shape)?,
-        drr_1: g.array("DRR_1", &shape)?,
-        drr_2: g.array("DRR_2", &shape)?,
-        slides: g.array("slides", &shape)?,
-        flag: g.array("T_new_flag", &shape)?,
-        band: g.array("T_new_band", &shape)?,
+    let levels = axes.as_ref().map_or(0, BuildingAxes::max_storeys);
+    let shape_of = |t: Trailing| {
+        let mut s = shape.clone();
+        if t == Trailing::Storey {
+            s.push(levels);
+        }
+        s
     };
+    let vars = TnewVars::read(&g, shape_of)?;
     let codes: Vec<u8> = band_flags(&g)?.into_iter().map(|f| f.0).collect();
     if let Some(code) = vars.band.iter().find(|c| !codes.contains(c)) {
         return Err(StoreError::corrupt(
@@ -509,32 +329,9 @@ pub fn read_zone_tnew_in(
             ),
         ));
     }
-    let lambda = match &axes {
-        None => None,
-        Some(a) => {
-            let mut per_storey = shape.clone();
-            per_storey.push(a.max_storeys());
-            Some(AttachedVars {
-                base_shear_stack_mean: g.array("base_shear_stack_mean", &shape)?,
-                base_shear_rigid_mean: g.array("base_shear_rigid_mean", &shape)?,
-                base_shear_bare_mean: g.array("base_shear_bare_mean", &shape)?,
-                base_shear_ratio_bare: g.array("base_shear_ratio_bare", &shape)?,
-                base_shear_ratio_rigid: g.array("base_shear_ratio_rigid", &shape)?,
-                stuck_share_mean: g.array("stuck_share_mean", &shape)?,
-                lambda: g.array("lambda", &shape)?,
-                flag: g.array("lambda_flag", &shape)?,
-                lambda_storey: g.array("lambda_storey", &per_storey)?,
-                lambda_storey_flag: g.array("lambda_storey_flag", &per_storey)?,
-                lambda_overturning: g.array("lambda_overturning", &shape)?,
-                lambda_overturning_flag: g.array("lambda_overturning_flag", &shape)?,
-                lambda_code: g.array("lambda_code", &shape)?,
-                lambda_code_flag: g.array("lambda_code_flag", &shape)?,
-                attached_fraction_roof: g.array("attached_fraction_roof", &shape)?,
-                attached_fraction_roof_flag: g.array("attached_fraction_roof_flag", &shape)?,
-                t_new_first_mode: g.array("T_new_first_mode", &shape)?,
-            })
-        }
-    };
+    let lambda = (axes.is_some())
+        .then(|| AttachedVars::read(&g, shape_of))
+        .transpose()?;
     let period_sd_s = g.vector("period_sd")?;
     let sd_mean_m = g.array("sd_mean", &[period_sd_s.len()])?;
     let z = ZoneTnew {
@@ -545,9 +342,7 @@ pub fn read_zone_tnew_in(
         sd_mean_m: sd_mean_m.iter().copied().collect(),
         roof_participation,
         lambda,
-        rocks_share: (g.has("rocks_share"))
-            .then(|| g.array("rocks_share", &shape))
-            .transpose()?,
+        rocks_share: read_optional(&g, ROCKS_SHARE.name, &shape)?,
     };
     Ok((grid, axes, z))
 }

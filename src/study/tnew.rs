@@ -26,7 +26,7 @@ use crate::fit::{BuildingFeatures, Sample, features};
 use crate::grid::{BuildingAxes, Grid};
 use crate::ground_motion::Record;
 use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
-use crate::store::sweep::{BuildingVars, SweepVars};
+use crate::store::sweep::{BuildingVars, ZoneSweep};
 use crate::store::tnew::{AttachedVars, TnewVars, ZoneTnew};
 use crate::study::attached::{
     self, AttachedError, CaseFractions, FRACTION_FLAGS, FractionFlag, FractionUnit, ZoneFamily,
@@ -310,7 +310,7 @@ pub struct ZoneInputs<'a> {
     pub frames: &'a [Option<Frame>],
     pub motions: &'a [Record],
     /// The zone's sweep, its motion axis the order of `motions`.
-    pub sweep: &'a SweepVars,
+    pub sweep: &'a ZoneSweep,
     /// Asked before each case of the attached fractions (Ctrl-C).
     pub keep_going: &'a (dyn Fn() -> bool + Sync),
 }
@@ -378,7 +378,9 @@ impl FractionCounts {
 /// its `DRR`s and, in a building study, its attached fractions: [`ZoneWork`] with every unit
 /// computed here (the units in parallel).
 pub fn zone(inp: &ZoneInputs) -> Result<ZoneOutcome, TnewError> {
-    let work = ZoneWork::new(inp);
+    let frames: Vec<Frame> = inp.frames.iter().flatten().cloned().collect();
+    let units = attached::fraction_units(inp.grid, &frames);
+    let work = ZoneWork::new(inp, &units);
     let of_units = (work.units().par_iter())
         .map(|u| work.fractions_of(u))
         .collect::<Result<Vec<_>, _>>()?;
@@ -401,13 +403,14 @@ pub struct ZoneWork<'a> {
     frames: Vec<Frame>,
     /// A building study's sweep means per case and its units; empty on one storey.
     swept: Vec<attached::Swept>,
-    units: Vec<FractionUnit>,
+    units: &'a [FractionUnit],
 }
 
 impl<'a> ZoneWork<'a> {
-    /// The zone's means over the motions and its units, from the sweep (no simulation).
-    pub fn new(inp: &'a ZoneInputs<'a>) -> Self {
-        let (grid, v) = (inp.grid, inp.sweep);
+    /// The zone's means over the motions, from the sweep (no simulation), and its `units`:
+    /// [`attached::fraction_units`] of the study's grid and frames (none on one storey).
+    pub fn new(inp: &'a ZoneInputs<'a>, units: &'a [FractionUnit]) -> Self {
+        let (grid, v) = (inp.grid, &inp.sweep.vars);
         let m = inp.motions.len();
         let mean = |v: &ArrayD<f64>| v.sum_axis(Axis(0)) / m as f64;
         let (u_stack, u_single, u_rigid) = (mean(&v.u_stack), mean(&v.u_single), mean(&v.u_rigid));
@@ -415,12 +418,9 @@ impl<'a> ZoneWork<'a> {
         let cases = inp.frames.len() * per_frame;
         let slides = slides(&v.slip_peak, m, cases, grid.blocks());
         let frames: Vec<Frame> = inp.frames.iter().flatten().cloned().collect();
-        let (swept, units) = match (&v.building, inp.building) {
-            (Some(bv), Some(_)) => (
-                swept(bv, &u_stack, &u_rigid, &frames, per_frame, m),
-                attached::fraction_units(grid, &frames),
-            ),
-            _ => (Vec::new(), Vec::new()),
+        let swept = match (&inp.sweep.building, inp.building) {
+            (Some(bv), Some(_)) => swept(bv, &u_stack, &u_rigid, &frames, per_frame, m),
+            _ => Vec::new(),
         };
         // The motions' accelerations, for the units' simulations only.
         let accels = match units.is_empty() {
@@ -442,7 +442,7 @@ impl<'a> ZoneWork<'a> {
 
     /// The units of the zone's attached fractions (none on one storey).
     pub fn units(&self) -> &[FractionUnit] {
-        &self.units
+        self.units
     }
 
     /// The attached fractions of `unit`'s cases, in its order.
@@ -479,9 +479,7 @@ impl<'a> ZoneWork<'a> {
             ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
         };
         let fractions = match (&inp.sweep.building, inp.building) {
-            (Some(_), Some(_)) => {
-                Some(attached::spread(grid, &self.frames, &self.units, &of_units))
-            }
+            (Some(_), Some(_)) => Some(attached::spread(grid, &self.frames, self.units, &of_units)),
             _ => None,
         };
         let participation: Vec<f64> = (inp.frames.iter())

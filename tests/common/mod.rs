@@ -370,3 +370,73 @@ pub fn output_files(dir: &Path, skip: &[&str]) -> std::collections::BTreeMap<Pat
     }
     out
 }
+
+/// The shard-resume checks the sharded stages (`sweep`, `tnew`, `ida`) share.
+pub mod shards {
+    use super::{ok, slidestack};
+    use std::path::{Path, PathBuf};
+
+    fn s(p: &Path) -> &str {
+        p.to_str().unwrap()
+    }
+
+    /// `slidestack STAGE CONFIG --out OUT --shard K` on `threads` threads: it succeeds and says
+    /// the shard is done.
+    pub fn run(stage: &str, cfg: &Path, out: &Path, k: &str, threads: &str) {
+        let o = ok(slidestack(
+            &[stage, s(cfg), "--out", s(out), "--shard", k],
+            threads,
+        ));
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(text.contains(&format!("shard {k} done")), "{text}");
+    }
+
+    /// The unit files under `dir`, sorted.
+    pub fn unit_files(dir: &Path) -> Vec<PathBuf> {
+        let mut files: Vec<PathBuf> = (std::fs::read_dir(dir).unwrap())
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        files
+    }
+
+    /// Flips one byte of the stored unit `file`, then runs `STAGE CONFIG --out OUT` unsharded
+    /// on one thread: it must refuse the file by its checksum and compute that unit again. Its
+    /// output.
+    pub fn rerun_with_a_damaged_unit(
+        stage: &str,
+        cfg: &Path,
+        out: &Path,
+        file: &Path,
+    ) -> std::process::Output {
+        let mut bytes = std::fs::read(file).unwrap();
+        bytes[40] ^= 1;
+        std::fs::write(file, bytes).unwrap();
+        let o = ok(slidestack(&[stage, s(cfg), "--out", s(out)], "1"));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("fails its checksum") && err.contains("computing it again"),
+            "{err}"
+        );
+        o
+    }
+
+    /// `--shard 1/N` with `N` more than the stage's units is bad input: exit 2, the message
+    /// naming the bound (`needs`, e.g. `"1 ≤ K ≤ N ≤ 48"`).
+    pub fn refuses_more_shards_than_units(
+        stage: &str,
+        cfg: &Path,
+        out: &Path,
+        n: usize,
+        needs: &str,
+    ) {
+        let k = format!("1/{n}");
+        let o = slidestack(
+            &[stage, s(cfg), "--out", s(out), "--shard", &k, "--force"],
+            "1",
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(&format!("shard {k}: needs {needs}")), "{err}");
+    }
+}

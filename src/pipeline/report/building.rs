@@ -15,7 +15,7 @@
 
 use super::text::fixed;
 use super::{Files, Inputs, ReportError};
-use crate::grid::{BuildingAxes, StackFloor};
+use crate::grid::{BuildingAxes, Grid, StackFloor};
 use crate::pipeline::files;
 use crate::pipeline::{PipelineError, StageId};
 use crate::render::chart::{Axis, Figure, PALETTE, Panel, Series, Stroke};
@@ -103,18 +103,15 @@ struct BuildingZone {
 /// grid and frames.
 fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
     let study = inp.study;
-    let grid = inp.grid;
     let axes = study
         .building()
         .expect("the building section of a building study");
     let frames = study.distinct_frames();
     let path = study.path(StageId::Sweep.output());
-    let per = grid.cases();
-    let n_max = axes.max_storeys();
     let mut out = Vec::new();
     for z in &inp.zones {
         let sweep = files::sweep_zone(study, &z.name, None)?;
-        let Some(b) = &sweep.vars.building else {
+        let Some(b) = &sweep.building else {
             let why = format!("zone_{}: has no per-floor peaks", z.name);
             return Err(StoreError::corrupt(&path, why).into());
         };
@@ -122,114 +119,153 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
             let why = format!("zone_{}: has no λ", z.name);
             return Err(StoreError::corrupt(&study.path("tnew.h5"), why).into());
         };
-        let motions = sweep.motions.len();
-        let fr = axes.frame_count();
         let flat = |v: &ndarray::ArrayD<f64>| v.iter().copied().collect::<Vec<f64>>();
-        let (u_stack, u_rigid) = (flat(&sweep.vars.u_stack), flat(&sweep.vars.u_rigid));
-        let (d_stack, d_rigid) = (flat(&b.drift_ratio_stack), flat(&b.drift_ratio_rigid));
-        let (a_stack, a_rigid) = (flat(&b.floor_accel_stack), flat(&b.floor_accel_rigid));
-        let (v_stack, v_rigid) = (
-            flat(&lambda.base_shear_stack_mean),
-            flat(&lambda.base_shear_rigid_mean),
-        );
-        let (lam, t_new) = (flat(&lambda.lambda), flat(&z.tnew.vars.t_new));
-        let (ratio_bare, lam_code) = (
-            flat(&lambda.base_shear_ratio_bare),
-            flat(&lambda.lambda_code),
-        );
-        let (vm_stack, vm_rigid) = (flat(&b.base_shear_stack), flat(&b.base_shear_rigid));
-        let slip_peak = flat(&sweep.vars.slip_peak);
-        let blocks = grid.blocks();
-        let mut zone_frames = Vec::new();
-        for &(f, ref frame) in &frames {
-            let n = frame.storeys();
-            // Mean over the motions of `value(m, case)`, per case.
-            let over_motions = |value: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
-                (0..per)
-                    .map(|c| (0..motions).map(|m| value(m, c)).sum::<f64>() / motions as f64)
-                    .collect()
-            };
-            let at = |m: usize, c: usize| (m * fr + f) * per + c;
-            let peak_over = |v: &[f64], m: usize, c: usize| {
-                let i = at(m, c) * n_max;
-                v[i..i + n]
-                    .iter()
-                    .copied()
-                    .fold(f64::NEG_INFINITY, f64::max)
-            };
-            let profile = |v: &[f64]| -> Vec<f64> {
-                (0..n)
-                    .map(|j| percentile(&over_motions(&|m, c| v[at(m, c) * n_max + j]), 50.0))
-                    .collect()
-            };
-            let in_frame = |v: &[f64]| v[f * per..(f + 1) * per].to_vec();
-            // Per case and motion (pooled), `value(m, c)`.
-            let each = |value: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
-                (0..per)
-                    .flat_map(|c| (0..motions).map(move |m| (m, c)))
-                    .map(|(m, c)| value(m, c))
-                    .collect()
-            };
-            let mut accel_floor_count = vec![0; n];
-            for c in 0..per {
-                for m in 0..motions {
-                    let i = at(m, c) * n_max;
-                    let top = (0..n)
-                        .reduce(|a, j| {
-                            if a_stack[i + j] > a_stack[i + a] {
-                                j
-                            } else {
-                                a
-                            }
-                        })
-                        .unwrap_or(0);
-                    accel_floor_count[top] += 1;
-                }
-            }
-            zone_frames.push(FrameCases {
-                roof_each: each(&|m, c| u_stack[at(m, c)] / u_rigid[at(m, c)]),
-                drift_each: each(&|m, c| peak_over(&d_stack, m, c) / peak_over(&d_rigid, m, c)),
-                accel_each: each(&|m, c| peak_over(&a_stack, m, c) / peak_over(&a_rigid, m, c)),
-                shear_each: if n > 1 {
-                    each(&|m, c| vm_stack[at(m, c)] / vm_rigid[at(m, c)])
-                } else {
-                    Vec::new()
-                },
-                accel_floor_count,
-                slip: over_motions(&|m, c| slip_peak[at(m, c) * blocks]),
-                ratio_bare: in_frame(&ratio_bare),
-                lambda_code: in_frame(&lam_code),
-                frame: frame.clone(),
-                roof: Pair {
-                    stack: over_motions(&|m, c| u_stack[at(m, c)]),
-                    rigid: over_motions(&|m, c| u_rigid[at(m, c)]),
-                },
-                drift: Pair {
-                    stack: over_motions(&|m, c| peak_over(&d_stack, m, c)),
-                    rigid: over_motions(&|m, c| peak_over(&d_rigid, m, c)),
-                },
-                accel: Pair {
-                    stack: over_motions(&|m, c| peak_over(&a_stack, m, c)),
-                    rigid: over_motions(&|m, c| peak_over(&a_rigid, m, c)),
-                },
-                shear: Pair {
-                    stack: in_frame(&v_stack),
-                    rigid: in_frame(&v_rigid),
-                },
-                lambda: in_frame(&lam),
-                t_ratio: (0..per)
-                    .map(|c| t_new[f * per + c] / grid.case(c).period_s)
-                    .collect(),
-                drift_profile: (profile(&d_stack), profile(&d_rigid)),
-                accel_profile: (profile(&a_stack), profile(&a_rigid)),
-            });
-        }
+        let columns = ZoneColumns {
+            grid: inp.grid,
+            motions: sweep.motions.len(),
+            frame_count: axes.frame_count(),
+            n_max: axes.max_storeys(),
+            u_stack: flat(&sweep.vars.u_stack),
+            u_rigid: flat(&sweep.vars.u_rigid),
+            slip_peak: flat(&sweep.vars.slip_peak),
+            d_stack: flat(&b.drift_ratio_stack),
+            d_rigid: flat(&b.drift_ratio_rigid),
+            a_stack: flat(&b.floor_accel_stack),
+            a_rigid: flat(&b.floor_accel_rigid),
+            vm_stack: flat(&b.base_shear_stack),
+            vm_rigid: flat(&b.base_shear_rigid),
+            v_stack: flat(&lambda.base_shear_stack_mean),
+            v_rigid: flat(&lambda.base_shear_rigid_mean),
+            lambda: flat(&lambda.lambda),
+            t_new: flat(&z.tnew.vars.t_new),
+            ratio_bare: flat(&lambda.base_shear_ratio_bare),
+            lambda_code: flat(&lambda.lambda_code),
+        };
         out.push(BuildingZone {
             name: z.name.clone(),
-            frames: zone_frames,
+            frames: (frames.iter())
+                .map(|(f, frame)| columns.frame_cases(*f, frame))
+                .collect(),
         });
     }
     Ok(out)
+}
+
+/// One zone's stored variables the section reads, flat in their stored order: the sweep's
+/// `[motion, frame, case(, level)]` (level `N_max` long), `tnew.h5`'s `[frame, case]`.
+struct ZoneColumns<'a> {
+    grid: &'a Grid,
+    motions: usize,
+    frame_count: usize,
+    n_max: usize,
+    u_stack: Vec<f64>,
+    u_rigid: Vec<f64>,
+    slip_peak: Vec<f64>,
+    d_stack: Vec<f64>,
+    d_rigid: Vec<f64>,
+    a_stack: Vec<f64>,
+    a_rigid: Vec<f64>,
+    vm_stack: Vec<f64>,
+    vm_rigid: Vec<f64>,
+    v_stack: Vec<f64>,
+    v_rigid: Vec<f64>,
+    lambda: Vec<f64>,
+    t_new: Vec<f64>,
+    ratio_bare: Vec<f64>,
+    lambda_code: Vec<f64>,
+}
+
+impl ZoneColumns<'_> {
+    /// Frame `f` (`frame`, stored `f`-th): its cases' means, ratios and profiles.
+    fn frame_cases(&self, f: usize, frame: &Frame) -> FrameCases {
+        let (per, motions, n_max) = (self.grid.cases(), self.motions, self.n_max);
+        let n = frame.storeys();
+        // Mean over the motions of `value(m, case)`, per case.
+        let over_motions = |value: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
+            (0..per)
+                .map(|c| (0..motions).map(|m| value(m, c)).sum::<f64>() / motions as f64)
+                .collect()
+        };
+        let at = |m: usize, c: usize| (m * self.frame_count + f) * per + c;
+        let peak_over = |v: &[f64], m: usize, c: usize| {
+            let i = at(m, c) * n_max;
+            v[i..i + n]
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let profile = |v: &[f64]| -> Vec<f64> {
+            (0..n)
+                .map(|j| percentile(&over_motions(&|m, c| v[at(m, c) * n_max + j]), 50.0))
+                .collect()
+        };
+        let in_frame = |v: &[f64]| v[f * per..(f + 1) * per].to_vec();
+        // Per case and motion (pooled), `value(m, c)`.
+        let each = |value: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
+            (0..per)
+                .flat_map(|c| (0..motions).map(move |m| (m, c)))
+                .map(|(m, c)| value(m, c))
+                .collect()
+        };
+        let (u_stack, u_rigid) = (&self.u_stack, &self.u_rigid);
+        let (d_stack, d_rigid) = (&self.d_stack, &self.d_rigid);
+        let (a_stack, a_rigid) = (&self.a_stack, &self.a_rigid);
+        let (vm_stack, vm_rigid) = (&self.vm_stack, &self.vm_rigid);
+        let mut accel_floor_count = vec![0; n];
+        for c in 0..per {
+            for m in 0..motions {
+                let i = at(m, c) * n_max;
+                let top = (0..n)
+                    .reduce(|a, j| {
+                        if a_stack[i + j] > a_stack[i + a] {
+                            j
+                        } else {
+                            a
+                        }
+                    })
+                    .unwrap_or(0);
+                accel_floor_count[top] += 1;
+            }
+        }
+        let blocks = self.grid.blocks();
+        FrameCases {
+            roof_each: each(&|m, c| u_stack[at(m, c)] / u_rigid[at(m, c)]),
+            drift_each: each(&|m, c| peak_over(d_stack, m, c) / peak_over(d_rigid, m, c)),
+            accel_each: each(&|m, c| peak_over(a_stack, m, c) / peak_over(a_rigid, m, c)),
+            shear_each: if n > 1 {
+                each(&|m, c| vm_stack[at(m, c)] / vm_rigid[at(m, c)])
+            } else {
+                Vec::new()
+            },
+            accel_floor_count,
+            slip: over_motions(&|m, c| self.slip_peak[at(m, c) * blocks]),
+            ratio_bare: in_frame(&self.ratio_bare),
+            lambda_code: in_frame(&self.lambda_code),
+            frame: frame.clone(),
+            roof: Pair {
+                stack: over_motions(&|m, c| u_stack[at(m, c)]),
+                rigid: over_motions(&|m, c| u_rigid[at(m, c)]),
+            },
+            drift: Pair {
+                stack: over_motions(&|m, c| peak_over(d_stack, m, c)),
+                rigid: over_motions(&|m, c| peak_over(d_rigid, m, c)),
+            },
+            accel: Pair {
+                stack: over_motions(&|m, c| peak_over(a_stack, m, c)),
+                rigid: over_motions(&|m, c| peak_over(a_rigid, m, c)),
+            },
+            shear: Pair {
+                stack: in_frame(&self.v_stack),
+                rigid: in_frame(&self.v_rigid),
+            },
+            lambda: in_frame(&self.lambda),
+            t_ratio: (0..per)
+                .map(|c| self.t_new[f * per + c] / self.grid.case(c).period_s)
+                .collect(),
+            drift_profile: (profile(d_stack), profile(d_rigid)),
+            accel_profile: (profile(a_stack), profile(a_rigid)),
+        }
+    }
 }
 
 /// The answer table's header.
@@ -419,6 +455,28 @@ fn by_storeys(z: &BuildingZone) -> Vec<(usize, Vec<&FrameCases>)> {
     out
 }
 
+/// The band of the 10th to 90th percentiles of `at_percentile` over `x` and its median line, in
+/// `colour`, named after `name`.
+fn band_and_median(
+    name: &str,
+    colour: RGBColor,
+    x: &[f64],
+    at_percentile: impl Fn(f64) -> Vec<f64>,
+) -> [Series; 2] {
+    [
+        Series::band(
+            format!("{name}: 10th–90th percentile"),
+            x.to_vec(),
+            at_percentile(10.0),
+            at_percentile(90.0),
+        )
+        .colour(colour),
+        Series::line(format!("{name}: median"), x.to_vec(), at_percentile(50.0))
+            .colour(colour)
+            .stroke(Stroke::Solid, 2),
+    ]
+}
+
 /// `T_new/T_1` and `λ` against `T_1`: a panel per storey count and quantity.
 fn against_period(
     z: &BuildingZone,
@@ -475,20 +533,7 @@ fn against_period(
                 } else {
                     format!("stack on {}", floor_name(f.frame.stack_floor))
                 };
-                series.push(
-                    Series::band(
-                        format!("{name}: 10th–90th percentile"),
-                        tp.clone(),
-                        over_t(&v, 10.0),
-                        over_t(&v, 90.0),
-                    )
-                    .colour(colour),
-                );
-                series.push(
-                    Series::line(format!("{name}: median"), tp.clone(), over_t(&v, 50.0))
-                        .colour(colour)
-                        .stroke(Stroke::Solid, 2),
-                );
+                series.extend(band_and_median(&name, colour, tp, |p| over_t(&v, p)));
             }
             if let Some((label, y)) = reference {
                 series.push(

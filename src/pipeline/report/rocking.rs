@@ -22,7 +22,7 @@ pub(super) fn rocking_section(study: &Study) -> Result<Option<Section>, Pipeline
     let mut rows = Vec::new();
     for zc in &study.cfg.zones {
         let z = super::super::files::sweep_zone(study, &zc.name, None)?;
-        let Some(rocks) = &z.vars.rocks_stack else {
+        let Some(rocks) = &z.rocks_stack else {
             return Err(crate::store::StoreError::corrupt(
                 &study.path("sweep.h5"),
                 format!(

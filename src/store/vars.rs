@@ -1,0 +1,275 @@
+//! Stored variables declared once. A stage file's variables are a struct declared with
+//! [`stored_vars!`](crate::stored_vars): each field gives its variable's name, trailing axis, units
+//! and long name (and, where a building study says more, its building long name). From that one
+//! declaration come the struct, the writer's loop ([`write_declared`]), the reader's shape check
+//! (`read`) and the variable table of `docs/variables.md` ([`table`]).
+
+use super::StoreError;
+use super::h5::{GroupReader, attach_all, attach_scale, write_flags, write_var};
+use ndarray::ArrayD;
+
+/// The axis a variable has after its file's case dimensions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Trailing {
+    /// None: the case dimensions alone.
+    Case,
+    /// `interface` (1 = structure–block 1).
+    Interface,
+    /// `block` (1 = the lowest).
+    Block,
+    /// `floor` of a building (1 the lowest; `N_max` long, NaN above a building's roof).
+    Floor,
+    /// `storey` of a building (1 between the ground and floor 1).
+    Storey,
+}
+
+impl Trailing {
+    /// The coordinate's name, as the docs' table shows it after the case dimensions.
+    pub fn axis(self) -> Option<&'static str> {
+        match self {
+            Trailing::Case => None,
+            Trailing::Interface => Some("interface"),
+            Trailing::Block => Some("block"),
+            Trailing::Floor => Some("floor"),
+            Trailing::Storey => Some("storey"),
+        }
+    }
+}
+
+/// How a `u8` variable's CF `flag_values`/`flag_meanings` are given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Codes {
+    /// Not a code variable: `f64` with NaN fill.
+    Value,
+    /// Codes fixed by the layout.
+    Fixed(&'static [(u8, &'static str)]),
+    /// Codes the writer is given (they come from the study's flag tables).
+    Given,
+}
+
+/// One stored variable's declaration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Var {
+    pub name: &'static str,
+    pub trailing: Trailing,
+    /// CF units (`""` for a code variable, which has none).
+    pub units: &'static str,
+    pub long_name: &'static str,
+    /// The long name in a building study's file, where it says more.
+    pub building_long_name: Option<&'static str>,
+    pub codes: Codes,
+}
+
+impl Var {
+    /// The long name in a building study's file (`building`) or a one-storey study's.
+    pub fn long_name_in(&self, building: bool) -> &'static str {
+        match self.building_long_name {
+            Some(b) if building => b,
+            _ => self.long_name,
+        }
+    }
+}
+
+/// The stored element type of a declared field: `f64` values or `u8` codes.
+pub trait Element: hdf5::H5Type + Copy {
+    const CODES: Codes;
+    fn data(a: &ArrayD<Self>) -> Data<'_>;
+}
+
+impl Element for f64 {
+    const CODES: Codes = Codes::Value;
+    fn data(a: &ArrayD<f64>) -> Data<'_> {
+        Data::Values(a)
+    }
+}
+
+impl Element for u8 {
+    const CODES: Codes = Codes::Given;
+    fn data(a: &ArrayD<u8>) -> Data<'_> {
+        Data::Codes(a)
+    }
+}
+
+/// A declared field's array.
+#[derive(Debug, Clone, Copy)]
+pub enum Data<'a> {
+    Values(&'a ArrayD<f64>),
+    Codes(&'a ArrayD<u8>),
+}
+
+/// Declares a struct of stored variables, one `ArrayD` field per variable, and derives from it
+/// `VARS` (the declarations, in field order: the order they are written and read), `data`
+/// (each declaration with its array) and `read` (each variable read and checked against the
+/// shape `shape(trailing)` gives).
+///
+/// ```text
+/// stored_vars! {
+///     /// doc
+///     pub struct Vars {
+///         /// doc
+///         field: f64 => "name", Trailing, "units", "long name" [, building "long name"] [, codes TABLE];
+///     }
+/// }
+/// ```
+#[macro_export]
+macro_rules! stored_vars {
+    (@building) => { None };
+    (@building $b:literal) => { Some($b) };
+    (@codes $t:ty) => { <$t as $crate::store::vars::Element>::CODES };
+    (@codes $t:ty, $c:expr) => { $crate::store::vars::Codes::Fixed($c) };
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $name:ident {
+            $(
+                $(#[$fmeta:meta])*
+                $field:ident : $t:ty => $var:literal, $trailing:ident, $units:literal, $long:expr
+                    $(, building $blong:literal)? $(, codes $codes:expr)? ;
+            )*
+        }
+    ) => {
+        $(#[$meta])*
+        $vis struct $name {
+            $( $(#[$fmeta])* pub $field: ndarray::ArrayD<$t>, )*
+        }
+
+        impl $name {
+            /// The declarations of this struct's variables, in field order.
+            pub const VARS: &'static [$crate::store::vars::Var] = &[
+                $(
+                    $crate::store::vars::Var {
+                        name: $var,
+                        trailing: $crate::store::vars::Trailing::$trailing,
+                        units: $units,
+                        long_name: $long,
+                        building_long_name: $crate::stored_vars!(@building $($blong)?),
+                        codes: $crate::stored_vars!(@codes $t $(, $codes)?),
+                    },
+                )*
+            ];
+
+            /// Each variable's declaration with its array, in field order.
+            pub fn data(&self) -> Vec<(&'static $crate::store::vars::Var, $crate::store::vars::Data<'_>)> {
+                Self::VARS
+                    .iter()
+                    .zip([$(<$t as $crate::store::vars::Element>::data(&self.$field)),*])
+                    .collect()
+            }
+
+            /// Every variable of group `g`, each refused unless its shape is `shape(trailing)`.
+            pub fn read(
+                g: &$crate::store::h5::GroupReader,
+                shape: impl Fn($crate::store::vars::Trailing) -> Vec<usize>,
+            ) -> Result<Self, $crate::store::StoreError> {
+                Ok(Self {
+                    $( $field: g.array($var, &shape($crate::store::vars::Trailing::$trailing))?, )*
+                })
+            }
+        }
+    };
+}
+
+/// Where declared variables go: their group, chunking, dimension scales and the given codes.
+pub struct Target<'a> {
+    pub group: &'a hdf5::Group,
+    /// A building study's file (the long names to use).
+    pub building: bool,
+    /// The chunk of a variable without a trailing axis; a trailing axis is one chunk long.
+    pub chunk: &'a [usize],
+    /// The scales of the case dimensions, in order.
+    pub scales: &'a [hdf5::Dataset],
+    /// The scale of each trailing axis the file has.
+    pub trailing: &'a dyn Fn(Trailing) -> Option<&'a hdf5::Dataset>,
+    /// The codes of a [`Codes::Given`] variable, by its name.
+    pub given: &'a dyn Fn(&str) -> &'a [(u8, &'a str)],
+}
+
+/// Writes `vars` into `to` in order, each chunked, labelled from its declaration and attached
+/// to its dimension scales.
+pub fn write_declared(to: &Target, vars: &[(&'static Var, Data)]) -> hdf5::Result<()> {
+    for (var, data) in vars {
+        let shape = match data {
+            Data::Values(a) => a.shape(),
+            Data::Codes(a) => a.shape(),
+        };
+        let mut chunk = to.chunk.to_vec();
+        let scale = var.trailing.axis().map(|_| {
+            chunk.push(shape[shape.len() - 1]);
+            (to.trailing)(var.trailing)
+                .unwrap_or_else(|| panic!("{} needs its {:?} scale", var.name, var.trailing))
+        });
+        let long = var.long_name_in(to.building);
+        let ds = match (data, var.codes) {
+            (Data::Values(a), _) => {
+                write_var(to.group, var.name, a.view(), &chunk, var.units, long)?
+            }
+            (Data::Codes(a), Codes::Fixed(codes)) => {
+                write_flags(to.group, var.name, a.view(), &chunk, long, codes)?
+            }
+            (Data::Codes(a), _) => write_flags(
+                to.group,
+                var.name,
+                a.view(),
+                &chunk,
+                long,
+                (to.given)(var.name),
+            )?,
+        };
+        attach_all(&ds, to.scales)?;
+        if let Some(s) = scale {
+            attach_scale(&ds, s, to.scales.len())?;
+        }
+    }
+    Ok(())
+}
+
+/// The Markdown table of `vars`: name, dimensions (the case dimensions `case`, then the trailing
+/// axis), units and long name (with the building study's where it differs).
+pub fn table(case: &str, vars: &[Var]) -> String {
+    let mut s = String::from("| variable | dimensions | units | long name |\n|---|---|---|---|\n");
+    for v in vars {
+        let dims = match v.trailing.axis() {
+            Some(a) => format!("{case}, {a}"),
+            None => case.to_string(),
+        };
+        let units = match v.codes {
+            Codes::Value => format!("`{}`", v.units),
+            _ => "codes".to_string(),
+        };
+        let long = match v.building_long_name {
+            Some(b) => match b.strip_prefix(v.long_name) {
+                Some(more) => format!("{}; in a building study{more}", v.long_name),
+                None => format!("{}; in a building study: {b}", v.long_name),
+            },
+            None => v.long_name.to_string(),
+        };
+        s.push_str(&format!("| `{}` | [{dims}] | {units} | {long} |\n", v.name));
+    }
+    s
+}
+
+/// Reads a declared variable the declaration does not hold (an optional one): `Ok(None)` when
+/// the group lacks it.
+pub fn read_optional<T: hdf5::H5Type>(
+    g: &GroupReader,
+    name: &str,
+    shape: &[usize],
+) -> Result<Option<ArrayD<T>>, StoreError> {
+    g.has(name).then(|| g.array(name, shape)).transpose()
+}
+
+/// Whether two declared sets hold the same variables with equal bits (NaN fill included): how
+/// a stage checks what it reads back against what it meant to write.
+pub fn same_bits(a: &[(&'static Var, Data)], b: &[(&'static Var, Data)]) -> bool {
+    let bits = |x: &ArrayD<f64>, y: &ArrayD<f64>| {
+        x.shape() == y.shape() && x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())
+    };
+    a.len() == b.len()
+        && a.iter().zip(b).all(|((va, da), (vb, db))| {
+            va.name == vb.name
+                && match (da, db) {
+                    (Data::Values(x), Data::Values(y)) => bits(x, y),
+                    (Data::Codes(x), Data::Codes(y)) => x == y,
+                    _ => false,
+                }
+        })
+}
