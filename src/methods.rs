@@ -80,10 +80,11 @@ pub const FLOORS: Method = Method {
 /// The report's pages and figures (7: the design page's data by name, `ZoneDesign`'s
 /// `building` and `lambda`; 8: where the stacks would rock, the table and the design page's
 /// note; 9: the design page's `rocks_share` row; 10: ASCE 7-22's floor spectrum in the floors
-/// figure; 11: the design page takes the stack at mid-height, `mid`).
+/// figure; 11: the design page takes the stack at mid-height, `mid`; 12: the design page's
+/// opening paragraph names `mid` among the floors an address may give).
 pub const REPORT: Method = Method {
     name: "report",
-    version: 11,
+    version: 12,
 };
 
 /// The methods as they enter a fingerprint: `name-version` joined by spaces.

@@ -8,7 +8,7 @@ use super::text::num;
 use super::{Files, Inputs, ReportError};
 use crate::fit::extrapolation::{LOWER_T_P, UPPER_T_RIGID};
 use crate::fit::forms::DAMPING_DEPTH;
-use crate::grid::StackFloor;
+use crate::grid::{Grid, StackFloor};
 use crate::limits::STRUCTURE_PERIOD_RANGE_S;
 use crate::pipeline::{PipelineError, files};
 use crate::render::design::{FrameInputs, PageForm, design_page};
@@ -79,8 +79,17 @@ pub(super) fn building_example(inp: &Inputs) -> Option<String> {
     ))
 }
 
-/// Writes `design.html` into `files`.
-pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), PipelineError> {
+/// What the page shows of every zone.
+struct Designs {
+    /// Each zone's design (a building study: one per frame of each zone).
+    zones: Vec<ZoneDesign>,
+    /// The `DRR`s drawn beside each.
+    drr: Vec<Ratios>,
+    /// The frames' labels, every zone's in order (none on one storey).
+    labels: Vec<String>,
+}
+
+fn zone_designs(inp: &Inputs) -> Result<Designs, PipelineError> {
     let grid = inp.grid;
     // Each zone's stored target, in the config's order, as `inp.zones` is.
     let targets = files::targets(inp.study)?;
@@ -127,6 +136,13 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
             }
         }
     }
+    Ok(Designs { zones, drr, labels })
+}
+
+/// Writes `design.html` into `files`.
+pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), PipelineError> {
+    let grid = inp.grid;
+    let Designs { zones, drr, labels } = zone_designs(inp)?;
     let example = building_example(inp);
     let frames = example.as_ref().map(|example| Frames {
         labels: labels.clone(),
@@ -163,7 +179,28 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
     let mut ranges = vec![span(&grid.periods_s, " s")];
     ranges.extend(grid.alpha.iter().map(|a| span(a, "")));
     ranges.extend(grid.mu.iter().map(|m| span(m, "")));
-    let intro = match &example {
+    let intro = intro(grid, example.as_deref());
+    let form = PageForm {
+        zones: &names,
+        blocks: grid.blocks(),
+        ranges: &ranges,
+        building: frame_inputs.as_ref(),
+        rocking: inp.study.aspect().is_some(),
+    };
+    let html = design_page(
+        &format!("T_new for your structure: {}", report_name(inp)),
+        &intro,
+        &form,
+        &data,
+    );
+    files.files.push(("design.html".into(), html.into_bytes()));
+    Ok(())
+}
+
+/// The page's opening paragraph: what it answers, the command that answers the same, and an
+/// example address (`example`: a building study's query of a point of its grid).
+fn intro(grid: &Grid, example: Option<&str>) -> String {
+    match example {
         None => {
             let example = if grid.blocks() == 2 {
                 format!(
@@ -193,27 +230,13 @@ pub(super) fn design_file(inp: &Inputs, files: &mut Files) -> Result<(), Pipelin
              tick <em>extrapolate</em>; the fitted building equations; T_1,rigid with the stack \
              rigidly attached to its floor(s)). A building the study does not hold (a storey count, \
              a floor) is refused: nothing is interpolated between frames. The inputs can be given \
-             in the address (floor a number, <code>roof</code> or <code>all</code>; add \
+             in the address (floor a number, <code>mid</code>, <code>roof</code> or \
+             <code>all</code>; add \
              <code>&amp;extrapolate=1</code> to extrapolate), e.g. a point of the study's grid: \
              <a href='design.html?{q}'>design.html?{q}</a>.</p>",
             q = escape(example)
         ),
-    };
-    let form = PageForm {
-        zones: &names,
-        blocks: grid.blocks(),
-        ranges: &ranges,
-        building: frame_inputs.as_ref(),
-        rocking: inp.study.aspect().is_some(),
-    };
-    let html = design_page(
-        &format!("T_new for your structure: {}", report_name(inp)),
-        &intro,
-        &form,
-        &data,
-    );
-    files.files.push(("design.html".into(), html.into_bytes()));
-    Ok(())
+    }
 }
 
 fn report_name(inp: &Inputs) -> String {

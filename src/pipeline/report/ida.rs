@@ -49,57 +49,8 @@ pub(super) fn ida_section(study: &Study, files: &mut Files) -> Result<Section, P
         .map(|(_, f)| f.to_string())
         .collect();
     let shown = |frame: &Option<String>| frame.as_ref().is_none_or(|f| distinct.contains(f));
-    let rows: Vec<Vec<String>> = fragility_table(study)?
-        .into_iter()
-        .filter(|r| shown(&r.frame))
-        .map(|r| {
-            let mut row = vec![
-                r.zone,
-                r.case.to_string(),
-                r.system,
-                r.limit_state,
-                g3(r.theta_sa_g),
-                format!("{}–{}", g3(r.theta_ci_sa_g.0), g3(r.theta_ci_sa_g.1)),
-                g3(r.beta),
-                format!("{}–{}", g3(r.beta_ci.0), g3(r.beta_ci.1)),
-                r.status.into(),
-            ];
-            if let Some(f) = r.frame {
-                row.insert(2, f);
-            }
-            row
-        })
-        .collect();
-    let medians: Vec<Vec<String>> = median_demand(study)?
-        .into_iter()
-        .filter(|m| shown(&m.frame))
-        .map(|m| {
-            let value = |x: f64| {
-                if building && x.is_finite() {
-                    format!("{x:.4}")
-                } else {
-                    g3(x)
-                }
-            };
-            let mut row = vec![
-                m.zone,
-                m.case.to_string(),
-                format!("{} × {:.3} g", m.factor, m.target_sa_g),
-                value(m.stack),
-                value(m.rigid),
-                if m.stack.is_finite() && m.rigid.is_finite() {
-                    format!("{:+.1}", 100.0 * (m.stack / m.rigid - 1.0))
-                } else {
-                    "–".into()
-                },
-                format!("{:.4}", m.stack_max_slip_m),
-            ];
-            if let Some(f) = m.frame {
-                row.insert(2, f);
-            }
-            row
-        })
-        .collect();
+    let rows = fragility_rows(study, &shown)?;
+    let medians = median_rows(study, &shown)?;
     let what = if building {
         "A yielding building (storey strengths from the base-shear coefficient by IS 1893 \
          Clause 7.6.3) traced by hunt & fill (Vamvatsikos & Cornell 2002) with its stack \
@@ -162,6 +113,72 @@ pub(super) fn ida_section(study: &Study, files: &mut Files) -> Result<Section, P
         "Incremental dynamic analysis of a yielding structure"
     };
     Ok(Section::new("ida", title, body))
+}
+
+/// The fragility table's rows of the frames `shown` (every row on one storey).
+fn fragility_rows(
+    study: &Study,
+    shown: &dyn Fn(&Option<String>) -> bool,
+) -> Result<Vec<Vec<String>>, PipelineError> {
+    Ok(fragility_table(study)?
+        .into_iter()
+        .filter(|r| shown(&r.frame))
+        .map(|r| {
+            let mut row = vec![
+                r.zone,
+                r.case.to_string(),
+                r.system,
+                r.limit_state,
+                g3(r.theta_sa_g),
+                format!("{}–{}", g3(r.theta_ci_sa_g.0), g3(r.theta_ci_sa_g.1)),
+                g3(r.beta),
+                format!("{}–{}", g3(r.beta_ci.0), g3(r.beta_ci.1)),
+                r.status.into(),
+            ];
+            if let Some(f) = r.frame {
+                row.insert(2, f);
+            }
+            row
+        })
+        .collect())
+}
+
+/// The median demands' rows of the frames `shown` (a building's drift ratios to 4 decimals).
+fn median_rows(
+    study: &Study,
+    shown: &dyn Fn(&Option<String>) -> bool,
+) -> Result<Vec<Vec<String>>, PipelineError> {
+    let building = study.building().is_some();
+    Ok(median_demand(study)?
+        .into_iter()
+        .filter(|m| shown(&m.frame))
+        .map(|m| {
+            let value = |x: f64| {
+                if building && x.is_finite() {
+                    format!("{x:.4}")
+                } else {
+                    g3(x)
+                }
+            };
+            let mut row = vec![
+                m.zone,
+                m.case.to_string(),
+                format!("{} × {:.3} g", m.factor, m.target_sa_g),
+                value(m.stack),
+                value(m.rigid),
+                if m.stack.is_finite() && m.rigid.is_finite() {
+                    format!("{:+.1}", 100.0 * (m.stack / m.rigid - 1.0))
+                } else {
+                    "–".into()
+                },
+                format!("{:.4}", m.stack_max_slip_m),
+            ];
+            if let Some(f) = m.frame {
+                row.insert(2, f);
+            }
+            row
+        })
+        .collect())
 }
 
 /// One row of the fragility table.

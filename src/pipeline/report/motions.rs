@@ -4,6 +4,7 @@ use super::{Files, ReportError, ZoneMotions};
 use crate::pipeline::Study;
 use crate::render::chart::{Axis, FAINT, Figure, PALETTE, Panel, Series, Stroke};
 use crate::render::page::{Section, para};
+use crate::store::motions::ZoneSpectra;
 use plotters::style::RGBColor;
 
 pub(super) fn motions_section(
@@ -21,57 +22,8 @@ pub(super) fn motions_section(
          / target: ASCE 7-16 asks that it not fall below 0.9."
     ));
     for z in zones {
-        let s = &z.spectra;
-        let t = &s.periods_s;
-        let scaled = |f: f64| s.target_psa_g.iter().map(|v| v * f).collect::<Vec<_>>();
-        let mut series: Vec<Series> = s
-            .psa_g
-            .rows()
-            .into_iter()
-            .map(|r| Series::faint(t.clone(), r.to_vec()).colour(FAINT))
-            .collect();
-        if let Some(first) = series.first_mut() {
-            first.label = format!("each matched motion ({})", s.psa_g.nrows());
-        }
-        series.push(
-            Series::band(
-                format!("matching band {lo}–{hi} × target"),
-                t.clone(),
-                scaled(lo),
-                scaled(hi),
-            )
-            .colour(PALETTE[0]),
-        );
-        series.push(
-            Series::line("target", t.clone(), s.target_psa_g.clone()).colour(RGBColor(0, 0, 0)),
-        );
-        series.push(
-            Series::line("mean of the motions", t.clone(), s.mean_psa_g.clone()).colour(PALETTE[1]),
-        );
-        let ratio: Vec<f64> = s
-            .mean_psa_g
-            .iter()
-            .zip(&s.target_psa_g)
-            .map(|(m, t)| m / t)
-            .collect();
-        let (t0, t1) = (t[0], t[t.len() - 1]);
-        let (r0, r1) = ratio
-            .iter()
-            .fold((lo, hi), |(a, b), &v| (a.min(v), b.max(v)));
+        let (series, ratio_series, (r0, r1)) = spectra_series(z.spectra, lo, hi);
         let pad = 0.15 * (r1 - r0);
-        let ratio_series = vec![
-            Series::band(
-                format!("matching band {lo}–{hi} × target"),
-                vec![t0, t1],
-                vec![lo, lo],
-                vec![hi, hi],
-            )
-            .colour(PALETTE[0]),
-            Series::hline("ASCE 7-16 minimum (0.9)", t0, t1, 0.9)
-                .colour(RGBColor(0, 0, 0))
-                .stroke(Stroke::Dashed, 1),
-            Series::line("mean of the motions", t.clone(), ratio).colour(PALETTE[1]),
-        ];
         let x = || Axis::new("period T (s)");
         let mut fig = Figure::grid(
             format!(
@@ -107,4 +59,63 @@ pub(super) fn motions_section(
         )?;
     }
     Ok(Section::new("motions", "Ground motions (Figs 4–5)", body))
+}
+
+/// A zone's spectra panel (every motion, the band `lo`–`hi` × target, the target, the mean) and
+/// its mean-over-target panel, with that panel's range.
+fn spectra_series(
+    spectra: &ZoneSpectra,
+    lo: f64,
+    hi: f64,
+) -> (Vec<Series>, Vec<Series>, (f64, f64)) {
+    let s = spectra;
+    let t = &s.periods_s;
+    let scaled = |f: f64| s.target_psa_g.iter().map(|v| v * f).collect::<Vec<_>>();
+    let mut series: Vec<Series> = s
+        .psa_g
+        .rows()
+        .into_iter()
+        .map(|r| Series::faint(t.clone(), r.to_vec()).colour(FAINT))
+        .collect();
+    if let Some(first) = series.first_mut() {
+        first.label = format!("each matched motion ({})", s.psa_g.nrows());
+    }
+    series.push(
+        Series::band(
+            format!("matching band {lo}–{hi} × target"),
+            t.clone(),
+            scaled(lo),
+            scaled(hi),
+        )
+        .colour(PALETTE[0]),
+    );
+    series
+        .push(Series::line("target", t.clone(), s.target_psa_g.clone()).colour(RGBColor(0, 0, 0)));
+    series.push(
+        Series::line("mean of the motions", t.clone(), s.mean_psa_g.clone()).colour(PALETTE[1]),
+    );
+    let ratio: Vec<f64> = s
+        .mean_psa_g
+        .iter()
+        .zip(&s.target_psa_g)
+        .map(|(m, t)| m / t)
+        .collect();
+    let (t0, t1) = (t[0], t[t.len() - 1]);
+    let (r0, r1) = ratio
+        .iter()
+        .fold((lo, hi), |(a, b), &v| (a.min(v), b.max(v)));
+    let ratio_series = vec![
+        Series::band(
+            format!("matching band {lo}–{hi} × target"),
+            vec![t0, t1],
+            vec![lo, lo],
+            vec![hi, hi],
+        )
+        .colour(PALETTE[0]),
+        Series::hline("ASCE 7-16 minimum (0.9)", t0, t1, 0.9)
+            .colour(RGBColor(0, 0, 0))
+            .stroke(Stroke::Dashed, 1),
+        Series::line("mean of the motions", t.clone(), ratio).colour(PALETTE[1]),
+    ];
+    (series, ratio_series, (r0, r1))
 }
