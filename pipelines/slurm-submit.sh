@@ -223,12 +223,13 @@ if [[ ,$STAGES, == *,ida,* ]] && [ -z "$ARRAY" ] && { [ "$IDA" != up_to_date ] |
 fi
 
 # The tnew array (a building study, whose attached fractions are tnew's work units, when tnew.h5
-# is not up to date or --force), not when only some sweep shards are resubmitted (--array): the
-# finishing job's `tnew` computes them. Its N is the sweep's, at most tnew's work units, and its
-# time limit the sweep task's (its units cost about as much as the sweep's); with the sweep to
-# run, a merge job goes between the two arrays.
+# is not up to date or --force), also when only some sweep shards are resubmitted (--array): the
+# first submission's tnew array was cancelled with its failed merge, and its units are the
+# costly part. Its N is the sweep's, at most tnew's work units, and its time limit the sweep
+# task's (its units cost about as much as the sweep's); with the sweep to run, a merge job goes
+# between the two arrays. A tnew task skips the units already stored.
 NEED_TNEW=0
-if [ "$TNEW_UNITS" -gt 0 ] && [ -z "$ARRAY" ] && { [ "$TNEW" != up_to_date ] || [ $FORCE = 1 ]; }; then
+if [ "$TNEW_UNITS" -gt 0 ] && { [ "$TNEW" != up_to_date ] || [ $FORCE = 1 ]; }; then
   NEED_TNEW=1
 fi
 
