@@ -23,10 +23,16 @@ HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 ROOT=$(dirname "$HERE")
 PROG=pipelines/slurm-submit.sh
 
-# A sweep unit's cost: 188 ns per simulated record sample per thread, measured by the paper
-# study on 2 threads (docs/evidence/study.md, docs/performance.md "The paper's study"); the time limit
-# adds a factor 2 and 5 minutes on top of the bound this gives.
-NS_PER_SAMPLE=${SLIDESTACK_NS_PER_SAMPLE:-188}
+# A sweep unit's cost per record sample of its work bound comes from `slidestack status`
+# (SWEEP_NS_PER_SAMPLE, src/study/cost.rs): on one storey 188 ns per simulated sample per thread,
+# measured by the paper study on 2 threads (docs/performance.md "The paper's study"), a bound; in
+# a building study the mean over its frames of a cost measured per storey count
+# (scripts/storey-cost), an estimate. SLIDESTACK_NS_PER_SAMPLE overrides it. The time limit adds a
+# factor 2 and 5 minutes on top.
+# A building study's tnew array: its CPU time over the sweep's, as measured on the costliest
+# frame of configs/mdof-research.yaml (20 storeys, the stack on the roof: 363.2 against 159.8
+# CPU-s, pipelines/README.md "A research-sized building study").
+TNEW_PER_SWEEP=2.3
 # Before the motions job has run, `slidestack status` cannot know the motions' length: the sizing
 # then assumes this many record samples per motion (the built-in stochastic motion has 4001, the
 # eleven FEMA P695 records of tests/fixtures 1800 to 7991).
@@ -161,6 +167,7 @@ status=$("$SLIDESTACK" status "$CONFIG" --out "$OUT" --format env) ||
 # shellcheck disable=SC2034 # TNEW, FIT, IDA and REPORT are read through ${!v} below
 MOTIONS="" SWEEP="" TNEW="" FIT="" IDA="" REPORT="" SWEEP_UNITS="" SWEEP_UNITS_DONE=""
 SWEEP_CASES_PER_UNIT="" SWEEP_SAMPLES_PER_MOTION="" SWEEP_SAMPLES_PER_UNIT="" STAGES=""
+SWEEP_NS_PER_SAMPLE=""
 IDA_UNITS="" IDA_UNITS_DONE="" TNEW_UNITS="" TNEW_UNITS_DONE=""
 # KEY=VALUE lines; the keys used here are checked below, others are left alone. A stage the
 # config does not configure has no line (STAGES lists the configured ones).
@@ -169,6 +176,7 @@ while IFS= read -r line; do
   case ${BASH_REMATCH[1]} in
   MOTIONS | SWEEP | TNEW | FIT | IDA | REPORT | SWEEP_UNITS | SWEEP_UNITS_DONE | \
     SWEEP_CASES_PER_UNIT | SWEEP_SAMPLES_PER_MOTION | SWEEP_SAMPLES_PER_UNIT | STAGES | \
+    SWEEP_NS_PER_SAMPLE | \
     IDA_UNITS | IDA_UNITS_DONE | TNEW_UNITS | TNEW_UNITS_DONE)
     printf -v "${BASH_REMATCH[1]}" '%s' "${BASH_REMATCH[2]}" ;;
   esac
@@ -191,9 +199,18 @@ for stage in "${stages[@]}"; do
   states="$states${states:+, }$stage ${!v}"
 done
 for v in SWEEP_UNITS SWEEP_UNITS_DONE SWEEP_CASES_PER_UNIT SWEEP_SAMPLES_PER_MOTION SWEEP_SAMPLES_PER_UNIT \
-  IDA_UNITS IDA_UNITS_DONE TNEW_UNITS TNEW_UNITS_DONE; do
+  SWEEP_NS_PER_SAMPLE IDA_UNITS IDA_UNITS_DONE TNEW_UNITS TNEW_UNITS_DONE; do
   is_uint "${!v}" || die "slidestack status gave $v='${!v}'"
 done
+NS_PER_SAMPLE=${SLIDESTACK_NS_PER_SAMPLE:-$SWEEP_NS_PER_SAMPLE}
+is_uint "$NS_PER_SAMPLE" || die "SLIDESTACK_NS_PER_SAMPLE must be a whole number of nanoseconds"
+if [ -n "${SLIDESTACK_NS_PER_SAMPLE:-}" ]; then
+  ns_from="SLIDESTACK_NS_PER_SAMPLE"
+elif [ "$TNEW_UNITS" -gt 0 ]; then
+  ns_from="the building study's frames' estimate, src/study/cost.rs"
+else
+  ns_from="the one-storey bound, src/study/cost.rs"
+fi
 units=()
 [ $HAS_SWEEP = 0 ] || units+=("$SWEEP_UNITS_DONE of $SWEEP_UNITS sweep units")
 [ "$TNEW_UNITS" = 0 ] || units+=("$TNEW_UNITS_DONE of $TNEW_UNITS tnew units")
@@ -348,12 +365,13 @@ elif [ "$SAMPLES_PER_UNIT" -gt 0 ] && [ "$SWEEP_UNITS" -gt 0 ]; then
       printf "%.3f %.1f %d %d %.0f %d\n", u, w, c, n, est, t
     }')
   [ -n "$TIME" ] || TIME=$TMIN
-  note "sizing: $SWEEP_UNITS work units of $SWEEP_CASES_PER_UNIT cases, each at most $UNIT_S CPU-s (at most $SAMPLES_PER_UNIT simulated record samples x $NS_PER_SAMPLE ns; $samples_from); $W CPU-s in all, at most $EST s per task"
+  if [ "$TNEW_UNITS" -gt 0 ] && [ -z "${SLIDESTACK_NS_PER_SAMPLE:-}" ]; then
+    note "sizing: $SWEEP_UNITS work units of $SWEEP_CASES_PER_UNIT cases, each about $UNIT_S CPU-s ($SAMPLES_PER_UNIT record samples of the work bound x $NS_PER_SAMPLE ns, $ns_from; $samples_from); $W CPU-s in all, about $EST s per task"
+  else
+    note "sizing: $SWEEP_UNITS work units of $SWEEP_CASES_PER_UNIT cases, each at most $UNIT_S CPU-s (at most $SAMPLES_PER_UNIT simulated record samples x $NS_PER_SAMPLE ns, $ns_from; $samples_from); $W CPU-s in all, at most $EST s per task"
+  fi
 elif [ -n "$sized" ]; then
   note "warning: the grid has no work to size from: default 1 shard, 1 CPU, 4 hours where not given"
-fi
-if [ "$TNEW_UNITS" -gt 0 ] && [[ $sized == *time* ]] && [ -z "${SLIDESTACK_NS_PER_SAMPLE:-}" ]; then
-  note "warning: a building study's simulated sample costs far more than the one-storey sweep's $NS_PER_SAMPLE ns the sizing assumes (16.5 µs at 20 storeys: pipelines/README.md, \"A research-sized building study\"), so the time limit sized here is too short: give --time, or SLIDESTACK_NS_PER_SAMPLE"
 fi
 CPUS=${CPUS:-1}
 SHARDS=${SHARDS:-1}
@@ -473,9 +491,23 @@ ida_cmd=(sbatch "${common[@]}" --job-name=slidestack-ida --time="$STAGE_TIME" --
   "$OUT" "$IDA_SHARDS")
 TNEW_SHARDS=$SHARDS
 if [ "$TNEW_UNITS" -lt "$TNEW_SHARDS" ]; then TNEW_SHARDS=$TNEW_UNITS; fi
+# A tnew task's time limit: the sweep's when given, else from the sweep's estimated CPU time
+# (W) times TNEW_PER_SWEEP over the tnew tasks, sized as the sweep's (twice plus 5 minutes, at
+# least 10 minutes, at most the partition's limit).
+TNEW_TIME=$TIME
+if [ $NEED_TNEW = 1 ] && [[ $given != *time* ]] && [ -n "${W:-}" ] && [ "$TNEW_SHARDS" -ge 1 ]; then
+  read -r TNEW_W TNEW_EST TNEW_TIME < <(awk -v w="$W" -v r="$TNEW_PER_SWEEP" -v n="$TNEW_SHARDS" -v c="$CPUS" '
+    function ceil(x) { return (x == int(x)) ? x : int(x) + 1 }
+    BEGIN {
+      tw = r * w; est = ceil(tw / (n * c)); t = ceil((2 * est + 300) / 60); if (t < 10) t = 10
+      printf "%.1f %d %d\n", tw, est, t
+    }')
+  if [ -n "$plim" ] && [ "$TNEW_TIME" -gt "$plim" ]; then TNEW_TIME=$PART_LIMIT; fi
+  note "sizing: tnew's $TNEW_UNITS work units, about $TNEW_W CPU-s in all ($TNEW_PER_SWEEP × the sweep's), about $TNEW_EST s per task: a limit of $(show_time "$TNEW_TIME") per tnew task"
+fi
 TNEW_SPEC="1-$TNEW_SHARDS"
 [ -z "$MAX_RUNNING" ] || TNEW_SPEC="$TNEW_SPEC%$MAX_RUNNING"
-tnew_cmd=(sbatch "${common[@]}" --job-name=slidestack-tnew --time="$TIME" --array="$TNEW_SPEC"
+tnew_cmd=(sbatch "${common[@]}" --job-name=slidestack-tnew --time="$TNEW_TIME" --array="$TNEW_SPEC"
   --output="$LOGS/tnew-%A_%a.out" "${EXTRA[@]}" "$HERE/shard.slurm" "${FORCE_ARG[@]}" tnew "$JOB_BIN" "$CONFIG"
   "$OUT" "$TNEW_SHARDS")
 # With the sweep and tnew both as arrays, the finishing job is split: the merge job between them
@@ -491,7 +523,7 @@ finish_cmd=(sbatch "${common[@]}" --job-name=slidestack-finish --time="$STAGE_TI
 
 parts="finishing job"
 [ $NEED_IDA = 0 ] || parts="ida array ($IDA_SHARDS shards of $IDA_UNITS units, $(show_time "$STAGE_TIME") each), $parts"
-[ $NEED_TNEW = 0 ] || parts="tnew array ($TNEW_SHARDS shards of $TNEW_UNITS units, $(show_time "$TIME") each), $parts"
+[ $NEED_TNEW = 0 ] || parts="tnew array ($TNEW_SHARDS shards of $TNEW_UNITS units, $(show_time "$TNEW_TIME") each), $parts"
 [ $NEED_MERGE = 0 ] || parts="merge job, $parts"
 [ $NEED_SWEEP = 0 ] || parts="sweep array (tasks $ARRAY_SPEC of N = $SHARDS shards, $CPUS CPUs and $(show_time "$TIME") each), $parts"
 [ $NEED_MOTIONS = 0 ] || parts="motions job, $parts"

@@ -380,6 +380,7 @@ fn status<'py>(
     d.set_item("sweep_cases_per_unit", st.cases_per_unit)?;
     d.set_item("sweep_samples_per_motion", st.samples_per_motion)?;
     d.set_item("sweep_samples_per_unit", st.samples_per_unit)?;
+    d.set_item("sweep_ns_per_sample", st.ns_per_sample)?;
     Ok(d)
 }
 

@@ -44,6 +44,7 @@ def test_status_is_the_clis(quick, cli):
         assert want[stage.upper()] == word == "up_to_date"
     assert str(st["sweep_units"]) == want["SWEEP_UNITS"]
     assert str(st["sweep_samples_per_unit"]) == want["SWEEP_SAMPLES_PER_UNIT"]
+    assert f"{st['sweep_ns_per_sample']:.0f}" == want["SWEEP_NS_PER_SAMPLE"] == "188"
 
 
 def test_design_is_the_clis(quick, cli):

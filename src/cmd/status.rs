@@ -46,6 +46,7 @@ pub fn run(args: Args) -> Result<()> {
             println!("SWEEP_CASES_PER_UNIT={}", st.cases_per_unit);
             println!("SWEEP_SAMPLES_PER_MOTION={}", st.samples_per_motion);
             println!("SWEEP_SAMPLES_PER_UNIT={}", st.samples_per_unit);
+            println!("SWEEP_NS_PER_SAMPLE={:.0}", st.ns_per_sample);
             println!("TNEW_UNITS={}", st.tnew_units);
             println!("TNEW_UNITS_DONE={}", st.tnew_units_done);
             println!("IDA_UNITS={}", st.ida_units);

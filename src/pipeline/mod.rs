@@ -929,6 +929,8 @@ pub struct Status {
     /// Record samples a unit simulates at most (every system of every case simulated): the work
     /// bound job scripts size their tasks with.
     pub samples_per_unit: usize,
+    /// CPU nanoseconds per sample of that bound ([`crate::study::cost::ns_per_sample`]).
+    pub ns_per_sample: f64,
 }
 
 /// What is on disk for every stage; reads only, takes no lock.
@@ -976,5 +978,6 @@ pub fn status(study: &Study) -> Result<Status, PipelineError> {
         cases_per_unit,
         samples_per_motion,
         samples_per_unit: SystemKind::ALL.len() * cases_per_unit * samples_per_motion,
+        ns_per_sample: crate::study::cost::ns_per_sample(&study.frames()),
     })
 }

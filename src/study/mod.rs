@@ -28,6 +28,7 @@ pub mod building;
 pub mod case_units;
 pub mod cases;
 pub mod config;
+pub mod cost;
 pub mod design;
 pub mod equations;
 pub mod floors;
