@@ -147,7 +147,7 @@ pub const SPECTRA: [Var; 4] = [
 ];
 
 /// The matching report of every seed, `[seed]`: whether it was kept, then each column of its
-/// [`MatchReport`] ([`SEED_REPORT_OF`] in the same order).
+/// [`MatchReport`] (`SEED_REPORT_OF` in the same order).
 pub const SEED_REPORT: [Var; 10] = [
     value(
         "kept",
