@@ -192,11 +192,14 @@ pub fn write_declared(to: &Target, vars: &[(&'static Var, Data)]) -> hdf5::Resul
             Data::Codes(a) => a.shape(),
         };
         let mut chunk = to.chunk.to_vec();
-        let scale = var.trailing.axis().map(|_| {
-            chunk.push(shape[shape.len() - 1]);
-            (to.trailing)(var.trailing)
-                .unwrap_or_else(|| panic!("{} needs its {:?} scale", var.name, var.trailing))
-        });
+        let scale = match var.trailing.axis() {
+            None => None,
+            Some(axis) => {
+                chunk.push(shape[shape.len() - 1]);
+                let missing = || hdf5::Error::from(format!("{}: no `{axis}` scale", var.name));
+                Some((to.trailing)(var.trailing).ok_or_else(missing)?)
+            }
+        };
         let long = var.long_name_in(to.building);
         let ds = match (data, var.codes) {
             (Data::Values(a), _) => {
@@ -247,8 +250,8 @@ pub fn table(case: &str, vars: &[Var]) -> String {
     s
 }
 
-/// Reads a declared variable the declaration does not hold (an optional one): `Ok(None)` when
-/// the group lacks it.
+/// An optional variable, declared on its own (as `sweep.h5`'s `rocks_stack`): `Ok(None)` when
+/// the group lacks it, else refused unless its shape is `shape`.
 pub fn read_optional<T: hdf5::H5Type>(
     g: &GroupReader,
     name: &str,
