@@ -10,6 +10,10 @@
 //! * [`history`]: one simulation's time history.
 //! * [`fingerprint`]: SHA-256 of inputs, for up-to-date checks.
 
+// First, so that `stored_vars!` is in scope in the stage files' modules below.
+#[macro_use]
+pub mod vars;
+
 pub mod atomic;
 pub mod checksum;
 pub mod fingerprint;
@@ -23,7 +27,6 @@ pub mod report;
 pub mod sweep;
 pub mod tnew;
 pub mod units;
-pub mod vars;
 
 pub use history::{HistoryFormat, HistoryLayout, write_history};
 

@@ -60,7 +60,7 @@ pub struct SweepMeta<'a> {
     pub settings: &'a [(&'a str, Attr<'a>)],
 }
 
-crate::stored_vars! {
+stored_vars! {
     /// One zone's variables, each shaped `[motion, T_p, alpha…, mu…]` (in a building study
     /// `[motion, storeys, stack_floor, T_p, …]`), some with a trailing `interface` or `block`
     /// axis.
@@ -126,7 +126,7 @@ pub const ROCKS_STACK: Var = Var {
     codes: Codes::Fixed(&[(0, "slides_only"), (1, "rocks")]),
 };
 
-crate::stored_vars! {
+stored_vars! {
     /// A building study's per-floor and per-storey peaks (a trailing `floor` or `storey` axis of
     /// length `N_max`, NaN above a building's roof) and base shear, with the stack (`_stack`) and
     /// with it rigidly attached (`_rigid`); docs/model.md, "Base shear, drift ratio, floor

@@ -32,7 +32,7 @@ use crate::grid::{BuildingAxes, Grid};
 use ndarray::ArrayD;
 use std::path::Path;
 
-crate::stored_vars! {
+stored_vars! {
     /// One zone's derived quantities, each shaped `[T_p, alpha…, mu…]` (in a building study
     /// `[storeys, stack_floor, T_p, …]`).
     #[derive(Debug, Clone, PartialEq)]
@@ -100,7 +100,7 @@ const FRACTION_FLAG: &str = "how the fraction was found: the root of its mean pe
                              scan (the one nearest the stuck share of several), the scan point \
                              nearest when none, no_slide when nothing slid";
 
-crate::stored_vars! {
+stored_vars! {
     /// A building study's attached fractions of every case (docs/model.md, "The attached
     /// fraction") and the mean peaks they come from, each over the bare building; shaped as
     /// [`TnewVars`]' variables, the per-storey ones with a trailing `storey` axis of length

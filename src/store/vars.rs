@@ -1,5 +1,5 @@
 //! Stored variables declared once. A stage file's variables are a struct declared with
-//! [`stored_vars!`](crate::stored_vars): each field gives its variable's name, trailing axis, units
+//! `stored_vars!` (in scope in every module of `store` after this one): each field gives its variable's name, trailing axis, units
 //! and long name (and, where a building study says more, its building long name). From that one
 //! declaration come the struct, the writer's loop ([`write_declared`]), the reader's shape check
 //! (`read`) and the variable table of `docs/variables.md` ([`table`]).
@@ -111,7 +111,6 @@ pub enum Data<'a> {
 ///     }
 /// }
 /// ```
-#[macro_export]
 macro_rules! stored_vars {
     (@building) => { None };
     (@building $b:literal) => { Some($b) };
@@ -141,8 +140,8 @@ macro_rules! stored_vars {
                         trailing: $crate::store::vars::Trailing::$trailing,
                         units: $units,
                         long_name: $long,
-                        building_long_name: $crate::stored_vars!(@building $($blong)?),
-                        codes: $crate::stored_vars!(@codes $t $(, $codes)?),
+                        building_long_name: stored_vars!(@building $($blong)?),
+                        codes: stored_vars!(@codes $t $(, $codes)?),
                     },
                 )*
             ];
