@@ -162,11 +162,10 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let study = &s.study;
     let me = StageId::Fit;
     let grid = study.grid(me)?;
-    let frames: Vec<Frame> = study.frames().into_iter().flatten().collect();
     let tnew = (study.cfg.zones.iter())
         .map(|zc| super::files::tnew_zone(study, &zc.name))
         .collect::<Result<Vec<_>, _>>()?;
-    let fitted = fit_study(grid, &frames, &tnew)?;
+    let fitted = fit_study(grid, study.frames(), &tnew)?;
     for z in &fitted.zones {
         report_zone(s, z);
     }
@@ -175,8 +174,12 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
         fingerprint: study.fingerprint(me)?.to_string(),
         features: fitted.features,
         folds: FOLDS,
-        building: (frames.len() == 1).then(|| frames[0].to_string()),
-        frames: frames.iter().map(Frame::spec).collect(),
+        building: (study.frames().len() == 1)
+            .then(|| study.shape.label(0))
+            .flatten(),
+        frames: (study.shape.building_frames().iter())
+            .map(Frame::spec)
+            .collect(),
         zones: fitted.zones.into_iter().map(|z| z.fit).collect(),
     };
     let (h5, yaml) = (study.path(me.output()), study.path("fit.yaml"));

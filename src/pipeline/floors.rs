@@ -80,11 +80,11 @@ pub fn build(s: &Session) -> Result<StageOutcome, PipelineError> {
     let physics = study.physics();
     let frames = study.frames();
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
-    let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
+    let plan = UnitPlan::new(&counts, cfg.cases.len(), frames);
     let inp = UnitInputs {
         physics: &physics,
         cfg,
-        frames: &frames,
+        frames,
         motions: &motions,
         spec: &spec,
     };
@@ -154,7 +154,7 @@ fn check_records(study: &Study, motions: &[Vec<Record>]) -> Result<(), FloorsSta
 struct UnitInputs<'a> {
     physics: &'a Physics,
     cfg: &'a FloorsConfig,
-    frames: &'a [Option<Frame>],
+    frames: &'a [Frame],
     motions: &'a [Vec<Record>],
     spec: &'a FloorSpectraSpec,
 }
@@ -187,14 +187,14 @@ fn run_units(
         .map(|&u| -> Result<FloorUnit, PipelineError> {
             s.check_cancelled(me)?;
             let rec = &inp.motions[u.zone][u.motion];
-            let frame = inp.frames[u.frame].as_ref();
+            let frame = &inp.frames[u.frame];
             let case = &inp.cfg.cases[u.case];
             let unit = floor_unit(inp.physics, case, frame, rec, inp.spec).map_err(|source| {
                 FloorsStageError::Unit {
                     zone: study.cfg.zones[u.zone].name.clone(),
                     motion: rec.name.clone(),
                     case: u.case,
-                    frame: frame.map_or(String::new(), |f| format!(", {f}")),
+                    frame: (study.shape.label(u.frame)).map_or(String::new(), |l| format!(", {l}")),
                     source: Box::new(source),
                 }
             })?;

@@ -27,7 +27,6 @@ use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::h5::Attr;
 use crate::store::ida::{IdaMeta, write_ida};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
-use crate::study::building::Frame;
 use crate::study::case_units::{CaseUnit, UnitPlan};
 use crate::study::config::StudyConfig;
 use crate::study::ida::{IdaConfig, RunDemand, SYSTEMS};
@@ -80,7 +79,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     let targets = super::files::targets(study)?;
     let frames = study.frames();
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
-    let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
+    let plan = UnitPlan::new(&counts, cfg.cases.len(), frames);
     let units = plan.run.len();
     let in_shard = super::shard_filter(me, shard, units)?;
     let store = CaseUnits {
@@ -103,7 +102,6 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
     let inputs = TraceInputs {
         physics: study.physics(),
         targets: &targets,
-        frames: &frames,
     };
     for (i, traced) in trace_units(s, &store, &inputs, &todo)? {
         held[i] = Some(traced);
@@ -155,7 +153,6 @@ struct TraceInputs<'a> {
     physics: Physics,
     /// Each zone's target spectrum (as `motions.h5` stores it).
     targets: &'a [TargetSpectrum],
-    frames: &'a [Option<Frame>],
 }
 
 /// Traces the units `todo` (`(index, unit)`) in parallel, each stored as it ends, and reports
@@ -169,30 +166,32 @@ fn trace_units(
     let (me, cfg, study) = (StageId::Ida, store.cfg, store.study);
     let start = std::time::Instant::now();
     let bar = s.reporter.progress(me, todo.len() as u64);
-    let done = todo
-        .par_iter()
-        .map(|&(i, u)| -> Result<(usize, UnitTraces), PipelineError> {
-            s.check_cancelled(me)?;
-            let (record, frame) = (
-                &store.motions[u.zone][u.motion],
-                inp.frames[u.frame].as_ref(),
-            );
-            let case = &cfg.cases[u.case];
-            let traced = trace_unit(cfg, &inp.physics, &inp.targets[u.zone], case, frame, record)
-                .map_err(|f| IdaStageError::Simulation {
-                zone: study.cfg.zones[u.zone].name.clone(),
-                motion: record.name.clone(),
-                case: u.case,
-                frame: frame.map_or(String::new(), |f| format!(", {f}")),
-                system: f.system,
-                why: f.why,
-            })?;
-            store.write(u, &traced)?;
-            bar.inc();
-            s.pass("ida.trace", me)?;
-            Ok((i, traced))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let done =
+        todo.par_iter()
+            .map(|&(i, u)| -> Result<(usize, UnitTraces), PipelineError> {
+                s.check_cancelled(me)?;
+                let record = &store.motions[u.zone][u.motion];
+                let of = (
+                    &cfg.cases[u.case],
+                    &study.frames()[u.frame],
+                    study.shape.is_building(),
+                );
+                let traced = trace_unit(cfg, &inp.physics, &inp.targets[u.zone], of, record)
+                    .map_err(|f| IdaStageError::Simulation {
+                        zone: study.cfg.zones[u.zone].name.clone(),
+                        motion: record.name.clone(),
+                        case: u.case,
+                        frame: (study.shape.label(u.frame))
+                            .map_or(String::new(), |l| format!(", {l}")),
+                        system: f.system,
+                        why: f.why,
+                    })?;
+                store.write(u, &traced)?;
+                bar.inc();
+                s.pass("ida.trace", me)?;
+                Ok((i, traced))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
     bar.finish();
     if !done.is_empty() {
         let runs: usize = (done.iter())
@@ -229,7 +228,7 @@ fn write_stage_file(
     let mut at = 0;
     for (z, zc) in study.cfg.zones.iter().enumerate() {
         let motions = &store.motions[z];
-        let count = motions.len() * cfg.cases.len() * inp.frames.len();
+        let count = motions.len() * cfg.cases.len() * study.frames().len();
         let names = motions.iter().map(|m| m.name.clone()).collect();
         let (zone, target) = ((zc.name.as_str(), zc.target.as_str()), &inp.targets[z]);
         let building = study.cfg.building.as_ref();
@@ -260,12 +259,12 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize), PipelineError> {
     let frames = study.frames();
     if study.state(StageId::Motions)? != super::StageState::UpToDate {
         let counts = study.motions_per_zone();
-        let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
+        let plan = UnitPlan::new(&counts, cfg.cases.len(), frames);
         return Ok((plan.run.len(), 0));
     }
     let motions = super::files::motions(study)?;
     let counts: Vec<usize> = motions.iter().map(Vec::len).collect();
-    let plan = UnitPlan::new(&counts, cfg.cases.len(), &frames);
+    let plan = UnitPlan::new(&counts, cfg.cases.len(), frames);
     let done = if study.state(StageId::Ida)? == super::StageState::UpToDate {
         plan.run.len()
     } else {

@@ -45,6 +45,7 @@ use crate::study::config::{ConfigError, Seeds, StudyConfig};
 use crate::study::floors::FloorsConfig;
 use crate::study::ida::IdaConfig;
 use crate::study::physics::{Physics, SystemKind};
+use crate::study::shape::StudyShape;
 use lock::{LockError, LockMode, OutputLock};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -320,9 +321,8 @@ pub struct Study {
     pub out: PathBuf,
     /// SHA-256 of the config file's bytes.
     pub config_sha256: String,
-    grid: Option<Grid>,
-    /// The building axes of a building study.
-    building: Option<BuildingAxes>,
+    /// Its grid and frames.
+    pub shape: StudyShape,
     /// The cases a fit would have and the least it needs ([`crate::study::equations::case_count`]); `None`
     /// without a grid.
     fit_cases: Option<(usize, usize)>,
@@ -352,14 +352,6 @@ pub fn check_output_dir(out: &Path) -> Result<(), String> {
 }
 
 /// The frames of a building study in stored order; empty on one storey.
-fn frames_of(cfg: &StudyConfig, building: Option<&BuildingAxes>) -> Vec<Frame> {
-    building.map_or_else(Vec::new, |b| {
-        (0..b.frame_count())
-            .filter_map(|f| cfg.frame(b, f))
-            .collect()
-    })
-}
-
 /// The physics settings every stage file after the motions' stores as file attributes.
 pub fn physics_attrs(p: &Physics) -> [(&'static str, crate::store::h5::Attr<'static>); 2] {
     use crate::store::h5::Attr;
@@ -399,8 +391,7 @@ impl Study {
                 cfg.output_dir.clone()
             }
         };
-        let grid = cfg.grid.as_ref().map(|g| g.axes());
-        let building = cfg.building_axes();
+        let shape = StudyShape::of(&cfg);
         let compare = match cfg.report.as_ref().and_then(|r| r.compare_with.as_ref()) {
             Some(path) => {
                 let mut other = StudyConfig::load(path)?;
@@ -414,14 +405,13 @@ impl Study {
         let motions_fp = motions::fingerprint(&cfg);
         let ida = ida::fingerprint(&cfg, &motions_fp);
         let floors = floors::fingerprint(&cfg, &motions_fp);
-        let sweep = grid.as_ref().map(|_| sweep::fingerprint(&cfg, &motions_fp));
+        let sweep = (shape.grid()).map(|_| sweep::fingerprint(&cfg, &motions_fp));
         let tnew = sweep.as_deref().map(tnew::fingerprint);
-        let fit_cases = grid
-            .as_ref()
-            .map(|g| crate::study::equations::case_count(g, &frames_of(&cfg, building.as_ref())));
+        let fit_cases =
+            (shape.grid()).map(|g| crate::study::equations::case_count(g, shape.frames()));
         let fit = match (&tnew, fit_cases) {
             (Some(t), Some((cases, needed))) if cases >= needed => {
-                Some(fit::fingerprint(t, building.is_some()))
+                Some(fit::fingerprint(t, shape.is_building()))
             }
             _ => None,
         };
@@ -438,8 +428,7 @@ impl Study {
             config_sha256: cfg.loaded.config_sha256.clone(),
             cfg,
             out,
-            grid,
-            building,
+            shape,
             fit_cases,
             fingerprints: Fingerprints {
                 motions: motions_fp,
@@ -499,7 +488,7 @@ impl Study {
 
     /// The grid, or an error naming the stage that needs it.
     pub fn grid(&self, stage: StageId) -> Result<&Grid, PipelineError> {
-        self.grid.as_ref().ok_or_else(|| PipelineError::NoGrid {
+        self.shape.grid().ok_or_else(|| PipelineError::NoGrid {
             config: self.config_path.clone(),
             stage,
         })
@@ -550,30 +539,12 @@ impl Study {
 
     /// The building axes of a building study (`None` on one storey).
     pub fn building(&self) -> Option<&BuildingAxes> {
-        self.building.as_ref()
+        self.shape.building()
     }
 
-    /// The frames of a building study in stored order (storeys, then stack floor fastest);
-    /// `[None]` on one storey.
-    pub fn frames(&self) -> Vec<Option<Frame>> {
-        match &self.building {
-            None => vec![None],
-            Some(_) => frames_of(&self.cfg, self.building.as_ref())
-                .into_iter()
-                .map(Some)
-                .collect(),
-        }
-    }
-
-    /// A building study's frames that are not an earlier one's building
-    /// ([`crate::study::building::repeats`]), with their stored index; what the fit counts and
-    /// the report shows. Empty on one storey.
-    pub fn distinct_frames(&self) -> Vec<(usize, Frame)> {
-        let frames: Vec<Frame> = self.frames().into_iter().flatten().collect();
-        let repeated = crate::study::building::repeats(&frames);
-        (frames.into_iter().enumerate())
-            .filter(|(f, _)| !repeated[*f])
-            .collect()
+    /// The frames in stored order ([`StudyShape::frames`]; one on one storey).
+    pub fn frames(&self) -> &[Frame] {
+        self.shape.frames()
     }
 
     /// The physics of every case (`grid.damping`, `grid.mu_static_ratio`).
@@ -953,11 +924,11 @@ pub fn status(study: &Study) -> Result<Status, PipelineError> {
         }
         stages.push((stage, state));
     }
-    let (sweep_units, sweep_units_done, samples_per_motion) = match &study.grid {
+    let (sweep_units, sweep_units_done, samples_per_motion) = match study.shape.grid() {
         Some(_) => sweep::unit_status(study)?,
         None => (0, 0, 0),
     };
-    let cases_per_unit = study.grid.as_ref().map_or(0, Grid::cases_per_unit);
+    let cases_per_unit = study.shape.grid().map_or(0, Grid::cases_per_unit);
     let (tnew_units, tnew_units_done) = match study.configured(StageId::Tnew) {
         true => tnew::unit_status(study)?,
         false => (0, 0),
@@ -978,6 +949,6 @@ pub fn status(study: &Study) -> Result<Status, PipelineError> {
         cases_per_unit,
         samples_per_motion,
         samples_per_unit: SystemKind::ALL.len() * cases_per_unit * samples_per_motion,
-        ns_per_sample: crate::study::cost::ns_per_sample(&study.frames()),
+        ns_per_sample: crate::study::cost::ns_per_sample(&study.shape),
     })
 }

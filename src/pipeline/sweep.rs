@@ -97,17 +97,12 @@ struct Unit {
     period: usize,
 }
 
-/// Frames of the study: its building axes' (1 on one storey).
-fn frames(study: &Study) -> usize {
-    study.building().map_or(1, BuildingAxes::frame_count)
-}
-
 /// Every unit in the fixed order shards count in (the order of the stored axes).
 fn all_units(study: &Study, grid: &Grid, motions: &[Vec<Record>]) -> Vec<Unit> {
     let mut v = Vec::new();
     for (zone, ms) in motions.iter().enumerate() {
         for motion in 0..ms.len() {
-            for frame in 0..frames(study) {
+            for frame in 0..study.frames().len() {
                 for period in 0..grid.periods_s.len() {
                     v.push(Unit {
                         zone,
@@ -313,11 +308,10 @@ fn compute_units(s: &Session, units: &Units, todo: &[Unit]) -> Result<(), Pipeli
             let rec = &units.motions[u.zone][u.motion];
             let accel = rec.accel_mps2(1.0);
             let ground = Ground::new(rec.dt_s, &accel);
-            let frame = (study.building()).and_then(|b| study.cfg.frame(b, u.frame));
             let r = run_unit(
                 grid,
                 &physics,
-                frame.as_ref(),
+                &study.frames()[u.frame],
                 &ground,
                 u.period,
                 UnitOptions {
@@ -385,7 +379,8 @@ pub fn merge(s: &Session) -> Result<StageOutcome, PipelineError> {
 fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, PipelineError> {
     let study = units.study;
     let read = units.read_all(all)?;
-    let count = |z: usize| units.motions[z].len() * frames(study) * units.grid.periods_s.len();
+    let count =
+        |z: usize| units.motions[z].len() * study.frames().len() * units.grid.periods_s.len();
     let mut zones = Vec::new();
     let mut at = 0;
     for z in 0..study.cfg.zones.len() {
@@ -595,7 +590,7 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError
     let grid = study.grid(StageId::Sweep)?;
     if study.state(StageId::Motions)? != super::StageState::UpToDate {
         let motions: usize = study.motions_per_zone().iter().sum();
-        return Ok((motions * frames(study) * grid.periods_s.len(), 0, 0));
+        return Ok((motions * study.frames().len() * grid.periods_s.len(), 0, 0));
     }
     let motions = super::files::motions(study)?;
     let units = Units {

@@ -24,11 +24,10 @@ use crate::store::StoreError;
 use crate::store::fingerprint::fingerprint as hash_parts;
 use crate::store::tnew::{TnewMeta, write_tnew};
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
-use crate::study::attached::{
-    CaseFractions, FRACTION_FLAGS, FractionFlag, FractionUnit, Means, fraction_units,
+use crate::study::attached::{CaseFractions, FRACTION_FLAGS, FractionFlag, FractionUnit, Means};
+use crate::study::tnew::{
+    self, BAND_FLAGS, SD_STEP_S, TNEW_FLAG_CODES, TnewError, ZoneInputs, fraction_units,
 };
-use crate::study::building::Frame;
-use crate::study::tnew::{self, BAND_FLAGS, SD_STEP_S, TNEW_FLAG_CODES, TnewError, ZoneInputs};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -83,7 +82,7 @@ pub fn build(s: &Session, shard: Option<(usize, usize)>) -> Result<StageOutcome,
             grid,
             physics: &physics,
             building,
-            frames: &frames,
+            frames,
             motions: &motions[z],
             sweep: &sw,
             keep_going: &keep_going,
@@ -223,22 +222,16 @@ struct FractionUnits<'a> {
     study: &'a Study,
     /// Every zone's units (the same for each zone: they follow the grid and the frames).
     units: Vec<FractionUnit>,
-    frames: Vec<Frame>,
     fingerprint: String,
 }
 
 impl<'a> FractionUnits<'a> {
     fn new(study: &'a Study) -> Result<Self, PipelineError> {
         let me = StageId::Tnew;
-        let frames: Vec<Frame> = study.frames().into_iter().flatten().collect();
-        let units = match study.building() {
-            Some(_) => fraction_units(study.grid(me)?, &frames),
-            None => Vec::new(),
-        };
+        let units = fraction_units(study.grid(me)?, study.building(), study.frames());
         Ok(Self {
             study,
             units,
-            frames,
             fingerprint: study.fingerprint(me)?.to_string(),
         })
     }
@@ -251,7 +244,7 @@ impl<'a> FractionUnits<'a> {
     fn place(&self, z: usize, u: usize) -> (PathBuf, UnitId) {
         let zone = &self.study.cfg.zones[z].name;
         let unit = &self.units[u];
-        let grid = self.study.grid.as_ref().expect("tnew has a grid");
+        let grid = self.study.shape.grid().expect("tnew has a grid");
         let first = unit.cases[0] % grid.cases();
         let path = (self.study.path(UNITS_DIR)).join(format!("{zone}_{u:04}.unit"));
         let id = UnitId {
@@ -298,7 +291,7 @@ impl<'a> FractionUnits<'a> {
             Stored::Missing | Stored::Stale => return Ok(None),
         };
         let unit = &self.units[u];
-        let n = self.frames[unit.frame].storeys();
+        let n = self.study.frames()[unit.frame].storeys();
         let (nf, nu) = (3 * (n + 2) + 1 + (n + 3), n + 3);
         let decoded = (c.f64s.len() == unit.cases.len() && c.u8s.len() == unit.cases.len())
             .then(|| {

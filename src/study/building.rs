@@ -184,6 +184,18 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// The one-storey study's structure as a frame: one floor of relative mass 1, one storey of
+    /// [`DEFAULT_STOREY_HEIGHT_M`], the stack on it; the frame `building: {storeys: [1]}` gives,
+    /// whose results are the one-storey study's to the bit (docs/model.md, "Identity").
+    pub fn one_storey() -> Self {
+        Frame {
+            floor_masses: vec![1.0],
+            storey_stiffnesses: vec![1.0],
+            storey_heights_m: vec![DEFAULT_STOREY_HEIGHT_M],
+            stack_floor: StackFloor::Roof,
+        }
+    }
+
     pub fn storeys(&self) -> usize {
         self.floor_masses.len()
     }

@@ -25,14 +25,10 @@ pub struct UnitPlan {
 }
 
 impl UnitPlan {
-    /// The units of `motions[z]` motions in each zone, `cases` cases and `frames` (`[None]` on
-    /// one storey).
-    pub fn new(motions: &[usize], cases: usize, frames: &[Option<Frame>]) -> Self {
-        let building: Vec<Frame> = frames.iter().flatten().cloned().collect();
-        let first = first_of_building(&building);
-        let first: Vec<usize> = (0..frames.len())
-            .map(|f| first.get(f).copied().unwrap_or(f))
-            .collect();
+    /// The units of `motions[z]` motions in each zone, `cases` cases and `frames` (one on one
+    /// storey).
+    pub fn new(motions: &[usize], cases: usize, frames: &[Frame]) -> Self {
+        let first = first_of_building(frames);
         let mut all = Vec::new();
         for (zone, &n) in motions.iter().enumerate() {
             for motion in 0..n {

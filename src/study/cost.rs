@@ -12,7 +12,7 @@
 //! save less than the research grid's costs more than it says. The job scripts' time limit is
 //! twice the estimate plus 5 minutes.
 
-use super::building::Frame;
+use super::shape::StudyShape;
 
 /// A one-storey study: ns per simulated record sample per thread (a bound on the sweep's cost
 /// when charged to every sample).
@@ -50,16 +50,19 @@ pub fn building_ns_per_sample(storeys: usize) -> f64 {
     y0 + (y1 - y0) * (n - n0 as f64) / (n1 - n0) as f64
 }
 
-/// A study's ns per work-bound sample: [`ONE_STOREY_NS_PER_SAMPLE`] on one storey (`frames` of
-/// `None`), else the mean of [`building_ns_per_sample`] over the frames (every frame has as many
-/// units of as many cases).
-pub fn ns_per_sample(frames: &[Option<Frame>]) -> f64 {
-    let storeys: Vec<usize> = frames.iter().flatten().map(Frame::storeys).collect();
-    if storeys.is_empty() {
+/// A study's ns per work-bound sample: [`ONE_STOREY_NS_PER_SAMPLE`] on one storey, else the mean
+/// of [`building_ns_per_sample`] over the frames (every frame has as many units of as many
+/// cases).
+pub fn ns_per_sample(shape: &StudyShape) -> f64 {
+    if !shape.is_building() {
         return ONE_STOREY_NS_PER_SAMPLE;
     }
-    let sum: f64 = storeys.iter().map(|&n| building_ns_per_sample(n)).sum();
-    sum / storeys.len() as f64
+    let frames = shape.frames();
+    let sum: f64 = frames
+        .iter()
+        .map(|f| building_ns_per_sample(f.storeys()))
+        .sum();
+    sum / frames.len() as f64
 }
 
 #[cfg(test)]

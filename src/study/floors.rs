@@ -98,7 +98,7 @@ fn run(
     physics: &Physics,
     kind: SystemKind,
     case: &Case,
-    frame: Option<&Frame>,
+    frame: &Frame,
     ground: &Ground,
 ) -> Result<BuildingResponse, CaseError> {
     let opts = ExactOptions {
@@ -107,27 +107,23 @@ fn run(
         abs_velocity: false,
         ..ExactOptions::default()
     };
-    match frame {
-        Some(f) => physics.simulate_building(kind, case, f, ground, &opts, None),
-        None => (physics.simulate(kind, case, ground, &opts, None))
-            .map(BuildingResponse::from_one_storey),
-    }
+    physics.simulate_building(kind, case, frame, ground, &opts, None)
 }
 
-/// `case` on `frame` (`None`: one storey) under `record`: each floor's spectra as `spec` asks,
+/// `case` on `frame` (one storey: [`Frame::one_storey`]) under `record`: each floor's spectra as `spec` asks,
 /// from its history on the record refined [`REFINEMENT`] times, with the stack sliding and
 /// rigidly attached.
 pub fn floor_unit(
     physics: &Physics,
     case: &Case,
-    frame: Option<&Frame>,
+    frame: &Frame,
     record: &Record,
     spec: &FloorSpectraSpec,
 ) -> Result<FloorUnit, FloorsError> {
     let fine = record.refined(REFINEMENT);
     let accel = fine.accel_mps2(1.0);
     let ground = Ground::new(fine.dt_s, &accel);
-    let floors = frame.map_or(1, Frame::storeys);
+    let floors = frame.storeys();
     let mut psa_g: [Vec<Vec<Vec<f64>>>; 2] = Default::default();
     let mut pfa_g: [Vec<f64>; 2] = Default::default();
     for (s, kind) in SYSTEMS.into_iter().enumerate() {

@@ -300,42 +300,36 @@ impl IdaConfig {
     }
 
     /// The systems of [`SYSTEMS`] of `case` on the bilinear structure of strength ratio `c_y`
-    /// (in `frame`: the building whose storeys have [`storey_strength_ratios`] of the base
-    /// shear coefficient `c_y`; one storey is the one-storey model).
+    /// in `frame`: the building whose storeys have [`storey_strength_ratios`] of the base shear
+    /// coefficient `c_y`; one storey is the one-storey model.
     pub fn systems(
         &self,
         physics: &Physics,
         case: &Case,
         c_y: f64,
-        frame: Option<&Frame>,
+        frame: &Frame,
     ) -> Result<Vec<Traced>, IdaSystemError> {
         let r = self.structure.post_yield_ratio;
-        match frame {
-            Some(f) if f.storeys() > 1 => {
-                let yielding = StoreyYielding {
-                    strength_ratios: storey_strength_ratios(
-                        c_y,
-                        &f.floor_masses,
-                        &f.storey_heights_m,
-                    ),
-                    post_yield_ratio: r,
-                };
-                SYSTEMS
-                    .iter()
-                    .map(|&kind| {
-                        let b = physics.yielding_building(kind, case, f, Some(yielding.clone()))?;
-                        Ok(Traced::Building(Box::new(b)))
-                    })
-                    .collect()
-            }
-            _ => {
-                let yielding = Yielding::bilinear(c_y, r);
-                SYSTEMS
-                    .iter()
-                    .map(|&kind| Ok(Traced::One(physics.system(kind, case, Some(yielding))?)))
-                    .collect()
-            }
+        if frame.storeys() == 1 {
+            let yielding = Yielding::bilinear(c_y, r);
+            return (SYSTEMS.iter())
+                .map(|&kind| Ok(Traced::One(physics.system(kind, case, Some(yielding))?)))
+                .collect();
         }
+        let yielding = StoreyYielding {
+            strength_ratios: storey_strength_ratios(
+                c_y,
+                &frame.floor_masses,
+                &frame.storey_heights_m,
+            ),
+            post_yield_ratio: r,
+        };
+        (SYSTEMS.iter())
+            .map(|&kind| {
+                let b = physics.yielding_building(kind, case, frame, Some(yielding.clone()))?;
+                Ok(Traced::Building(Box::new(b)))
+            })
+            .collect()
     }
 
     /// Every check that needs no record; `Err((key, why))` with keys under `ida.`.
@@ -430,15 +424,12 @@ impl IdaConfig {
             physics
                 .check(total)
                 .map_err(|why| (format!("ida.{}", key("alpha")), why))?;
-            let frames: Vec<Option<&Frame>> = match frames {
-                None => vec![None],
-                Some(f) => f.iter().map(Some).collect(),
-            };
+            let one = [Frame::one_storey()];
             for (zone, t) in targets {
                 let c_y = self.strength_ratio(t, c);
-                for frame in &frames {
-                    self.systems(physics, c, c_y, *frame).map_err(|e| {
-                        let at = frame.map_or(String::new(), |f| format!(" ({f})"));
+                for frame in frames.unwrap_or(&one) {
+                    self.systems(physics, c, c_y, frame).map_err(|e| {
+                        let at = frames.map_or(String::new(), |_| format!(" ({frame})"));
                         (
                             "ida.structure".to_string(),
                             format!("zone {zone}, case {i}{at}: {e}"),

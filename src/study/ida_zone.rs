@@ -66,14 +66,14 @@ pub struct UnitFailure {
     pub why: String,
 }
 
-/// Traces `case` under `record` on `frame` (a building study's; `None` on one storey), both
-/// systems, the strength from the zone's `target`.
+/// Traces `case` under `record` on `frame` ([`Frame::one_storey`] on one storey), both systems,
+/// the strength from the zone's `target`; `building`: a building study's, whose demands are
+/// drift ratios of the frame's storey heights ([`run_demand`](super::ida::run_demand)).
 pub fn trace_unit(
     cfg: &IdaConfig,
     physics: &Physics,
     target: &TargetSpectrum,
-    case: &Case,
-    frame: Option<&Frame>,
+    (case, frame, building): (&Case, &Frame, bool),
     record: &Record,
 ) -> Result<UnitTraces, UnitFailure> {
     let fail = |system: &'static str, why: String| UnitFailure { system, why };
@@ -84,7 +84,7 @@ pub fn trace_unit(
     let c_y = cfg.strength_ratio(target, case);
     let systems = (cfg.systems(physics, case, c_y, frame))
         .map_err(|e| fail(SYSTEMS[0].key(), e.to_string()))?;
-    let heights = frame.map(|f| f.storey_heights_m.as_slice());
+    let heights = building.then_some(frame.storey_heights_m.as_slice());
     let traces = (systems.iter().zip(SYSTEMS))
         .map(|(sys, kind)| {
             trace_system(cfg, sys, heights, &padded, record.dt_s, record_sa_g)

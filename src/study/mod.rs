@@ -19,6 +19,8 @@
 //!   fragilities.
 //! * [`motions`]: seeds, spectral matching per zone, the set checks.
 //! * [`physics`]: the physics of a case: damping basis, shared settings, its three systems.
+//! * [`shape`]: what a study is over: its grid and its frames (one on one storey), their
+//!   distinct buildings and labels.
 //! * [`storey_strength`]: a building's storey strengths from a base-shear coefficient (IS 1893).
 //! * [`sweep`]: the skip rules, one work unit.
 //! * [`tnew`]: `T_new` from the mean displacement spectrum; the fit's samples.
@@ -36,6 +38,7 @@ pub mod ida;
 pub mod ida_zone;
 pub mod motions;
 pub mod physics;
+pub mod shape;
 pub mod storey_strength;
 pub mod sweep;
 pub mod tnew;

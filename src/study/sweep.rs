@@ -27,7 +27,7 @@ use super::building::Frame;
 use super::physics::{CaseError, Physics, SystemKind};
 use crate::case::Case;
 use crate::dynamics::building::BuildingResponse;
-use crate::dynamics::{ExactOptions, G, Ground, Response, Rocking};
+use crate::dynamics::{ExactOptions, G, Ground, Rocking};
 use crate::grid::Grid;
 use std::collections::HashMap;
 
@@ -66,19 +66,19 @@ struct Peaks {
     slip_m: Vec<f64>,
     /// Energy dissipated by friction, J per kg of the bare structure's mass.
     friction: f64,
-    /// In a building: each floor's peak absolute acceleration, g, floor 1 first.
+    /// Each floor's peak absolute acceleration, g, floor 1 first.
     floor_a_g: Vec<f64>,
-    /// In a building: each storey's peak drift ratio `max|δ_i|/h_i`, storey 1 first.
+    /// Each storey's peak drift ratio `max|δ_i|/h_i`, storey 1 first.
     drift_ratio: Vec<f64>,
-    /// In a building: each floor's peak absolute velocity, m/s, floor 1 first.
+    /// Each floor's peak absolute velocity, m/s, floor 1 first.
     floor_v_mps: Vec<f64>,
-    /// In a building: each storey's drift at the record's end over its height (signed),
+    /// Each storey's drift at the record's end over its height (signed),
     /// storey 1 first.
     residual_drift_ratio: Vec<f64>,
     /// In a building: peak base shear over the bare building's weight `g·Σm_j` (NaN on one
     /// storey, whose integrator does not give it).
     base_shear: f64,
-    /// In a building: each storey's peak shear over the bare building's weight, storey 1 first
+    /// Each storey's peak shear over the bare building's weight, storey 1 first
     /// (NaN on one storey).
     storey_shear: Vec<f64>,
     /// In a building: the peak overturning moment at the base over the bare building's weight
@@ -103,31 +103,9 @@ struct Peaks {
 }
 
 impl Peaks {
-    fn of_structure(r: Response) -> Self {
-        Self {
-            u_m: r.peak_displacement_m,
-            a_mps2: r.peak_abs_accel_mps2[0],
-            a_hold_mps2: r.peak_abs_accel_mps2[0],
-            slip_m: r.peak_slip_m,
-            friction: r.energy.friction,
-            floor_a_g: Vec::new(),
-            drift_ratio: Vec::new(),
-            floor_v_mps: Vec::new(),
-            residual_drift_ratio: Vec::new(),
-            base_shear: f64::NAN,
-            storey_shear: Vec::new(),
-            overturning: f64::NAN,
-            stuck_share: f64::NAN,
-            v_hold_mps: r.peak_abs_velocity_mps[0],
-            block_a_mps2: r.peak_abs_accel_mps2[1..].to_vec(),
-            block_v_mps: r.peak_abs_velocity_mps[1..].to_vec(),
-            residual_slip_m: r.residual_slip_m,
-            rocks: r.rocking_onset.is_some(),
-        }
-    }
-
-    /// `blocks` blocks per stack, in `frame` (on its floors).
-    fn of_building(r: BuildingResponse, frame: &Frame, floors: &[usize], blocks: usize) -> Self {
+    /// `blocks` blocks per stack, in `frame` (on its floors). On one storey the structure's
+    /// own peaks, to the bit (each value is the only one its maximum runs over).
+    fn of(r: BuildingResponse, frame: &Frame, floors: &[usize], blocks: usize) -> Self {
         let roof = r.floor_peak_displacement_m.len() - 1;
         let a_hold_mps2 = floors
             .iter()
@@ -146,7 +124,8 @@ impl Peaks {
         let residual_slip_m = (0..blocks)
             .map(|i| {
                 of_block(&r.residual_slip_m, blocks, i)
-                    .fold(0.0, |a: f64, b: f64| if b.abs() > a.abs() { b } else { a })
+                    .reduce(|a: f64, b: f64| if b.abs() > a.abs() { b } else { a })
+                    .unwrap_or(0.0)
             })
             .collect();
         Self {
@@ -209,18 +188,18 @@ pub struct UnitResult {
     pub single_rule: Vec<u8>,
     /// Simulations run for this unit (not stored; for rates).
     pub simulations: usize,
-    /// In a building (empty on one storey): each floor's peak absolute acceleration, g,
-    /// `[case][floor]` row-major, the frame's `N` floors per case, with the stack and with it
-    /// rigidly attached.
+    /// Each floor's peak absolute acceleration, g, `[case][floor]` row-major, the frame's `N`
+    /// floors per case, with the stack and with it rigidly attached (and so on below: one
+    /// storey's are its structure's, which a one-storey `sweep.h5` does not store).
     pub floor_accel_stack: Vec<f64>,
     pub floor_accel_rigid: Vec<f64>,
-    /// In a building: each storey's peak drift ratio, `[case][storey]`, idem.
+    /// Each storey's peak drift ratio, `[case][storey]`, idem.
     pub drift_ratio_stack: Vec<f64>,
     pub drift_ratio_rigid: Vec<f64>,
-    /// In a building: each floor's peak absolute velocity, m/s, `[case][floor]`, idem.
+    /// Each floor's peak absolute velocity, m/s, `[case][floor]`, idem.
     pub floor_velocity_stack: Vec<f64>,
     pub floor_velocity_rigid: Vec<f64>,
-    /// In a building: each storey's drift at the record's end over its height (signed),
+    /// Each storey's drift at the record's end over its height (signed),
     /// `[case][storey]`, idem.
     pub residual_drift_ratio_stack: Vec<f64>,
     pub residual_drift_ratio_rigid: Vec<f64>,
@@ -228,7 +207,7 @@ pub struct UnitResult {
     /// a building of one storey).
     pub base_shear_stack: Vec<f64>,
     pub base_shear_rigid: Vec<f64>,
-    /// In a building: each storey's peak shear over the bare building's weight, `[case][storey]`,
+    /// Each storey's peak shear over the bare building's weight, `[case][storey]`,
     /// idem (NaN in a building of one storey).
     pub storey_shear_stack: Vec<f64>,
     pub storey_shear_rigid: Vec<f64>,
@@ -246,8 +225,8 @@ pub struct UnitResult {
 }
 
 impl UnitResult {
-    /// Appends a building's per-floor and per-storey peaks of the stack system `s` and the rigid
-    /// system `r` (nothing on one storey, where both are empty); `held`: a skip rule showed
+    /// Appends the per-floor and per-storey peaks of the stack system `s` and the rigid system
+    /// `r`; `held`: a skip rule showed
     /// that the stack never slides (its stuck share is then 1: the rule's state is the one the
     /// integrator keeps).
     fn push_profiles(&mut self, s: &Peaks, r: &Peaks, held: bool) {
@@ -263,19 +242,17 @@ impl UnitResult {
             .extend_from_slice(&r.residual_drift_ratio);
         self.storey_shear_stack.extend_from_slice(&s.storey_shear);
         self.storey_shear_rigid.extend_from_slice(&r.storey_shear);
-        if frame_of(s) {
-            self.base_shear_stack.push(s.base_shear);
-            self.base_shear_rigid.push(r.base_shear);
-            self.overturning_stack.push(s.overturning);
-            self.overturning_rigid.push(r.overturning);
-            // One storey's integrator gives no share (NaN, as its base shear).
-            let one_storey = r.base_shear.is_nan();
-            self.stuck_share_stack.push(if held && !one_storey {
-                1.0
-            } else {
-                s.stuck_share
-            });
-        }
+        self.base_shear_stack.push(s.base_shear);
+        self.base_shear_rigid.push(r.base_shear);
+        self.overturning_stack.push(s.overturning);
+        self.overturning_rigid.push(r.overturning);
+        // One storey's integrator gives no share (NaN, as its base shear).
+        let one_storey = r.base_shear.is_nan();
+        self.stuck_share_stack.push(if held && !one_storey {
+            1.0
+        } else {
+            s.stuck_share
+        });
     }
 }
 
@@ -292,11 +269,6 @@ fn stuck_rocks(case: &Case, aspect: &[f64], peak_mps2: f64) -> Result<bool, Case
     Ok(rocking.rocks_as_one(peak_mps2))
 }
 
-/// Whether peaks were taken in a building (they carry the per-floor profiles).
-fn frame_of(p: &Peaks) -> bool {
-    !p.floor_a_g.is_empty()
-}
-
 /// Options for [`run_unit`].
 #[derive(Debug, Clone, Copy)]
 pub struct UnitOptions<'a> {
@@ -307,12 +279,12 @@ pub struct UnitOptions<'a> {
     pub aspect: Option<&'a [f64]>,
 }
 
-/// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`, on
-/// one storey (`frame` `None`) or in the building `frame`.
+/// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`, in
+/// `frame` (one storey: [`Frame::one_storey`]).
 pub fn run_unit(
     grid: &Grid,
     physics: &Physics,
-    frame: Option<&Frame>,
+    frame: &Frame,
     ground: &Ground,
     period_index: usize,
     opts: UnitOptions<'_>,
@@ -326,18 +298,15 @@ pub fn run_unit(
         energy_balance: false,
         ..ExactOptions::default()
     };
-    let floors = frame.map(Frame::floors);
-    let simulate = |kind, case: &Case| match (frame, &floors) {
-        (Some(f), Some(floors)) => {
-            let blocks = match kind {
-                SystemKind::Stack => n,
-                SystemKind::SingleBlock => 1,
-                SystemKind::Rigid => 0,
-            };
-            (physics.simulate_building(kind, case, f, ground, &exact, opts.aspect))
-                .map(|r| Peaks::of_building(r, f, floors, blocks))
-        }
-        _ => (physics.simulate(kind, case, ground, &exact, opts.aspect)).map(Peaks::of_structure),
+    let floors = frame.floors();
+    let simulate = |kind, case: &Case| {
+        let blocks = match kind {
+            SystemKind::Stack => n,
+            SystemKind::SingleBlock => 1,
+            SystemKind::Rigid => 0,
+        };
+        (physics.simulate_building(kind, case, frame, ground, &exact, opts.aspect))
+            .map(|r| Peaks::of(r, frame, &floors, blocks))
     };
     // Keyed by the bits of α (and the index of μ_1): the same floating-point sum, the same system.
     let mut rigid: HashMap<u64, Peaks> = HashMap::new();

@@ -306,8 +306,8 @@ pub struct ZoneInputs<'a> {
     pub physics: &'a Physics,
     /// A building study's axes (`None` on one storey): the stored shape and `N_max`.
     pub building: Option<&'a BuildingAxes>,
-    /// The study's frames in stored order (`[None]` on one storey).
-    pub frames: &'a [Option<Frame>],
+    /// The study's frames in stored order ([`Frame::one_storey`] on one storey).
+    pub frames: &'a [Frame],
     pub motions: &'a [Record],
     /// The zone's sweep, its motion axis the order of `motions`.
     pub sweep: &'a ZoneSweep,
@@ -378,13 +378,26 @@ impl FractionCounts {
 /// its `DRR`s and, in a building study, its attached fractions: [`ZoneWork`] with every unit
 /// computed here (the units in parallel).
 pub fn zone(inp: &ZoneInputs) -> Result<ZoneOutcome, TnewError> {
-    let frames: Vec<Frame> = inp.frames.iter().flatten().cloned().collect();
-    let units = attached::fraction_units(inp.grid, &frames);
+    let units = fraction_units(inp.grid, inp.building, inp.frames);
     let work = ZoneWork::new(inp, &units);
     let of_units = (work.units().par_iter())
         .map(|u| work.fractions_of(u))
         .collect::<Result<Vec<_>, _>>()?;
     work.finish(of_units)
+}
+
+/// The units of a zone's attached fractions: [`attached::fraction_units`] of `grid`'s cases in
+/// each of `frames` in a building study (of `building` axes); none on one storey, which stores
+/// no `λ`.
+pub fn fraction_units(
+    grid: &Grid,
+    building: Option<&BuildingAxes>,
+    frames: &[Frame],
+) -> Vec<FractionUnit> {
+    match building {
+        Some(_) => attached::fraction_units(grid, frames),
+        None => Vec::new(),
+    }
 }
 
 /// A zone's `T_new` in two parts, so that its costly part can be split (`tnew --shard`): the
@@ -400,7 +413,6 @@ pub struct ZoneWork<'a> {
     u_rigid: ArrayD<f64>,
     /// Per case (flat over `[frame][case]`): whether any interface slipped under any motion.
     slides: Vec<bool>,
-    frames: Vec<Frame>,
     /// A building study's sweep means per case and its units; empty on one storey.
     swept: Vec<attached::Swept>,
     units: &'a [FractionUnit],
@@ -417,9 +429,8 @@ impl<'a> ZoneWork<'a> {
         let per_frame = grid.cases();
         let cases = inp.frames.len() * per_frame;
         let slides = slides(&v.slip_peak, m, cases, grid.blocks());
-        let frames: Vec<Frame> = inp.frames.iter().flatten().cloned().collect();
         let swept = match (&inp.sweep.building, inp.building) {
-            (Some(bv), Some(_)) => swept(bv, &u_stack, &u_rigid, &frames, per_frame, m),
+            (Some(bv), Some(_)) => swept(bv, &u_stack, &u_rigid, inp.frames, per_frame, m),
             _ => Vec::new(),
         };
         // The motions' accelerations, for the units' simulations only.
@@ -434,7 +445,6 @@ impl<'a> ZoneWork<'a> {
             u_single,
             u_rigid,
             slides,
-            frames,
             swept,
             units,
         }
@@ -453,7 +463,7 @@ impl<'a> ZoneWork<'a> {
         let family = ZoneFamily {
             physics: self.inp.physics,
             grid: self.inp.grid,
-            frames: &self.frames,
+            frames: self.inp.frames,
             grounds: &grounds,
             swept: &self.swept,
             slides: &self.slides,
@@ -479,12 +489,10 @@ impl<'a> ZoneWork<'a> {
             ArrayD::from_shape_vec(shape.clone(), v).expect("one value per case of the grid")
         };
         let fractions = match (&inp.sweep.building, inp.building) {
-            (Some(_), Some(_)) => Some(attached::spread(grid, &self.frames, self.units, &of_units)),
+            (Some(_), Some(_)) => Some(attached::spread(grid, inp.frames, self.units, &of_units)),
             _ => None,
         };
-        let participation: Vec<f64> = (inp.frames.iter())
-            .map(|f| f.as_ref().map_or(1.0, Frame::roof_participation))
-            .collect();
+        let participation: Vec<f64> = inp.frames.iter().map(Frame::roof_participation).collect();
         let p = CasePeriods::of(
             grid,
             inp.frames,
@@ -532,7 +540,7 @@ impl<'a> ZoneWork<'a> {
         let m = inp.motions.len();
         Ok(ZoneOutcome {
             fractions: (fractions.as_deref())
-                .map(|l| FractionCounts::new(l, &self.frames, per_frame)),
+                .map(|l| FractionCounts::new(l, inp.frames, per_frame)),
             tnew: ZoneTnew {
                 name: inp.name.to_string(),
                 target: inp.target.to_string(),
@@ -595,11 +603,13 @@ struct CasePeriods {
 }
 
 impl CasePeriods {
-    /// One storey keeps the paper's `T_new`; a building of several storeys reads it off the
-    /// attached fraction of its roof's mean peak displacement (`fractions`' `roof`).
+    /// One storey keeps the paper's `T_new` (its `T_rigid` and participation of 1 are the
+    /// paper's arithmetic, [`Frame::t_rigid_s`], [`Frame::roof_participation`]); a building of
+    /// several storeys reads it off the attached fraction of its roof's mean peak displacement
+    /// (`fractions`' `roof`).
     fn of(
         grid: &Grid,
-        frames: &[Option<Frame>],
+        frames: &[Frame],
         participation: &[f64],
         (period_sd_s, sd_mean_m): (&[f64], &[f64]),
         u_stack: &ArrayD<f64>,
@@ -618,15 +628,12 @@ impl CasePeriods {
         for (c, (&us, &slid)) in u_stack.iter().zip(slides).enumerate() {
             let case = grid.case(c % per_frame);
             let frame = &frames[c / per_frame];
-            let (tr, u) = match frame {
-                None => (case.t_rigid_s(), us),
-                Some(frame) => (frame.t_rigid_s(&case), us / participation[c / per_frame]),
-            };
+            let (tr, u) = (frame.t_rigid_s(&case), us / participation[c / per_frame]);
             let (first_mode, paper_flag) = t_new(period_sd_s, sd_mean_m, u, tr, slid);
-            let (tn, f) = match (frame, fractions) {
-                (Some(fr), Some(l)) if fr.storeys() > 1 => {
+            let (tn, f) = match fractions {
+                Some(l) if frame.storeys() > 1 => {
                     let (fraction, how) = l[c].roof;
-                    of_attached(fr.t1_attached_s(&case, fraction), how)
+                    of_attached(frame.t1_attached_s(&case, fraction), how)
                 }
                 _ => (first_mode, paper_flag),
             };

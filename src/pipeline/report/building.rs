@@ -11,7 +11,7 @@
 //! * the drift-ratio and floor-acceleration profiles over the height, with and without sliding
 //!   (per storey or floor, the median over the frame's cases of the mean over the motions).
 //!
-//! A frame that repeats an earlier one's building is shown once ([`crate::pipeline::Study::distinct_frames`]).
+//! A frame that repeats an earlier one's building is shown once ([`crate::study::shape::StudyShape::distinct`]).
 
 use super::text::fixed;
 use super::{Files, Inputs, ReportError};
@@ -106,7 +106,7 @@ fn load(inp: &Inputs) -> Result<Vec<BuildingZone>, PipelineError> {
     let axes = study
         .building()
         .expect("the building section of a building study");
-    let frames = study.distinct_frames();
+    let frames = study.shape.distinct();
     let path = study.path(StageId::Sweep.output());
     let mut out = Vec::new();
     for z in &inp.zones {

@@ -8,7 +8,7 @@ use crate::grid::Grid;
 use crate::render::chart::{Axis, Figure, Mark, PALETTE, Panel, Series, Stroke};
 use crate::render::page::{Section, para, table_with_id};
 use crate::store::fit::FormFit;
-use crate::study::building::{Frame, fit_features, repeats};
+use crate::study::building::{fit_features, repeats};
 use crate::study::cases::PAPER_TABLE_3;
 use crate::study::tnew::{building_samples, samples};
 use plotters::style::RGBColor;
@@ -92,7 +92,7 @@ fn frames_table(inp: &Inputs) -> String {
     let f3 =
         |m: Option<&Metrics>, v: fn(&Metrics) -> f64| m.map_or("–".into(), |m| fixed(v(m), 3));
     // fit.yaml lists every frame; one that repeats an earlier one's building is shown once.
-    let distinct: Vec<String> = (inp.study.distinct_frames().iter())
+    let distinct: Vec<String> = (inp.study.shape.distinct().iter())
         .map(|(_, f)| f.to_string())
         .collect();
     let mut rows = Vec::new();
@@ -252,15 +252,15 @@ fn fitted_samples(z: &Zone, inp: &Inputs) -> (Vec<Sample>, Vec<u8>) {
     let tr: Vec<f64> = v.t_rigid.iter().copied().collect();
     let band: Vec<u8> = v.band.iter().copied().collect();
     let with_t_new = (0..tn.len()).filter(|&c| tn[c].is_finite());
-    let frames: Vec<Frame> = inp.study.frames().into_iter().flatten().collect();
-    match fit_features(grid.blocks(), &frames) {
+    let frames = inp.study.frames();
+    match fit_features(grid.blocks(), frames) {
         None => (
             samples(grid, &tr, &tn),
             with_t_new.map(|c| band[c]).collect(),
         ),
         Some(features) => {
-            let repeated = repeats(&frames);
-            let every = building_samples(grid, &frames, features, &tr, &tn);
+            let repeated = repeats(frames);
+            let every = building_samples(grid, frames, features, &tr, &tn);
             (every.into_iter().zip(with_t_new))
                 .filter(|((f, _), _)| !repeated[*f])
                 .map(|((_, s), c)| (s, band[c]))

@@ -111,17 +111,16 @@ struct Shown {
     axes: FloorsAxes,
     zone: ZoneFloors,
     offsets: Offsets,
-    frames: Vec<(usize, Option<Frame>)>,
+    /// Each shown frame's stored index, the frame and its label (`None` on one storey).
+    frames: Vec<(usize, Frame, Option<String>)>,
 }
 
 impl Shown {
     fn read(study: &Study, zone: &str) -> Result<Self, PipelineError> {
         let (axes, zone) = floors_zone(study, zone)?;
-        let all = study.frames();
-        let offsets = Offsets::of(&axes, all.len());
-        let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
-        let frames = (all.into_iter().enumerate())
-            .filter(|(f, frame)| frame.is_none() || distinct.contains(f))
+        let offsets = Offsets::of(&axes, study.frames().len());
+        let frames = (study.shape.distinct().into_iter())
+            .map(|(f, frame)| (f, frame.clone(), study.shape.label(f)))
             .collect();
         Ok(Self {
             axes,
@@ -164,12 +163,11 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
         let v = Shown::read(study, &zone.name)?;
         let z = &v.zone;
         for c in 0..v.offsets.cases {
-            for (f, frame) in &v.frames {
+            for (f, frame, label) in &v.frames {
                 let f = *f;
-                let floors = frame.as_ref().map_or(1, Frame::storeys);
-                for j in 0..floors {
+                for j in 0..frame.storeys() {
                     // One storey: the structure is the roof.
-                    let z_over_h = frame.as_ref().map_or(1.0, |fr| fr.height_ratio(j + 1));
+                    let z_over_h = frame.height_ratio(j + 1);
                     let ratio = |pfa: &ArrayD<f64>| v.mean(|m| v.pfa(pfa, m, c, f, j) / z.pga_g[m]);
                     let peak = |psa: &ArrayD<f64>, pfa: &ArrayD<f64>| {
                         let spectrum = v.mean_spectrum(psa, c, f, j);
@@ -179,7 +177,7 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
                     rows.push(FloorRow {
                         zone: zone.name.clone(),
                         case: c + 1,
-                        frame: frame.as_ref().map(|fr| fr.to_string()),
+                        frame: label.clone(),
                         floor: j + 1,
                         z_over_h,
                         pfa_ratio_stack: ratio(&z.pfa_stack),
@@ -253,8 +251,8 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
     for zone in &study.cfg.zones {
         let v = Shown::read(study, &zone.name)?;
         let a = &v.axes;
-        for (f, frame) in &v.frames {
-            let floors = frame.as_ref().map_or(1, Frame::storeys);
+        for (f, frame, label) in &v.frames {
+            let floors = frame.storeys();
             let mut shown = vec![floors];
             if floors >= 3 {
                 shown.insert(0, floors.div_ceil(2));
@@ -278,7 +276,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
                         line
                     });
                 }
-                let z_over_h = frame.as_ref().map_or(1.0, |fr| fr.height_ratio(j));
+                let z_over_h = frame.height_ratio(j);
                 let pga_g = v.mean(|m| v.zone.pga_g[m]);
                 for (code, (x, y)) in
                     code_floor_spectra(z_over_h, a.case_period_s[0], pga_g, &a.periods_s)
@@ -288,7 +286,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
                     );
                 }
             }
-            let at = frame.as_ref().map_or(String::new(), |fr| format!(", {fr}"));
+            let at = label.as_ref().map_or(String::new(), |l| format!(", {l}"));
             // The case is every panel's: the figure's title names it.
             title.get_or_insert_with(|| {
                 format!(

@@ -45,7 +45,7 @@ pub(super) fn ida_section(study: &Study, files: &mut Files) -> Result<Section, P
         .figure("ida.svg", &figure_of(study)?, caption)
         .map_err(|e: ReportError| PipelineError::from(e))?;
     // Each building once: on one storey every stack floor is the first's.
-    let distinct: Vec<String> = (study.distinct_frames().iter())
+    let distinct: Vec<String> = (study.shape.distinct().iter())
         .map(|(_, f)| f.to_string())
         .collect();
     let shown = |frame: &Option<String>| frame.as_ref().is_none_or(|f| distinct.contains(f));
@@ -236,10 +236,8 @@ pub fn fragility_table(study: &Study) -> Result<Vec<FragilityRow>, PipelineError
 
 /// The frames' labels in stored order (`[None]` on one storey).
 fn frame_labels(study: &Study) -> Vec<Option<String>> {
-    study
-        .frames()
-        .into_iter()
-        .map(|f| f.map(|f| f.to_string()))
+    (0..study.frames().len())
+        .map(|f| study.shape.label(f))
         .collect()
 }
 
@@ -371,7 +369,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
     let clip = |v: f64| if v.is_infinite() { cap } else { v };
     let labels = frame_labels(study);
     // Each building once (on one storey every stack floor is the first's).
-    let distinct: Vec<usize> = study.distinct_frames().iter().map(|(f, _)| *f).collect();
+    let distinct: Vec<usize> = study.shape.distinct().iter().map(|(f, _)| *f).collect();
     let d = DemandLayout::PRIMARY;
     let mut panels = Vec::new();
     for zone in &study.cfg.zones {
@@ -379,7 +377,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
         let x = axes.sa_grid_g.clone();
         // The first case in every frame: folded index `f` (crate::store::ida).
         for (f, label) in labels.iter().enumerate() {
-            if building && !distinct.contains(&f) {
+            if !distinct.contains(&f) {
                 continue;
             }
             let mut series = Vec::new();

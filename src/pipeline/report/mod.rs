@@ -347,7 +347,12 @@ fn facts(inp: &Inputs) -> Vec<String> {
         ),
     ];
     let mut shown: Vec<usize> = Vec::new();
-    for (_, f) in study.distinct_frames() {
+    // A building study names its buildings; the one-storey structure is described above.
+    let buildings = match study.shape.is_building() {
+        true => study.shape.distinct(),
+        false => Vec::new(),
+    };
+    for (_, f) in buildings {
         if shown.contains(&f.storeys()) {
             continue;
         }

@@ -12,12 +12,9 @@ pub(super) fn rocking_section(study: &Study) -> Result<Option<Section>, Pipeline
         return Ok(None);
     };
     // The frames to show, with their stored index (a building's repeats left out).
-    let shown: Vec<(usize, String)> = match study.building() {
-        None => vec![(0, "one storey".to_string())],
-        Some(_) => (study.distinct_frames().into_iter())
-            .map(|(f, frame)| (f, frame.to_string()))
-            .collect(),
-    };
+    let shown: Vec<(usize, String)> = (study.shape.distinct().into_iter())
+        .map(|(f, _)| (f, study.shape.label(f).unwrap_or("one storey".into())))
+        .collect();
     let frames = study.frames().len();
     let mut rows = Vec::new();
     for zc in &study.cfg.zones {
