@@ -62,7 +62,7 @@ fn the_building_ida_runs_is_deterministic_resumes_and_is_labelled() {
     // against the formula by hand, src/study/storey_strength.rs); storey 1 is c_y itself.
     let (axes, z) = zone(&out, "III");
     assert_eq!(axes.frame_count(), 2);
-    let stored = z.vars.storey_c_y.as_ref().unwrap();
+    let stored = z.storey_c_y.as_ref().unwrap();
     let want_c = storey_strength_ratios(0.3, &[1.0; 3], &[3.0; 3]);
     for (i, w) in want_c.iter().enumerate() {
         assert_eq!(stored[[0, 0, i]], *w);
@@ -193,7 +193,7 @@ fn a_building_of_one_storey_is_the_one_storey_ida() {
         assert_eq!(bits(&va.run_sa_g), bits(&vb.run_sa_g), "zone {name}");
         assert_eq!(va.run_collapsed, vb.run_collapsed);
         assert_eq!(bits(&va.collapse_sa_g), bits(&vb.collapse_sa_g));
-        assert_eq!(bits(&va.c_y), bits(&vb.c_y));
+        assert_eq!(bits(&za.c_y), bits(&zb.c_y));
         let blocks = 2;
         // One-storey demands: ductility, residual drift (m), slips; the building's: peak drift
         // ratio, residual drift ratio, floor acceleration, ductility, slips.
@@ -368,12 +368,12 @@ fn design_strengths_come_from_the_zone_s_spectrum_at_t_1() {
     for (name, z) in [("III", 0.16), ("V", 0.36)] {
         let (_, zone) = zone(&out, name);
         let want = z / 2.0 / 3.0;
-        let c_y = zone.vars.c_y[[0]];
+        let c_y = zone.c_y[[0]];
         assert!(
             (c_y - want).abs() <= 1e-12 * want,
             "{name}: {c_y} vs {want}"
         );
-        let storeys = zone.vars.storey_c_y.unwrap();
+        let storeys = zone.storey_c_y.unwrap();
         assert_eq!(storeys[[0, 0, 0]], c_y);
         assert!(storeys[[0, 0, 1]] > c_y && storeys[[0, 0, 2]] > storeys[[0, 0, 1]]);
         // Every trace ran: the first run of every record and system has a drift.

@@ -301,8 +301,6 @@ fn write_ida_file(path: &Path) {
     };
     let fit = [s, c, l];
     let vars = IdaVars {
-        c_y: zeros(&[c]),
-        storey_c_y: None,
         record_sa_g: zeros(&[r, c]),
         run_sa_g: zeros(&[s, r, c, n]),
         run_demand: zeros(&[s, r, c, n, d]),
@@ -325,6 +323,8 @@ fn write_ida_file(path: &Path) {
         name: "III".into(),
         target: "is1893:zone=III,soil=I".into(),
         records: vec!["a".into()],
+        c_y: zeros(&[c]),
+        storey_c_y: None,
         vars,
     };
     let meta = IdaMeta {
@@ -339,43 +339,25 @@ fn write_ida_file(path: &Path) {
 
 #[test]
 fn ida_h5() {
-    each_variable(
-        &[
-            "system",
-            "record",
-            "case",
-            "block",
-            "run",
-            "Sa",
-            "demand",
-            "limit_state",
-            "limit_state_definition",
-            "fractile",
-            "case_T_p",
-            "case_alpha",
-            "case_mu",
-            "c_y",
-            "record_Sa",
-            "run_Sa",
-            "run_demand",
-            "run_collapsed",
-            "run_slip_exceeded",
-            "collapse_Sa",
-            "curve",
-            "fractile_curve",
-            "exceed_fraction",
-            "fragility_curve",
-            "theta",
-            "beta",
-            "theta_ci_low",
-            "theta_ci_high",
-            "beta_ci_low",
-            "beta_ci_high",
-            "fit_status",
-        ],
-        write_ida_file,
-        |p, _| read_zone_ida(p, "III"),
-    );
+    // The coordinates, the cases and their strengths, then every declared variable.
+    let mut variables = vec![
+        "system",
+        "record",
+        "case",
+        "block",
+        "run",
+        "Sa",
+        "demand",
+        "limit_state",
+        "limit_state_definition",
+        "fractile",
+        "case_T_p",
+        "case_alpha",
+        "case_mu",
+        "c_y",
+    ];
+    variables.extend(IdaVars::VARS.iter().map(|v| v.name));
+    each_variable(&variables, write_ida_file, |p, _| read_zone_ida(p, "III"));
 }
 
 fn fit_report(coefficients: usize) -> FitReport {

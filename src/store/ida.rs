@@ -8,15 +8,8 @@
 //!                                                    coordinates (dimension scales)
 //!     case_T_p (s) [case]; case_alpha, case_mu [case, block]; c_y [case]
 //!     limit_state_definition [limit_state]
-//!     record_Sa (g) [record, case]: Sa(T_p, 5 %) of the unscaled motion
-//!     run_Sa (g) [system, record, case, run]; run_demand [system, record, case, run, demand];
-//!     run_collapsed, run_slip_exceeded (CF flags) [system, record, case, run]
-//!     collapse_Sa (g) [system, record, case]: lowest collapsing intensity (NaN: none)
-//!     curve [system, record, case, Sa, demand]
-//!     fractile_curve [system, case, fractile, Sa, demand]
-//!     exceed_fraction, fragility_curve [system, case, limit_state, Sa]
-//!     theta (g), beta, theta_ci_low, theta_ci_high (g), beta_ci_low, beta_ci_high,
-//!     fit_status (CF flags) [system, case, limit_state]
+//!     record_Sa, run_Sa, run_demand, …, fit_status: declared once in [`IdaVars`] (each one's
+//!     axes before and after the case, units and long name; docs/variables.md)
 //! ```
 //! In a building study (docs/model.md, "Incremental dynamic analysis", "In a building") every
 //! variable over `case` is over `case, storeys, stack_floor` instead (the frames, dimension
@@ -38,6 +31,7 @@ use super::h5::{
     write_flags, write_stage_file, write_strings, write_var,
 };
 use super::sweep::{building_coordinates, read_building_coordinates};
+use super::vars::{Codes, Data, Element};
 use crate::grid::BuildingAxes;
 use ndarray::{ArrayD, IxDyn};
 use std::path::Path;
@@ -72,29 +66,153 @@ impl IdaAxes {
     }
 }
 
-/// One zone's variables (shapes in the module doc).
-#[derive(Debug, Clone, PartialEq)]
-pub struct IdaVars {
-    pub c_y: ArrayD<f64>,
-    /// `[case, storeys, storey]`, in a building study.
-    pub storey_c_y: Option<ArrayD<f64>>,
-    pub record_sa_g: ArrayD<f64>,
-    pub run_sa_g: ArrayD<f64>,
-    pub run_demand: ArrayD<f64>,
-    pub run_collapsed: ArrayD<u8>,
-    pub run_slip_exceeded: ArrayD<u8>,
-    pub collapse_sa_g: ArrayD<f64>,
-    pub curve: ArrayD<f64>,
-    pub fractile_curve: ArrayD<f64>,
-    pub exceed_fraction: ArrayD<f64>,
-    pub fragility_curve: ArrayD<f64>,
-    pub theta_sa_g: ArrayD<f64>,
-    pub beta: ArrayD<f64>,
-    pub theta_ci_low_sa_g: ArrayD<f64>,
-    pub theta_ci_high_sa_g: ArrayD<f64>,
-    pub beta_ci_low: ArrayD<f64>,
-    pub beta_ci_high: ArrayD<f64>,
-    pub fit_status: ArrayD<u8>,
+/// An axis a variable of `ida.h5` has before or after its case dimensions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IdaAxis {
+    System,
+    Record,
+    Run,
+    Demand,
+    Sa,
+    Fractile,
+    LimitState,
+}
+
+impl IdaAxis {
+    /// The coordinate's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            IdaAxis::System => "system",
+            IdaAxis::Record => "record",
+            IdaAxis::Run => "run",
+            IdaAxis::Demand => "demand",
+            IdaAxis::Sa => "Sa",
+            IdaAxis::Fractile => "fractile",
+            IdaAxis::LimitState => "limit_state",
+        }
+    }
+}
+
+/// One declared variable of `ida.h5`: over `before`, the case dimensions (`case`, or `case,
+/// storeys, stack_floor` in a building study), then `after`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IdaVar {
+    pub name: &'static str,
+    pub before: &'static [IdaAxis],
+    pub after: &'static [IdaAxis],
+    /// CF units (`""` for a code variable).
+    pub units: &'static str,
+    pub long_name: &'static str,
+    /// The long name in a building study's file, where it differs.
+    pub building_long_name: Option<&'static str>,
+    pub codes: Codes,
+}
+
+/// Declares [`IdaVars`]: one `ArrayD` field per variable, its cases and frames folded into one
+/// axis (module doc), and derives `VARS`, `data` and `read` from it, as `stored_vars!` does for
+/// the files whose variables have one trailing axis.
+macro_rules! ida_vars {
+    (@building) => { None };
+    (@building $b:literal) => { Some($b) };
+    (@codes $t:ty) => { <$t as Element>::CODES };
+    (@codes $t:ty, $c:expr) => { Codes::Fixed($c) };
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $name:ident {
+            $(
+                $(#[$fmeta:meta])*
+                $field:ident : $t:ty => $var:literal, [$($before:ident),*] [$($after:ident),*],
+                    $units:literal, $long:literal $(, building $blong:literal)? $(, codes $codes:expr)? ;
+            )*
+        }
+    ) => {
+        $(#[$meta])*
+        $vis struct $name {
+            $( $(#[$fmeta])* pub $field: ArrayD<$t>, )*
+        }
+
+        impl $name {
+            /// The declarations, in field order: the order they are written and read.
+            pub const VARS: &'static [IdaVar] = &[
+                $(
+                    IdaVar {
+                        name: $var,
+                        before: &[$(IdaAxis::$before),*],
+                        after: &[$(IdaAxis::$after),*],
+                        units: $units,
+                        long_name: $long,
+                        building_long_name: ida_vars!(@building $($blong)?),
+                        codes: ida_vars!(@codes $t $(, $codes)?),
+                    },
+                )*
+            ];
+
+            /// Each variable's declaration with its array, in field order.
+            pub fn data(&self) -> Vec<(&'static IdaVar, Data<'_>)> {
+                Self::VARS
+                    .iter()
+                    .zip([$(<$t as Element>::data(&self.$field)),*])
+                    .collect()
+            }
+
+            /// Every variable of group `g`, each refused unless its stored shape is
+            /// `shape(var)`, its frames folded into the case axis.
+            fn read(
+                g: &GroupReader,
+                shape: impl Fn(&IdaVar) -> Vec<usize>,
+                frames: Option<[usize; 2]>,
+            ) -> Result<Self, StoreError> {
+                let mut vars = Self::VARS.iter();
+                Ok(Self {
+                    $( $field: {
+                        let v = vars.next().expect("one declaration per field");
+                        fold(g.array(v.name, &shape(v))?, v.before.len(), frames)
+                    }, )*
+                })
+            }
+        }
+    };
+}
+
+ida_vars! {
+    /// One zone's traces, curves and fits (in memory the frames folded into the case axis,
+    /// case-major).
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct IdaVars {
+        record_sa_g: f64 => "record_Sa", [Record] [], "g",
+            "Sa(T_p, 5 %) of the unscaled motion",
+            building "Sa(T_1, 5 %) of the unscaled motion (T_1 the bare building's first-mode period)";
+        run_sa_g: f64 => "run_Sa", [System, Record] [Run], "g", "intensity of each traced run";
+        run_demand: f64 => "run_demand", [System, Record] [Run, Demand], "demand",
+            "demands of each traced run (units in the demand names)";
+        run_collapsed: u8 => "run_collapsed", [System, Record] [Run], "",
+            "the run reached the collapse ductility",
+            building "the run reached the collapse drift ratio", codes &YES_NO;
+        run_slip_exceeded: u8 => "run_slip_exceeded", [System, Record] [Run], "",
+            "some block's peak slip reached slip_limit_m", codes &YES_NO;
+        collapse_sa_g: f64 => "collapse_Sa", [System, Record] [], "g",
+            "lowest collapsing intensity of the trace (NaN: no collapse up to the cap)";
+        curve: f64 => "curve", [System, Record] [Sa, Demand], "demand",
+            "IDA curve on the common grid (linear between runs; +inf from the collapse on; NaN above the last run)";
+        fractile_curve: f64 => "fractile_curve", [System] [Fractile, Sa, Demand], "demand",
+            "fractiles of the curves over the records (type 7; collapsed records count as +inf)";
+        exceed_fraction: f64 => "exceed_fraction", [System] [LimitState, Sa], "1",
+            "fraction of the records whose curve exceeds the limit state (the stripe data of the fit)";
+        fragility_curve: f64 => "fragility_curve", [System] [LimitState, Sa], "1",
+            "fitted lognormal fragility Phi(ln(Sa/theta)/beta)";
+        theta_sa_g: f64 => "theta", [System] [LimitState], "g",
+            "median capacity theta (maximum likelihood, multiple stripes, Baker 2015)";
+        beta: f64 => "beta", [System] [LimitState], "1", "logarithmic standard deviation beta";
+        theta_ci_low_sa_g: f64 => "theta_ci_low", [System] [LimitState], "g",
+            "95 % Wald interval of theta, observed information, lower end";
+        theta_ci_high_sa_g: f64 => "theta_ci_high", [System] [LimitState], "g",
+            "95 % Wald interval of theta, upper end";
+        beta_ci_low: f64 => "beta_ci_low", [System] [LimitState], "1",
+            "95 % Wald interval of beta (on ln beta), lower end";
+        beta_ci_high: f64 => "beta_ci_high", [System] [LimitState], "1",
+            "95 % Wald interval of beta, upper end";
+        fit_status: u8 => "fit_status", [System] [LimitState], "", "how the fragility fit ended";
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -102,6 +220,10 @@ pub struct ZoneIda {
     pub name: String,
     pub target: String,
     pub records: Vec<String>,
+    /// `[case]`: the structure's yield strength ratio (a building's base-shear coefficient).
+    pub c_y: ArrayD<f64>,
+    /// `[case, storeys, storey]`, in a building study.
+    pub storey_c_y: Option<ArrayD<f64>>,
     pub vars: IdaVars,
 }
 
@@ -117,6 +239,23 @@ pub struct IdaMeta<'a> {
 }
 
 const YES_NO: [(u8, &str); 2] = [(0, "no"), (1, "yes")];
+
+/// The Markdown table of [`IdaVars::VARS`] (`docs/variables.md`), `case` standing for the case
+/// dimensions.
+pub fn variables_table() -> String {
+    let mut s = String::from(super::vars::TABLE_HEAD);
+    for v in IdaVars::VARS {
+        let names = |a: &[IdaAxis]| a.iter().map(|a| a.name()).collect::<Vec<_>>();
+        let dims = [names(v.before), vec!["case"], names(v.after)].concat();
+        s.push_str(&super::vars::table_row(
+            v.name,
+            &dims.join(", "),
+            (v.units, v.codes),
+            (v.long_name, v.building_long_name),
+        ));
+    }
+    s
+}
 
 /// Writes `ida.h5` (checked and atomic).
 pub fn write_ida(
@@ -171,6 +310,18 @@ struct Coordinates {
 }
 
 impl Coordinates {
+    fn axis(&self, a: IdaAxis) -> &hdf5::Dataset {
+        match a {
+            IdaAxis::System => &self.system,
+            IdaAxis::Record => &self.record,
+            IdaAxis::Run => &self.run,
+            IdaAxis::Demand => &self.demand,
+            IdaAxis::Sa => &self.sa,
+            IdaAxis::Fractile => &self.fractile,
+            IdaAxis::LimitState => &self.limit,
+        }
+    }
+
     /// `before`, then the case's dimensions (`case`, or `case, storeys, stack_floor` in a
     /// building study), then `after`.
     fn around<'a>(
@@ -222,9 +373,8 @@ fn write_zone(f: &hdf5::File, axes: &IdaAxes, z: &ZoneIda, meta: &IdaMeta) -> hd
     attr_str(&g, "target", &z.target)?;
     let dims = write_coordinates(&g, axes, z)?;
     let frames = axes.building.as_ref().map(BuildingAxes::shape);
-    write_cases(&g, axes, &z.vars, &dims, frames)?;
-    write_runs(&g, &z.vars, &dims, frames)?;
-    write_fits(&g, &z.vars, &dims, meta, frames)
+    write_cases(&g, axes, z, &dims)?;
+    write_vars(&g, &z.vars, &dims, meta, frames)
 }
 
 /// A variable over the coordinates `dims`, chunked by [`chunk_of`].
@@ -237,22 +387,6 @@ fn put(
     long: &str,
 ) -> hdf5::Result<()> {
     let ds = write_var(g, name, data.view(), &chunk_of(data.shape()), units, long)?;
-    for (i, d) in dims.iter().enumerate() {
-        attach_scale(&ds, d, i)?;
-    }
-    Ok(())
-}
-
-/// A CF flag variable over the coordinates `dims`.
-fn put_flags(
-    g: &hdf5::Group,
-    name: &str,
-    data: &ArrayD<u8>,
-    dims: &[&hdf5::Dataset],
-    long: &str,
-    flags: &[(u8, &str)],
-) -> hdf5::Result<()> {
-    let ds = write_flags(g, name, data.view(), &chunk_of(data.shape()), long, flags)?;
     for (i, d) in dims.iter().enumerate() {
         attach_scale(&ds, d, i)?;
     }
@@ -355,14 +489,8 @@ fn write_coordinates(g: &hdf5::Group, axes: &IdaAxes, z: &ZoneIda) -> hdf5::Resu
     })
 }
 
-/// The cases and their strengths, and each record's intensity.
-fn write_cases(
-    g: &hdf5::Group,
-    axes: &IdaAxes,
-    v: &IdaVars,
-    d: &Coordinates,
-    frames: Option<[usize; 2]>,
-) -> hdf5::Result<()> {
+/// The cases and their strengths.
+fn write_cases(g: &hdf5::Group, axes: &IdaAxes, z: &ZoneIda, d: &Coordinates) -> hdf5::Result<()> {
     let shape = (
         axes.case_alpha.len(),
         axes.case_alpha.first().map_or(0, Vec::len),
@@ -397,7 +525,7 @@ fn write_cases(
     put(
         g,
         "c_y",
-        &v.c_y,
+        &z.c_y,
         &[&d.case],
         "1",
         if d.building.is_some() {
@@ -406,7 +534,7 @@ fn write_cases(
             "yield strength ratio F_y/(m_p g) of the structure"
         },
     )?;
-    if let (Some(c), Some([n, _, storey])) = (&v.storey_c_y, &d.building) {
+    if let (Some(c), Some([n, _, storey])) = (&z.storey_c_y, &d.building) {
         put(
             g,
             "storey_c_y",
@@ -417,161 +545,45 @@ fn write_cases(
              Clause 7.6.3 (NaN above the building)",
         )?;
     }
-    put(
-        g,
-        "record_Sa",
-        &split(&v.record_sa_g, 1, frames),
-        &d.around(&[&d.record], &[]),
-        "g",
-        if d.building.is_some() {
-            "Sa(T_1, 5 %) of the unscaled motion (T_1 the bare building's first-mode period)"
-        } else {
-            "Sa(T_p, 5 %) of the unscaled motion"
-        },
-    )
+    Ok(())
 }
 
-/// The traced runs, the curves on the common grid and their fractiles.
-fn write_runs(
-    g: &hdf5::Group,
-    v: &IdaVars,
-    d: &Coordinates,
-    frames: Option<[usize; 2]>,
-) -> hdf5::Result<()> {
-    let sys_run = d.around(&[&d.system, &d.record], &[&d.run]);
-    let at = |a: &ArrayD<f64>| split(a, 2, frames);
-    let at_flags = |a: &ArrayD<u8>| split(a, 2, frames);
-    put(
-        g,
-        "run_Sa",
-        &at(&v.run_sa_g),
-        &sys_run,
-        "g",
-        "intensity of each traced run",
-    )?;
-    put(
-        g,
-        "run_demand",
-        &at(&v.run_demand),
-        &d.around(&[&d.system, &d.record], &[&d.run, &d.demand]),
-        "demand",
-        "demands of each traced run (units in the demand names)",
-    )?;
-    put_flags(
-        g,
-        "run_collapsed",
-        &at_flags(&v.run_collapsed),
-        &sys_run,
-        if frames.is_some() {
-            "the run reached the collapse drift ratio"
-        } else {
-            "the run reached the collapse ductility"
-        },
-        &YES_NO,
-    )?;
-    put_flags(
-        g,
-        "run_slip_exceeded",
-        &at_flags(&v.run_slip_exceeded),
-        &sys_run,
-        "some block's peak slip reached slip_limit_m",
-        &YES_NO,
-    )?;
-    put(
-        g,
-        "collapse_Sa",
-        &at(&v.collapse_sa_g),
-        &d.around(&[&d.system, &d.record], &[]),
-        "g",
-        "lowest collapsing intensity of the trace (NaN: no collapse up to the cap)",
-    )?;
-    put(
-        g,
-        "curve",
-        &at(&v.curve),
-        &d.around(&[&d.system, &d.record], &[&d.sa, &d.demand]),
-        "demand",
-        "IDA curve on the common grid (linear between runs; +inf from the collapse on; NaN above the last run)",
-    )?;
-    put(
-        g,
-        "fractile_curve",
-        &split(&v.fractile_curve, 1, frames),
-        &d.around(&[&d.system], &[&d.fractile, &d.sa, &d.demand]),
-        "demand",
-        "fractiles of the curves over the records (type 7; collapsed records count as +inf)",
-    )
-}
-
-/// The stripes, the fragility fits and their intervals.
-fn write_fits(
+/// The declared variables ([`IdaVars::VARS`]), each over its coordinates with its frames split
+/// out of the case axis, chunked by [`chunk_of`]; `fit_status` with the writer's codes.
+fn write_vars(
     g: &hdf5::Group,
     v: &IdaVars,
     d: &Coordinates,
     meta: &IdaMeta,
     frames: Option<[usize; 2]>,
 ) -> hdf5::Result<()> {
-    let fr = d.around(&[&d.system], &[&d.limit, &d.sa]);
-    put(
-        g,
-        "exceed_fraction",
-        &split(&v.exceed_fraction, 1, frames),
-        &fr,
-        "1",
-        "fraction of the records whose curve exceeds the limit state (the stripe data of the fit)",
-    )?;
-    put(
-        g,
-        "fragility_curve",
-        &split(&v.fragility_curve, 1, frames),
-        &fr,
-        "1",
-        "fitted lognormal fragility Phi(ln(Sa/theta)/beta)",
-    )?;
-    let fit = d.around(&[&d.system], &[&d.limit]);
-    for (name, data, units, long) in [
-        (
-            "theta",
-            &v.theta_sa_g,
-            "g",
-            "median capacity theta (maximum likelihood, multiple stripes, Baker 2015)",
-        ),
-        ("beta", &v.beta, "1", "logarithmic standard deviation beta"),
-        (
-            "theta_ci_low",
-            &v.theta_ci_low_sa_g,
-            "g",
-            "95 % Wald interval of theta, observed information, lower end",
-        ),
-        (
-            "theta_ci_high",
-            &v.theta_ci_high_sa_g,
-            "g",
-            "95 % Wald interval of theta, upper end",
-        ),
-        (
-            "beta_ci_low",
-            &v.beta_ci_low,
-            "1",
-            "95 % Wald interval of beta (on ln beta), lower end",
-        ),
-        (
-            "beta_ci_high",
-            &v.beta_ci_high,
-            "1",
-            "95 % Wald interval of beta, upper end",
-        ),
-    ] {
-        put(g, name, &split(data, 1, frames), &fit, units, long)?;
+    for (var, data) in v.data() {
+        let axes = |a: &[IdaAxis]| a.iter().map(|&a| d.axis(a)).collect::<Vec<_>>();
+        let dims = d.around(&axes(var.before), &axes(var.after));
+        let long = match (var.building_long_name, frames) {
+            (Some(b), Some(_)) => b,
+            _ => var.long_name,
+        };
+        let at = var.before.len();
+        let ds = match (data, var.codes) {
+            (Data::Values(a), _) => {
+                let a = split(a, at, frames);
+                write_var(g, var.name, a.view(), &chunk_of(a.shape()), var.units, long)?
+            }
+            (Data::Codes(a), codes) => {
+                let a = split(a, at, frames);
+                let codes = match codes {
+                    Codes::Fixed(c) => c,
+                    _ => meta.fit_flags,
+                };
+                write_flags(g, var.name, a.view(), &chunk_of(a.shape()), long, codes)?
+            }
+        };
+        for (i, s) in dims.iter().enumerate() {
+            attach_scale(&ds, s, i)?;
+        }
     }
-    put_flags(
-        g,
-        "fit_status",
-        &split(&v.fit_status, 1, frames),
-        &fit,
-        "how the fragility fit ended",
-        meta.fit_flags,
-    )
+    Ok(())
 }
 
 /// Zone `zone` of `ida.h5` with the axes stored with it; every variable has the shape its
@@ -611,65 +623,34 @@ pub fn read_zone_ida(path: &Path, zone: &str) -> Result<(IdaAxes, ZoneIda), Stor
         },
     };
     let frames = axes.building.as_ref().map(BuildingAxes::shape);
-    let (s, r, c, n) = (axes.systems.len(), records.len(), cases, axes.runs);
-    let (d, sa, l, q) = (
-        axes.demands.len(),
-        axes.sa_grid_g.len(),
-        axes.limit_states.len(),
-        axes.fractiles.len(),
-    );
-    // Each variable over `[before.., case, after..]` as stored, folded back to one case axis.
-    let shape = |before: &[usize], after: &[usize]| -> Vec<usize> {
-        let mut v = before.to_vec();
-        v.push(c);
-        v.extend(frames.into_iter().flatten());
-        v.extend_from_slice(after);
-        v
+    let size = |a: &IdaAxis| match a {
+        IdaAxis::System => axes.systems.len(),
+        IdaAxis::Record => records.len(),
+        IdaAxis::Run => axes.runs,
+        IdaAxis::Demand => axes.demands.len(),
+        IdaAxis::Sa => axes.sa_grid_g.len(),
+        IdaAxis::Fractile => axes.fractiles.len(),
+        IdaAxis::LimitState => axes.limit_states.len(),
     };
-    let f64s = |name: &str, before: &[usize], after: &[usize]| -> Result<ArrayD<f64>, StoreError> {
-        Ok(fold(
-            g.array(name, &shape(before, after))?,
-            before.len(),
-            frames,
-        ))
-    };
-    let flags = |name: &str, before: &[usize], after: &[usize]| -> Result<ArrayD<u8>, StoreError> {
-        Ok(fold(
-            g.array(name, &shape(before, after))?,
-            before.len(),
-            frames,
-        ))
+    // Each variable over `[before.., case(, storeys, stack_floor), after..]` as stored.
+    let shape = |v: &IdaVar| -> Vec<usize> {
+        let mut s: Vec<usize> = v.before.iter().map(size).collect();
+        s.push(cases);
+        s.extend(frames.into_iter().flatten());
+        s.extend(v.after.iter().map(size));
+        s
     };
     let storey_c_y = match &axes.building {
         None => None,
-        Some(b) => Some(g.array("storey_c_y", &[c, b.storeys.len(), axes.max_storeys()])?),
-    };
-    let vars = IdaVars {
-        c_y: g.array("c_y", &[c])?,
-        storey_c_y,
-        record_sa_g: f64s("record_Sa", &[r], &[])?,
-        run_sa_g: f64s("run_Sa", &[s, r], &[n])?,
-        run_demand: f64s("run_demand", &[s, r], &[n, d])?,
-        run_collapsed: flags("run_collapsed", &[s, r], &[n])?,
-        run_slip_exceeded: flags("run_slip_exceeded", &[s, r], &[n])?,
-        collapse_sa_g: f64s("collapse_Sa", &[s, r], &[])?,
-        curve: f64s("curve", &[s, r], &[sa, d])?,
-        fractile_curve: f64s("fractile_curve", &[s], &[q, sa, d])?,
-        exceed_fraction: f64s("exceed_fraction", &[s], &[l, sa])?,
-        fragility_curve: f64s("fragility_curve", &[s], &[l, sa])?,
-        theta_sa_g: f64s("theta", &[s], &[l])?,
-        beta: f64s("beta", &[s], &[l])?,
-        theta_ci_low_sa_g: f64s("theta_ci_low", &[s], &[l])?,
-        theta_ci_high_sa_g: f64s("theta_ci_high", &[s], &[l])?,
-        beta_ci_low: f64s("beta_ci_low", &[s], &[l])?,
-        beta_ci_high: f64s("beta_ci_high", &[s], &[l])?,
-        fit_status: flags("fit_status", &[s], &[l])?,
+        Some(b) => Some(g.array("storey_c_y", &[cases, b.storeys.len(), axes.max_storeys()])?),
     };
     let z = ZoneIda {
         name: zone.to_string(),
         target: g.attr_str("target").unwrap_or_default(),
+        c_y: g.array("c_y", &[cases])?,
+        storey_c_y,
+        vars: IdaVars::read(&g, shape, frames)?,
         records,
-        vars,
     };
     Ok((axes, z))
 }

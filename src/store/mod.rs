@@ -152,7 +152,7 @@ pub fn variables_doc() -> String {
          Made by `slidestack::store::variables_doc()` from the declarations in `src/store/` \
          (`stored_vars!`), which also drive the writers and the readers' shape checks; \
          `SLIDESTACK_BLESS=1 cargo test --release --test variables_doc` rewrites it \
-         (`ida.h5` and `fit.h5` are described in their modules, `src/store/ida.rs` and \
+         (`fit.h5`, the fit's attributes beside `fit.yaml`, is described in its module, \
          `src/store/fit.rs`). \
          \"codes\" are `u8` CF flags (`flag_values`, `flag_meanings` on the variable, 255 the \
          fill); every other variable is `f64` with NaN as fill. A building study's variables \
@@ -219,5 +219,13 @@ pub fn variables_doc() -> String {
         "motion, case, (storeys, stack_floor,) damping, floor, period",
         &floors::SPECTRA,
     );
+    s.push_str(
+        "\n## `ida.h5`: traces, curves and fragility fits\n\n\
+         Per zone, over the listed cases (`ida.cases`); `case` is `case, storeys, stack_floor` \
+         in a building study. Beside them the coordinates, `case_T_p`, `case_alpha`, `case_mu`, \
+         `c_y` [case] and, in a building study, `storey_c_y` [case, storeys, storey] \
+         (`src/store/ida.rs`). `fit_status` takes its codes from the fragility fit's flags.\n\n",
+    );
+    s.push_str(&ida::variables_table());
     s
 }

@@ -227,26 +227,45 @@ pub fn write_declared(to: &Target, vars: &[(&'static Var, Data)]) -> hdf5::Resul
 /// The Markdown table of `vars`: name, dimensions (the case dimensions `case`, then the trailing
 /// axis), units and long name (with the building study's where it differs).
 pub fn table(case: &str, vars: &[Var]) -> String {
-    let mut s = String::from("| variable | dimensions | units | long name |\n|---|---|---|---|\n");
+    let mut s = String::from(TABLE_HEAD);
     for v in vars {
         let dims = match v.trailing.axis() {
             Some(a) => format!("{case}, {a}"),
             None => case.to_string(),
         };
-        let units = match v.codes {
-            Codes::Value => format!("`{}`", v.units),
-            _ => "codes".to_string(),
-        };
-        let long = match v.building_long_name {
-            Some(b) => match b.strip_prefix(v.long_name) {
-                Some(more) => format!("{}; in a building study{more}", v.long_name),
-                None => format!("{}; in a building study: {b}", v.long_name),
-            },
-            None => v.long_name.to_string(),
-        };
-        s.push_str(&format!("| `{}` | [{dims}] | {units} | {long} |\n", v.name));
+        s.push_str(&table_row(
+            v.name,
+            &dims,
+            (v.units, v.codes),
+            (v.long_name, v.building_long_name),
+        ));
     }
     s
+}
+
+/// The head of a variable table.
+pub const TABLE_HEAD: &str = "| variable | dimensions | units | long name |\n|---|---|---|---|\n";
+
+/// One variable's row of a variable table: its units (or `codes`), and its long name with the
+/// building study's where it differs.
+pub fn table_row(
+    name: &str,
+    dims: &str,
+    (units, codes): (&str, Codes),
+    (long, building): (&str, Option<&str>),
+) -> String {
+    let units = match codes {
+        Codes::Value => format!("`{units}`"),
+        _ => "codes".to_string(),
+    };
+    let long = match building {
+        Some(b) => match b.strip_prefix(long) {
+            Some(more) => format!("{long}; in a building study{more}"),
+            None => format!("{long}; in a building study: {b}"),
+        },
+        None => long.to_string(),
+    };
+    format!("| `{name}` | [{dims}] | {units} | {long} |\n")
 }
 
 /// An optional variable, declared on its own (as `sweep.h5`'s `rocks_stack`): `Ok(None)` when

@@ -38,14 +38,13 @@ pub fn zone_ida(
     let c_y: Vec<f64> = (cfg.cases.iter())
         .map(|c| cfg.strength_ratio(target, c))
         .collect();
-    let storey_c_y = storey_c_y(building, axes, &c_y);
-    let mut vars = zone_vars(cfg, axes, records.len(), units, c_y);
-    vars.storey_c_y = storey_c_y;
     ZoneIda {
         name: name.to_string(),
         target: target_name.to_string(),
+        storey_c_y: storey_c_y(building, axes, &c_y),
+        vars: zone_vars(cfg, axes, records.len(), units),
+        c_y: ArrayD::from_shape_vec(IxDyn(&[c_y.len()]), c_y).expect("one per case"),
         records,
-        vars,
     }
 }
 
@@ -142,13 +141,7 @@ fn array<T: Clone>(shape: &[usize], fill: T) -> ArrayD<T> {
 }
 
 /// One zone's variables from its units (record-major, then case).
-fn zone_vars(
-    cfg: &IdaConfig,
-    axes: &IdaAxes,
-    records: usize,
-    units: &[UnitTraces],
-    c_y: Vec<f64>,
-) -> IdaVars {
+fn zone_vars(cfg: &IdaConfig, axes: &IdaAxes, records: usize, units: &[UnitTraces]) -> IdaVars {
     // Cases and frames folded into one axis, case-major (crate::store::ida).
     let (ns, nc, nr) = (
         SYSTEMS.len(),
@@ -163,8 +156,6 @@ fn zone_vars(
     );
     let grid = &axes.sa_grid_g;
     let mut v = IdaVars {
-        c_y: ArrayD::from_shape_vec(IxDyn(&[cfg.cases.len()]), c_y).expect("one per case"),
-        storey_c_y: None,
         record_sa_g: array(&[records, nc], f64::NAN),
         run_sa_g: array(&[ns, records, nc, nr], f64::NAN),
         run_demand: array(&[ns, records, nc, nr, nd], f64::NAN),

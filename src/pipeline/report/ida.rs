@@ -417,7 +417,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
                     a.case_period_s[0],
                     a.case_alpha[0],
                     a.case_mu[0],
-                    z.vars.c_y[[0]]
+                    z.c_y[[0]]
                 ),
                 Axis::new("Sa(T_p, 5 %), g"),
                 Axis::new(y_label).range(0.0, cap),
