@@ -88,10 +88,10 @@ pub enum Floor {
 
 impl<'de> Deserialize<'de> for Floor {
     /// A whole number or a word; anything else refused in words
-    /// ([`crate::study::config::checked_value`]). A number or word that is no floor of the
+    /// ([`crate::study::yaml::checked_value`]). A number or word that is no floor of the
     /// building is refused with the building.
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use crate::study::config::{checked_value, shown};
+        use crate::study::yaml::{checked_value, shown};
         checked_value(d, |v| {
             match &v {
                 serde_yaml::Value::String(s) => Some(Floor::Name(s.clone())),

@@ -16,7 +16,7 @@
 //! The building's damping is the grid's (`damping`, `damping_basis`: modal, `ζ` in every mode
 //! of the basis); its period the grid's `period_s`; its storeys elastic.
 
-use super::config::{checked_value, shown};
+use super::yaml::{checked_value, shown};
 use crate::case::Case;
 use crate::dynamics::G;
 use crate::dynamics::building::model::modes;

@@ -24,6 +24,7 @@
 //! * [`storey_strength`]: a building's storey strengths from a base-shear coefficient (IS 1893).
 //! * [`sweep`]: the skip rules, one work unit.
 //! * [`tnew`]: `T_new` from the mean displacement spectrum; the fit's samples.
+//! * [`yaml`]: YAML values read by hand, refused in words with their key's line.
 
 pub mod attached;
 pub mod building;
@@ -42,3 +43,4 @@ pub mod shape;
 pub mod storey_strength;
 pub mod sweep;
 pub mod tnew;
+pub mod yaml;
