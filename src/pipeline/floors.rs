@@ -194,7 +194,7 @@ fn run_units(
                     zone: study.cfg.zones[u.zone].name.clone(),
                     motion: rec.name.clone(),
                     case: u.case,
-                    frame: (study.shape.label(u.frame)).map_or(String::new(), |l| format!(", {l}")),
+                    frame: study.shape.label_suffix(u.frame),
                     source: Box::new(source),
                 }
             })?;

@@ -166,32 +166,35 @@ fn trace_units(
     let (me, cfg, study) = (StageId::Ida, store.cfg, store.study);
     let start = std::time::Instant::now();
     let bar = s.reporter.progress(me, todo.len() as u64);
-    let done =
-        todo.par_iter()
-            .map(|&(i, u)| -> Result<(usize, UnitTraces), PipelineError> {
-                s.check_cancelled(me)?;
-                let record = &store.motions[u.zone][u.motion];
-                let of = (
-                    &cfg.cases[u.case],
-                    &study.frames()[u.frame],
-                    study.shape.is_building(),
-                );
-                let traced = trace_unit(cfg, &inp.physics, &inp.targets[u.zone], of, record)
-                    .map_err(|f| IdaStageError::Simulation {
-                        zone: study.cfg.zones[u.zone].name.clone(),
-                        motion: record.name.clone(),
-                        case: u.case,
-                        frame: (study.shape.label(u.frame))
-                            .map_or(String::new(), |l| format!(", {l}")),
-                        system: f.system,
-                        why: f.why,
-                    })?;
-                store.write(u, &traced)?;
-                bar.inc();
-                s.pass("ida.trace", me)?;
-                Ok((i, traced))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+    let trace = |u: CaseUnit| -> Result<UnitTraces, IdaStageError> {
+        let record = &store.motions[u.zone][u.motion];
+        let of = (
+            &cfg.cases[u.case],
+            &study.frames()[u.frame],
+            study.shape.is_building(),
+        );
+        (trace_unit(cfg, &inp.physics, &inp.targets[u.zone], of, record)).map_err(|f| {
+            IdaStageError::Simulation {
+                zone: study.cfg.zones[u.zone].name.clone(),
+                motion: record.name.clone(),
+                case: u.case,
+                frame: study.shape.label_suffix(u.frame),
+                system: f.system,
+                why: f.why,
+            }
+        })
+    };
+    let done = todo
+        .par_iter()
+        .map(|&(i, u)| -> Result<(usize, UnitTraces), PipelineError> {
+            s.check_cancelled(me)?;
+            let traced = trace(u)?;
+            store.write(u, &traced)?;
+            bar.inc();
+            s.pass("ida.trace", me)?;
+            Ok((i, traced))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     bar.finish();
     if !done.is_empty() {
         let runs: usize = (done.iter())

@@ -351,7 +351,6 @@ pub fn check_output_dir(out: &Path) -> Result<(), String> {
     why.map_or(Ok(()), Err)
 }
 
-/// The frames of a building study in stored order; empty on one storey.
 /// The physics settings every stage file after the motions' stores as file attributes.
 pub fn physics_attrs(p: &Physics) -> [(&'static str, crate::store::h5::Attr<'static>); 2] {
     use crate::store::h5::Attr;

@@ -76,6 +76,12 @@ impl StudyShape {
     pub fn label(&self, f: usize) -> Option<String> {
         self.is_building().then(|| self.frames[f].to_string())
     }
+
+    /// What a message about frame `f` appends: `, 3 storeys, stack on the roof`; nothing on one
+    /// storey.
+    pub fn label_suffix(&self, f: usize) -> String {
+        self.label(f).map_or(String::new(), |l| format!(", {l}"))
+    }
 }
 
 #[cfg(test)]
@@ -109,6 +115,7 @@ mod tests {
         assert_eq!(shape.frames(), [Frame::one_storey()]);
         assert_eq!(shape.distinct(), [(0, &Frame::one_storey())]);
         assert_eq!(shape.label(0), None);
+        assert_eq!(shape.label_suffix(0), "");
         assert!(shape.building_frames().is_empty());
     }
 
@@ -126,5 +133,6 @@ mod tests {
             Some("2 storeys, stack on the roof")
         );
         assert_eq!(shape.building_frames(), shape.frames());
+        assert_eq!(shape.label_suffix(4), ", 2 storeys, stack on the roof");
     }
 }
