@@ -54,7 +54,9 @@ options (defaults in brackets; "sized" = from the grid's work units and their me
   -p, --partition NAME      submit to this partition [the site's default]
   -n, --shards N            sweep array tasks [sized]; 1 <= N <= work units, N < MaxArraySize
   -c, --cpus-per-task C     CPUs (threads) of every job [sized, at most $MAX_DEFAULT_CPUS]
-  -t, --time TIME           time limit of each sweep task (and tnew task), any sbatch form [sized]
+  -t, --time TIME           time limit of each sweep task, any sbatch form [sized]
+      --tnew-time TIME      time limit of each tnew task of a building study [sized; --time
+                            when that is given]
       --stage-time TIME     time limit of the motions job and the finishing job [30:00]
       --mem SIZE            memory of every job, e.g. 2G [the site's default]
       --array LIST          submit only these shard indices, e.g. 3 or 2,5-7: to rerun failed
@@ -81,7 +83,7 @@ die() {
 note() { echo "$PROG: $*"; }
 is_uint() { [[ $1 =~ ^[0-9]+$ ]]; }
 
-CONFIG="" OUT="" SHARDS="" CPUS="" TIME="" STAGE_TIME="" MEM="" ACCOUNT="" PARTITION=""
+CONFIG="" OUT="" SHARDS="" CPUS="" TIME="" TNEW_TIME="" STAGE_TIME="" MEM="" ACCOUNT="" PARTITION=""
 ARRAY="" MAX_RUNNING="" DRY_RUN=0 FORCE=0
 EXTRA=()
 POSITIONAL=()
@@ -97,12 +99,13 @@ while [ $# -gt 0 ]; do
   -n | --shards) need_value "$1" $#; SHARDS=$2; shift 2 ;;
   -c | --cpus-per-task) need_value "$1" $#; CPUS=$2; shift 2 ;;
   -t | --time) need_value "$1" $#; TIME=$2; shift 2 ;;
+  --tnew-time) need_value "$1" $#; TNEW_TIME=$2; shift 2 ;;
   --stage-time) need_value "$1" $#; STAGE_TIME=$2; shift 2 ;;
   --mem) need_value "$1" $#; MEM=$2; shift 2 ;;
   --array) need_value "$1" $#; ARRAY=$2; shift 2 ;;
   --max-running) need_value "$1" $#; MAX_RUNNING=$2; shift 2 ;;
-  --account=* | --partition=* | --shards=* | --cpus-per-task=* | --time=* | --stage-time=* | \
-    --mem=* | --array=* | --max-running=*)
+  --account=* | --partition=* | --shards=* | --cpus-per-task=* | --time=* | --tnew-time=* | \
+    --stage-time=* | --mem=* | --array=* | --max-running=*)
     opt=${1%%=*}
     set -- "$opt" "${1#*=}" "${@:2}"
     ;;
@@ -405,7 +408,8 @@ fi
 if [ -n "$NODE_CPUS" ] && is_uint "$NODE_CPUS" && [ "$CPUS" -gt "$NODE_CPUS" ]; then
   die "--cpus-per-task $CPUS: the largest node of partition '$part' has $NODE_CPUS CPUs, so the jobs would never start; give at most $NODE_CPUS"
 fi
-for v in TIME STAGE_TIME; do
+for v in TIME STAGE_TIME TNEW_TIME; do
+  [ -n "${!v}" ] || continue
   opt=--$(tr _ - <<<"${v,,}")
   m=$(minutes "${!v}") || die "$opt '${!v}' is not a Slurm time (MM, HH:MM:SS, D-HH:MM:SS, ...)"
   if [ -n "$plim" ] && [ -n "$m" ] && [ "$m" -gt "$plim" ]; then
@@ -459,20 +463,6 @@ common=(--parsable --chdir="$OUT" --open-mode=append --cpus-per-task="$CPUS")
 sha=$(sha256sum "$SLIDESTACK" | cut -c1-16)
 JOB_BIN=$SLURM_DIR/bin/slidestack-$sha
 
-# The command that resubmits failed shards of this submission with the same binary, N and sizes;
-# the finishing job prints it with --array LIST added.
-RESUBMIT_CMD="SLIDESTACK=$(printf '%q' "$JOB_BIN") $(printf '%q' "$HERE/slurm-submit.sh")"
-resubmit=(--shards "$SHARDS" --cpus-per-task "$CPUS" --time "$TIME" --stage-time "$STAGE_TIME")
-[ -z "$ACCOUNT" ] || resubmit+=(--account "$ACCOUNT")
-[ -z "$PARTITION" ] || resubmit+=(--partition "$PARTITION")
-[ -z "$MEM" ] || resubmit+=(--mem "$MEM")
-[ -z "$MAX_RUNNING" ] || resubmit+=(--max-running "$MAX_RUNNING")
-[ $FORCE = 0 ] || resubmit+=(--force)
-resubmit+=("$CONFIG" "$OUT")
-[ ${#EXTRA[@]} -eq 0 ] || resubmit+=(-- "${EXTRA[@]}")
-RESUBMIT_ARGS=$(printf '%q ' "${resubmit[@]}")
-RESUBMIT_ARGS=${RESUBMIT_ARGS% }
-
 # --force goes first to each batch script, which passes it to every slidestack stage it runs.
 FORCE_ARG=()
 [ $FORCE = 0 ] || FORCE_ARG=(--force)
@@ -491,11 +481,12 @@ ida_cmd=(sbatch "${common[@]}" --job-name=slidestack-ida --time="$STAGE_TIME" --
   "$OUT" "$IDA_SHARDS")
 TNEW_SHARDS=$SHARDS
 if [ "$TNEW_UNITS" -lt "$TNEW_SHARDS" ]; then TNEW_SHARDS=$TNEW_UNITS; fi
-# A tnew task's time limit: the sweep's when given, else from the sweep's estimated CPU time
-# (W) times TNEW_PER_SWEEP over the tnew tasks, sized as the sweep's (twice plus 5 minutes, at
-# least 10 minutes, at most the partition's limit).
-TNEW_TIME=$TIME
-if [ $NEED_TNEW = 1 ] && [[ $given != *time* ]] && [ -n "${W:-}" ] && [ "$TNEW_SHARDS" -ge 1 ]; then
+# A tnew task's time limit: --tnew-time, else the sweep's when given, else from the sweep's
+# estimated CPU time (W) times TNEW_PER_SWEEP over the tnew tasks, sized as the sweep's (twice
+# plus 5 minutes, at least 10 minutes, at most the partition's limit).
+if [ -n "$TNEW_TIME" ]; then
+  :
+elif [ $NEED_TNEW = 1 ] && [[ $given != *time* ]] && [ -n "${W:-}" ] && [ "$TNEW_SHARDS" -ge 1 ]; then
   read -r TNEW_W TNEW_EST TNEW_TIME < <(awk -v w="$W" -v r="$TNEW_PER_SWEEP" -v n="$TNEW_SHARDS" -v c="$CPUS" '
     function ceil(x) { return (x == int(x)) ? x : int(x) + 1 }
     BEGIN {
@@ -504,12 +495,29 @@ if [ $NEED_TNEW = 1 ] && [[ $given != *time* ]] && [ -n "${W:-}" ] && [ "$TNEW_S
     }')
   if [ -n "$plim" ] && [ "$TNEW_TIME" -gt "$plim" ]; then TNEW_TIME=$PART_LIMIT; fi
   note "sizing: tnew's $TNEW_UNITS work units, about $TNEW_W CPU-s in all ($TNEW_PER_SWEEP × the sweep's), about $TNEW_EST s per task: a limit of $(show_time "$TNEW_TIME") per tnew task"
+else
+  TNEW_TIME=$TIME
 fi
 TNEW_SPEC="1-$TNEW_SHARDS"
 [ -z "$MAX_RUNNING" ] || TNEW_SPEC="$TNEW_SPEC%$MAX_RUNNING"
 tnew_cmd=(sbatch "${common[@]}" --job-name=slidestack-tnew --time="$TNEW_TIME" --array="$TNEW_SPEC"
   --output="$LOGS/tnew-%A_%a.out" "${EXTRA[@]}" "$HERE/shard.slurm" "${FORCE_ARG[@]}" tnew "$JOB_BIN" "$CONFIG"
   "$OUT" "$TNEW_SHARDS")
+# The command that resubmits failed shards of this submission with the same binary, N and sizes;
+# the finishing job prints it with --array LIST added.
+RESUBMIT_CMD="SLIDESTACK=$(printf '%q' "$JOB_BIN") $(printf '%q' "$HERE/slurm-submit.sh")"
+resubmit=(--shards "$SHARDS" --cpus-per-task "$CPUS" --time "$TIME" --stage-time "$STAGE_TIME")
+[ "$TNEW_UNITS" = 0 ] || resubmit+=(--tnew-time "$TNEW_TIME")
+[ -z "$ACCOUNT" ] || resubmit+=(--account "$ACCOUNT")
+[ -z "$PARTITION" ] || resubmit+=(--partition "$PARTITION")
+[ -z "$MEM" ] || resubmit+=(--mem "$MEM")
+[ -z "$MAX_RUNNING" ] || resubmit+=(--max-running "$MAX_RUNNING")
+[ $FORCE = 0 ] || resubmit+=(--force)
+resubmit+=("$CONFIG" "$OUT")
+[ ${#EXTRA[@]} -eq 0 ] || resubmit+=(-- "${EXTRA[@]}")
+RESUBMIT_ARGS=$(printf '%q ' "${resubmit[@]}")
+RESUBMIT_ARGS=${RESUBMIT_ARGS% }
+
 # With the sweep and tnew both as arrays, the finishing job is split: the merge job between them
 # and the rest after tnew's.
 NEED_MERGE=0 FINISH_PART=()
