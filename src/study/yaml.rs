@@ -21,8 +21,8 @@ pub fn shown(v: &serde_yaml::Value) -> String {
 
 /// A value read whole and turned into a `T` by `check`, whose `Err` says in words what the
 /// value should have been: refused inside the parser's call for the key, so that the message
-/// carries the key's path and line ([`yaml_problem`]), as a derived type's would (an untagged
-/// enum's says only that no variant matched).
+/// carries the key's path and line ([`super::config::yaml_problem`]), as a derived type's
+/// would (an untagged enum's says only that no variant matched).
 pub fn checked_value<'de, D, T>(
     d: D,
     check: impl FnOnce(serde_yaml::Value) -> Result<T, String>,
