@@ -111,8 +111,8 @@ struct Shown {
     axes: FloorsAxes,
     zone: ZoneFloors,
     offsets: Offsets,
-    /// Each shown frame's stored index, the frame and its label (`None` on one storey).
-    frames: Vec<(usize, Frame, Option<String>)>,
+    /// Each shown frame's stored index and the frame.
+    frames: Vec<(usize, Frame)>,
 }
 
 impl Shown {
@@ -120,7 +120,7 @@ impl Shown {
         let (axes, zone) = floors_zone(study, zone)?;
         let offsets = Offsets::of(&axes, study.frames().len());
         let frames = (study.shape.distinct().into_iter())
-            .map(|(f, frame)| (f, frame.clone(), study.shape.label(f)))
+            .map(|(f, frame)| (f, frame.clone()))
             .collect();
         Ok(Self {
             axes,
@@ -163,7 +163,7 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
         let v = Shown::read(study, &zone.name)?;
         let z = &v.zone;
         for c in 0..v.offsets.cases {
-            for (f, frame, label) in &v.frames {
+            for (f, frame) in &v.frames {
                 let f = *f;
                 for j in 0..frame.storeys() {
                     // One storey: the structure is the roof.
@@ -177,7 +177,7 @@ pub fn amplification_table(study: &Study) -> Result<Vec<FloorRow>, PipelineError
                     rows.push(FloorRow {
                         zone: zone.name.clone(),
                         case: c + 1,
-                        frame: label.clone(),
+                        frame: study.shape.label(f),
                         floor: j + 1,
                         z_over_h,
                         pfa_ratio_stack: ratio(&z.pfa_stack),
@@ -251,7 +251,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
     for zone in &study.cfg.zones {
         let v = Shown::read(study, &zone.name)?;
         let a = &v.axes;
-        for (f, frame, label) in &v.frames {
+        for (f, frame) in &v.frames {
             let floors = frame.storeys();
             let mut shown = vec![floors];
             if floors >= 3 {
@@ -286,7 +286,7 @@ pub fn figure_of(study: &Study) -> Result<crate::render::chart::Figure, Pipeline
                     );
                 }
             }
-            let at = label.as_ref().map_or(String::new(), |l| format!(", {l}"));
+            let at = study.shape.label_suffix(*f);
             // The case is every panel's: the figure's title names it.
             title.get_or_insert_with(|| {
                 format!(

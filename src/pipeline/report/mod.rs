@@ -347,12 +347,9 @@ fn facts(inp: &Inputs) -> Vec<String> {
         ),
     ];
     let mut shown: Vec<usize> = Vec::new();
-    // A building study names its buildings; the one-storey structure is described above.
-    let buildings = match study.shape.is_building() {
-        true => study.shape.distinct(),
-        false => Vec::new(),
-    };
-    for (_, f) in buildings {
+    // A building study names its buildings, once per storey count; the one-storey structure
+    // is described above.
+    for f in study.shape.building_frames() {
         if shown.contains(&f.storeys()) {
             continue;
         }
