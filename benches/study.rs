@@ -46,7 +46,9 @@ fn main() {
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
     println!("| stage | time (s) |\n|---|---|");
-    if let Some(line) = text.lines().find(|l| l.starts_with("run: ")) {
+    // `run` prints the stages it will run, then their times: the line with the total.
+    let times = |l: &&str| l.starts_with("run: ") && l.contains(" (total ");
+    if let Some(line) = text.lines().find(times) {
         let (stages, total) = line
             .trim_start_matches("run: ")
             .split_once(" (total ")
