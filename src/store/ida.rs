@@ -28,10 +28,10 @@
 use super::StoreError;
 use super::h5::{
     Attr, GroupReader, attach_scale, attr_str, coordinate, string_coordinate, write_attrs,
-    write_flags, write_stage_file, write_strings, write_var,
+    write_stage_file, write_strings, write_var,
 };
 use super::sweep::{building_coordinates, read_building_coordinates};
-use super::vars::{Codes, Data, Element};
+use super::vars::{Codes, Data, Element, long_name_in, write_data};
 use crate::grid::BuildingAxes;
 use ndarray::{ArrayD, IxDyn};
 use std::path::Path;
@@ -560,25 +560,28 @@ fn write_vars(
     for (var, data) in v.data() {
         let axes = |a: &[IdaAxis]| a.iter().map(|&a| d.axis(a)).collect::<Vec<_>>();
         let dims = d.around(&axes(var.before), &axes(var.after));
-        let long = match (var.building_long_name, frames) {
-            (Some(b), Some(_)) => b,
-            _ => var.long_name,
-        };
+        let long = long_name_in((var.long_name, var.building_long_name), frames.is_some());
+        // The frames split out of the case axis.
         let at = var.before.len();
-        let ds = match (data, var.codes) {
-            (Data::Values(a), _) => {
-                let a = split(a, at, frames);
-                write_var(g, var.name, a.view(), &chunk_of(a.shape()), var.units, long)?
+        let (values, codes);
+        let data = match data {
+            Data::Values(a) => {
+                values = split(a, at, frames);
+                Data::Values(&values)
             }
-            (Data::Codes(a), codes) => {
-                let a = split(a, at, frames);
-                let codes = match codes {
-                    Codes::Fixed(c) => c,
-                    _ => meta.fit_flags,
-                };
-                write_flags(g, var.name, a.view(), &chunk_of(a.shape()), long, codes)?
+            Data::Codes(a) => {
+                codes = split(a, at, frames);
+                Data::Codes(&codes)
             }
         };
+        let ds = write_data(
+            g,
+            (var.name, data),
+            &chunk_of(data.shape()),
+            (var.units, long),
+            var.codes,
+            || meta.fit_flags,
+        )?;
         for (i, s) in dims.iter().enumerate() {
             attach_scale(&ds, s, i)?;
         }

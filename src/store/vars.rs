@@ -63,10 +63,19 @@ pub struct Var {
 impl Var {
     /// The long name in a building study's file (`building`) or a one-storey study's.
     pub fn long_name_in(&self, building: bool) -> &'static str {
-        match self.building_long_name {
-            Some(b) if building => b,
-            _ => self.long_name,
-        }
+        long_name_in((self.long_name, self.building_long_name), building)
+    }
+}
+
+/// Of a declaration's long name and, where it says more, its building study's: the one a
+/// building study's file (`building`) or a one-storey study's carries.
+pub fn long_name_in(
+    (long, building_long): (&'static str, Option<&'static str>),
+    building: bool,
+) -> &'static str {
+    match building_long {
+        Some(b) if building => b,
+        _ => long,
     }
 }
 
@@ -95,6 +104,32 @@ impl Element for u8 {
 pub enum Data<'a> {
     Values(&'a ArrayD<f64>),
     Codes(&'a ArrayD<u8>),
+}
+
+impl Data<'_> {
+    pub fn shape(&self) -> &[usize] {
+        match self {
+            Data::Values(a) => a.shape(),
+            Data::Codes(a) => a.shape(),
+        }
+    }
+}
+
+/// Writes one declared array as `name` in `g`, chunked by `chunk`: values with their `units`
+/// (NaN fill), or codes as CF flags, the declaration's fixed table (`codes`) or else `given`'s.
+pub fn write_data<'c>(
+    g: &hdf5::Group,
+    (name, data): (&str, Data),
+    chunk: &[usize],
+    (units, long): (&str, &str),
+    codes: Codes,
+    given: impl FnOnce() -> &'c [(u8, &'c str)],
+) -> hdf5::Result<hdf5::Dataset> {
+    match (data, codes) {
+        (Data::Values(a), _) => write_var(g, name, a.view(), chunk, units, long),
+        (Data::Codes(a), Codes::Fixed(codes)) => write_flags(g, name, a.view(), chunk, long, codes),
+        (Data::Codes(a), _) => write_flags(g, name, a.view(), chunk, long, given()),
+    }
 }
 
 /// Declares a struct of stored variables, one `ArrayD` field per variable, and derives from it
@@ -186,10 +221,7 @@ pub struct Target<'a> {
 /// to its dimension scales.
 pub fn write_declared(to: &Target, vars: &[(&'static Var, Data)]) -> hdf5::Result<()> {
     for (var, data) in vars {
-        let shape = match data {
-            Data::Values(a) => a.shape(),
-            Data::Codes(a) => a.shape(),
-        };
+        let shape = data.shape();
         let mut chunk = to.chunk.to_vec();
         let scale = match var.trailing.axis() {
             None => None,
@@ -199,23 +231,14 @@ pub fn write_declared(to: &Target, vars: &[(&'static Var, Data)]) -> hdf5::Resul
                 Some((to.trailing)(var.trailing).ok_or_else(missing)?)
             }
         };
-        let long = var.long_name_in(to.building);
-        let ds = match (data, var.codes) {
-            (Data::Values(a), _) => {
-                write_var(to.group, var.name, a.view(), &chunk, var.units, long)?
-            }
-            (Data::Codes(a), Codes::Fixed(codes)) => {
-                write_flags(to.group, var.name, a.view(), &chunk, long, codes)?
-            }
-            (Data::Codes(a), _) => write_flags(
-                to.group,
-                var.name,
-                a.view(),
-                &chunk,
-                long,
-                (to.given)(var.name),
-            )?,
-        };
+        let ds = write_data(
+            to.group,
+            (var.name, *data),
+            &chunk,
+            (var.units, var.long_name_in(to.building)),
+            var.codes,
+            || (to.given)(var.name),
+        )?;
         attach_all(&ds, to.scales)?;
         if let Some(s) = scale {
             attach_scale(&ds, s, to.scales.len())?;
