@@ -45,7 +45,8 @@ fn main() {
          at the start)",
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
-    println!("| stage | time (s) |\n|---|---|");
+    // Each stage's time also as a ratio to the sweep's in the same run, the baseline row.
+    println!("| stage | time (s) | × sweep |\n|---|---|---|");
     // `run` prints the stages it will run, then their times: the line with the total.
     let times = |l: &&str| l.starts_with("run: ") && l.contains(" (total ");
     if let Some(line) = text.lines().find(times) {
@@ -53,12 +54,23 @@ fn main() {
             .trim_start_matches("run: ")
             .split_once(" (total ")
             .unwrap_or((line, ""));
-        for part in stages.split(", ") {
-            if let Some((name, t)) = part.split_once(' ') {
-                println!("| {name} | {} |", t.trim_end_matches(" s"));
-            }
+        let rows: Vec<(&str, &str)> = stages
+            .split(", ")
+            .filter_map(|part| part.split_once(' '))
+            .map(|(name, t)| (name, t.trim_end_matches(" s")))
+            .chain([("total", total.trim_end_matches(" s)"))])
+            .collect();
+        let sweep_s = rows
+            .iter()
+            .find(|(name, _)| *name == "sweep")
+            .and_then(|(_, t)| t.parse::<f64>().ok());
+        for (name, t) in rows {
+            let ratio = match (t.parse::<f64>(), sweep_s) {
+                (Ok(t), Some(sweep)) if sweep > 0.0 => format!("{:.3}", t / sweep),
+                _ => "–".into(),
+            };
+            println!("| {name} | {t} | {ratio} |");
         }
-        println!("| total | {} |", total.trim_end_matches(" s)"));
     }
     for line in text.lines().filter(|l| {
         (l.starts_with("sweep: ") && l.contains("cases/s"))
