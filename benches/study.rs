@@ -1,5 +1,6 @@
 //! The study end to end: `slidestack run` on a config (default `configs/paper.yaml`, the paper's
-//! full grid, both zones) into a fresh directory, printing the time of each stage, cases per
+//! full grid, both zones) into a fresh directory, printing the time of each stage (and its ratio
+//! to the sweep's in the same run), cases per
 //! second and simulations per second (and, for a config with an `ida:` section, the IDA's runs
 //! per second and time per simulated sample).
 //!
