@@ -16,7 +16,9 @@
 //! pair of zeros is missed).
 //!
 //! Eight oscillators advance together in lanes so the recurrences overlap in the pipeline, and
-//! groups of eight run in parallel.
+//! groups of eight run in parallel. The lanes hold eight periods under one record
+//! ([`response_spectrum`]) or one period under eight records of one step and length
+//! ([`peaks_of_records`]); each lane's peak is the same bits either way.
 
 use crate::dynamics::closed_form::{Basis, Osc, Wave};
 use crate::limits::{DT_RANGE_S, MAX_SAMPLES, PERIOD_RANGE_S};
@@ -58,6 +60,15 @@ pub struct Peak {
     pub time_s: f64,
 }
 
+impl Peak {
+    /// Pseudo-spectral acceleration `PSA = ω²·Sd` of this peak of an oscillator of `period_s`,
+    /// in g.
+    pub fn psa_g(&self, period_s: f64) -> f64 {
+        let w = std::f64::consts::TAU / period_s;
+        w * w * self.sd_m / crate::dynamics::G
+    }
+}
+
 /// A response spectrum at one damping ratio.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResponseSpectrum {
@@ -78,8 +89,8 @@ impl ResponseSpectrum {
     }
     /// Pseudo-spectral acceleration `PSA = ω²·Sd`, in g.
     pub fn psa_g(&self) -> Vec<f64> {
-        self.iter_omega()
-            .map(|(w, p)| w * w * p.sd_m / crate::dynamics::G)
+        (self.periods_s.iter().zip(&self.peaks))
+            .map(|(&t, p)| p.psa_g(t))
             .collect()
     }
     fn iter_omega(&self) -> impl Iterator<Item = (f64, &Peak)> {
@@ -134,7 +145,11 @@ pub fn response_spectrum(
         .map(|chunk| {
             let mut lanes = [periods_s[0]; LANES];
             lanes[..chunk.len()].copy_from_slice(chunk);
-            peaks_in_lanes(accel_mps2, &reach, dt_s, &lanes, damping)[..chunk.len()].to_vec()
+            let record = Shared {
+                accel: accel_mps2,
+                reach: &reach,
+            };
+            peaks_in_lanes(&record, dt_s, &lanes, damping)[..chunk.len()].to_vec()
         })
         .collect();
     let peaks: Vec<Peak> = groups.into_iter().flatten().collect();
@@ -160,11 +175,15 @@ pub fn response_spectrum_while(
         validate_oscillator(t, damping)?;
     }
     let reach = Reach::new(accel_mps2, dt_s);
+    let record = Shared {
+        accel: accel_mps2,
+        reach: &reach,
+    };
     let mut peaks = Vec::with_capacity(periods_s.len());
     for (i, chunk) in periods_s.chunks(LANES).enumerate() {
         let mut lanes = [periods_s[0]; LANES];
         lanes[..chunk.len()].copy_from_slice(chunk);
-        let group = peaks_in_lanes(accel_mps2, &reach, dt_s, &lanes, damping);
+        let group = peaks_in_lanes(&record, dt_s, &lanes, damping);
         if !keep_going(i * LANES, &group[..chunk.len()]) {
             return Ok(None);
         }
@@ -175,6 +194,53 @@ pub fn response_spectrum_while(
         periods_s: periods_s.to_vec(),
         peaks,
     }))
+}
+
+/// The peak of one oscillator (`period_s`, `damping`) under each of `records`
+/// (`(accel_mps2, dt_s)`), in their order, on this thread: each the bits of
+/// [`response_spectrum`] of its record at `period_s`. Records of one step and length run eight
+/// at a time, one per lane; the inputs are checked in the order [`response_spectrum`] of each
+/// record in turn would check them.
+pub fn peaks_of_records(
+    records: &[(&[f64], f64)],
+    period_s: f64,
+    damping: f64,
+) -> Result<Vec<Peak>, SpectrumError> {
+    for &(accel_mps2, dt_s) in records {
+        validate_record(accel_mps2, dt_s)?;
+        validate_oscillator(period_s, damping)?;
+    }
+    let reaches: Vec<Reach> = (records.iter())
+        .map(|&(accel_mps2, dt_s)| Reach::new(accel_mps2, dt_s))
+        .collect();
+    let mut groups: Vec<((u64, usize), Vec<usize>)> = Vec::new();
+    for (i, &(accel_mps2, dt_s)) in records.iter().enumerate() {
+        let key = (dt_s.to_bits(), accel_mps2.len());
+        match groups.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, members)) => members.push(i),
+            None => groups.push((key, vec![i])),
+        }
+    }
+    let mut peaks: Vec<Option<Peak>> = vec![None; records.len()];
+    for (_, members) in &groups {
+        for batch in members.chunks(LANES) {
+            // Fewer records than lanes: the first fills the rest, its copies' peaks dropped.
+            let pick = |l: usize| *batch.get(l).unwrap_or(&batch[0]);
+            let lanes = PerLane {
+                accel: std::array::from_fn(|l| records[pick(l)].0),
+                reach: std::array::from_fn(|l| &reaches[pick(l)]),
+            };
+            let dt_s = records[batch[0]].1;
+            let got = peaks_in_lanes(&lanes, dt_s, &[period_s; LANES], damping);
+            for (&i, p) in batch.iter().zip(got) {
+                peaks[i] = Some(p);
+            }
+        }
+    }
+    Ok(peaks
+        .into_iter()
+        .map(|p| p.expect("every record is in a batch"))
+        .collect())
 }
 
 /// Peak response of one oscillator.
@@ -230,6 +296,71 @@ impl Reach {
             block_sum,
             block_max,
         }
+    }
+}
+
+/// The ground accelerations the lanes run under, every lane the same number of samples at the
+/// same step: one record in every lane (a spectrum's periods) or one record per lane (one
+/// period under several records).
+trait Records {
+    /// Lane `l`'s ground acceleration at sample `k`, m/s².
+    fn accel(&self, l: usize, k: usize) -> f64;
+    /// Every lane's ground acceleration at sample `k`, m/s² (read before a step of every lane,
+    /// so that the step's stores cannot make them be read again).
+    fn accels(&self, k: usize) -> [f64; LANES];
+    /// Lane `l`'s [`Reach`].
+    fn reach(&self, l: usize) -> &Reach;
+    /// Samples of every lane's record.
+    fn samples(&self) -> usize;
+}
+
+/// One record in every lane.
+struct Shared<'a> {
+    accel: &'a [f64],
+    reach: &'a Reach,
+}
+
+impl Records for Shared<'_> {
+    #[inline(always)]
+    fn accel(&self, _: usize, k: usize) -> f64 {
+        self.accel[k]
+    }
+    #[inline(always)]
+    fn accels(&self, k: usize) -> [f64; LANES] {
+        [self.accel[k]; LANES]
+    }
+    #[inline(always)]
+    fn reach(&self, _: usize) -> &Reach {
+        self.reach
+    }
+    #[inline(always)]
+    fn samples(&self) -> usize {
+        self.accel.len()
+    }
+}
+
+/// A record per lane, all of one length.
+struct PerLane<'a> {
+    accel: [&'a [f64]; LANES],
+    reach: [&'a Reach; LANES],
+}
+
+impl Records for PerLane<'_> {
+    #[inline(always)]
+    fn accel(&self, l: usize, k: usize) -> f64 {
+        self.accel[l][k]
+    }
+    #[inline(always)]
+    fn accels(&self, k: usize) -> [f64; LANES] {
+        self.accel.map(|a| a[k])
+    }
+    #[inline(always)]
+    fn reach(&self, l: usize) -> &Reach {
+        self.reach[l]
+    }
+    #[inline(always)]
+    fn samples(&self) -> usize {
+        self.accel[0].len()
     }
 }
 
@@ -326,26 +457,26 @@ impl Lanes {
     ///
     /// Compiled twice: for AVX2 (chosen at run time where the processor has it) and for the
     /// baseline. Neither contracts a multiply and an add, so both give the same bits.
-    fn peaks(&self, accel: &[f64], reach: &Reach) -> [Peak; LANES] {
+    fn peaks<R: Records>(&self, records: &R) -> [Peak; LANES] {
         #[cfg(target_arch = "x86_64")]
         {
             if std::arch::is_x86_feature_detected!("avx2") {
                 // SAFETY: the processor has AVX2 (checked just above).
-                return unsafe { self.peaks_avx2(accel, reach) };
+                return unsafe { self.peaks_avx2(records) };
             }
         }
-        self.peaks_generic(accel, reach)
+        self.peaks_generic(records)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn peaks_avx2(&self, accel: &[f64], reach: &Reach) -> [Peak; LANES] {
-        self.peaks_generic(accel, reach)
+    unsafe fn peaks_avx2<R: Records>(&self, records: &R) -> [Peak; LANES] {
+        self.peaks_generic(records)
     }
 
     #[inline(always)]
-    fn peaks_generic(&self, accel: &[f64], reach: &Reach) -> [Peak; LANES] {
-        let st = self.sample_states(accel, reach);
+    fn peaks_generic<R: Records>(&self, records: &R) -> [Peak; LANES] {
+        let st = self.sample_states(records);
         let mut peaks: [Peak; LANES] = std::array::from_fn(|l| {
             let k = st.best_k[l];
             Peak {
@@ -357,28 +488,28 @@ impl Lanes {
         let omega_peak: [f64; LANES] = std::array::from_fn(|l| self.omega[l] * st.best[l]);
         let two_zw = self.omega.map(|w| 2.0 * self.zeta * w);
         let inv_h = 1.0 / self.h;
-        let intervals = accel.len() - 1;
+        let intervals = records.samples() - 1;
         for &b in &st.blocks {
             for k in b * BLOCK..((b + 1) * BLOCK).min(intervals) {
                 let (u0, v0) = (&st.u[k], &st.v[k]);
                 let mut any = false;
                 for l in 0..LANES {
                     let e = self.w2[l] * u0[l] * u0[l] + v0[l] * v0[l];
-                    let room = omega_peak[l] - reach.interval[k];
+                    let room = omega_peak[l] - records.reach(l).interval[k];
                     any |= !(room > 0.0 && e <= room * room * SLACK);
                 }
                 if !any {
                     continue;
                 }
                 let (u1, v1) = (&st.u[k + 1], &st.v[k + 1]);
-                let (ag0, ag1) = (accel[k], accel[k + 1]);
-                let load = IntervalLoad {
-                    ag0,
-                    ag1,
-                    slope: (ag0 - ag1) * inv_h,
-                    reach: reach.interval[k],
-                };
                 for l in 0..LANES {
+                    let (ag0, ag1) = (records.accel(l, k), records.accel(l, k + 1));
+                    let load = IntervalLoad {
+                        ag0,
+                        ag1,
+                        slope: (ag0 - ag1) * inv_h,
+                        reach: records.reach(l).interval[k],
+                    };
                     let a0 = -ag0 - self.w2[l] * u0[l] - two_zw[l] * v0[l];
                     let a1 = -ag1 - self.w2[l] * u1[l] - two_zw[l] * v1[l];
                     let sign_change =
@@ -405,13 +536,13 @@ impl Lanes {
     /// sample on ties), and the states of the blocks that may hold a larger `|u|`
     /// (see [`Lanes::peaks_generic`]).
     #[inline(always)]
-    fn sample_states(&self, accel: &[f64], reach: &Reach) -> SampleStates {
+    fn sample_states<R: Records>(&self, records: &R) -> SampleStates {
         let c = |f: fn(&Step) -> f64| self.steps.map(|s| f(&s));
         let (uu, uv, ug0, ug1) = (c(|s| s.uu), c(|s| s.uv), c(|s| s.ug0), c(|s| s.ug1));
         let (vu, vv, vg0, vg1) = (c(|s| s.vu), c(|s| s.vv), c(|s| s.vg0), c(|s| s.vg1));
         let (mut us, mut vs, mut blocks) = STATES.take();
-        us.resize(accel.len(), [0.0; LANES]);
-        vs.resize(accel.len(), [0.0; LANES]);
+        us.resize(records.samples(), [0.0; LANES]);
+        vs.resize(records.samples(), [0.0; LANES]);
         blocks.clear();
         let (mut u, mut v) = ([0.0f64; LANES], [0.0f64; LANES]);
         let mut best = [0.0f64; LANES];
@@ -421,8 +552,9 @@ impl Lanes {
         // macro rather than a closure, so that it is compiled into the AVX2 copy).
         macro_rules! step {
             ($k:expr) => {
-                let (ag0, ag1) = (accel[$k], accel[$k + 1]);
+                let (a0, a1) = (records.accels($k), records.accels($k + 1));
                 for l in 0..LANES {
+                    let (ag0, ag1) = (a0[l], a1[l]);
                     let (u0, v0) = (u[l], v[l]);
                     u[l] = uu[l] * u0 + uv[l] * v0 + ug0[l] * ag0 + ug1[l] * ag1;
                     v[l] = vu[l] * u0 + vv[l] * v0 + vg0[l] * ag0 + vg1[l] * ag1;
@@ -433,13 +565,14 @@ impl Lanes {
             };
         }
         const MARGIN: f64 = SLACK * (1.0 - 1e-9);
-        let intervals = accel.len() - 1;
+        let intervals = records.samples() - 1;
         for b in 0..intervals.div_ceil(BLOCK) {
             let k0 = b * BLOCK;
-            let grow = reach.block_sum[b];
-            let near = reach.block_max[b];
+            let grow: [f64; LANES] = std::array::from_fn(|l| records.reach(l).block_sum[b]);
+            let near: [f64; LANES] = std::array::from_fn(|l| records.reach(l).block_max[b]);
             let mut may = false;
             for l in 0..LANES {
+                let (grow, near) = (grow[l], near[l]);
                 let e = self.w2[l] * u[l] * u[l] + v[l] * v[l];
                 let bound = e.sqrt() + grow;
                 let room = self.omega[l] * best[l] - near;
@@ -513,9 +646,8 @@ impl Lanes {
     }
 }
 
-fn peaks_in_lanes(
-    accel: &[f64],
-    reach: &Reach,
+fn peaks_in_lanes<R: Records>(
+    records: &R,
     h: f64,
     periods_s: &[f64; LANES],
     zeta: f64,
@@ -532,7 +664,7 @@ fn peaks_in_lanes(
         zeta,
         h,
     };
-    lanes.peaks(accel, reach)
+    lanes.peaks(records)
 }
 
 /// One sample interval of one oscillator, for the exact search of `max |u|` inside it.
@@ -721,5 +853,60 @@ mod tests {
             p.sd_m
         );
         assert!(sampled_peak(&accel, dt, period, 0.0) < 0.99 * exact);
+    }
+
+    #[test]
+    fn records_in_lanes_give_each_record_its_own_bits() {
+        // Eleven records of two steps and three lengths (a batch of eight and one of two at
+        // 0.01 s, one alone at 0.02 s): every peak equals its record's own spectrum's at the
+        // period, to the bit, at short and long periods, damped and undamped; the first record
+        // at fault is named, as the spectrum of each record in turn would.
+        let record = |seed: u64, len: usize| -> Vec<f64> {
+            let mut x = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (0..len)
+                .map(|k| {
+                    x = x
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    let noise = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                    let envelope = (k as f64 / len as f64 * std::f64::consts::PI).sin();
+                    3.0 * envelope * noise
+                })
+                .collect()
+        };
+        let shapes = [(0.01, 900); 8]
+            .into_iter()
+            .chain([(0.02, 500), (0.01, 900), (0.01, 700)]);
+        let owned: Vec<(Vec<f64>, f64)> = (shapes.enumerate())
+            .map(|(i, (dt, len))| (record(i as u64, len), dt))
+            .collect();
+        let records: Vec<(&[f64], f64)> = owned.iter().map(|(a, dt)| (&a[..], *dt)).collect();
+        for period in [0.03, 0.3, 1.0, 6.0] {
+            for zeta in [0.0, 0.05] {
+                let got = peaks_of_records(&records, period, zeta).unwrap();
+                for (i, (&(a, dt), p)) in records.iter().zip(&got).enumerate() {
+                    let own = response_spectrum(a, dt, &[period], zeta).unwrap().peaks[0];
+                    let bits = |p: &Peak| [p.sd_m, p.u_m, p.time_s].map(f64::to_bits);
+                    assert_eq!(bits(p), bits(&own), "record {i}, T = {period}, ζ = {zeta}");
+                }
+            }
+        }
+        let mut bad = owned.clone();
+        bad[9].0[3] = f64::NAN;
+        let records: Vec<(&[f64], f64)> = bad.iter().map(|(a, dt)| (&a[..], *dt)).collect();
+        assert_eq!(
+            peaks_of_records(&records, 1.0, 0.05)
+                .unwrap_err()
+                .to_string(),
+            "ground acceleration sample 3 is not finite (NaN)"
+        );
+        assert_eq!(
+            peaks_of_records(&records, 0.0, 0.05)
+                .unwrap_err()
+                .to_string(),
+            "period 0.0 s must be within 0.001 … 10000 s"
+        );
     }
 }

@@ -42,7 +42,8 @@ use crate::dynamics::building::{
     Building, BuildingResponse, LinearBuilding, LinearOutput, simulate_building,
 };
 use crate::dynamics::{ExactOptions, G, Ground};
-use crate::spectrum::{SpectrumError, TARGET_DAMPING, response_spectrum};
+use crate::spectrum::response::peaks_of_records;
+use crate::spectrum::{SpectrumError, TARGET_DAMPING};
 use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::brent::BrentRoot;
 use std::cell::RefCell;
@@ -600,13 +601,12 @@ pub fn load_ratio(case: &Case, frame: &Frame) -> f64 {
 }
 
 /// The mean over the motions of their 5 %-damped pseudo-spectral acceleration at `period_s`
-/// exactly (each summed in motion order, then divided), g.
+/// exactly (each summed in motion order, then divided), g; the motions in the spectrum's lanes
+/// ([`peaks_of_records`]).
 pub fn mean_psa_g(grounds: &[Ground], period_s: f64) -> Result<f64, SpectrumError> {
-    let mut sum = 0.0;
-    for g in grounds {
-        let s = response_spectrum(g.accel_mps2, g.dt_s, &[period_s], TARGET_DAMPING)?;
-        sum += s.psa_g()[0];
-    }
+    let records: Vec<(&[f64], f64)> = grounds.iter().map(|g| (g.accel_mps2, g.dt_s)).collect();
+    let peaks = peaks_of_records(&records, period_s, TARGET_DAMPING)?;
+    let sum = (peaks.iter()).fold(0.0, |sum, p| sum + p.psa_g(period_s));
     Ok(sum / grounds.len() as f64)
 }
 

@@ -207,21 +207,6 @@ impl Outputs {
         }
     }
 
-    /// [`Self::lane_eval_all`] of a table of one output: its value in `f[0][l][0]`, the rest
-    /// of `f` left as it is (zero, as the other's padding), at `1/LANE` of the work.
-    #[inline(always)]
-    fn lane_eval_one<const L: usize>(&self, y: &[[f64; L]], f: &mut [[[f64; LANE]; L]]) {
-        let mut acc = [0.0; L];
-        for (w, s) in self.wrows.iter().zip(y) {
-            for l in 0..L {
-                acc[l] += w * s[l];
-            }
-        }
-        for l in 0..L {
-            f[0][l][0] = acc[l];
-        }
-    }
-
     /// Output `o` at modal state `y`: the same sum as [`Self::eval_all`]'s, the same bits.
     fn eval_one(&self, o: usize, y: &[f64]) -> f64 {
         let row = &self.wrows[o * y.len()..(o + 1) * y.len()];
@@ -647,6 +632,9 @@ impl LinearBuilding {
         carries: &mut [Carry],
         blocks: usize,
     ) {
+        if out.count == 1 {
+            return Self::lane_blocks_one(out, steps, accels, inv_h, passes, carries, blocks);
+        }
         const L: usize = MOTIONS;
         let m = steps.len();
         let groups = out.count.div_ceil(LANE);
@@ -669,11 +657,7 @@ impl LinearBuilding {
                 let a0: [f64; L] = std::array::from_fn(|l| accels[l][k]);
                 let a1: [f64; L] = std::array::from_fn(|l| accels[l][k + 1]);
                 Self::lane_step(steps, &mut y, &mut q, a0, a1, inv_h);
-                if out.count == 1 {
-                    out.lane_eval_one(&y, &mut f);
-                } else {
-                    out.lane_eval_all(&y, &mut f);
-                }
+                out.lane_eval_all(&y, &mut f);
                 for ((bm, fa), fo) in bm.iter_mut().zip(f_abs.iter_mut()).zip(&f) {
                     for l in 0..L {
                         for i in 0..LANE {
@@ -708,6 +692,68 @@ impl LinearBuilding {
             for (g, fa) in f_abs.iter().enumerate() {
                 carry.f_abs[g] = fa[l];
             }
+        }
+    }
+
+    /// [`Self::lane_blocks`] of a table of one output (a search of one attached fraction): its
+    /// `|f|` kept per lane alone, not in a group of [`LANE`] whose other seven are zero, and
+    /// summed as [`Self::lane_eval_all`] sums it; the same values in `passes` and `carries`.
+    #[inline(always)]
+    fn lane_blocks_one(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]; MOTIONS],
+        inv_h: f64,
+        passes: &mut [FirstPass],
+        carries: &mut [Carry],
+        blocks: usize,
+    ) {
+        const L: usize = MOTIONS;
+        let m = steps.len();
+        let row = &out.wrows[..2 * m];
+        let mut y = vec![[0.0; L]; 2 * m];
+        let mut q = vec![[0.0; L]; m];
+        let mut f_abs = [0.0; L];
+        for b in 0..blocks {
+            for (l, pass) in passes.iter_mut().enumerate() {
+                for (c, y) in y.iter().enumerate() {
+                    pass.starts[b * 2 * m + c] = y[l];
+                }
+            }
+            let mut bm = f_abs;
+            for q in q.iter_mut() {
+                *q = [0.0; L];
+            }
+            for k in b * BLOCK..(b + 1) * BLOCK {
+                let a0: [f64; L] = std::array::from_fn(|l| accels[l][k]);
+                let a1: [f64; L] = std::array::from_fn(|l| accels[l][k + 1]);
+                Self::lane_step(steps, &mut y, &mut q, a0, a1, inv_h);
+                let mut f = [0.0; L];
+                for (w, s) in row.iter().zip(&y) {
+                    for l in 0..L {
+                        f[l] += w * s[l];
+                    }
+                }
+                for l in 0..L {
+                    let a = f[l].abs();
+                    f_abs[l] = a;
+                    bm[l] = if a > bm[l] { a } else { bm[l] };
+                }
+            }
+            for (l, pass) in passes.iter_mut().enumerate() {
+                for (r, q) in q.iter().enumerate() {
+                    pass.block_q[b * m + r] = q[l];
+                }
+                pass.block_max[b][0] = bm[l];
+                let best = &mut pass.best[0][0];
+                *best = if bm[l] > *best { bm[l] } else { *best };
+            }
+        }
+        for (l, carry) in carries.iter_mut().enumerate() {
+            for (c, y) in y.iter().enumerate() {
+                carry.y[c] = y[l];
+            }
+            carry.f_abs[0][0] = f_abs[l];
         }
     }
 
