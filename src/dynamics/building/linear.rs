@@ -269,6 +269,15 @@ fn has_avx2() -> bool {
     }
 }
 
+/// Lane `l` of a state held lane by lane (`[component][lane]`) into `out`, component by
+/// component.
+#[inline(always)]
+fn lane_of<const L: usize>(lanes: &[[f64; L]], l: usize, out: &mut [f64]) {
+    for (o, v) in out.iter_mut().zip(lanes) {
+        *o = v[l];
+    }
+}
+
 /// Records whose first passes run side by side, one per lane of four `f64` (one AVX2
 /// register).
 const MOTIONS: usize = 4;
@@ -645,14 +654,10 @@ impl LinearBuilding {
         let mut bm = vec![[[0.0; LANE]; L]; groups];
         for b in 0..blocks {
             for (l, pass) in passes.iter_mut().enumerate() {
-                for (c, y) in y.iter().enumerate() {
-                    pass.starts[b * 2 * m + c] = y[l];
-                }
+                lane_of(&y, l, &mut pass.starts[b * 2 * m..(b + 1) * 2 * m]);
             }
             bm.copy_from_slice(&f_abs);
-            for q in q.iter_mut() {
-                *q = [0.0; L];
-            }
+            q.fill([0.0; L]);
             for k in b * BLOCK..(b + 1) * BLOCK {
                 let a0: [f64; L] = std::array::from_fn(|l| accels[l][k]);
                 let a1: [f64; L] = std::array::from_fn(|l| accels[l][k + 1]);
@@ -669,9 +674,7 @@ impl LinearBuilding {
                 }
             }
             for (l, pass) in passes.iter_mut().enumerate() {
-                for (r, q) in q.iter().enumerate() {
-                    pass.block_q[b * m + r] = q[l];
-                }
+                lane_of(&q, l, &mut pass.block_q[b * m..(b + 1) * m]);
                 for (g, bm) in bm.iter().enumerate() {
                     pass.block_max[b * groups + g] = bm[l];
                     let best = &mut pass.best[g];
@@ -686,9 +689,7 @@ impl LinearBuilding {
             }
         }
         for (l, carry) in carries.iter_mut().enumerate() {
-            for (c, y) in y.iter().enumerate() {
-                carry.y[c] = y[l];
-            }
+            lane_of(&y, l, &mut carry.y);
             for (g, fa) in f_abs.iter().enumerate() {
                 carry.f_abs[g] = fa[l];
             }
@@ -716,14 +717,10 @@ impl LinearBuilding {
         let mut f_abs = [0.0; L];
         for b in 0..blocks {
             for (l, pass) in passes.iter_mut().enumerate() {
-                for (c, y) in y.iter().enumerate() {
-                    pass.starts[b * 2 * m + c] = y[l];
-                }
+                lane_of(&y, l, &mut pass.starts[b * 2 * m..(b + 1) * 2 * m]);
             }
             let mut bm = f_abs;
-            for q in q.iter_mut() {
-                *q = [0.0; L];
-            }
+            q.fill([0.0; L]);
             for k in b * BLOCK..(b + 1) * BLOCK {
                 let a0: [f64; L] = std::array::from_fn(|l| accels[l][k]);
                 let a1: [f64; L] = std::array::from_fn(|l| accels[l][k + 1]);
@@ -741,18 +738,14 @@ impl LinearBuilding {
                 }
             }
             for (l, pass) in passes.iter_mut().enumerate() {
-                for (r, q) in q.iter().enumerate() {
-                    pass.block_q[b * m + r] = q[l];
-                }
+                lane_of(&q, l, &mut pass.block_q[b * m..(b + 1) * m]);
                 pass.block_max[b][0] = bm[l];
                 let best = &mut pass.best[0][0];
                 *best = if bm[l] > *best { bm[l] } else { *best };
             }
         }
         for (l, carry) in carries.iter_mut().enumerate() {
-            for (c, y) in y.iter().enumerate() {
-                carry.y[c] = y[l];
-            }
+            lane_of(&y, l, &mut carry.y);
             carry.f_abs[0][0] = f_abs[l];
         }
     }
