@@ -303,8 +303,6 @@ impl Reach {
 /// same step: one record in every lane (a spectrum's periods) or one record per lane (one
 /// period under several records).
 trait Records {
-    /// Lane `l`'s ground acceleration at sample `k`, m/s².
-    fn accel(&self, l: usize, k: usize) -> f64;
     /// Every lane's ground acceleration at sample `k`, m/s² (read before a step of every lane,
     /// so that the step's stores cannot make them be read again).
     fn accels(&self, k: usize) -> [f64; LANES];
@@ -321,10 +319,6 @@ struct Shared<'a> {
 }
 
 impl Records for Shared<'_> {
-    #[inline(always)]
-    fn accel(&self, _: usize, k: usize) -> f64 {
-        self.accel[k]
-    }
     #[inline(always)]
     fn accels(&self, k: usize) -> [f64; LANES] {
         [self.accel[k]; LANES]
@@ -346,10 +340,6 @@ struct PerLane<'a> {
 }
 
 impl Records for PerLane<'_> {
-    #[inline(always)]
-    fn accel(&self, l: usize, k: usize) -> f64 {
-        self.accel[l][k]
-    }
     #[inline(always)]
     fn accels(&self, k: usize) -> [f64; LANES] {
         self.accel.map(|a| a[k])
@@ -502,8 +492,9 @@ impl Lanes {
                     continue;
                 }
                 let (u1, v1) = (&st.u[k + 1], &st.v[k + 1]);
+                let (ground0, ground1) = (records.accels(k), records.accels(k + 1));
                 for l in 0..LANES {
-                    let (ag0, ag1) = (records.accel(l, k), records.accel(l, k + 1));
+                    let (ag0, ag1) = (ground0[l], ground1[l]);
                     let load = IntervalLoad {
                         ag0,
                         ag1,
