@@ -550,15 +550,15 @@ impl<'b> Integrator<'b> {
                 }
                 let mut first: Option<(f64, usize)> = None;
                 for e in 0..self.events.len() {
-                    let g = self.events[e].g;
-                    if first.is_none() && self.clear(&mode, &g, h, 0.0, f64::INFINITY) {
+                    let g = &self.events[e].g;
+                    if first.is_none() && self.clear(&mode, g, h, 0.0, f64::INFINITY) {
                         continue;
                     }
-                    let f = self.func(&mode, &g);
-                    let n0 = self.node0(&mode, &g);
+                    let f = self.func(&mode, g);
+                    let n0 = self.node0(&mode, g);
                     let limit = first.map_or(h, |f| f.0);
                     let n1 = if limit == h {
-                        self.node_at(&mode, &g, &self.p_end)
+                        self.node_at(&mode, g, &self.p_end)
                     } else {
                         Node::of(&f, limit)
                     };
@@ -1185,7 +1185,8 @@ impl<'b> Integrator<'b> {
         // ride on each floor), storey shears, floor velocities (with their riders), the
         // overturning moment.
         for idx in 0..self.peaks.len() {
-            let (of, g) = self.peaks[idx];
+            // Borrowed, not copied: a copy of the function stalls the loads that follow it.
+            let (of, g) = (self.peaks[idx].0, &self.peaks[idx].1);
             let best = match of {
                 PeakOf::Disp(j) => self.out.floor_peak_displacement_m[j],
                 PeakOf::Drift(i) => self.out.storey_peak_drift_m[i],
@@ -1203,12 +1204,12 @@ impl<'b> Integrator<'b> {
                     floor
                 }
             };
-            if self.clear(mode, &g, end, -best, best) {
+            if self.clear(mode, g, end, -best, best) {
                 continue;
             }
-            let f = self.func(mode, &g);
-            let n0 = self.node0(mode, &g);
-            let n1 = self.node_at(mode, &g, &self.p_end);
+            let f = self.func(mode, g);
+            let n0 = self.node0(mode, g);
+            let n1 = self.node_at(mode, g, &self.p_end);
             let (peak, _) = search::peak_abs(&f, &n0, &n1, best, dt)?;
             if peak > best {
                 match of {
