@@ -434,6 +434,50 @@ fn the_energy_balance_closes_on_real_records() {
     }
 }
 
+/// The sweep's option that searches the roof's peak displacement alone
+/// (`floor_displacements: false`) leaves every other output to the bit, as its argument says
+/// (each peak is searched on its own): the floors below the roof are NaN, the rest of the
+/// response prints the same (`Debug` prints each float's shortest round-trip form), on three
+/// storeys with stacks on two floors, elastic and yielding, under the real records.
+#[test]
+fn the_roof_only_displacement_option_changes_nothing_else() {
+    let mut s = three_storeys(DampingBasis::Structure);
+    s.stacks = vec![
+        stack(3, &[0.5, 0.5], &[0.2, 0.1], Some(&[0.25, 0.1])),
+        stack(1, &[0.4, 0.2], &[0.15, 0.05], None),
+    ];
+    let elastic = s.clone();
+    s.yielding = Some(StoreyYielding {
+        strength_ratios: vec![0.15, 0.12, 0.1],
+        post_yield_ratio: 0.05,
+    });
+    let roof_only = ExactOptions {
+        floor_displacements: false,
+        ..opts()
+    };
+    for rec in real_records() {
+        let accel = rec.accel_mps2(1.5);
+        let ground = Ground {
+            dt_s: rec.dt_s,
+            accel_mps2: &accel,
+        };
+        for spec in [&elastic, &s] {
+            let b = Building::new(spec).unwrap();
+            let mut all = simulate_building(&b, &ground, &opts()).unwrap();
+            let roof = simulate_building(&b, &ground, &roof_only).unwrap();
+            let n = all.floor_peak_displacement_m.len();
+            assert!(
+                roof.floor_peak_displacement_m[..n - 1]
+                    .iter()
+                    .all(|x| x.is_nan())
+            );
+            assert!(all.floor_peak_displacement_m[n - 1] > 0.0);
+            all.floor_peak_displacement_m[..n - 1].fill(f64::NAN);
+            assert_eq!(format!("{all:?}"), format!("{roof:?}"), "{}", rec.name);
+        }
+    }
+}
+
 /// A 20-storey building with stacks on several floors runs and balances its energy.
 #[test]
 fn a_twenty_storey_building_runs() {

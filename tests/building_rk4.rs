@@ -20,6 +20,7 @@ const HIST: ExactOptions = ExactOptions {
     max_switches_per_step: 1000,
     energy_balance: true,
     abs_velocity: true,
+    floor_displacements: true,
 };
 
 /// Three storeys (stiffnesses 3:2:1, first period 0.6 s), a two-block stack on floor 3 and one

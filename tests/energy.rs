@@ -15,6 +15,7 @@ const HIST: ExactOptions = ExactOptions {
     max_switches_per_step: 1000,
     energy_balance: true,
     abs_velocity: true,
+    floor_displacements: true,
 };
 
 /// Exact integrator on real records: input = kinetic + strain + damping + friction to 1e-9 of
@@ -203,6 +204,7 @@ fn switch_guard_gives_clear_error() {
         max_switches_per_step: 0,
         energy_balance: true,
         abs_velocity: true,
+        floor_displacements: true,
     };
     let msg = simulate_exact(&sys, &ground, &opts)
         .unwrap_err()

@@ -12,6 +12,7 @@ const HIST: ExactOptions = ExactOptions {
     max_switches_per_step: 1000,
     energy_balance: true,
     abs_velocity: true,
+    floor_displacements: true,
 };
 
 /// μ large: the stack never slides and the structure is a linear SDOF of mass m_p(1+α) with the

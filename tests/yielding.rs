@@ -18,6 +18,7 @@ const HIST: ExactOptions = ExactOptions {
     max_switches_per_step: 1000,
     energy_balance: true,
     abs_velocity: true,
+    floor_displacements: true,
 };
 
 /// A bare structure (no blocks) of period `tp`, bare-structure damping `zeta`.

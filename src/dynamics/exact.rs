@@ -67,6 +67,10 @@ pub struct ExactOptions {
     /// Search the peak absolute velocities (docs/model.md, "Absolute velocities"). Off, they
     /// are NaN; the study's stages, which do not store them, turn it off.
     pub abs_velocity: bool,
+    /// Search every floor's peak displacement. Off, a building's floors below the roof have NaN
+    /// (the roof's is searched: one storey is unaffected); the study's stages, which store only
+    /// the roof's, turn it off.
+    pub floor_displacements: bool,
 }
 
 impl Default for ExactOptions {
@@ -76,6 +80,7 @@ impl Default for ExactOptions {
             max_switches_per_step: 1000,
             energy_balance: true,
             abs_velocity: true,
+            floor_displacements: true,
         }
     }
 }

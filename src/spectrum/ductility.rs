@@ -127,6 +127,7 @@ const RUN: ExactOptions = ExactOptions {
     max_switches_per_step: 1000,
     energy_balance: false,
     abs_velocity: false,
+    floor_displacements: true,
 };
 
 fn point(

@@ -619,9 +619,11 @@ pub fn trace_system(
     dt_s: f64,
     record_sa_g: f64,
 ) -> Result<Trace<RunDemand>, SimError> {
+    // What `run_demand` reads: no energies, velocities or floor displacements.
     let opts = ExactOptions {
         energy_balance: false,
         abs_velocity: false,
+        floor_displacements: false,
         ..ExactOptions::default()
     };
     let mut accel = Vec::with_capacity(padded_mps2.len());

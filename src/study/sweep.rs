@@ -293,9 +293,11 @@ pub fn run_unit(
     let n = grid.blocks();
     let cases = grid.cases_per_unit();
     let mut out = UnitResult::default();
-    // Only friction energy is stored: the input and damping integrals are not needed.
+    // Only friction energy is stored: the input and damping integrals are not needed; of the
+    // floors' displacements only the roof's.
     let exact = ExactOptions {
         energy_balance: false,
+        floor_displacements: false,
         ..ExactOptions::default()
     };
     let floors = frame.floors();

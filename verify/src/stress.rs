@@ -553,6 +553,7 @@ fn options(case: &StressCase) -> ExactOptions {
         max_switches_per_step: case.max_switches_per_step,
         energy_balance: true,
         abs_velocity: true,
+        floor_displacements: true,
     }
 }
 

@@ -999,7 +999,12 @@ impl<'b> Integrator<'b> {
         }
         // Peak functions start at the state; inside the piece the modal values differ from it
         // by round-off only, so they need no anchoring.
-        for j in 0..n {
+        let lowest_disp = if self.opts.floor_displacements {
+            0
+        } else {
+            n - 1
+        };
+        for j in lowest_disp..n {
             peaks.push((
                 PeakOf::Disp(j),
                 Func {
@@ -1477,6 +1482,9 @@ impl<'b> Integrator<'b> {
         if !self.opts.abs_velocity {
             self.out.floor_peak_abs_velocity_mps.fill(f64::NAN);
             self.out.block_peak_abs_velocity_mps.fill(f64::NAN);
+        }
+        if !self.opts.floor_displacements {
+            self.out.floor_peak_displacement_m[..n - 1].fill(f64::NAN);
         }
         for i in 0..n {
             self.out.storey_residual_drift_m[i] = drift(i, &self.x);

@@ -149,7 +149,6 @@ impl BuildingResponse {
     /// Refuses a response with a non-finite number.
     pub fn check_finite(&self) -> Result<(), super::super::SimError> {
         let lists = [
-            &self.floor_peak_displacement_m,
             &self.floor_peak_abs_accel_mps2,
             &self.storey_peak_drift_m,
             &self.storey_residual_drift_m,
@@ -162,8 +161,11 @@ impl BuildingResponse {
             &self.floor_peak_abs_velocity_mps,
             &self.block_peak_abs_velocity_mps,
         ];
-        // NaN velocities: left out by the options.
-        let finite = lists.iter().all(|l| l.iter().all(|x| x.is_finite()))
+        // NaN velocities and displacements below the roof: left out by the options.
+        let roof_finite = (self.floor_peak_displacement_m.split_last())
+            .is_none_or(|(roof, below)| roof.is_finite() && below.iter().all(|x| !x.is_infinite()));
+        let finite = roof_finite
+            && lists.iter().all(|l| l.iter().all(|x| x.is_finite()))
             && velocities
                 .iter()
                 .all(|l| l.iter().all(|x| !x.is_infinite()))
