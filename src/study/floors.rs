@@ -105,6 +105,7 @@ fn run(
         history: true,
         energy_balance: false,
         abs_velocity: false,
+        floor_displacements: false,
         ..ExactOptions::default()
     };
     physics.simulate_building(kind, case, frame, ground, &opts, None)
