@@ -6,13 +6,16 @@
 //! `exact/N` and `kernel/N` rows of one run is the kernel's speed-up (every output: floor
 //! displacements and accelerations, drifts, storey shears, overturning moment);
 //! `base_shear/N` is the base shear alone (what a `λ` evaluation needs); `new/N` is the
-//! kernel's set-up (modal basis and output rows), paid once per building.
+//! kernel's set-up (modal basis and output rows), paid once per building; `records/N` is the
+//! base shear under each of the eleven FEMA P-695 records of the study's seeds (their first
+//! passes four records at a time, `LinearBuilding::peaks_of_records`), its throughput their
+//! samples together.
 //!
 //! `cargo bench --bench linear`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use slidestack::dynamics::building::{
-    Building, BuildingSpec, LinearBuilding, StackSpec, simulate_building,
+    Building, BuildingSpec, LinearBuilding, LinearOutput, StackSpec, simulate_building,
 };
 use slidestack::dynamics::{ExactOptions, Ground};
 use slidestack::ground_motion::read_record;
@@ -35,6 +38,7 @@ fn linear(c: &mut Criterion) {
     };
     let mut g = c.benchmark_group("linear");
     g.throughput(Throughput::Elements(accel.len() as u64));
+    let mut rows = Vec::new();
     for (n, period_s) in [(3, 0.6), (6, 0.8), (20, 2.0)] {
         let mut spec = BuildingSpec::uniform(n, period_s);
         spec.stacks = vec![
@@ -56,6 +60,28 @@ fn linear(c: &mut Criterion) {
         });
         g.bench_function(format!("new/{n}"), |bn| {
             bn.iter(|| black_box(LinearBuilding::new(&b).unwrap()))
+        });
+        rows.push((n, lin));
+    }
+    g.finish();
+
+    let eleven: Vec<(f64, Vec<f64>)> = (common::eleven_records().iter())
+        .map(|r| (r.dt_s, r.accel_mps2(1.0)))
+        .collect();
+    let grounds: Vec<Ground> = (eleven.iter())
+        .map(|(dt_s, a)| Ground {
+            dt_s: *dt_s,
+            accel_mps2: a,
+        })
+        .collect();
+    let mut g = c.benchmark_group("linear");
+    g.throughput(Throughput::Elements(
+        eleven.iter().map(|(_, a)| a.len() as u64).sum(),
+    ));
+    for (n, lin) in &rows {
+        let base = lin.select(&[LinearOutput::StoreyShear(0)]);
+        g.bench_function(format!("records/{n}"), |bn| {
+            bn.iter(|| black_box(lin.peaks_of_records(&base, &grounds).unwrap()))
         });
     }
     g.finish();

@@ -282,6 +282,91 @@ fn lane_of<const L: usize>(lanes: &[[f64; L]], l: usize, out: &mut [f64]) {
 /// register).
 const MOTIONS: usize = 4;
 
+/// `LinearBuilding::lane_step` of [`MOTIONS`] lanes in AVX2 registers: the same operations in
+/// the same order (no multiply–add contracted), so the same bits. Written with intrinsics
+/// because the compiler vectorises the portable version's loop over the modes as well, four
+/// modes at a time through transposes and spills, which made ten or more modes in lanes no
+/// faster than each record alone (`cargo bench --bench linear`, `records/20`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn lane_step_avx2<const SUM: bool>(
+    steps: &[ModeStep],
+    y: &mut [[f64; MOTIONS]],
+    q_max: &mut [[f64; MOTIONS]],
+    (a0, a1): ([f64; MOTIONS], [f64; MOTIONS]),
+    inv_h: f64,
+    row: &[f64],
+    f: &mut [[f64; MOTIONS]; 2],
+) {
+    use std::arch::x86_64::{
+        __m256d, _mm256_add_pd, _mm256_andnot_pd, _mm256_loadu_pd, _mm256_max_pd, _mm256_mul_pd,
+        _mm256_set1_pd, _mm256_storeu_pd, _mm256_sub_pd,
+    };
+    // SAFETY (every load and store): a `[f64; MOTIONS]` is four contiguous `f64`.
+    let load = |v: &[f64; MOTIONS]| unsafe { _mm256_loadu_pd(v.as_ptr()) };
+    let store = |v: &mut [f64; MOTIONS], x: __m256d| unsafe { _mm256_storeu_pd(v.as_mut_ptr(), x) };
+    let (mul, add, sub, splat) = (_mm256_mul_pd, _mm256_add_pd, _mm256_sub_pd, _mm256_set1_pd);
+    let m = steps.len();
+    let (re, im) = y.split_at_mut(m);
+    let (a0, a1) = (load(&a0), load(&a1));
+    let slope = mul(sub(a1, a0), splat(inv_h));
+    let sign = splat(-0.0);
+    let (w_re, w_im) = if SUM { row.split_at(m) } else { (row, row) };
+    if SUM {
+        assert_eq!(w_im.len(), m, "one output's row: 2·modes weights");
+    }
+    let (mut f0, mut f1) = (load(&f[0]), splat(0.0));
+    for (r, (((s, yr), yi), q_max)) in steps.iter().zip(re).zip(im).zip(q_max).enumerate() {
+        let (y0r, y0i) = (load(yr), load(yi));
+        if SUM {
+            f0 = add(f0, mul(splat(w_im[r]), y0i));
+        }
+        let qr = add(
+            add(
+                sub(mul(splat(s.l2.0), y0r), mul(splat(s.l2.1), y0i)),
+                mul(splat(s.lg.0), a0),
+            ),
+            mul(splat(s.ng.0), slope),
+        );
+        let qi = add(
+            add(
+                add(mul(splat(s.l2.0), y0i), mul(splat(s.l2.1), y0r)),
+                mul(splat(s.lg.1), a0),
+            ),
+            mul(splat(s.ng.1), slope),
+        );
+        let qa = add(_mm256_andnot_pd(sign, qr), _mm256_andnot_pd(sign, qi));
+        // `q_max` is never NaN (from 0, raised by `f64::max`), and `maxpd` gives its second
+        // operand where either is NaN: `f64::max(q_max, qa)`.
+        store(q_max, _mm256_max_pd(qa, load(q_max)));
+        let y1r = add(
+            add(
+                sub(mul(splat(s.e.0), y0r), mul(splat(s.e.1), y0i)),
+                mul(splat(s.fa0.0), a0),
+            ),
+            mul(splat(s.fa1.0), a1),
+        );
+        store(yr, y1r);
+        store(
+            yi,
+            add(
+                add(
+                    add(mul(splat(s.e.0), y0i), mul(splat(s.e.1), y0r)),
+                    mul(splat(s.fa0.1), a0),
+                ),
+                mul(splat(s.fa1.1), a1),
+            ),
+        );
+        if SUM {
+            f1 = add(f1, mul(splat(w_re[r]), y1r));
+        }
+    }
+    if SUM {
+        store(&mut f[0], f0);
+        store(&mut f[1], f1);
+    }
+}
+
 /// One mode's coefficients over a sample interval of `h`.
 #[derive(Debug, Clone, Copy)]
 struct ModeStep {
@@ -492,39 +577,71 @@ impl LinearBuilding {
     }
 
     /// The first pass over the samples (module doc) of up to [`MOTIONS`] records of one sample
-    /// interval: side by side, one per SIMD lane, over the blocks they all fill, then each alone
-    /// (one record: alone throughout). Every lane does the scalar pass's operations in its
-    /// order, so each record's pass has the same bits as its own. Compiled twice: for AVX2
-    /// (chosen at run time where the processor has it) and for the baseline; neither contracts a
-    /// multiply and an add, so both give the same bits.
+    /// interval: side by side, one per SIMD lane, over the longest record's whole blocks (a
+    /// shorter record's lane runs on over zeros, its pass and state kept as they stood at its
+    /// own last whole block), then each record's partial last block alone (one record: alone
+    /// throughout). Every lane does the scalar pass's operations in its order, so each record's
+    /// pass has the same bits as its own. Compiled twice: for AVX2 (chosen at run time where the
+    /// processor has it) and for the baseline; neither contracts a multiply and an add, so both
+    /// give the same bits.
     fn first_passes(
         out: &Outputs,
         steps: &[ModeStep],
         accels: &[&[f64]],
         inv_h: f64,
     ) -> Vec<FirstPass> {
+        Self::first_passes_in(has_avx2(), out, steps, accels, inv_h)
+    }
+
+    /// [`Self::first_passes`] by its AVX2 copies where `avx2` (which the processor must have)
+    /// or by the baseline's.
+    fn first_passes_in(
+        avx2: bool,
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]],
+        inv_h: f64,
+    ) -> Vec<FirstPass> {
         let m = steps.len();
-        let avx2 = has_avx2();
         let mut passes: Vec<FirstPass> = (accels.iter())
             .map(|a| FirstPass::new(out, m, a.len() - 1))
             .collect();
         let mut carries: Vec<Carry> = accels.iter().map(|_| Carry::new(out, m)).collect();
-        let common = (accels.iter())
-            .map(|a| (a.len() - 1) / BLOCK)
-            .min()
-            .unwrap_or(0);
-        let from = if accels.len() > 1 { common } else { 0 };
-        if from > 0 {
+        // Each record's whole blocks, and the most of them.
+        let whole: Vec<usize> = accels.iter().map(|a| (a.len() - 1) / BLOCK).collect();
+        let most = whole.iter().copied().max().unwrap_or(0);
+        let mut from = vec![0; accels.len()];
+        if accels.len() > 1 && most > 0 {
+            // A record shorter than the longest's whole blocks, padded with zeros to them.
+            let padded: Vec<Vec<f64>> = (accels.iter())
+                .map(|a| {
+                    let mut v = Vec::new();
+                    if a.len() < most * BLOCK + 1 {
+                        v.extend_from_slice(a);
+                        v.resize(most * BLOCK + 1, 0.0);
+                    }
+                    v
+                })
+                .collect();
+            let source = |l: usize| -> &[f64] {
+                if padded[l].is_empty() {
+                    accels[l]
+                } else {
+                    &padded[l]
+                }
+            };
             // Fewer records than lanes: the first fills the rest, its copies' passes dropped.
             let lanes: [&[f64]; MOTIONS] =
-                std::array::from_fn(|l| *accels.get(l).unwrap_or(&accels[0]));
-            for a in &lanes[accels.len()..] {
-                passes.push(FirstPass::new(out, m, a.len() - 1));
+                std::array::from_fn(|l| source(if l < accels.len() { l } else { 0 }));
+            let ends: [usize; MOTIONS] =
+                std::array::from_fn(|l| whole[if l < accels.len() { l } else { 0 }]);
+            for _ in accels.len()..MOTIONS {
+                passes.push(FirstPass::new(out, m, accels[0].len() - 1));
                 carries.push(Carry::new(out, m));
             }
             #[cfg(target_arch = "x86_64")]
             if avx2 {
-                // SAFETY: the processor has AVX2 (`has_avx2`).
+                // SAFETY: `avx2` only where the processor has AVX2.
                 unsafe {
                     Self::lane_blocks_avx2(
                         out,
@@ -533,19 +650,30 @@ impl LinearBuilding {
                         inv_h,
                         &mut passes,
                         &mut carries,
-                        from,
+                        ends,
                     )
                 };
             }
             if !avx2 {
-                Self::lane_blocks(out, steps, &lanes, inv_h, &mut passes, &mut carries, from);
+                Self::lane_blocks::<false>(
+                    out,
+                    steps,
+                    &lanes,
+                    inv_h,
+                    &mut passes,
+                    &mut carries,
+                    ends,
+                );
             }
+            from = whole;
         }
         passes.truncate(accels.len());
-        for ((pass, carry), accel) in passes.iter_mut().zip(&mut carries).zip(accels) {
+        for (((pass, carry), accel), from) in
+            passes.iter_mut().zip(&mut carries).zip(accels).zip(from)
+        {
             #[cfg(target_arch = "x86_64")]
             if avx2 {
-                // SAFETY: the processor has AVX2 (`has_avx2`).
+                // SAFETY: `avx2` only where the processor has AVX2.
                 unsafe { Self::blocks_avx2(out, steps, accel, inv_h, pass, carry, from) };
                 continue;
             }
@@ -623,26 +751,28 @@ impl LinearBuilding {
         inv_h: f64,
         passes: &mut [FirstPass],
         carries: &mut [Carry],
-        blocks: usize,
+        ends: [usize; MOTIONS],
     ) {
-        Self::lane_blocks(out, steps, accels, inv_h, passes, carries, blocks)
+        Self::lane_blocks::<true>(out, steps, accels, inv_h, passes, carries, ends)
     }
 
-    /// [`Self::blocks`] over the first `blocks` blocks of [`MOTIONS`] records at once, one per
-    /// lane (each lane the scalar operations in their order), leaving each record's state in
-    /// its `carries`.
+    /// [`Self::blocks`] over [`MOTIONS`] records at once, one per lane (each lane the scalar
+    /// operations in their order), lane `l` kept for its first `ends[l]` blocks: its pass
+    /// written over them and its state after them left in its `carries`. The lanes run the
+    /// most blocks of any (`accels[l]` holds at least `BLOCK·max(ends) + 1` samples). `AVX2`:
+    /// called from [`Self::lane_blocks_avx2`] alone, its steps by [`lane_step_avx2`].
     #[inline(always)]
-    fn lane_blocks(
+    fn lane_blocks<const AVX2: bool>(
         out: &Outputs,
         steps: &[ModeStep],
         accels: &[&[f64]; MOTIONS],
         inv_h: f64,
         passes: &mut [FirstPass],
         carries: &mut [Carry],
-        blocks: usize,
+        ends: [usize; MOTIONS],
     ) {
         if out.count == 1 {
-            return Self::lane_blocks_one(out, steps, accels, inv_h, passes, carries, blocks);
+            return Self::lane_blocks_one::<AVX2>(out, steps, accels, inv_h, passes, carries, ends);
         }
         const L: usize = MOTIONS;
         let m = steps.len();
@@ -652,8 +782,10 @@ impl LinearBuilding {
         let mut f = vec![[[0.0; LANE]; L]; groups];
         let mut f_abs = vec![[[0.0; LANE]; L]; groups];
         let mut bm = vec![[[0.0; LANE]; L]; groups];
+        let mut sums = [[0.0; L]; 2];
+        let blocks = ends.iter().copied().max().unwrap_or(0);
         for b in 0..blocks {
-            for (l, pass) in passes.iter_mut().enumerate() {
+            for (l, pass) in passes.iter_mut().enumerate().filter(|(l, _)| b < ends[*l]) {
                 lane_of(&y, l, &mut pass.starts[b * 2 * m..(b + 1) * 2 * m]);
             }
             bm.copy_from_slice(&f_abs);
@@ -661,7 +793,15 @@ impl LinearBuilding {
             for k in b * BLOCK..(b + 1) * BLOCK {
                 let a0: [f64; L] = std::array::from_fn(|l| accels[l][k]);
                 let a1: [f64; L] = std::array::from_fn(|l| accels[l][k + 1]);
-                Self::lane_step(steps, &mut y, &mut q, a0, a1, inv_h);
+                Self::lane_step_in::<AVX2, false>(
+                    steps,
+                    &mut y,
+                    &mut q,
+                    (a0, a1),
+                    inv_h,
+                    &[],
+                    &mut sums,
+                );
                 out.lane_eval_all(&y, &mut f);
                 for ((bm, fa), fo) in bm.iter_mut().zip(f_abs.iter_mut()).zip(&f) {
                     for l in 0..L {
@@ -673,7 +813,7 @@ impl LinearBuilding {
                     }
                 }
             }
-            for (l, pass) in passes.iter_mut().enumerate() {
+            for (l, pass) in passes.iter_mut().enumerate().filter(|(l, _)| b < ends[*l]) {
                 lane_of(&q, l, &mut pass.block_q[b * m..(b + 1) * m]);
                 for (g, bm) in bm.iter().enumerate() {
                     pass.block_max[b * groups + g] = bm[l];
@@ -687,11 +827,15 @@ impl LinearBuilding {
                     }
                 }
             }
-        }
-        for (l, carry) in carries.iter_mut().enumerate() {
-            lane_of(&y, l, &mut carry.y);
-            for (g, fa) in f_abs.iter().enumerate() {
-                carry.f_abs[g] = fa[l];
+            for (l, carry) in carries
+                .iter_mut()
+                .enumerate()
+                .filter(|(l, _)| b + 1 == ends[*l])
+            {
+                lane_of(&y, l, &mut carry.y);
+                for (g, fa) in f_abs.iter().enumerate() {
+                    carry.f_abs[g] = fa[l];
+                }
             }
         }
     }
@@ -700,14 +844,14 @@ impl LinearBuilding {
     /// `|f|` kept per lane alone, not in a group of [`LANE`] whose other seven are zero, and
     /// summed as [`Self::lane_eval_all`] sums it; the same values in `passes` and `carries`.
     #[inline(always)]
-    fn lane_blocks_one(
+    fn lane_blocks_one<const AVX2: bool>(
         out: &Outputs,
         steps: &[ModeStep],
         accels: &[&[f64]; MOTIONS],
         inv_h: f64,
         passes: &mut [FirstPass],
         carries: &mut [Carry],
-        blocks: usize,
+        ends: [usize; MOTIONS],
     ) {
         const L: usize = MOTIONS;
         let m = steps.len();
@@ -715,56 +859,112 @@ impl LinearBuilding {
         let mut y = vec![[0.0; L]; 2 * m];
         let mut q = vec![[0.0; L]; m];
         let mut f_abs = [0.0; L];
+        let mut f = [[0.0; L]; 2];
+        let blocks = ends.iter().copied().max().unwrap_or(0);
         for b in 0..blocks {
-            for (l, pass) in passes.iter_mut().enumerate() {
+            for (l, pass) in passes.iter_mut().enumerate().filter(|(l, _)| b < ends[*l]) {
                 lane_of(&y, l, &mut pass.starts[b * 2 * m..(b + 1) * 2 * m]);
             }
             let mut bm = f_abs;
             q.fill([0.0; L]);
-            for k in b * BLOCK..(b + 1) * BLOCK {
-                let a0: [f64; L] = std::array::from_fn(|l| accels[l][k]);
-                let a1: [f64; L] = std::array::from_fn(|l| accels[l][k + 1]);
-                Self::lane_step(steps, &mut y, &mut q, a0, a1, inv_h);
-                let mut f = [0.0; L];
-                for (w, s) in row.iter().zip(&y) {
-                    for l in 0..L {
-                        f[l] += w * s[l];
-                    }
-                }
+            let mut keep = |f: [f64; L]| {
                 for l in 0..L {
                     let a = f[l].abs();
                     f_abs[l] = a;
                     bm[l] = if a > bm[l] { a } else { bm[l] };
                 }
+            };
+            // Each step completes the output of the sample before it (`lane_step`'s `SUM`):
+            // the first step's is discarded (the last block's was completed below).
+            for (j, k) in (b * BLOCK..(b + 1) * BLOCK).enumerate() {
+                let a0: [f64; L] = std::array::from_fn(|l| accels[l][k]);
+                let a1: [f64; L] = std::array::from_fn(|l| accels[l][k + 1]);
+                Self::lane_step_in::<AVX2, true>(
+                    steps,
+                    &mut y,
+                    &mut q,
+                    (a0, a1),
+                    inv_h,
+                    row,
+                    &mut f,
+                );
+                if j > 0 {
+                    keep(f[0]);
+                }
+                f[0] = f[1];
             }
-            for (l, pass) in passes.iter_mut().enumerate() {
+            for (w, s) in row[m..].iter().zip(&y[m..]) {
+                for l in 0..L {
+                    f[0][l] += w * s[l];
+                }
+            }
+            keep(f[0]);
+            for (l, pass) in passes.iter_mut().enumerate().filter(|(l, _)| b < ends[*l]) {
                 lane_of(&q, l, &mut pass.block_q[b * m..(b + 1) * m]);
                 pass.block_max[b][0] = bm[l];
                 let best = &mut pass.best[0][0];
                 *best = if bm[l] > *best { bm[l] } else { *best };
             }
-        }
-        for (l, carry) in carries.iter_mut().enumerate() {
-            lane_of(&y, l, &mut carry.y);
-            carry.f_abs[0][0] = f_abs[l];
+            for (l, carry) in carries
+                .iter_mut()
+                .enumerate()
+                .filter(|(l, _)| b + 1 == ends[*l])
+            {
+                lane_of(&y, l, &mut carry.y);
+                carry.f_abs[0][0] = f_abs[l];
+            }
         }
     }
 
-    /// [`Self::step`] in every lane.
+    /// [`Self::lane_step`] of [`MOTIONS`] lanes, by [`lane_step_avx2`] where `AVX2` (the
+    /// same bits).
     #[inline(always)]
-    fn lane_step<const L: usize>(
+    fn lane_step_in<const AVX2: bool, const SUM: bool>(
+        steps: &[ModeStep],
+        y: &mut [[f64; MOTIONS]],
+        q_max: &mut [[f64; MOTIONS]],
+        a: ([f64; MOTIONS], [f64; MOTIONS]),
+        inv_h: f64,
+        row: &[f64],
+        f: &mut [[f64; MOTIONS]; 2],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX2 {
+            // SAFETY: `AVX2` is true only in `lane_blocks_avx2`'s calls, made where the
+            // processor has AVX2.
+            return unsafe { lane_step_avx2::<SUM>(steps, y, q_max, a, inv_h, row, f) };
+        }
+        Self::lane_step::<MOTIONS, SUM>(steps, y, q_max, a, inv_h, row, f)
+    }
+
+    /// [`Self::step`] in every lane. `SUM` (one output, its row `row`, [`Self::eval_one`]'s
+    /// terms in its order, spread over two steps so that the sum's chain of additions overlaps
+    /// the steps' arithmetic): `f[0]`, the previous state's output with its real parts' terms
+    /// summed, gains the imaginary parts' terms (so holds that output, the same bits), and
+    /// `f[1]` becomes the new state's real parts' terms summed from 0.
+    #[inline(always)]
+    fn lane_step<const L: usize, const SUM: bool>(
         steps: &[ModeStep],
         y: &mut [[f64; L]],
         q_max: &mut [[f64; L]],
-        a0: [f64; L],
-        a1: [f64; L],
+        (a0, a1): ([f64; L], [f64; L]),
         inv_h: f64,
+        row: &[f64],
+        f: &mut [[f64; L]; 2],
     ) {
         let m = steps.len();
         let (re, im) = y.split_at_mut(m);
         let slope: [f64; L] = std::array::from_fn(|l| (a1[l] - a0[l]) * inv_h);
-        for (((s, yr), yi), q_max) in steps.iter().zip(re).zip(im).zip(q_max) {
+        let (w_re, w_im) = if SUM { row.split_at(m) } else { (row, row) };
+        if SUM {
+            assert_eq!(w_im.len(), m, "one output's row: 2·modes weights");
+            f[1] = [0.0; L];
+        }
+        for (r, (((s, yr), yi), q_max)) in steps.iter().zip(re).zip(im).zip(q_max).enumerate() {
             let (y0r, y0i) = (*yr, *yi);
+            if SUM {
+                f[0] = std::array::from_fn(|l| f[0][l] + w_im[r] * y0i[l]);
+            }
             let qr: [f64; L] = std::array::from_fn(|l| {
                 s.l2.0 * y0r[l] - s.l2.1 * y0i[l] + s.lg.0 * a0[l] + s.ng.0 * slope[l]
             });
@@ -782,6 +982,9 @@ impl LinearBuilding {
             *yi = std::array::from_fn(|l| {
                 s.e.0 * y0i[l] + s.e.1 * y0r[l] + s.fa0.1 * a0[l] + s.fa1.1 * a1[l]
             });
+            if SUM {
+                f[1] = std::array::from_fn(|l| f[1][l] + w_re[r] * yr[l]);
+            }
         }
     }
 
@@ -1062,6 +1265,66 @@ mod tests {
         let lin = LinearBuilding::new(&b).unwrap();
         let e = lin.run(&Ground::new(0.01, &[0.0])).unwrap_err();
         assert_eq!(e, LinearBuildingError::Ground(SimError::TooShort(1)));
+    }
+
+    /// The first passes of records side by side, by the AVX2 copies (where the processor has
+    /// them) and by the baseline's, against each record's pass alone (no lanes): every stored
+    /// number the same bits, for one output (its sum spread over two steps) and several, with
+    /// records shorter than the longest's whole blocks, one shorter than a block and a batch
+    /// short of lanes. `tests/building_linear.rs` checks the peaks; this reaches the baseline's
+    /// copy, which a processor with AVX2 never runs there.
+    #[test]
+    fn lanes_give_each_records_first_pass_on_either_instruction_set() {
+        let lin = LinearBuilding::new(&Building::new(&spec()).unwrap()).unwrap();
+        let steps = lin.mode_steps(0.01);
+        let wave = |n: usize, w: f64| -> Vec<f64> {
+            (0..n)
+                .map(|k| 3.0 * (k as f64 * w).sin() * (-(k as f64) / 500.0).exp())
+                .collect()
+        };
+        let records: Vec<Vec<f64>> = [700, 1001, 333, 20, 961]
+            .iter()
+            .enumerate()
+            .map(|(i, &n)| wave(n, 0.05 + 0.02 * i as f64))
+            .collect();
+        let one = lin.select(&[LinearOutput::StoreyShear(0)]);
+        let several = lin.select(&[
+            LinearOutput::FloorDisplacement(2),
+            LinearOutput::OverturningMoment,
+            LinearOutput::FloorAbsAccel(0),
+        ]);
+        let bits = |p: &FirstPass| -> Vec<u64> {
+            (p.starts.iter().chain(&p.block_q))
+                .chain(p.block_max.as_flattened())
+                .chain(p.best.as_flattened())
+                .map(|x| x.to_bits())
+                .collect()
+        };
+        for out in [&one.0, &several.0] {
+            for batch in [&records[..4], &records[..2], &records[2..]] {
+                let accels: Vec<&[f64]> = batch.iter().map(|a| &a[..]).collect();
+                let alone: Vec<Vec<u64>> = (accels.iter())
+                    .map(|a| {
+                        bits(&LinearBuilding::first_passes_in(false, out, &steps, &[a], 100.0)[0])
+                    })
+                    .collect();
+                let mut sets = vec![false];
+                if has_avx2() {
+                    sets.push(true);
+                }
+                for avx2 in sets {
+                    let lanes = LinearBuilding::first_passes_in(avx2, out, &steps, &accels, 100.0);
+                    let got: Vec<Vec<u64>> = lanes.iter().map(bits).collect();
+                    assert_eq!(
+                        got,
+                        alone,
+                        "avx2 {avx2}, {} outputs, {} records",
+                        out.count,
+                        batch.len()
+                    );
+                }
+            }
+        }
     }
 
     /// The recurrence's coefficients against the closed form of one interval: a state and a
