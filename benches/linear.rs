@@ -69,10 +69,7 @@ fn linear(c: &mut Criterion) {
         .map(|r| (r.dt_s, r.accel_mps2(1.0)))
         .collect();
     let grounds: Vec<Ground> = (eleven.iter())
-        .map(|(dt_s, a)| Ground {
-            dt_s: *dt_s,
-            accel_mps2: a,
-        })
+        .map(|(dt_s, a)| Ground::new(*dt_s, a))
         .collect();
     let mut g = c.benchmark_group("linear");
     g.throughput(Throughput::Elements(

@@ -35,6 +35,7 @@ use super::super::{Ground, SimError};
 use super::modal::{ModalError, ModalFn, Piece, StateModes, mode_terms};
 use super::model::Building;
 use crate::numeric::Cx;
+use std::borrow::Cow;
 use thiserror::Error;
 
 /// Sample intervals per block of the first pass: the second pass repeats a block's recurrence
@@ -593,8 +594,8 @@ impl LinearBuilding {
         Self::first_passes_in(has_avx2(), out, steps, accels, inv_h)
     }
 
-    /// [`Self::first_passes`] by its AVX2 copies where `avx2` (which the processor must have)
-    /// or by the baseline's.
+    /// [`Self::first_passes`] by its AVX2 copies where `avx2` and the processor has AVX2, else
+    /// by the baseline's.
     fn first_passes_in(
         avx2: bool,
         out: &Outputs,
@@ -602,6 +603,7 @@ impl LinearBuilding {
         accels: &[&[f64]],
         inv_h: f64,
     ) -> Vec<FirstPass> {
+        let avx2 = avx2 && has_avx2();
         let m = steps.len();
         let mut passes: Vec<FirstPass> = (accels.iter())
             .map(|a| FirstPass::new(out, m, a.len() - 1))
@@ -613,28 +615,20 @@ impl LinearBuilding {
         let mut from = vec![0; accels.len()];
         if accels.len() > 1 && most > 0 {
             // A record shorter than the longest's whole blocks, padded with zeros to them.
-            let padded: Vec<Vec<f64>> = (accels.iter())
-                .map(|a| {
-                    let mut v = Vec::new();
-                    if a.len() < most * BLOCK + 1 {
-                        v.extend_from_slice(a);
-                        v.resize(most * BLOCK + 1, 0.0);
+            let samples = most * BLOCK + 1;
+            let padded: Vec<Cow<[f64]>> = (accels.iter())
+                .map(|&a| {
+                    if a.len() < samples {
+                        Cow::Owned([a, &vec![0.0; samples - a.len()]].concat())
+                    } else {
+                        Cow::Borrowed(a)
                     }
-                    v
                 })
                 .collect();
-            let source = |l: usize| -> &[f64] {
-                if padded[l].is_empty() {
-                    accels[l]
-                } else {
-                    &padded[l]
-                }
-            };
             // Fewer records than lanes: the first fills the rest, its copies' passes dropped.
-            let lanes: [&[f64]; MOTIONS] =
-                std::array::from_fn(|l| source(if l < accels.len() { l } else { 0 }));
-            let ends: [usize; MOTIONS] =
-                std::array::from_fn(|l| whole[if l < accels.len() { l } else { 0 }]);
+            let record = |l: usize| if l < accels.len() { l } else { 0 };
+            let lanes: [&[f64]; MOTIONS] = std::array::from_fn(|l| &*padded[record(l)]);
+            let ends: [usize; MOTIONS] = std::array::from_fn(|l| whole[record(l)]);
             for _ in accels.len()..MOTIONS {
                 passes.push(FirstPass::new(out, m, accels[0].len() - 1));
                 carries.push(Carry::new(out, m));
@@ -1308,11 +1302,8 @@ mod tests {
                         bits(&LinearBuilding::first_passes_in(false, out, &steps, &[a], 100.0)[0])
                     })
                     .collect();
-                let mut sets = vec![false];
-                if has_avx2() {
-                    sets.push(true);
-                }
-                for avx2 in sets {
+                // Without AVX2 on the processor, `true` runs the baseline's copy again.
+                for avx2 in [false, true] {
                     let lanes = LinearBuilding::first_passes_in(avx2, out, &steps, &accels, 100.0);
                     let got: Vec<Vec<u64>> = lanes.iter().map(bits).collect();
                     assert_eq!(
