@@ -591,7 +591,7 @@ impl LinearBuilding {
         accels: &[&[f64]],
         inv_h: f64,
     ) -> Vec<FirstPass> {
-        Self::first_passes_in(has_avx2(), out, steps, accels, inv_h)
+        Self::first_passes_in(true, out, steps, accels, inv_h)
     }
 
     /// [`Self::first_passes`] by its AVX2 copies where `avx2` and the processor has AVX2, else
