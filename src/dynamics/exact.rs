@@ -372,6 +372,14 @@ impl Smooth for OverPiece<'_> {
         (f.eval(b), d1.eval(b))
     }
 
+    fn value(&self, b: &Basis) -> f64 {
+        let f = &self.g.f;
+        if b.tau == 0.0 {
+            return f.p[0] + f.c;
+        }
+        f.eval(b)
+    }
+
     fn slope(&self, b: &Basis) -> f64 {
         self.g.d1.eval(b)
     }

@@ -80,6 +80,10 @@ pub(crate) trait Smooth {
     fn tau(at: &Self::At) -> f64;
     /// `(f, f')` at the point.
     fn eval(&self, at: &Self::At) -> (f64, f64);
+    /// `f` at the point (what a search for a root refines): `eval`'s, the same bits.
+    fn value(&self, at: &Self::At) -> f64 {
+        self.eval(at).0
+    }
     /// `f'` at the point (what a search for an extremum refines).
     fn slope(&self, at: &Self::At) -> f64 {
         self.eval(at).1
@@ -172,7 +176,7 @@ pub(crate) fn first_violation<S: Smooth>(
     let Some((a, b)) = search(s, &lo, end, min_width, 0, &mut budget)? else {
         return Ok(None);
     };
-    Ok(Some(refine(|t| s.eval(&s.at(t)).0, a, b, min_width)))
+    Ok(Some(refine(|t| s.value(&s.at(t)), a, b, min_width)))
 }
 
 /// Largest `τ_c` with `g₁τ + g₂τ²/2 − g₃τ³/6 > 0` on `(0, τ_c)`; 0 if there is none.
@@ -294,7 +298,7 @@ fn peak_rec<S: Smooth>(
             // f' is monotone here: its single zero is the only interior extremum.
             let sign = lo.df.signum();
             let t = refine(|t| s.slope(&s.at(t)) * sign, t_lo, t_hi, min_width);
-            let v = s.eval(&s.at(t)).0.abs();
+            let v = s.value(&s.at(t)).abs();
             if v > best.0 {
                 *best = (v, t);
             }

@@ -31,7 +31,7 @@ use super::super::response::{Energy, History};
 use super::super::rocking::{self, RockingOnset};
 use super::super::search::{self, Node};
 use super::super::{Ground, SimError, Unwatched, Watch, watched};
-use super::modal::{ModalError, ModalFn, ModalPoint, Piece, StateModes, mode_terms};
+use super::modal::{ModalError, ModalFn, ModalPoint, Piece, RowsByMode, StateModes, mode_terms};
 use super::model::{Building, StoreySpring};
 use super::response::BuildingResponse;
 use crate::numeric::{Cx, GAUSS8};
@@ -151,6 +151,8 @@ struct Mode {
     /// `ROWS × N` rows of `m` coefficients, and their magnitudes times the modes' weights.
     rows: Vec<Cx>,
     rows_abs: Vec<f64>,
+    /// The same rows mode by mode, for the passes that evaluate every row at once.
+    by_mode: RowsByMode,
     /// [`mode_terms`] at `dt`, per kept mode.
     terms_dt: Vec<[Cx; 4]>,
 }
@@ -202,18 +204,25 @@ impl Mode {
                 rows[(Row::Accel as usize * n + j) * m + r] = modes.lambda[r].mul(v);
             }
         }
-        let rows_abs = rows
+        let rows_abs: Vec<f64> = rows
             .iter()
             .enumerate()
             .map(|(i, c)| modes.weight[i % m] * c.abs())
             .collect();
         let terms_dt = modes.lambda.iter().map(|&l| mode_terms(l, dt)).collect();
+        let by_mode = RowsByMode::new(&rows, &rows_abs, m);
         Self {
             modes,
             rows,
             rows_abs,
+            by_mode,
             terms_dt,
         }
+    }
+
+    /// Where row `(row, j)` is in the tables, and in the passes over all rows.
+    fn index(&self, row: Row, j: usize) -> usize {
+        row as usize * self.modes.n + j
     }
 
     fn row(&self, row: Row, j: usize) -> &[Cx] {
@@ -359,6 +368,11 @@ struct Integrator<'b> {
     p_start: ModalPoint,
     p_end: ModalPoint,
     p_quad: ModalPoint,
+    /// Every row of the mode at `p_end` (`ROWS × N`, [`Mode::index`]), the modal part of each
+    /// row's curvature bound over the piece, and the floors' [`Row::Accel`] rows at `p_start`.
+    end_rows: Vec<f64>,
+    curvatures: Vec<f64>,
+    start_accel: Vec<f64>,
     z: Vec<f64>,
     p0: Vec<f64>,
     events: Vec<Event>,
@@ -492,6 +506,9 @@ impl<'b> Integrator<'b> {
             p_start: ModalPoint::default(),
             p_end: ModalPoint::default(),
             p_quad: ModalPoint::default(),
+            end_rows: vec![0.0; ROWS * n],
+            curvatures: vec![0.0; ROWS * n],
+            start_accel: vec![0.0; n],
             z: vec![0.0; 2 * n],
             p0: vec![0.0; n],
             events: Vec::new(),
@@ -542,12 +559,7 @@ impl<'b> Integrator<'b> {
                 self.build(ga, slope)?;
                 let h = self.dt - tau;
                 let mode = self.mode();
-                if tau == 0.0 {
-                    self.p_end
-                        .at_terms(&mode.modes, &self.piece, h, &mode.terms_dt);
-                } else {
-                    self.p_end.at(&mode.modes, &self.piece, h);
-                }
+                self.end_at(&mode, h, tau == 0.0);
                 let mut first: Option<(f64, usize)> = None;
                 for e in 0..self.events.len() {
                     let g = &self.events[e].g;
@@ -572,7 +584,7 @@ impl<'b> Integrator<'b> {
                 }
                 let end = first.map_or(h, |f| f.0);
                 if end != h {
-                    self.p_end.at(&mode.modes, &self.piece, end);
+                    self.end_at(&mode, end, false);
                 }
                 self.rocking(&mode, t0 + tau, end)
                     .map_err(|source| SimError::Search { time_s: t0, source })?;
@@ -648,7 +660,7 @@ impl<'b> Integrator<'b> {
                         f0: 0.0,
                         df0: None,
                     };
-                    g.f0 = Self::value_at(mode, &g, &self.p_start).0;
+                    g.f0 = self.start_accel_value(&g);
                     if self.clear(mode, &g, end, 0.0, f64::INFINITY) {
                         continue;
                     }
@@ -668,6 +680,19 @@ impl<'b> Integrator<'b> {
             self.out.rocking_onset[si] = found;
         }
         Ok(())
+    }
+
+    /// `p_end` at `tau` (with the mode's terms at `dt` where `whole`: the piece spans the sample
+    /// interval) and every row there.
+    fn end_at(&mut self, mode: &Mode, tau: f64, whole: bool) {
+        if whole {
+            self.p_end
+                .at_terms(&mode.modes, &self.piece, tau, &mode.terms_dt);
+        } else {
+            self.p_end.at(&mode.modes, &self.piece, tau);
+        }
+        mode.by_mode
+            .dots(&mode.modes.weight, &self.p_end.y, 0, &mut self.end_rows);
     }
 
     fn mode(&self) -> Rc<Mode> {
@@ -699,6 +724,18 @@ impl<'b> Integrator<'b> {
         (f, df)
     }
 
+    /// `f` of a function of a floor's [`Row::Accel`] row at `p_start`: [`Self::value_at`]'s
+    /// value, its row taken from the pass over the floors' accelerations.
+    fn start_accel_value(&self, g: &Func) -> f64 {
+        let t = self.p_start.tau;
+        let q = &g.poly;
+        let f = q[0] + t * (q[1] + t * (q[2] + t * q[3]));
+        match g.row {
+            Some((Row::Accel, j)) => f + g.scale * self.start_accel[j],
+            _ => unreachable!("a floor's acceleration row"),
+        }
+    }
+
     fn node_at(&self, mode: &Mode, g: &Func, p: &ModalPoint) -> Node<f64> {
         let (f, df) = Self::value_at(mode, g, p);
         Node { at: p.tau, f, df }
@@ -712,14 +749,9 @@ impl<'b> Integrator<'b> {
         let mut f1 = q[0] + h * (q[1] + h * (q[2] + h * q[3]));
         let mut curv = 2.0 * q[2].abs() + 6.0 * h * q[3].abs();
         if let Some((row, j)) = g.row {
-            f1 += g.scale * ModalPoint::dot(&mode.modes, mode.row(row, j), &self.p_end.y);
-            let modal: f64 = mode
-                .row_abs(row, j)
-                .iter()
-                .zip(&self.piece.mag)
-                .map(|(a, m)| a * m[0])
-                .sum();
-            curv += g.scale.abs() * modal * (1.0 + 1e-12);
+            let i = mode.index(row, j);
+            f1 += g.scale * self.end_rows[i];
+            curv += g.scale.abs() * self.curvatures[i] * (1.0 + 1e-12);
         }
         let slack = curv * h * h / 8.0;
         g.f0.min(f1) - slack >= lower && g.f0.max(f1) + slack <= upper
@@ -782,6 +814,14 @@ impl<'b> Integrator<'b> {
         }
         mode.modes.piece(&self.z, &self.p0, -slope, &mut self.piece);
         self.p_start.start(&mode.modes, &self.piece);
+        mode.by_mode
+            .curvatures(&self.piece.mag, &mut self.curvatures);
+        mode.by_mode.dots(
+            &mode.modes.weight,
+            &self.p_start.y,
+            mode.index(Row::Accel, 0),
+            &mut self.start_accel,
+        );
         for c in &mut self.free {
             c.disp = [
                 self.x[c.bottom],
@@ -921,7 +961,7 @@ impl<'b> Integrator<'b> {
                         f0: 0.0,
                         df0: None,
                     };
-                    g.f0 = Self::value_at(mode, &g, &self.p_start).0;
+                    g.f0 = self.start_accel_value(&g);
                     events.push(Event {
                         kind: EventKind::Break(k, side),
                         g,
@@ -1041,7 +1081,7 @@ impl<'b> Integrator<'b> {
                 f0: 0.0,
                 df0: None,
             };
-            g.f0 = Self::value_at(mode, &g, &self.p_start).0;
+            g.f0 = self.start_accel_value(&g);
             peaks.push((PeakOf::Accel(f), g));
         }
         let heights = self.b.storey_heights_m();
@@ -1254,8 +1294,8 @@ impl<'b> Integrator<'b> {
         let mut x_new = std::mem::take(&mut self.x_new);
         let mut v_new = std::mem::take(&mut self.v_new);
         for j in 0..n {
-            x_new[j] = ModalPoint::dot(&mode.modes, mode.row(Row::Disp, j), &self.p_end.y);
-            v_new[j] = ModalPoint::dot(&mode.modes, mode.row(Row::Vel, j), &self.p_end.y);
+            x_new[j] = self.end_rows[mode.index(Row::Disp, j)];
+            v_new[j] = self.end_rows[mode.index(Row::Vel, j)];
         }
         if self.opts.energy_balance {
             let mut input = 0.0;

@@ -388,6 +388,69 @@ impl ModalPoint {
     }
 }
 
+/// A table of rows stored mode by mode: row `i`'s coefficient of mode `r` at `r·stride + i`,
+/// real and imaginary parts apart, and `w_r·|c|` of each.
+#[derive(Debug, Clone, Default)]
+pub struct RowsByMode {
+    /// Rows per mode.
+    pub stride: usize,
+    pub re: Vec<f64>,
+    pub im: Vec<f64>,
+    pub abs: Vec<f64>,
+}
+
+impl RowsByMode {
+    /// The table of `rows` (`rows.len() / m` rows of `m` coefficients each, row-major) and
+    /// their weighted magnitudes `rows_abs` (the same layout).
+    pub fn new(rows: &[Cx], rows_abs: &[f64], m: usize) -> Self {
+        let stride = rows.len() / m.max(1);
+        let mut re = vec![0.0; rows.len()];
+        let mut im = re.clone();
+        let mut abs = re.clone();
+        for i in 0..stride {
+            for r in 0..m {
+                re[r * stride + i] = rows[i * m + r].0;
+                im[r * stride + i] = rows[i * m + r].1;
+                abs[r * stride + i] = rows_abs[i * m + r];
+            }
+        }
+        Self {
+            stride,
+            re,
+            im,
+            abs,
+        }
+    }
+
+    /// `out[i] = Σ_r w_r·Re(c_{r,first+i}·x_r)` for the rows `first …` (as many as `out`
+    /// holds), in one pass over the modes: [`ModalPoint::dot`] of each row, the same terms
+    /// added in the same order (from the same start as `f64`'s `Sum`), so the same bits.
+    pub fn dots(&self, weight: &[f64], x: &[Cx], first: usize, out: &mut [f64]) {
+        let rows = out.len();
+        out.fill(std::iter::empty::<f64>().sum());
+        for (r, (&w, xr)) in weight.iter().zip(x).enumerate() {
+            let at = r * self.stride + first;
+            let (cr, ci) = (&self.re[at..at + rows], &self.im[at..at + rows]);
+            for ((o, &a), &b) in out.iter_mut().zip(cr).zip(ci) {
+                *o += w * (a * xr.0 - b * xr.1);
+            }
+        }
+    }
+
+    /// `out[i] = Σ_r w_r·|c_{r,i}|·mag_r[0]` for every row: each row's modal curvature bound
+    /// over a piece (what [`ModalFn`]'s bound of `k = 2` sums from a decaying start), the
+    /// terms in mode order.
+    pub fn curvatures(&self, mag: &[[f64; 3]], out: &mut [f64]) {
+        out.fill(std::iter::empty::<f64>().sum());
+        for (r, m) in mag.iter().enumerate() {
+            let a = &self.abs[r * self.stride..(r + 1) * self.stride];
+            for (o, &a) in out.iter_mut().zip(a) {
+                *o += a * m[0];
+            }
+        }
+    }
+}
+
 /// `[e^{λτ}, τφ₁(λτ), τ²φ₂(λτ), τ³φ₃(λτ)]`.
 #[inline]
 pub fn mode_terms(lambda: Cx, tau: f64) -> [Cx; 4] {
@@ -428,6 +491,22 @@ pub fn value_terms(lambda: Cx, tau: f64) -> [Cx; 3] {
         [e, p1, p1.sub(Cx(1.0, 0.0)).div(x)]
     };
     [e, p1.scale(tau), p2.scale(tau * tau)]
+}
+
+/// `[e^{λτ}, τφ₁(λτ)]`, what a slope needs: [`value_terms`]' first two, the same bits, without
+/// `φ₂`'s division where the closed form does not need it.
+#[inline]
+pub fn slope_terms(lambda: Cx, tau: f64) -> [Cx; 2] {
+    let x = lambda.scale(tau);
+    let [e, p1] = if x.norm_sqr() < 0.25 {
+        let p2 = horner(x, &INV_FACTORIAL[2..15]);
+        let p1 = Cx(1.0, 0.0).add(x.mul(p2));
+        [Cx(1.0, 0.0).add(x.mul(p1)), p1]
+    } else {
+        let e = x.exp();
+        [e, Cx(e.0 - 1.0, e.1).div(x)]
+    };
+    [e, p1.scale(tau)]
 }
 
 /// `1/k!` for `k = 0 … 19`.
@@ -503,6 +582,35 @@ impl super::super::search::Smooth for ModalFn<'_> {
             df += w * c.mul(dy).0;
         }
         (f, df)
+    }
+
+    /// `eval`'s value alone, the same bits (a root's refinement needs no slope).
+    fn value(&self, &t: &f64) -> f64 {
+        let (mut f, _, _) = self.poly_eval(t);
+        for (r, c) in self.c.iter().enumerate() {
+            let [e, p1, p2] = value_terms(self.modes.lambda[r], t);
+            let pc = self.piece;
+            let y = e.mul(pc.y0[r]).add(p1.mul(pc.b0[r])).add(p2.mul(pc.b1[r]));
+            f += self.scale * self.modes.weight[r] * c.mul(y).0;
+        }
+        f
+    }
+
+    /// `eval`'s slope alone, the same bits (an extremum's refinement needs no value).
+    fn slope(&self, &t: &f64) -> f64 {
+        let (_, mut df, _) = self.poly_eval(t);
+        for (r, c) in self.c.iter().enumerate() {
+            let l = self.modes.lambda[r];
+            let [e, p1] = slope_terms(l, t);
+            let pc = self.piece;
+            let dy = l
+                .mul(e)
+                .mul(pc.y0[r])
+                .add(e.mul(pc.b0[r]))
+                .add(p1.mul(pc.b1[r]));
+            df += self.scale * self.modes.weight[r] * c.mul(dy).0;
+        }
+        df
     }
 
     fn second(&self, &t: &f64) -> f64 {
@@ -668,6 +776,79 @@ mod tests {
                     z[i]
                 );
             }
+        }
+    }
+
+    /// A building's piece and functions of it for the tests below: the stack sliding (a
+    /// non-classical state), a ramp in the load, an eigenvalue scale that puts `|λτ|` on both
+    /// sides of the series' switch within a sample interval.
+    fn a_piece() -> (StateModes, Piece) {
+        let b = building();
+        let sm = StateModes::new(&[1.0, 3.0, 1.0], b.stiffness(), b.damping()).unwrap();
+        let mut piece = Piece::default();
+        sm.piece(
+            &[0.01, -0.02, 0.03, 0.4, 0.1, -0.3],
+            &[-1.0, 2.0, 0.5],
+            -3.0,
+            &mut piece,
+        );
+        (sm, piece)
+    }
+
+    /// The value and the slope alone are `eval`'s, bit for bit: the searches refine roots and
+    /// extrema with them, and the stored peaks and switch times must not move.
+    #[test]
+    fn value_and_slope_alone_have_the_bits_of_eval() {
+        use super::super::super::search::Smooth;
+        let (sm, piece) = a_piece();
+        let fastest = sm.fastest();
+        for i in 0..6 {
+            let c: Vec<Cx> = sm.row(i).to_vec();
+            let c_abs: Vec<f64> = c.iter().zip(&sm.weight).map(|(c, w)| w * c.abs()).collect();
+            let f = ModalFn {
+                modes: &sm,
+                piece: &piece,
+                c: &c,
+                c_abs: &c_abs,
+                scale: -1.5,
+                poly: [0.3, -0.2, 0.1, 0.05],
+            };
+            // |λ|τ from 0 through 0.5 (the switch of the value terms) to 3.
+            for k in 0..=60 {
+                let t = k as f64 * 0.05 / fastest;
+                let (v, d) = f.eval(&t);
+                assert_eq!(f.value(&t).to_bits(), v.to_bits(), "row {i}, τ {t}");
+                assert_eq!(f.slope(&t).to_bits(), d.to_bits(), "row {i}, τ {t}");
+            }
+        }
+    }
+
+    /// Every row at once mode by mode has the bits of each row's [`ModalPoint::dot`], for a
+    /// range of rows starting anywhere; the curvatures those of the sum over the modes.
+    #[test]
+    fn rows_by_mode_have_each_rows_bits() {
+        let (sm, piece) = a_piece();
+        let m = sm.modes();
+        let rows: Vec<Cx> = (0..6).flat_map(|i| sm.row(i).to_vec()).collect();
+        let rows_abs: Vec<f64> = (0..rows.len())
+            .map(|i| sm.weight[i % m] * rows[i].abs())
+            .collect();
+        let table = RowsByMode::new(&rows, &rows_abs, m);
+        let mut pt = ModalPoint::default();
+        pt.at(&sm, &piece, 0.7 / sm.fastest());
+        for first in [0, 2, 5] {
+            let mut out = vec![f64::NAN; 6 - first];
+            table.dots(&sm.weight, &pt.y, first, &mut out);
+            for (k, got) in out.iter().enumerate() {
+                let want = ModalPoint::dot(&sm, sm.row(first + k), &pt.y);
+                assert_eq!(got.to_bits(), want.to_bits(), "row {}", first + k);
+            }
+        }
+        let mut curv = vec![f64::NAN; 6];
+        table.curvatures(&piece.mag, &mut curv);
+        for (i, got) in curv.iter().enumerate() {
+            let want: f64 = (0..m).map(|r| rows_abs[i * m + r] * piece.mag[r][0]).sum();
+            assert_eq!(got.to_bits(), want.to_bits(), "row {i}");
         }
     }
 
