@@ -478,6 +478,63 @@ fn the_roof_only_displacement_option_changes_nothing_else() {
     }
 }
 
+/// A thread keeps the bases of the states its runs met, by the bits of what a basis depends
+/// on: a run after another gives the bits of the same run on a fresh thread, for buildings that
+/// differ from the one before in only one such input (the damping, the storey heights, the
+/// floor masses, the storeys' stiffnesses after yield, the time step). A key that left one out would hand a run the
+/// basis of the building before it.
+#[test]
+fn a_run_after_others_on_its_thread_gives_the_bits_of_a_fresh_thread() {
+    let mut s = three_storeys(DampingBasis::Structure);
+    s.stacks = vec![
+        stack(3, &[0.5, 0.5], &[0.2, 0.1], None),
+        stack(1, &[0.4, 0.2], &[0.15, 0.05], None),
+    ];
+    let mut damping = s.clone();
+    damping.damping_ratio = 0.03;
+    let mut heights = damping.clone();
+    heights.storey_heights_m = vec![4.0, 3.0, 3.0];
+    // Heavier blocks: the floors' masses in a stuck state, the storeys the same.
+    let mut masses = heights.clone();
+    masses.stacks[0] = stack(3, &[0.6, 0.5], &[0.2, 0.1], None);
+    // Yielding storeys, then a stiffer branch after yield: the storeys' stiffnesses in a
+    // plastic state, the damping the same.
+    let mut yielding = masses.clone();
+    yielding.yielding = Some(StoreyYielding {
+        strength_ratios: vec![0.15, 0.12, 0.1],
+        post_yield_ratio: 0.05,
+    });
+    let mut stiffer = yielding.clone();
+    stiffer.yielding.as_mut().unwrap().post_yield_ratio = 0.1;
+    let rec = &real_records()[0];
+    let accel = rec.accel_mps2(1.5);
+    // The same samples at another step: a basis keeps its transition over `dt`.
+    let runs: Vec<(BuildingSpec, f64)> = [&s, &damping, &heights, &masses, &yielding, &stiffer]
+        .into_iter()
+        .map(|spec| (spec.clone(), rec.dt_s))
+        .chain(std::iter::once((stiffer.clone(), 0.5 * rec.dt_s)))
+        .collect();
+    let run = |spec: &BuildingSpec, dt_s: f64| {
+        let ground = Ground {
+            dt_s,
+            accel_mps2: &accel,
+        };
+        format!(
+            "{:?}",
+            simulate_building(&Building::new(spec).unwrap(), &ground, &opts()).unwrap()
+        )
+    };
+    let after_others: Vec<String> = runs.iter().map(|(spec, dt)| run(spec, *dt)).collect();
+    for ((spec, dt), got) in runs.iter().zip(&after_others) {
+        let fresh = std::thread::scope(|t| t.spawn(|| run(spec, *dt)).join().unwrap());
+        assert_eq!(got, &fresh, "{spec:?} at dt {dt}");
+    }
+    // The buildings differ: each run gives other numbers than the one before it.
+    for w in after_others.windows(2) {
+        assert_ne!(w[0], w[1]);
+    }
+}
+
 /// A 20-storey building with stacks on several floors runs and balances its energy.
 #[test]
 fn a_twenty_storey_building_runs() {

@@ -35,6 +35,7 @@ use super::modal::{ModalError, ModalFn, ModalPoint, Piece, RowsByMode, StateMode
 use super::model::{Building, StoreySpring};
 use super::response::BuildingResponse;
 use crate::numeric::{Cx, GAUSS8};
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::rc::Rc;
 
@@ -73,6 +74,60 @@ enum Branch {
     Elastic { offset: f64, lo: f64, hi: f64 },
     /// On the bounding line of side `dir`: `k_b = r·k`, `f_off = dir·(1 − r)·F_y`.
     Plastic(i8),
+}
+
+/// The bases met by the runs on this thread, by the exact bits of everything a [`Mode`]
+/// depends on: a sweep runs one building under many frictions and motions, and each meets the
+/// same few contact and yield states. A basis is a function of its inputs alone, so a run gives
+/// the same bits whether its bases come from here or are computed again.
+#[derive(Default)]
+struct BasisMemo {
+    bases: HashMap<Vec<u64>, Rc<Mode>>,
+    /// Their numbers (8 bytes each), counted against [`BASIS_MEMO_VALUES`].
+    values: usize,
+}
+
+/// Numbers the memo of one thread holds before it starts again empty: 16 MiB, about 90
+/// twenty-storey bases or a thousand six-storey ones (each about 8 numbers per row
+/// coefficient: the rows, their magnitudes, the tables by mode and the basis itself).
+const BASIS_MEMO_VALUES: usize = 2 << 20;
+
+thread_local! {
+    static BASES: RefCell<BasisMemo> = RefCell::new(BasisMemo::default());
+}
+
+impl BasisMemo {
+    /// The basis of a state with floor masses `floor_mass` (kg, with their stuck blocks) and
+    /// storey stiffnesses `k_t` (N/m) in `b` (its damping and storey heights) at step `dt`
+    /// (s): from the memo, or built by `build` and kept.
+    fn get_or_build(
+        &mut self,
+        dt: f64,
+        floor_mass: &[f64],
+        k_t: &[f64],
+        b: &Building,
+        build: impl FnOnce() -> Result<Mode, ModalError>,
+    ) -> Result<Rc<Mode>, ModalError> {
+        let key: Vec<u64> = std::iter::once(dt)
+            .chain(floor_mass.iter().copied())
+            .chain(k_t.iter().copied())
+            .chain(b.damping().iter().copied())
+            .chain(b.storey_heights_m().iter().copied())
+            .map(f64::to_bits)
+            .collect();
+        if let Some(m) = self.bases.get(&key) {
+            return Ok(Rc::clone(m));
+        }
+        let m = Rc::new(build()?);
+        let values = 8 * m.rows.len();
+        if self.values + values > BASIS_MEMO_VALUES {
+            self.bases.clear();
+            self.values = 0;
+        }
+        self.values += values;
+        self.bases.insert(key, Rc::clone(&m));
+        Ok(m)
+    }
 }
 
 /// One storey's spring and its branch (an elastic storey is elastic over an unbounded range).
@@ -906,13 +961,17 @@ impl<'b> Integrator<'b> {
         let mode = match self.cache.get(&self.key) {
             Some(m) => Rc::clone(m),
             None => {
-                let m = Rc::new(Mode::new(
-                    StateModes::new(&self.floor_mass, &self.k_t, b.damping())?,
-                    self.dt,
-                    &self.k_t,
-                    &self.damping_above,
-                    b.storey_heights_m(),
-                ));
+                let m = BASES.with_borrow_mut(|bases| {
+                    bases.get_or_build(self.dt, &self.floor_mass, &self.k_t, b, || {
+                        Ok(Mode::new(
+                            StateModes::new(&self.floor_mass, &self.k_t, b.damping())?,
+                            self.dt,
+                            &self.k_t,
+                            &self.damping_above,
+                            b.storey_heights_m(),
+                        ))
+                    })
+                })?;
                 self.cache.insert(self.key.clone(), Rc::clone(&m));
                 m
             }
