@@ -715,7 +715,7 @@ impl<'b> Integrator<'b> {
                         f0: 0.0,
                         df0: None,
                     };
-                    g.f0 = self.start_accel_value(&g);
+                    g.f0 = self.start_value(mode, &g);
                     if self.clear(mode, &g, end, 0.0, f64::INFINITY) {
                         continue;
                     }
@@ -779,16 +779,16 @@ impl<'b> Integrator<'b> {
         (f, df)
     }
 
-    /// `f` of a function of a floor's [`Row::Accel`] row at `p_start`: [`Self::value_at`]'s
-    /// value, its row taken from the pass over the floors' accelerations.
-    fn start_accel_value(&self, g: &Func) -> f64 {
+    /// `f` of `g` at `p_start`: [`Self::value_at`]'s value, a floor's [`Row::Accel`] row taken
+    /// from the pass over the floors' accelerations.
+    fn start_value(&self, mode: &Mode, g: &Func) -> f64 {
+        let Some((Row::Accel, j)) = g.row else {
+            return Self::value_at(mode, g, &self.p_start).0;
+        };
         let t = self.p_start.tau;
         let q = &g.poly;
         let f = q[0] + t * (q[1] + t * (q[2] + t * q[3]));
-        match g.row {
-            Some((Row::Accel, j)) => f + g.scale * self.start_accel[j],
-            _ => unreachable!("a floor's acceleration row"),
-        }
+        f + g.scale * self.start_accel[j]
     }
 
     fn node_at(&self, mode: &Mode, g: &Func, p: &ModalPoint) -> Node<f64> {
@@ -1020,7 +1020,7 @@ impl<'b> Integrator<'b> {
                         f0: 0.0,
                         df0: None,
                     };
-                    g.f0 = self.start_accel_value(&g);
+                    g.f0 = self.start_value(mode, &g);
                     events.push(Event {
                         kind: EventKind::Break(k, side),
                         g,
@@ -1140,7 +1140,7 @@ impl<'b> Integrator<'b> {
                 f0: 0.0,
                 df0: None,
             };
-            g.f0 = self.start_accel_value(&g);
+            g.f0 = self.start_value(mode, &g);
             peaks.push((PeakOf::Accel(f), g));
         }
         let heights = self.b.storey_heights_m();

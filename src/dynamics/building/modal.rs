@@ -393,10 +393,10 @@ impl ModalPoint {
 #[derive(Debug, Clone, Default)]
 pub struct RowsByMode {
     /// Rows per mode.
-    pub stride: usize,
-    pub re: Vec<f64>,
-    pub im: Vec<f64>,
-    pub abs: Vec<f64>,
+    stride: usize,
+    re: Vec<f64>,
+    im: Vec<f64>,
+    abs: Vec<f64>,
 }
 
 impl RowsByMode {
