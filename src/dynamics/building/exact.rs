@@ -130,6 +130,12 @@ impl BasisMemo {
     }
 }
 
+/// `q₀ + q₁τ + q₂τ² + q₃τ³` by Horner's rule (a function's polynomial part).
+#[inline]
+fn cubic(q: &[f64; 4], t: f64) -> f64 {
+    q[0] + t * (q[1] + t * (q[2] + t * q[3]))
+}
+
 /// One storey's spring and its branch (an elastic storey is elastic over an unbounded range).
 #[derive(Debug, Clone, Copy)]
 struct Storey {
@@ -769,7 +775,7 @@ impl<'b> Integrator<'b> {
     fn value_at(mode: &Mode, g: &Func, p: &ModalPoint) -> (f64, f64) {
         let t = p.tau;
         let q = &g.poly;
-        let mut f = q[0] + t * (q[1] + t * (q[2] + t * q[3]));
+        let mut f = cubic(q, t);
         let mut df = q[1] + t * (2.0 * q[2] + 3.0 * t * q[3]);
         if let Some((row, j)) = g.row {
             let c = mode.row(row, j);
@@ -785,10 +791,7 @@ impl<'b> Integrator<'b> {
         let Some((Row::Accel, j)) = g.row else {
             return Self::value_at(mode, g, &self.p_start).0;
         };
-        let t = self.p_start.tau;
-        let q = &g.poly;
-        let f = q[0] + t * (q[1] + t * (q[2] + t * q[3]));
-        f + g.scale * self.start_accel[j]
+        cubic(&g.poly, self.p_start.tau) + g.scale * self.start_accel[j]
     }
 
     fn node_at(&self, mode: &Mode, g: &Func, p: &ModalPoint) -> Node<f64> {
@@ -801,7 +804,7 @@ impl<'b> Integrator<'b> {
     /// [`search::range_within`], without the slopes, which most functions of most pieces pass.
     fn clear(&self, mode: &Mode, g: &Func, h: f64, lower: f64, upper: f64) -> bool {
         let q = &g.poly;
-        let mut f1 = q[0] + h * (q[1] + h * (q[2] + h * q[3]));
+        let mut f1 = cubic(q, h);
         let mut curv = 2.0 * q[2].abs() + 6.0 * h * q[3].abs();
         if let Some((row, j)) = g.row {
             let i = mode.index(row, j);

@@ -319,6 +319,23 @@ pub struct Piece {
 }
 
 impl Piece {
+    /// `y_r(τ)` from the mode terms `[e^{λτ}, τφ₁, τ²φ₂]` at `τ`.
+    #[inline]
+    fn y(&self, r: usize, e: Cx, p1: Cx, p2: Cx) -> Cx {
+        e.mul(self.y0[r])
+            .add(p1.mul(self.b0[r]))
+            .add(p2.mul(self.b1[r]))
+    }
+
+    /// `y_r'(τ)` of mode `r` (eigenvalue `l`) from the mode terms `[e^{λτ}, τφ₁]` at `τ`.
+    #[inline]
+    fn dy(&self, r: usize, l: Cx, e: Cx, p1: Cx) -> Cx {
+        l.mul(e)
+            .mul(self.y0[r])
+            .add(e.mul(self.b0[r]))
+            .add(p1.mul(self.b1[r]))
+    }
+
     fn resize(&mut self, m: usize) {
         for v in [&mut self.y0, &mut self.b0, &mut self.b1, &mut self.q2] {
             v.resize(m, Cx(0.0, 0.0));
@@ -367,14 +384,12 @@ impl ModalPoint {
         self.iy.resize(m, Cx(0.0, 0.0));
         for r in 0..m {
             let [e, p1, p2, p3] = terms(r);
-            let (y0, b0, b1) = (piece.y0[r], piece.b0[r], piece.b1[r]);
-            self.y[r] = e.mul(y0).add(p1.mul(b0)).add(p2.mul(b1));
-            self.dy[r] = modes.lambda[r]
-                .mul(e)
-                .mul(y0)
-                .add(e.mul(b0))
-                .add(p1.mul(b1));
-            self.iy[r] = p1.mul(y0).add(p2.mul(b0)).add(p3.mul(b1));
+            self.y[r] = piece.y(r, e, p1, p2);
+            self.dy[r] = piece.dy(r, modes.lambda[r], e, p1);
+            self.iy[r] = p1
+                .mul(piece.y0[r])
+                .add(p2.mul(piece.b0[r]))
+                .add(p3.mul(piece.b1[r]));
         }
     }
 
@@ -480,16 +495,7 @@ pub fn mode_terms(lambda: Cx, tau: f64) -> [Cx; 4] {
 /// recurrence. Agrees with [`mode_terms`] to a few ulps (tested).
 #[inline]
 pub fn value_terms(lambda: Cx, tau: f64) -> [Cx; 3] {
-    let x = lambda.scale(tau);
-    let [e, p1, p2] = if x.norm_sqr() < 0.25 {
-        let p2 = horner(x, &INV_FACTORIAL[2..15]);
-        let p1 = Cx(1.0, 0.0).add(x.mul(p2));
-        [Cx(1.0, 0.0).add(x.mul(p1)), p1, p2]
-    } else {
-        let e = x.exp();
-        let p1 = Cx(e.0 - 1.0, e.1).div(x);
-        [e, p1, p1.sub(Cx(1.0, 0.0)).div(x)]
-    };
+    let [e, p1, p2] = phi_terms::<true>(lambda.scale(tau));
     [e, p1.scale(tau), p2.scale(tau * tau)]
 }
 
@@ -497,16 +503,28 @@ pub fn value_terms(lambda: Cx, tau: f64) -> [Cx; 3] {
 /// `φ₂`'s division where the closed form does not need it.
 #[inline]
 pub fn slope_terms(lambda: Cx, tau: f64) -> [Cx; 2] {
-    let x = lambda.scale(tau);
-    let [e, p1] = if x.norm_sqr() < 0.25 {
+    let [e, p1, _] = phi_terms::<false>(lambda.scale(tau));
+    [e, p1.scale(tau)]
+}
+
+/// `[e^x, φ₁(x), φ₂(x)]` as [`value_terms`] states them; `φ₂` zero where `!P2` and the closed
+/// form would spend a division on it.
+#[inline(always)]
+fn phi_terms<const P2: bool>(x: Cx) -> [Cx; 3] {
+    if x.norm_sqr() < 0.25 {
         let p2 = horner(x, &INV_FACTORIAL[2..15]);
         let p1 = Cx(1.0, 0.0).add(x.mul(p2));
-        [Cx(1.0, 0.0).add(x.mul(p1)), p1]
+        [Cx(1.0, 0.0).add(x.mul(p1)), p1, p2]
     } else {
         let e = x.exp();
-        [e, Cx(e.0 - 1.0, e.1).div(x)]
-    };
-    [e, p1.scale(tau)]
+        let p1 = Cx(e.0 - 1.0, e.1).div(x);
+        let p2 = if P2 {
+            p1.sub(Cx(1.0, 0.0)).div(x)
+        } else {
+            Cx(0.0, 0.0)
+        };
+        [e, p1, p2]
+    }
 }
 
 /// `1/k!` for `k = 0 … 19`.
@@ -570,16 +588,9 @@ impl super::super::search::Smooth for ModalFn<'_> {
         for (r, c) in self.c.iter().enumerate() {
             let l = self.modes.lambda[r];
             let [e, p1, p2] = value_terms(l, t);
-            let pc = self.piece;
-            let y = e.mul(pc.y0[r]).add(p1.mul(pc.b0[r])).add(p2.mul(pc.b1[r]));
-            let dy = l
-                .mul(e)
-                .mul(pc.y0[r])
-                .add(e.mul(pc.b0[r]))
-                .add(p1.mul(pc.b1[r]));
             let w = self.scale * self.modes.weight[r];
-            f += w * c.mul(y).0;
-            df += w * c.mul(dy).0;
+            f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
+            df += w * c.mul(self.piece.dy(r, l, e, p1)).0;
         }
         (f, df)
     }
@@ -589,9 +600,8 @@ impl super::super::search::Smooth for ModalFn<'_> {
         let (mut f, _, _) = self.poly_eval(t);
         for (r, c) in self.c.iter().enumerate() {
             let [e, p1, p2] = value_terms(self.modes.lambda[r], t);
-            let pc = self.piece;
-            let y = e.mul(pc.y0[r]).add(p1.mul(pc.b0[r])).add(p2.mul(pc.b1[r]));
-            f += self.scale * self.modes.weight[r] * c.mul(y).0;
+            let w = self.scale * self.modes.weight[r];
+            f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
         }
         f
     }
@@ -602,13 +612,8 @@ impl super::super::search::Smooth for ModalFn<'_> {
         for (r, c) in self.c.iter().enumerate() {
             let l = self.modes.lambda[r];
             let [e, p1] = slope_terms(l, t);
-            let pc = self.piece;
-            let dy = l
-                .mul(e)
-                .mul(pc.y0[r])
-                .add(e.mul(pc.b0[r]))
-                .add(p1.mul(pc.b1[r]));
-            df += self.scale * self.modes.weight[r] * c.mul(dy).0;
+            let w = self.scale * self.modes.weight[r];
+            df += w * c.mul(self.piece.dy(r, l, e, p1)).0;
         }
         df
     }
