@@ -190,8 +190,6 @@ enum Row {
     Vel,
     /// `δ_j = u_j − u_{j−1}`.
     Drift,
-    /// `δ̇_j`.
-    DriftRate,
     /// `ü_j` without the load (`(A·z)_{N+j}`): with the load's constant, a floor's absolute
     /// acceleration.
     Accel,
@@ -200,16 +198,23 @@ enum Row {
     /// shear `k_t,1·δ_1 + 1ᵀ·C·u̇`.
     Shear,
     /// The overturning moment at the base without the storeys' force offsets, `Σ_j h_j·V_j`
-    /// over the [`Row::Shear`] rows; kept for `j = 0` only.
+    /// over the [`Row::Shear`] rows; one row, `j = 0`.
     Overturning,
+    /// `δ̇_j`: only a yielding storey's unloading asks for it, so it comes last, and the passes
+    /// over every row leave it out for elastic storeys ([`Mode::live_rows`]).
+    DriftRate,
 }
 
-const ROWS: usize = 7;
+/// Rows of a building of `n` storeys: `N` of each kind, one overturning moment.
+fn row_count(n: usize) -> usize {
+    6 * n + 1
+}
 
 /// A mode's basis, its rows and what a whole sample interval needs of it.
 struct Mode {
     modes: StateModes,
-    /// `ROWS × N` rows of `m` coefficients, and their magnitudes times the modes' weights.
+    /// [`row_count`] rows of `m` coefficients ([`Mode::index`]), and their magnitudes times the
+    /// modes' weights.
     rows: Vec<Cx>,
     rows_abs: Vec<f64>,
     /// The same rows mode by mode, for the passes that evaluate every row at once.
@@ -231,7 +236,8 @@ impl Mode {
         heights_m: &[f64],
     ) -> Self {
         let (n, m) = (modes.n, modes.modes());
-        let mut rows = vec![Cx(0.0, 0.0); ROWS * n * m];
+        let mut rows = vec![Cx(0.0, 0.0); row_count(n) * m];
+        let at = |row: Row, j: usize, r: usize| Self::index_in(n, row, j) * m + r;
         for r in 0..m {
             let mut moment = Cx(0.0, 0.0);
             for j in 0..n {
@@ -244,10 +250,10 @@ impl Mode {
                 for l in 0..n {
                     shear = shear.add(modes.row(n + l)[r].scale(damping_above[j * n + l]));
                 }
-                rows[(Row::Shear as usize * n + j) * m + r] = shear;
+                rows[at(Row::Shear, j, r)] = shear;
                 moment = moment.add(shear.scale(heights_m[j]));
             }
-            rows[(Row::Overturning as usize * n) * m + r] = moment;
+            rows[at(Row::Overturning, 0, r)] = moment;
         }
         for j in 0..n {
             for r in 0..m {
@@ -258,11 +264,11 @@ impl Mode {
                 } else {
                     (Cx(0.0, 0.0), Cx(0.0, 0.0))
                 };
-                rows[(Row::Disp as usize * n + j) * m + r] = u;
-                rows[(Row::Vel as usize * n + j) * m + r] = v;
-                rows[(Row::Drift as usize * n + j) * m + r] = u.sub(u_prev);
-                rows[(Row::DriftRate as usize * n + j) * m + r] = v.sub(v_prev);
-                rows[(Row::Accel as usize * n + j) * m + r] = modes.lambda[r].mul(v);
+                rows[at(Row::Disp, j, r)] = u;
+                rows[at(Row::Vel, j, r)] = v;
+                rows[at(Row::Drift, j, r)] = u.sub(u_prev);
+                rows[at(Row::DriftRate, j, r)] = v.sub(v_prev);
+                rows[at(Row::Accel, j, r)] = modes.lambda[r].mul(v);
             }
         }
         let rows_abs: Vec<f64> = rows
@@ -283,18 +289,37 @@ impl Mode {
 
     /// Where row `(row, j)` is in the tables, and in the passes over all rows.
     fn index(&self, row: Row, j: usize) -> usize {
-        row as usize * self.modes.n + j
+        Self::index_in(self.modes.n, row, j)
+    }
+
+    /// [`Self::index`] in a building of `n` storeys: the kinds in [`Row`]'s order, `N` rows
+    /// each but the overturning moment's one.
+    fn index_in(n: usize, row: Row, j: usize) -> usize {
+        debug_assert!(j < n && (row != Row::Overturning || j == 0), "{row:?} {j}");
+        match row {
+            Row::DriftRate => (Row::Overturning as usize) * n + 1 + j,
+            _ => row as usize * n + j,
+        }
+    }
+
+    /// The rows the passes over every row evaluate, from the first: all of them where a storey
+    /// can yield, else all but the [`Row::DriftRate`] rows, which no function reads.
+    fn live_rows(&self, yielding: bool) -> usize {
+        match yielding {
+            true => row_count(self.modes.n),
+            false => self.index(Row::DriftRate, 0),
+        }
     }
 
     fn row(&self, row: Row, j: usize) -> &[Cx] {
-        let (n, m) = (self.modes.n, self.modes.modes());
-        let at = (row as usize * n + j) * m;
+        let m = self.modes.modes();
+        let at = self.index(row, j) * m;
         &self.rows[at..at + m]
     }
 
     fn row_abs(&self, row: Row, j: usize) -> &[f64] {
-        let (n, m) = (self.modes.n, self.modes.modes());
-        let at = (row as usize * n + j) * m;
+        let m = self.modes.modes();
+        let at = self.index(row, j) * m;
         &self.rows_abs[at..at + m]
     }
 }
@@ -429,8 +454,9 @@ struct Integrator<'b> {
     p_start: ModalPoint,
     p_end: ModalPoint,
     p_quad: ModalPoint,
-    /// Every row of the mode at `p_end` (`ROWS × N`, [`Mode::index`]), the modal part of each
-    /// row's curvature bound over the piece, and the floors' [`Row::Accel`] rows at `p_start`.
+    /// Every row of the mode at `p_end` ([`Mode::index`]; the first [`Mode::live_rows`]), the
+    /// modal part of each row's curvature bound over the piece (the same rows), and the floors'
+    /// [`Row::Accel`] rows at `p_start`.
     end_rows: Vec<f64>,
     curvatures: Vec<f64>,
     start_accel: Vec<f64>,
@@ -567,8 +593,8 @@ impl<'b> Integrator<'b> {
             p_start: ModalPoint::default(),
             p_end: ModalPoint::default(),
             p_quad: ModalPoint::default(),
-            end_rows: vec![0.0; ROWS * n],
-            curvatures: vec![0.0; ROWS * n],
+            end_rows: vec![0.0; row_count(n)],
+            curvatures: vec![0.0; row_count(n)],
             start_accel: vec![0.0; n],
             z: vec![0.0; 2 * n],
             p0: vec![0.0; n],
@@ -752,8 +778,13 @@ impl<'b> Integrator<'b> {
         } else {
             self.p_end.at(&mode.modes, &self.piece, tau);
         }
-        mode.by_mode
-            .dots(&mode.modes.weight, &self.p_end.y, 0, &mut self.end_rows);
+        let live = mode.live_rows(self.yielding);
+        mode.by_mode.dots(
+            &mode.modes.weight,
+            &self.p_end.y,
+            0,
+            &mut self.end_rows[..live],
+        );
     }
 
     fn mode(&self) -> Rc<Mode> {
@@ -872,8 +903,9 @@ impl<'b> Integrator<'b> {
         }
         mode.modes.piece(&self.z, &self.p0, -slope, &mut self.piece);
         self.p_start.start(&mode.modes, &self.piece);
+        let live = mode.live_rows(self.yielding);
         mode.by_mode
-            .curvatures(&self.piece.mag, &mut self.curvatures);
+            .curvatures(&self.piece.mag, &mut self.curvatures[..live]);
         mode.by_mode.dots(
             &mode.modes.weight,
             &self.p_start.y,

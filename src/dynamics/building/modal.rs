@@ -53,7 +53,9 @@ pub struct StateModes {
     pub weight: Vec<f64>,
     /// `V`: `2N × m` row-major, `z_i = Σ_r w_r·Re(v[i][r]·y_r)`.
     v: Vec<Cx>,
-    /// Rows of `V⁻¹` for the kept modes: `y = uz·z` (`m × 2N`), `β = up·p` (`m × N`).
+    /// Rows of `V⁻¹` for the kept modes, `y = uz·z` and `β = up·p`, stored column by column
+    /// (`uz[i·m + r]`, `2N × m`; `up[j·m + r]`, `N × m`) for [`Self::piece`]'s pass over the
+    /// modes.
     uz: Vec<Cx>,
     up: Vec<Cx>,
     /// `up·1` (`β₁ = −ȧ_g·up_ones`).
@@ -158,13 +160,13 @@ impl StateModes {
                     gu += inv[(row, q)] * (s[q] * pm);
                     gv += inv[(row, n + q)] * pm;
                 }
-                uz[r * dim + j] = Cx(gu.re, gu.im);
-                uz[r * dim + n + j] = Cx(gv.re, gv.im);
-                up[r * n + j] = Cx(gv.re, gv.im);
+                uz[j * m + r] = Cx(gu.re, gu.im);
+                uz[(n + j) * m + r] = Cx(gv.re, gv.im);
+                up[j * m + r] = Cx(gv.re, gv.im);
             }
         }
         let up_ones = (0..m)
-            .map(|r| (0..n).map(|j| up[r * n + j]).fold(Cx(0.0, 0.0), Cx::add))
+            .map(|r| (0..n).map(|j| up[j * m + r]).fold(Cx(0.0, 0.0), Cx::add))
             .collect();
         let lambda: Vec<Cx> = lambda.iter().map(|l| Cx(l.re, l.im)).collect();
         let abs_lambda = lambda.iter().map(|l| l.abs()).collect();
@@ -204,23 +206,23 @@ impl StateModes {
 
     /// The piece from state `z` (`2N`) under `p(τ) = p₀ + p₁·1·τ` (`p₀` per floor, m/s²).
     pub fn piece(&self, z: &[f64], p0: &[f64], p1: f64, out: &mut Piece) {
-        let (m, n, dim) = (self.modes(), self.n, 2 * self.n);
+        let m = self.modes();
         out.resize(m);
+        // `y₀ = uz·z` and `β₀ = up·p₀`, one column at a time over every mode: each mode's sum
+        // still adds its terms in column order from zero.
+        for (sum, columns, x) in [(&mut out.y0, &self.uz, z), (&mut out.b0, &self.up, p0)] {
+            sum.fill(Cx(0.0, 0.0));
+            for (col, &x) in columns.chunks_exact(m).zip(x) {
+                for (s, c) in sum.iter_mut().zip(col) {
+                    *s = s.add(c.scale(x));
+                }
+            }
+        }
         for r in 0..m {
-            let row = &self.uz[r * dim..(r + 1) * dim];
-            let y0 = row
-                .iter()
-                .zip(z)
-                .fold(Cx(0.0, 0.0), |s, (c, &x)| s.add(c.scale(x)));
-            let b0 = self.up[r * n..(r + 1) * n]
-                .iter()
-                .zip(p0)
-                .fold(Cx(0.0, 0.0), |s, (c, &x)| s.add(c.scale(x)));
+            let (y0, b0) = (out.y0[r], out.b0[r]);
             let b1 = self.up_ones[r].scale(p1);
             let l = self.lambda[r];
             let q2 = l.mul(l).mul(y0).add(l.mul(b0)).add(b1);
-            out.y0[r] = y0;
-            out.b0[r] = b0;
             out.b1[r] = b1;
             out.q2[r] = q2;
             let a = q2.norm_sqr().sqrt();
@@ -316,6 +318,57 @@ pub struct Piece {
     pub q2: Vec<Cx>,
     /// `|q₂|·|λ|^{k−2}` for `k = 2, 3, 4`.
     pub mag: Vec<[f64; 3]>,
+    /// Per mode the largest `e^{Re λ_r·τ}` over the latest interval `[lo, t1]` a bound was
+    /// asked over: a search asks for the bounds of several orders over one interval, and every
+    /// function of the piece over the same intervals, each the same exponentials.
+    envelopes: Latest<f64>,
+    /// Per mode [`value_terms`] at the latest `τ` a value and slope were asked at: the searches
+    /// of the piece's functions split their intervals at the same points.
+    terms: Latest<[Cx; 3]>,
+}
+
+/// Per-mode numbers of a piece for the latest key they were asked for (the bits of one or two
+/// times), computed again for another key. They depend on the modes' eigenvalues and the key
+/// alone, so they are kept for the modes the piece was built from: emptied whenever the piece's
+/// coefficients are set ([`Piece::forget_kept`]).
+#[derive(Debug, Clone)]
+struct Latest<T> {
+    key: std::cell::Cell<Option<(u64, u64)>>,
+    values: std::cell::RefCell<Vec<T>>,
+}
+
+impl<T> Default for Latest<T> {
+    fn default() -> Self {
+        Self {
+            key: Default::default(),
+            values: Default::default(),
+        }
+    }
+}
+
+impl<T> Latest<T> {
+    /// `with` of the values of `key`, filled by `value` for each of `modes` modes where they are
+    /// not those of `key`.
+    fn with<R>(
+        &self,
+        key: (f64, f64),
+        modes: usize,
+        value: impl FnMut(usize) -> T,
+        with: impl FnOnce(&[T]) -> R,
+    ) -> R {
+        let key = Some((key.0.to_bits(), key.1.to_bits()));
+        let mut values = self.values.borrow_mut();
+        if self.key.get() != key || values.len() != modes {
+            values.clear();
+            values.extend((0..modes).map(value));
+            self.key.set(key);
+        }
+        with(&values)
+    }
+
+    fn forget(&self) {
+        self.key.set(None);
+    }
 }
 
 impl Piece {
@@ -341,6 +394,14 @@ impl Piece {
             v.resize(m, Cx(0.0, 0.0));
         }
         self.mag.resize(m, [0.0; 3]);
+        self.forget_kept();
+    }
+
+    /// Forgets the numbers kept for the latest interval and time ([`Latest`]): called whenever
+    /// the coefficients are set.
+    pub(crate) fn forget_kept(&mut self) {
+        self.envelopes.forget();
+        self.terms.forget();
     }
 }
 
@@ -452,13 +513,13 @@ impl RowsByMode {
         }
     }
 
-    /// `out[i] = Σ_r w_r·|c_{r,i}|·mag_r[0]` for every row: each row's modal curvature bound
-    /// over a piece (what [`ModalFn`]'s bound of `k = 2` sums from a decaying start), the
-    /// terms in mode order.
+    /// `out[i] = Σ_r w_r·|c_{r,i}|·mag_r[0]` for the first rows (as many as `out` holds): each
+    /// row's modal curvature bound over a piece (what [`ModalFn`]'s bound of `k = 2` sums from
+    /// a decaying start), the terms in mode order.
     pub fn curvatures(&self, mag: &[[f64; 3]], out: &mut [f64]) {
         out.fill(std::iter::empty::<f64>().sum());
         for (r, m) in mag.iter().enumerate() {
-            let a = &self.abs[r * self.stride..(r + 1) * self.stride];
+            let a = &self.abs[r * self.stride..r * self.stride + out.len()];
             for (o, &a) in out.iter_mut().zip(a) {
                 *o += a * m[0];
             }
@@ -585,13 +646,18 @@ impl super::super::search::Smooth for ModalFn<'_> {
 
     fn eval(&self, &t: &f64) -> (f64, f64) {
         let (mut f, mut df, _) = self.poly_eval(t);
-        for (r, c) in self.c.iter().enumerate() {
-            let l = self.modes.lambda[r];
-            let [e, p1, p2] = value_terms(l, t);
-            let w = self.scale * self.modes.weight[r];
-            f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
-            df += w * c.mul(self.piece.dy(r, l, e, p1)).0;
+        if self.c.is_empty() {
+            return (f, df);
         }
+        let lambda = &self.modes.lambda;
+        let terms = |r: usize| value_terms(lambda[r], t);
+        (self.piece.terms).with((t, 0.0), lambda.len(), terms, |terms| {
+            for (r, (c, &[e, p1, p2])) in self.c.iter().zip(terms).enumerate() {
+                let w = self.scale * self.modes.weight[r];
+                f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
+                df += w * c.mul(self.piece.dy(r, lambda[r], e, p1)).0;
+            }
+        });
         (f, df)
     }
 
@@ -635,17 +701,30 @@ impl super::super::search::Smooth for ModalFn<'_> {
             3 => 6.0 * p[3].abs(),
             _ => 0.0,
         };
-        let mut modal = 0.0;
-        for (r, a) in self.c_abs.iter().enumerate() {
-            // e^{Re λ·τ} over the interval; 1 from the start of a decaying mode.
-            let re = self.modes.lambda[r].0;
-            let env = if lo == 0.0 && re <= 0.0 {
+        // The modal terms times each mode's envelope over the interval (none for the
+        // polynomial alone).
+        let terms = (self.c_abs.iter())
+            .zip(&self.piece.mag)
+            .map(|(a, m)| (*a, m[k - 2]));
+        let lambda = &self.modes.lambda;
+        let envelope = |r: usize| {
+            let re = lambda[r].0;
+            if lo == 0.0 && re <= 0.0 {
                 1.0
             } else {
                 (re * lo).max(re * t1).exp()
-            };
-            modal += a * self.piece.mag[r][k - 2] * env;
-        }
+            }
+        };
+        let modal = match self.c_abs.is_empty() {
+            true => 0.0,
+            false => (self.piece.envelopes).with((lo, t1), lambda.len(), envelope, |env| {
+                let mut sum = 0.0;
+                for ((a, m), e) in terms.zip(env) {
+                    sum += a * m * e;
+                }
+                sum
+            }),
+        };
         // A few ulps of slack for the rounding of the terms above.
         (poly + self.scale.abs() * modal) * (1.0 + 1e-12)
     }
@@ -824,6 +903,58 @@ mod tests {
                 let (v, d) = f.eval(&t);
                 assert_eq!(f.value(&t).to_bits(), v.to_bits(), "row {i}, τ {t}");
                 assert_eq!(f.slope(&t).to_bits(), d.to_bits(), "row {i}, τ {t}");
+            }
+        }
+    }
+
+    /// A piece's values, slopes and bounds with the numbers it keeps for the latest time and
+    /// interval ([`Latest`]) have the bits of a fresh piece's, whichever rows asked before, and
+    /// after its buffer served other modes at the same times.
+    #[test]
+    fn kept_numbers_follow_the_times_and_the_modes() {
+        use super::super::super::search::Smooth;
+        let b = building();
+        let bases = [
+            StateModes::new(&[1.0, 3.0, 1.0], b.stiffness(), b.damping()).unwrap(),
+            StateModes::new(&[2.0, 1.0, 1.5], b.stiffness(), b.damping()).unwrap(),
+        ];
+        assert_eq!(bases[0].modes(), bases[1].modes());
+        let (z, p0) = ([0.01, -0.02, 0.03, 0.4, 0.1, -0.3], [-1.0, 2.0, 0.5]);
+        let h = 0.9 / bases[0].fastest();
+        let mut kept = Piece::default();
+        // A time and an interval, then another: every row asks at each (the later rows find
+        // the numbers kept), and the next modes start where the last left off.
+        let asked = [(0.5, 0.25), (0.8, 0.5)];
+        for (round, sm) in [&bases[0], &bases[1], &bases[0]].into_iter().enumerate() {
+            sm.piece(&z, &p0, -3.0, &mut kept);
+            let at = |piece: &Piece, i: usize, (t, lo): (f64, f64)| {
+                let c = sm.row(i).to_vec();
+                let c_abs: Vec<f64> = c.iter().zip(&sm.weight).map(|(c, w)| w * c.abs()).collect();
+                let f = ModalFn {
+                    modes: sm,
+                    piece,
+                    c: &c,
+                    c_abs: &c_abs,
+                    scale: -1.5,
+                    poly: [0.3, -0.2, 0.1, 0.05],
+                };
+                let (t, lo) = (t * h, lo * h);
+                (f.eval(&t), [2, 3, 4].map(|k| f.bound(k, &lo, t)))
+            };
+            let order = if round % 2 == 0 { [0, 1] } else { [1, 0] };
+            for point in order.map(|k| asked[k]) {
+                for i in 0..6 {
+                    // From a piece that has kept nothing yet.
+                    let mut fresh = Piece::default();
+                    sm.piece(&z, &p0, -3.0, &mut fresh);
+                    let want = at(&fresh, i, point);
+                    let got = at(&kept, i, point);
+                    assert_eq!(
+                        format!("{got:?}"),
+                        format!("{want:?}"),
+                        "row {i} at {point:?}"
+                    );
+                }
             }
         }
     }
