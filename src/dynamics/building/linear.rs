@@ -1160,7 +1160,6 @@ impl LinearBuilding {
             v.clear();
         }
         out.mag.clear();
-        out.forget_kept();
         for r in 0..m {
             let l = self.modes.lambda[r];
             let y0 = Cx(y[r], y[m + r]);

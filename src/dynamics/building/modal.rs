@@ -62,7 +62,13 @@ pub struct StateModes {
     up_ones: Vec<Cx>,
     /// `|λ_r|`.
     abs_lambda: Vec<f64>,
+    /// This basis among those of the process (a clone keeps it: the same eigenvalues): what
+    /// a piece keeps for its modes is kept under it ([`Kept`]).
+    id: u64,
 }
+
+/// The next [`StateModes::id`].
+static NEXT_BASIS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl StateModes {
     /// The basis of `M = diag(masses)`, storey stiffnesses `k_t` (N/m, `≥ 0`) and damping
@@ -179,6 +185,7 @@ impl StateModes {
             up,
             up_ones,
             abs_lambda,
+            id: NEXT_BASIS.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         })
     }
 
@@ -318,56 +325,65 @@ pub struct Piece {
     pub q2: Vec<Cx>,
     /// `|q₂|·|λ|^{k−2}` for `k = 2, 3, 4`.
     pub mag: Vec<[f64; 3]>,
-    /// Per mode the largest `e^{Re λ_r·τ}` over the latest interval `[lo, t1]` a bound was
-    /// asked over: a search asks for the bounds of several orders over one interval, and every
-    /// function of the piece over the same intervals, each the same exponentials.
-    envelopes: Latest<f64>,
-    /// Per mode [`value_terms`] at the latest `τ` a value and slope were asked at: the searches
-    /// of the piece's functions split their intervals at the same points.
-    terms: Latest<[Cx; 3]>,
+    /// Per mode the largest `e^{Re λ_r·τ}` over an interval `[lo, t1]`: a search asks for the
+    /// bounds of several orders over one interval, and every function of a piece (and the next
+    /// piece, at the next sample) over the same intervals, each the same exponentials.
+    envelopes: Kept<f64>,
+    /// Per mode [`value_terms`] at a time `τ`: the searches split their intervals at the same
+    /// points.
+    terms: Kept<[Cx; 3]>,
 }
 
-/// Per-mode numbers of a piece for the latest key they were asked for (the bits of one or two
-/// times), computed again for another key. They depend on the modes' eigenvalues and the key
-/// alone, so they are kept for the modes the piece was built from: emptied whenever the piece's
-/// coefficients are set ([`Piece::forget_kept`]).
+/// Slots of a [`Kept`].
+const KEPT: usize = 4;
+
+/// A key (the basis' identity and two times' bits) and its numbers, one per mode.
+type Slot<T> = (Option<[u64; 3]>, Vec<T>);
+
+/// Per-mode numbers for the last [`KEPT`] keys they were asked for: a key is a basis
+/// ([`StateModes::id`]) and the bits of one or two times, on which alone the numbers depend, so
+/// a piece keeps them from one piece to the next (from one sample to the next) and gives the
+/// bits it would compute. A new key takes the oldest slot.
 #[derive(Debug, Clone)]
-struct Latest<T> {
-    key: std::cell::Cell<Option<(u64, u64)>>,
-    values: std::cell::RefCell<Vec<T>>,
+struct Kept<T> {
+    slots: std::cell::RefCell<[Slot<T>; KEPT]>,
+    oldest: std::cell::Cell<usize>,
 }
 
-impl<T> Default for Latest<T> {
+impl<T> Default for Kept<T> {
     fn default() -> Self {
         Self {
-            key: Default::default(),
-            values: Default::default(),
+            slots: std::cell::RefCell::new(std::array::from_fn(|_| (None, Vec::new()))),
+            oldest: std::cell::Cell::new(0),
         }
     }
 }
 
-impl<T> Latest<T> {
-    /// `with` of the values of `key`, filled by `value` for each of `modes` modes where they are
-    /// not those of `key`.
+impl<T> Kept<T> {
+    /// `with` of the numbers of `modes` at times `key`, filled by `value` for each mode where
+    /// they are not kept.
     fn with<R>(
         &self,
+        modes: &StateModes,
         key: (f64, f64),
-        modes: usize,
         value: impl FnMut(usize) -> T,
         with: impl FnOnce(&[T]) -> R,
     ) -> R {
-        let key = Some((key.0.to_bits(), key.1.to_bits()));
-        let mut values = self.values.borrow_mut();
-        if self.key.get() != key || values.len() != modes {
-            values.clear();
-            values.extend((0..modes).map(value));
-            self.key.set(key);
-        }
-        with(&values)
-    }
-
-    fn forget(&self) {
-        self.key.set(None);
+        let key = Some([modes.id, key.0.to_bits(), key.1.to_bits()]);
+        let mut slots = self.slots.borrow_mut();
+        let at = match slots.iter().position(|(k, _)| *k == key) {
+            Some(at) => at,
+            None => {
+                let at = self.oldest.get();
+                self.oldest.set((at + 1) % KEPT);
+                let (k, values) = &mut slots[at];
+                values.clear();
+                values.extend((0..modes.modes()).map(value));
+                *k = key;
+                at
+            }
+        };
+        with(&slots[at].1)
     }
 }
 
@@ -394,14 +410,6 @@ impl Piece {
             v.resize(m, Cx(0.0, 0.0));
         }
         self.mag.resize(m, [0.0; 3]);
-        self.forget_kept();
-    }
-
-    /// Forgets the numbers kept for the latest interval and time ([`Latest`]): called whenever
-    /// the coefficients are set.
-    pub(crate) fn forget_kept(&mut self) {
-        self.envelopes.forget();
-        self.terms.forget();
     }
 }
 
@@ -651,7 +659,7 @@ impl super::super::search::Smooth for ModalFn<'_> {
         }
         let lambda = &self.modes.lambda;
         let terms = |r: usize| value_terms(lambda[r], t);
-        (self.piece.terms).with((t, 0.0), lambda.len(), terms, |terms| {
+        (self.piece.terms).with(self.modes, (t, 0.0), terms, |terms| {
             for (r, (c, &[e, p1, p2])) in self.c.iter().zip(terms).enumerate() {
                 let w = self.scale * self.modes.weight[r];
                 f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
@@ -717,7 +725,7 @@ impl super::super::search::Smooth for ModalFn<'_> {
         };
         let modal = match self.c_abs.is_empty() {
             true => 0.0,
-            false => (self.piece.envelopes).with((lo, t1), lambda.len(), envelope, |env| {
+            false => (self.piece.envelopes).with(self.modes, (lo, t1), envelope, |env| {
                 let mut sum = 0.0;
                 for ((a, m), e) in terms.zip(env) {
                     sum += a * m * e;
@@ -907,9 +915,9 @@ mod tests {
         }
     }
 
-    /// A piece's values, slopes and bounds with the numbers it keeps for the latest time and
-    /// interval ([`Latest`]) have the bits of a fresh piece's, whichever rows asked before, and
-    /// after its buffer served other modes at the same times.
+    /// A piece's values, slopes and bounds with the numbers it keeps for times and intervals
+    /// ([`Kept`]) have the bits of a fresh piece's, whichever rows asked before, after its buffer
+    /// served other modes at the same times, and after more times than it keeps.
     #[test]
     fn kept_numbers_follow_the_times_and_the_modes() {
         use super::super::super::search::Smooth;
@@ -922,9 +930,18 @@ mod tests {
         let (z, p0) = ([0.01, -0.02, 0.03, 0.4, 0.1, -0.3], [-1.0, 2.0, 0.5]);
         let h = 0.9 / bases[0].fastest();
         let mut kept = Piece::default();
-        // A time and an interval, then another: every row asks at each (the later rows find
-        // the numbers kept), and the next modes start where the last left off.
-        let asked = [(0.5, 0.25), (0.8, 0.5)];
+        // Times and intervals, more than a piece keeps, one after another: every row asks at
+        // each (the later rows find the numbers kept), and the next modes start where the last
+        // left off (the other way round).
+        let asked = [
+            (0.5, 0.25),
+            (0.8, 0.5),
+            (0.3, 0.1),
+            (0.6, 0.3),
+            (0.9, 0.6),
+            (0.2, 0.0),
+        ];
+        assert!(asked.len() > KEPT);
         for (round, sm) in [&bases[0], &bases[1], &bases[0]].into_iter().enumerate() {
             sm.piece(&z, &p0, -3.0, &mut kept);
             let at = |piece: &Piece, i: usize, (t, lo): (f64, f64)| {
@@ -941,8 +958,11 @@ mod tests {
                 let (t, lo) = (t * h, lo * h);
                 (f.eval(&t), [2, 3, 4].map(|k| f.bound(k, &lo, t)))
             };
-            let order = if round % 2 == 0 { [0, 1] } else { [1, 0] };
-            for point in order.map(|k| asked[k]) {
+            let mut order = asked;
+            if round % 2 == 1 {
+                order.reverse();
+            }
+            for point in order {
                 for i in 0..6 {
                     // From a piece that has kept nothing yet.
                     let mut fresh = Piece::default();
