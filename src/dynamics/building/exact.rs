@@ -31,7 +31,9 @@ use super::super::response::{Energy, History};
 use super::super::rocking::{self, RockingOnset};
 use super::super::search::{self, Node};
 use super::super::{Ground, SimError, Unwatched, Watch, watched};
-use super::modal::{ModalError, ModalFn, ModalPoint, Piece, RowsByMode, StateModes, mode_terms};
+use super::modal::{
+    ModalError, ModalFn, ModalPoint, Piece, RowsByMode, StateModes, cubic, cubic_slope, mode_terms,
+};
 use super::model::{Building, StoreySpring};
 use super::response::BuildingResponse;
 use crate::numeric::{Cx, GAUSS8};
@@ -128,12 +130,6 @@ impl BasisMemo {
         self.bases.insert(key, Rc::clone(&m));
         Ok(m)
     }
-}
-
-/// `q₀ + q₁τ + q₂τ² + q₃τ³` by Horner's rule (a function's polynomial part).
-#[inline]
-fn cubic(q: &[f64; 4], t: f64) -> f64 {
-    q[0] + t * (q[1] + t * (q[2] + t * q[3]))
 }
 
 /// One storey's spring and its branch (an elastic storey is elastic over an unbounded range).
@@ -807,7 +803,7 @@ impl<'b> Integrator<'b> {
         let t = p.tau;
         let q = &g.poly;
         let mut f = cubic(q, t);
-        let mut df = q[1] + t * (2.0 * q[2] + 3.0 * t * q[3]);
+        let mut df = cubic_slope(q, t);
         if let Some((row, j)) = g.row {
             let c = mode.row(row, j);
             f += g.scale * ModalPoint::dot(&mode.modes, c, &p.y);

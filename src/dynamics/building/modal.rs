@@ -639,6 +639,18 @@ fn horner(x: Cx, c: &[f64]) -> Cx {
         .fold(Cx(0.0, 0.0), |acc, &ck| acc.mul(x).add(Cx(ck, 0.0)))
 }
 
+/// `q₀ + q₁τ + q₂τ² + q₃τ³` by Horner's rule (a function's polynomial part).
+#[inline]
+pub(super) fn cubic(q: &[f64; 4], t: f64) -> f64 {
+    q[0] + t * (q[1] + t * (q[2] + t * q[3]))
+}
+
+/// The slope of [`cubic`] at `τ`.
+#[inline]
+pub(super) fn cubic_slope(q: &[f64; 4], t: f64) -> f64 {
+    q[1] + t * (2.0 * q[2] + 3.0 * t * q[3])
+}
+
 /// A linear function of the floors' state plus a cubic in `τ`:
 /// `f(τ) = scale·Σ_r w_r·Re(c_r·y_r(τ)) + poly(τ)`, over one piece.
 #[derive(Clone, Copy)]
@@ -657,11 +669,7 @@ pub struct ModalFn<'a> {
 impl ModalFn<'_> {
     fn poly_eval(&self, t: f64) -> (f64, f64, f64) {
         let p = &self.poly;
-        (
-            p[0] + t * (p[1] + t * (p[2] + t * p[3])),
-            p[1] + t * (2.0 * p[2] + 3.0 * t * p[3]),
-            2.0 * p[2] + 6.0 * t * p[3],
-        )
+        (cubic(p, t), cubic_slope(p, t), 2.0 * p[2] + 6.0 * t * p[3])
     }
 }
 
