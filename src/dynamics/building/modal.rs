@@ -699,6 +699,22 @@ impl super::super::search::Smooth for ModalFn<'_> {
         (f, df)
     }
 
+    /// `eval`'s value and slope, the same bits, and the curvature from the same mode terms
+    /// (`e^{λτ}·q2`, no second exponential). A Newton step's time is asked once: its terms are
+    /// not kept (`Kept` holds the searches' points).
+    fn eval_second(&self, &t: &f64) -> (f64, f64, f64) {
+        let (mut f, mut df, mut d2) = self.poly_eval(t);
+        for (r, c) in self.c.iter().enumerate() {
+            let l = self.modes.lambda[r];
+            let [e, p1, p2] = value_terms(l, t);
+            let w = self.scale * self.modes.weight[r];
+            f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
+            df += w * c.mul(self.piece.dy(r, l, e, p1)).0;
+            d2 += w * c.mul(e.mul(self.piece.q2[r])).0;
+        }
+        (f, df, d2)
+    }
+
     /// `eval`'s value alone, the same bits (a root's refinement needs no slope).
     fn value(&self, &t: &f64) -> f64 {
         let (mut f, _, _) = self.poly_eval(t);
