@@ -85,7 +85,7 @@ pub(crate) trait Smooth {
     fn value(&self, at: &Self::At) -> f64 {
         self.eval(at).0
     }
-    /// `f'` at the point (what a search for an extremum refines).
+    /// `f'` at the point (what an extremum's refinement falls back to, as a root of `f'`).
     fn slope(&self, at: &Self::At) -> f64 {
         self.eval(at).1
     }

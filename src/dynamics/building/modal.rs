@@ -726,7 +726,8 @@ impl super::super::search::Smooth for ModalFn<'_> {
         f
     }
 
-    /// `eval`'s slope alone, the same bits (an extremum's refinement needs no value).
+    /// `eval`'s slope alone, the same bits (an extremum's refinement, where its Newton steps do
+    /// not converge, refines the slope's root, which needs no value).
     fn slope(&self, &t: &f64) -> f64 {
         let (_, mut df, _) = self.poly_eval(t);
         for (r, c) in self.c.iter().enumerate() {
@@ -926,8 +927,9 @@ mod tests {
         (sm, piece)
     }
 
-    /// The value and the slope alone are `eval`'s, bit for bit: the searches refine roots and
-    /// extrema with them, and the stored peaks and switch times must not move.
+    /// The value and the slope alone are `eval`'s, bit for bit: the searches refine roots with
+    /// the value (and an extremum, where Newton's steps fail, with the slope), and the stored
+    /// switch times must not move.
     #[test]
     fn value_and_slope_alone_have_the_bits_of_eval() {
         use super::super::super::search::Smooth;
