@@ -357,23 +357,23 @@ pub fn holds_everywhere(
 }
 
 /// The fraction whose value matches `target` (module doc): `scan` holds `(f, value)` at the
-/// scan's fractions (ascending), `prior` is the stuck mass share, `value` gives the value at any
+/// scan's fractions (ascending), `prior` is the stuck mass share, `values` gives the value at any
 /// other fraction (errors returned as they are). Of the fractions whose value lies within
 /// [`MATCH_TOL`] of the target, the one nearest the prior: the prior itself when it matches,
-/// else the nearest end of a matching stretch, a root of `value = target ± tolerance` (Brent's
-/// method) on the side the stretch is entered from.
+/// else the nearest end of a matching stretch, a root of `value = target ± tolerance` on the
+/// side the stretch is entered from ([`Values::root`]).
 pub fn solve<E>(
     target: f64,
     prior: f64,
     scan: &[(f64, f64)],
-    mut value: impl FnMut(f64) -> Result<f64, E>,
+    values: &mut Values<'_, E>,
 ) -> Result<(f64, FractionFlag), E> {
     let tol = MATCH_TOL * target.abs();
     let prior = prior_fraction(prior, scan);
     let mut points = scan.to_vec();
     if !points.iter().any(|p| p.0 == prior) {
         let at = points.partition_point(|p| p.0 < prior);
-        points.insert(at, (prior, value(prior)?));
+        points.insert(at, (prior, values.get(prior)?));
     }
     let at_prior = points.iter().find(|p| p.0 == prior).expect("inserted").1;
     let matches = |v: f64| (v - target).abs() <= tol;
@@ -404,7 +404,7 @@ pub fn solve<E>(
         if next > MAX_FRACTION + 1e-12 {
             break;
         }
-        points.push((next, value(next)?));
+        points.push((next, values.get(next)?));
         found = entered(&points, points.len() - 2);
     }
     let flag = match crossings(target, &points).len() {
@@ -454,7 +454,7 @@ pub fn solve<E>(
         // A far end inside the band with no crossing of the level: the band's end is where the
         // level is met, or the far end itself when the band is entered there exactly.
         let end = if (near.1 - level) * (far.1 - level) < 0.0 || far.1 == level {
-            root_in(level, a, b, &mut value)?
+            values.root(level, a, b)?
         } else {
             far.0
         };
@@ -495,99 +495,89 @@ fn crossings_from(target: f64, points: &[(f64, f64)], from: usize) -> Vec<usize>
         .collect()
 }
 
-/// The root of `value(f) = target` between the bracket's ends `(f, value)`.
-fn root_in<E>(
-    target: f64,
-    a: (f64, f64),
-    b: (f64, f64),
-    value: &mut impl FnMut(f64) -> Result<f64, E>,
-) -> Result<f64, E> {
-    if b.1 == target {
-        return Ok(b.0);
-    }
-    if a.1 == target {
-        return Ok(a.0);
-    }
-    let problem = Crossing {
-        target,
-        ends: [a, b],
-        value: RefCell::new(value),
-        error: RefCell::new(None),
-    };
-    let best = Executor::new(&problem, BrentRoot::new(a.0, b.0, FRACTION_TOL))
-        .configure(|s| s.max_iters(200))
-        .run()
-        .map(|r| r.state().get_best_param().copied());
-    if let Some(e) = problem.error.into_inner() {
-        return Err(e);
-    }
-    Ok(best
-        .expect("the ends bracket the root and every value is finite")
-        .expect("Brent keeps its best"))
+/// One function of the family over the cases of a unit (a quantity's mean peak, or the
+/// code-format ratio): every value known so far, by fraction, and how to compute another. The
+/// unit's cases search the same function (it depends on the unit's key alone), so they share it:
+/// a case whose search repeats an earlier one's (the same target and prior, as cases whose stacks
+/// move alike have) computes nothing, and every search takes the steps it would take alone.
+pub struct Values<'a, E> {
+    /// By the fraction's bits.
+    known: BTreeMap<u64, f64>,
+    compute: Box<dyn FnMut(f64) -> Result<f64, E> + 'a>,
 }
 
-/// `value(f) − target`, remembering the first error of `value`.
-struct Crossing<'v, F, E> {
-    target: f64,
-    /// The bracket's ends, `(f, value)`, already known.
-    ends: [(f64, f64); 2],
-    value: RefCell<&'v mut F>,
+impl<'a, E> Values<'a, E> {
+    /// `known` values `(f, value)` (the scan's, the priors'), then `compute` for any other `f`.
+    pub fn new(
+        known: impl IntoIterator<Item = (f64, f64)>,
+        compute: impl FnMut(f64) -> Result<f64, E> + 'a,
+    ) -> Self {
+        Self {
+            known: (known.into_iter()).map(|(f, x)| (f.to_bits(), x)).collect(),
+            compute: Box::new(compute),
+        }
+    }
+
+    /// The value at `f`: known, else computed and kept.
+    pub fn get(&mut self, f: f64) -> Result<f64, E> {
+        if let Some(&x) = self.known.get(&f.to_bits()) {
+            return Ok(x);
+        }
+        let x = (self.compute)(f)?;
+        self.known.insert(f.to_bits(), x);
+        Ok(x)
+    }
+
+    /// The root of `value(f) = level` between the ends `a` and `b` (`(f, value)`, ascending,
+    /// their values across the level) by Brent's method (argmin's `BrentRoot`) to
+    /// [`FRACTION_TOL`]; an end on the level is the root.
+    pub fn root(&mut self, level: f64, a: (f64, f64), b: (f64, f64)) -> Result<f64, E> {
+        if b.1 == level {
+            return Ok(b.0);
+        }
+        if a.1 == level {
+            return Ok(a.0);
+        }
+        for (f, x) in [a, b] {
+            self.known.entry(f.to_bits()).or_insert(x);
+        }
+        let problem = Crossing {
+            level,
+            values: RefCell::new(self),
+            error: RefCell::new(None),
+        };
+        let best = Executor::new(&problem, BrentRoot::new(a.0, b.0, FRACTION_TOL))
+            .configure(|s| s.max_iters(200))
+            .run()
+            .map(|r| r.state().get_best_param().copied());
+        if let Some(e) = problem.error.into_inner() {
+            return Err(e);
+        }
+        Ok(best
+            .expect("the ends bracket the root and every value is finite")
+            .expect("Brent keeps its best"))
+    }
+}
+
+/// `value(f) − level`, remembering the first error of the values.
+struct Crossing<'v, 'a, E> {
+    level: f64,
+    values: RefCell<&'v mut Values<'a, E>>,
     error: RefCell<Option<E>>,
 }
 
-impl<F: FnMut(f64) -> Result<f64, E>, E> CostFunction for &Crossing<'_, F, E> {
+impl<E> CostFunction for &Crossing<'_, '_, E> {
     type Param = f64;
     type Output = f64;
 
     fn cost(&self, f: &f64) -> Result<f64, ArgminError> {
-        let known = self.ends.iter().find(|e| e.0 == *f);
-        let v = match known {
-            Some(&(_, v)) => Ok(v),
-            None => (self.value.borrow_mut())(*f),
-        };
-        match v {
-            Ok(v) => Ok(v - self.target),
+        match self.values.borrow_mut().get(*f) {
+            Ok(v) => Ok(v - self.level),
             Err(e) => {
                 self.error.borrow_mut().get_or_insert(e);
                 Err(ArgminError::msg("the mean peak could not be computed"))
             }
         }
-    }
-}
-
-/// [`family_mean`]s remembered by fraction and quantity, seeded with [`Means`] already known
-/// (the scan's, and the prior's, which every quantity's search evaluates: one run for them
-/// all); each search runs only its own quantity beyond them.
-pub struct Memo<'a> {
-    known: BTreeMap<(u64, Quantity), f64>,
-    compute: Box<dyn FnMut(f64, Quantity) -> Result<f64, CaseError> + 'a>,
-}
-
-impl<'a> Memo<'a> {
-    pub fn new<'k>(
-        known: impl IntoIterator<Item = &'k (f64, Means)>,
-        compute: impl FnMut(f64, Quantity) -> Result<f64, CaseError> + 'a,
-    ) -> Self {
-        let known = (known.into_iter())
-            .flat_map(|(f, m)| {
-                let all = Quantity::all(m.storey_shear.len());
-                all.into_iter().map(move |q| ((f.to_bits(), q), m.get(q)))
-            })
-            .collect();
-        Self {
-            known,
-            compute: Box::new(compute),
-        }
-    }
-
-    pub fn get(&mut self, fraction: f64, q: Quantity) -> Result<f64, CaseError> {
-        let key = (fraction.to_bits(), q);
-        if let Some(&v) = self.known.get(&key) {
-            return Ok(v);
-        }
-        let v = (self.compute)(fraction, q)?;
-        self.known.insert(key, v);
-        Ok(v)
     }
 }
 
@@ -639,45 +629,52 @@ mod tests {
                 .map(|k| (k as f64 / 10.0, f(k as f64 / 10.0)))
                 .collect()
         };
+        let fresh = |f: fn(f64) -> f64| Values::new([], move |l| Ok::<_, ()>(f(l)));
         let near = |l: f64, want: f64| (l - want).abs() < FRACTION_TOL;
         let (lo, hi) = (1.0 - MATCH_TOL, 1.0 + MATCH_TOL);
         // V = 1 + f²: 1.49 is met at 0.7; from a prior below, the matching stretch is entered at
         // its lower end, where 1 + f² = 1.49·(1 − tol).
         let sq = |l: f64| 1.0 + l * l;
-        let (l, flag) = solve(1.49, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        let (l, flag) = solve(1.49, 0.5, &scan(&sq), &mut fresh(sq)).unwrap();
         assert_eq!(flag, FractionFlag::Root);
         assert!(near(l, (1.49 * lo - 1.0f64).sqrt()), "{l}");
         // From a prior above, at its upper end.
-        let (l, _) = solve(1.49, 0.95, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        let (l, _) = solve(1.49, 0.95, &scan(&sq), &mut fresh(sq)).unwrap();
         assert!(near(l, (1.49 * hi - 1.0f64).sqrt()), "{l}");
         // A prior whose value matches is taken itself (f² = 0.49 ± 1.5e-4: 0.7 ± 1.1e-4).
-        let (l, _) = solve(1.49, 0.70001, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        let (l, _) = solve(1.49, 0.70001, &scan(&sq), &mut fresh(sq)).unwrap();
         assert_eq!(l, 0.70001);
         // Below and above the range: the scan point of the smallest (largest) value.
         assert_eq!(
-            solve(0.5, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap(),
+            solve(0.5, 0.5, &scan(&sq), &mut fresh(sq)).unwrap(),
             (0.0, FractionFlag::Below)
         );
         // Above 1 the scan grows: 1 + f² = 3.25 near 1.5.
-        let (l, flag) = solve(3.25, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        let (l, flag) = solve(3.25, 0.5, &scan(&sq), &mut fresh(sq)).unwrap();
         assert_eq!(flag, FractionFlag::Root);
         assert!(near(l, (3.25 * lo - 1.0f64).sqrt()), "{l}");
         assert_eq!(
-            solve(9.0, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap(),
+            solve(9.0, 0.5, &scan(&sq), &mut fresh(sq)).unwrap(),
             (1.0, FractionFlag::Above)
         );
         // The end itself with a prior of 1 (a stack that never slid): exactly 1.
         assert_eq!(
-            solve(2.0, 1.0, &scan(&sq), |_| Ok::<_, ()>(f64::NAN)).unwrap(),
+            solve(
+                2.0,
+                1.0,
+                &scan(&sq),
+                &mut Values::new([], |_| Ok::<_, ()>(f64::NAN))
+            )
+            .unwrap(),
             (1.0, FractionFlag::Root)
         );
         // A stationary point: V = 1 + f² has its minimum 1 at 0; a target 1e-5 below it has no
         // root, but f = 0 matches within the tolerance: the prior 0.001 is taken, and from a
         // prior of 0.5 the stretch's end, where 1 + f² = target·(1 + tol).
         let t = 1.0 - 1e-5;
-        let (l, flag) = solve(t, 0.001, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        let (l, flag) = solve(t, 0.001, &scan(&sq), &mut fresh(sq)).unwrap();
         assert_eq!((l, flag), (0.001, FractionFlag::Near));
-        let (l, flag) = solve(t, 0.5, &scan(&sq), |l| Ok::<_, ()>(sq(l))).unwrap();
+        let (l, flag) = solve(t, 0.5, &scan(&sq), &mut fresh(sq)).unwrap();
         assert_eq!(flag, FractionFlag::Near);
         assert!(near(l, (t * hi - 1.0f64).sqrt()), "{l}");
         // A hump: 1 + sin(πf) meets 1.5 at 1/6 and 5/6; the stretch nearest the prior is taken,
@@ -691,15 +688,57 @@ mod tests {
             (0.6, 1.0 - above),
             (1.0, 1.0 - below),
         ] {
-            let (l, flag) = solve(1.5, prior, &scan(&hump), |l| Ok::<_, ()>(hump(l))).unwrap();
+            let (l, flag) = solve(1.5, prior, &scan(&hump), &mut fresh(hump)).unwrap();
             assert_eq!(flag, FractionFlag::Several);
             assert!(near(l, want), "prior {prior}: {l} vs {want}");
         }
         // An error of the value comes back as it is.
         assert_eq!(
-            solve(1.49, 0.55, &scan(&sq)[..5], |_| Err::<f64, _>(7)),
+            solve(
+                1.49,
+                0.55,
+                &scan(&sq)[..5],
+                &mut Values::new([], |_| Err::<f64, _>(7))
+            ),
             Err(7)
         );
+    }
+
+    #[test]
+    fn a_units_searches_share_values_and_take_their_own_steps() {
+        // One function searched for several targets and priors, as a unit's cases search it:
+        // with the values shared, each fraction is the one a search alone finds, to the bit,
+        // and a search that repeats an earlier one computes nothing.
+        let hump = |l: f64| 1.0 + (std::f64::consts::PI * l).sin();
+        let fresh = |f: fn(f64) -> f64| Values::new([], move |l| Ok::<_, ()>(f(l)));
+        let scan: Vec<(f64, f64)> = (0..=10)
+            .map(|k| k as f64 / 10.0)
+            .map(|l| (l, hump(l)))
+            .collect();
+        let calls = std::cell::Cell::new(0);
+        let mut shared = Values::new(scan.iter().copied(), |l| {
+            calls.set(calls.get() + 1);
+            Ok::<_, ()>(hump(l))
+        });
+        let searches = [(1.5, 0.0, true), (1.5, 0.3, true), (1.7, 0.05, true)];
+        let repeats = [(1.5, 0.3, false), (1.5, 0.0, false)];
+        for (target, prior, new) in searches.into_iter().chain(repeats) {
+            let alone = solve(target, prior, &scan, &mut fresh(hump));
+            let before = calls.get();
+            let (f, flag) = solve(target, prior, &scan, &mut shared).unwrap();
+            let (want, want_flag) = alone.unwrap();
+            assert_eq!(
+                (f.to_bits(), flag),
+                (want.to_bits(), want_flag),
+                "{target} from {prior}"
+            );
+            assert_eq!(
+                calls.get() > before,
+                new,
+                "{target} from {prior}: {}",
+                calls.get()
+            );
+        }
     }
 
     #[test]
@@ -813,13 +852,130 @@ pub struct ZoneFamily<'a> {
 type Scan = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64);
 
 impl ZoneFamily<'_> {
-    /// The attached fractions of every case of `unit`, in its order: the scan once, then each
-    /// case on its own (in parallel: the numbers do not depend on the threads).
+    /// The attached fractions of every case of `unit`, in its order: the scan once, each case's
+    /// targets and prior (the cases in parallel), then each function's searches over the cases
+    /// in the unit's order, sharing the function's [`Values`] (the functions in parallel: the
+    /// numbers depend on neither the threads nor the shards, a unit being computed whole).
     pub fn unit(&self, unit: &FractionUnit) -> Result<Vec<CaseFractions>, AttachedError> {
         use rayon::prelude::*;
         let scan = self.scan(unit.cases[0])?;
-        (unit.cases.par_iter())
-            .map(|&c| self.case(c, &scan))
+        let setups = (unit.cases.par_iter())
+            .map(|&c| self.setup(c, &scan.0))
+            .collect::<Result<Vec<_>, _>>()?;
+        let storeys = self.frame(unit.cases[0]).storeys();
+        let functions: Vec<Function> = (Quantity::all(storeys).into_iter())
+            .map(Function::Mean)
+            .chain([Function::Code])
+            .collect();
+        let found = (functions.par_iter())
+            .map(|&function| self.search(unit, function, &scan, &setups))
+            .collect::<Result<Vec<_>, _>>()?;
+        let (rigid, bare) = (rigid_of(&scan.0), bare_of(&scan.0));
+        Ok((setups.into_iter().enumerate())
+            .map(|(k, s)| {
+                let at = |i: usize| found[i][k];
+                CaseFractions {
+                    stack: s.stack,
+                    rigid: rigid.clone(),
+                    bare: bare.clone(),
+                    share: s.share,
+                    roof: at(0),
+                    storey: (1..=storeys).map(at).collect(),
+                    overturning: at(storeys + 1),
+                    code: at(storeys + 2),
+                }
+            })
+            .collect())
+    }
+
+    /// Case `c` of the zone (flat over `[frame][case]`).
+    fn case(&self, c: usize) -> Case {
+        self.grid.case(c % self.grid.cases())
+    }
+
+    /// Case `c`'s frame.
+    fn frame(&self, c: usize) -> &Frame {
+        &self.frames[c / self.grid.cases()]
+    }
+
+    /// Case `c`'s sliding stack and prior, from its key's scan.
+    fn setup(&self, c: usize, scan: &[(f64, Means)]) -> Result<Setup, AttachedError> {
+        let (physics, grounds) = (self.physics, self.grounds);
+        if !(self.keep_going)() {
+            return Err(AttachedError::Stopped);
+        }
+        let (case, frame) = (self.case(c), self.frame(c));
+        // The stack's means and share: the sweep's, or on one storey simulated here (the
+        // sweep's no-slip rule, whose argument holds whatever the integrator).
+        let (stack, share) = match &self.swept[c] {
+            Some((stack, _, share)) => (stack.clone(), *share),
+            None if holds_everywhere(physics, &case, frame, grounds)? => (rigid_of(scan), 1.0),
+            None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
+        };
+        // Every function's search evaluates the prior: one run gives them all.
+        let prior = prior_fraction(share, scan);
+        let at_prior = match scan.iter().any(|(f, _)| *f == prior) {
+            true => None,
+            false => Some((prior, family_means(physics, &case, frame, prior, grounds)?)),
+        };
+        Ok(Setup {
+            stack,
+            share,
+            at_prior,
+        })
+    }
+
+    /// The fraction of `function` for each of `unit`'s cases, in its order: one [`Values`] of
+    /// the function (evaluated with the unit's first case: the family depends on the unit's key
+    /// alone) for all their searches.
+    fn search(
+        &self,
+        unit: &FractionUnit,
+        function: Function,
+        (scan, code_scan, psa_rigid): &Scan,
+        setups: &[Setup],
+    ) -> Result<Vec<(f64, FractionFlag)>, AttachedError> {
+        let (physics, grounds) = (self.physics, self.grounds);
+        let (case, frame) = (self.case(unit.cases[0]), self.frame(unit.cases[0]));
+        let psa_rigid = *psa_rigid;
+        let (points, mut values): (Vec<(f64, f64)>, Values<AttachedError>) = match function {
+            Function::Mean(q) => {
+                let points: Vec<(f64, f64)> = scan.iter().map(|(f, m)| (*f, m.get(q))).collect();
+                let priors = (setups.iter().filter_map(|s| s.at_prior.as_ref()))
+                    .map(|(f, m)| (*f, m.get(q)));
+                let values = Values::new(points.iter().copied().chain(priors), move |f| {
+                    Ok(family_mean(physics, &case, frame, f, grounds, q)?)
+                });
+                (points, values)
+            }
+            Function::Code => {
+                let values = Values::new(code_scan.iter().copied(), move |f| {
+                    code_shear_ratio(&case, frame, grounds, f, psa_rigid).map_err(|source| {
+                        AttachedError::Spectrum {
+                            period_s: frame.t1_attached_s(&case, f),
+                            source,
+                        }
+                    })
+                });
+                (code_scan.clone(), values)
+            }
+        };
+        let rigid = rigid_of(scan);
+        (unit.cases.iter().zip(setups))
+            .map(|(&c, s)| {
+                if !(self.keep_going)() {
+                    return Err(AttachedError::Stopped);
+                }
+                let target = match function {
+                    Function::Mean(q) => s.stack.get(q),
+                    Function::Code => s.stack.storey_shear[0] / rigid.storey_shear[0],
+                };
+                let (f, flag) = solve(target, s.share, &points, &mut values)?;
+                Ok(match self.slides[c] {
+                    true => (f, flag),
+                    false => (f, FractionFlag::NoSlide),
+                })
+            })
             .collect()
     }
 
@@ -829,8 +985,7 @@ impl ZoneFamily<'_> {
         if !(self.keep_going)() {
             return Err(AttachedError::Stopped);
         }
-        let per_frame = self.grid.cases();
-        let (case, frame) = (self.grid.case(c % per_frame), &self.frames[c / per_frame]);
+        let (case, frame) = (self.case(c), self.frame(c));
         // The rigid system's means: the sweep's, or on one storey simulated here.
         let rigid = match &self.swept[c] {
             Some((_, rigid, _)) => rigid.clone(),
@@ -862,74 +1017,37 @@ impl ZoneFamily<'_> {
             .collect::<Result<Vec<_>, _>>()?;
         Ok((scan, code, psa_rigid))
     }
+}
 
-    /// Case `c`'s attached fractions from its key's scan.
-    fn case(
-        &self,
-        c: usize,
-        (scan, code_scan, psa_rigid): &Scan,
-    ) -> Result<CaseFractions, AttachedError> {
-        let (physics, grounds) = (self.physics, self.grounds);
-        if !(self.keep_going)() {
-            return Err(AttachedError::Stopped);
-        }
-        let per_frame = self.grid.cases();
-        let (case, frame) = (self.grid.case(c % per_frame), &self.frames[c / per_frame]);
-        let rigid = scan[scan.len() - 1].1.clone();
-        let bare = (scan.iter().find(|(f, _)| *f == 0.0))
-            .expect("the scan holds 0")
-            .1
-            .clone();
-        // The stack's means and share: the sweep's, or on one storey simulated here (the
-        // sweep's no-slip rule, whose argument holds whatever the integrator).
-        let (stack, share) = match &self.swept[c] {
-            Some((stack, _, share)) => (stack.clone(), *share),
-            None if holds_everywhere(physics, &case, frame, grounds)? => (rigid.clone(), 1.0),
-            None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
-        };
-        let slid = |flag| match self.slides[c] {
-            true => flag,
-            false => FractionFlag::NoSlide,
-        };
-        // Every quantity's search evaluates the prior: one run gives them all.
-        let prior = prior_fraction(share, scan);
-        let at_prior = match scan.iter().any(|(f, _)| *f == prior) {
-            true => None,
-            false => Some((prior, family_means(physics, &case, frame, prior, grounds)?)),
-        };
-        let mut memo = Memo::new(scan.iter().chain(&at_prior), |f, q| {
-            family_mean(physics, &case, frame, f, grounds, q)
-        });
-        let mut solve_for = |q: Quantity| -> Result<(f64, FractionFlag), CaseError> {
-            let points: Vec<(f64, f64)> = scan.iter().map(|(f, m)| (*f, m.get(q))).collect();
-            let (f, flag) = solve(stack.get(q), share, &points, |f| memo.get(f, q))?;
-            Ok((f, slid(flag)))
-        };
-        let roof = solve_for(Quantity::Roof)?;
-        let storey = (0..frame.storeys())
-            .map(|i| solve_for(Quantity::StoreyShear(i)))
-            .collect::<Result<Vec<_>, _>>()?;
-        let overturning = solve_for(Quantity::Overturning)?;
-        let target = stack.storey_shear[0] / rigid.storey_shear[0];
-        let code = solve(target, share, code_scan, |f| {
-            code_shear_ratio(&case, frame, grounds, f, *psa_rigid).map_err(|source| {
-                AttachedError::Spectrum {
-                    period_s: frame.t1_attached_s(&case, f),
-                    source,
-                }
-            })
-        })?;
-        Ok(CaseFractions {
-            stack,
-            rigid,
-            bare,
-            share,
-            roof,
-            storey,
-            overturning,
-            code: (code.0, slid(code.1)),
-        })
-    }
+/// What a case's searches start from: its sliding stack's means and stuck mass share (the
+/// sweep's, or simulated here on one storey), and the family's means at its prior unless the
+/// scan holds it.
+struct Setup {
+    stack: Means,
+    share: f64,
+    at_prior: Option<(f64, Means)>,
+}
+
+/// A function of the family whose fractions a case takes.
+#[derive(Debug, Clone, Copy)]
+enum Function {
+    /// A quantity's mean peak.
+    Mean(Quantity),
+    /// The code-format base shear ratio ([`code_shear_ratio`]).
+    Code,
+}
+
+/// The rigid system's means: the scan's last, at `f = 1`.
+fn rigid_of(scan: &[(f64, Means)]) -> Means {
+    scan[scan.len() - 1].1.clone()
+}
+
+/// The bare building's means: the scan's at `f = 0`.
+fn bare_of(scan: &[(f64, Means)]) -> Means {
+    (scan.iter().find(|(f, _)| *f == 0.0))
+        .expect("the scan holds 0")
+        .1
+        .clone()
 }
 
 /// The attached fractions of every case of a zone, flat over `[frame][case]` (`grid`'s cases in
