@@ -853,22 +853,40 @@ type Scan = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64);
 
 impl ZoneFamily<'_> {
     /// The attached fractions of every case of `unit`, in its order: the scan once, each case's
-    /// targets and prior (the cases in parallel), then each function's searches over the cases
-    /// in the unit's order, sharing the function's [`Values`] (the functions in parallel: the
-    /// numbers depend on neither the threads nor the shards, a unit being computed whole).
+    /// targets (the cases in parallel), the family's means at each distinct prior not scanned,
+    /// then each function's searches over the cases in the unit's order, sharing the function's
+    /// [`Values`] (the functions in parallel: the numbers depend on neither the threads nor the
+    /// shards, a unit being computed whole).
     pub fn unit(&self, unit: &FractionUnit) -> Result<Vec<CaseFractions>, AttachedError> {
         use rayon::prelude::*;
         let scan = self.scan(unit.cases[0])?;
         let setups = (unit.cases.par_iter())
             .map(|&c| self.setup(c, &scan.0))
             .collect::<Result<Vec<_>, _>>()?;
-        let storeys = self.frame(unit.cases[0]).storeys();
+        // Every function's search evaluates its case's prior: one run gives them all, once for
+        // cases that share it.
+        let (case, frame) = (self.case(unit.cases[0]), self.frame(unit.cases[0]));
+        let storeys = frame.storeys();
+        let mut priors: Vec<f64> = (setups.iter())
+            .map(|s| prior_fraction(s.share, &scan.0))
+            .filter(|p| !scan.0.iter().any(|(f, _)| f == p))
+            .collect();
+        priors.sort_by(f64::total_cmp);
+        priors.dedup_by(|a, b| a.to_bits() == b.to_bits());
+        let at_priors = (priors.par_iter())
+            .map(|&f| {
+                Ok((
+                    f,
+                    family_means(self.physics, &case, frame, f, self.grounds)?,
+                ))
+            })
+            .collect::<Result<Vec<_>, CaseError>>()?;
         let functions: Vec<Function> = (Quantity::all(storeys).into_iter())
             .map(Function::Mean)
             .chain([Function::Code])
             .collect();
         let found = (functions.par_iter())
-            .map(|&function| self.search(unit, function, &scan, &setups))
+            .map(|&function| self.search(unit, function, &scan, &at_priors, &setups))
             .collect::<Result<Vec<_>, _>>()?;
         let (rigid, bare) = (rigid_of(&scan.0), bare_of(&scan.0));
         Ok((setups.into_iter().enumerate())
@@ -898,7 +916,7 @@ impl ZoneFamily<'_> {
         &self.frames[c / self.grid.cases()]
     }
 
-    /// Case `c`'s sliding stack and prior, from its key's scan.
+    /// Case `c`'s sliding stack.
     fn setup(&self, c: usize, scan: &[(f64, Means)]) -> Result<Setup, AttachedError> {
         let (physics, grounds) = (self.physics, self.grounds);
         if !(self.keep_going)() {
@@ -912,17 +930,7 @@ impl ZoneFamily<'_> {
             None if holds_everywhere(physics, &case, frame, grounds)? => (rigid_of(scan), 1.0),
             None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
         };
-        // Every function's search evaluates the prior: one run gives them all.
-        let prior = prior_fraction(share, scan);
-        let at_prior = match scan.iter().any(|(f, _)| *f == prior) {
-            true => None,
-            false => Some((prior, family_means(physics, &case, frame, prior, grounds)?)),
-        };
-        Ok(Setup {
-            stack,
-            share,
-            at_prior,
-        })
+        Ok(Setup { stack, share })
     }
 
     /// The fraction of `function` for each of `unit`'s cases, in its order: one [`Values`] of
@@ -933,6 +941,8 @@ impl ZoneFamily<'_> {
         unit: &FractionUnit,
         function: Function,
         (scan, code_scan, psa_rigid): &Scan,
+        // The family's means at the cases' priors the scan does not hold.
+        at_priors: &[(f64, Means)],
         setups: &[Setup],
     ) -> Result<Vec<(f64, FractionFlag)>, AttachedError> {
         let (physics, grounds) = (self.physics, self.grounds);
@@ -941,8 +951,7 @@ impl ZoneFamily<'_> {
         let (points, mut values): (Vec<(f64, f64)>, Values<AttachedError>) = match function {
             Function::Mean(q) => {
                 let points: Vec<(f64, f64)> = scan.iter().map(|(f, m)| (*f, m.get(q))).collect();
-                let priors = (setups.iter().filter_map(|s| s.at_prior.as_ref()))
-                    .map(|(f, m)| (*f, m.get(q)));
+                let priors = at_priors.iter().map(|(f, m)| (*f, m.get(q)));
                 let values = Values::new(points.iter().copied().chain(priors), move |f| {
                     Ok(family_mean(physics, &case, frame, f, grounds, q)?)
                 });
@@ -1020,12 +1029,10 @@ impl ZoneFamily<'_> {
 }
 
 /// What a case's searches start from: its sliding stack's means and stuck mass share (the
-/// sweep's, or simulated here on one storey), and the family's means at its prior unless the
-/// scan holds it.
+/// sweep's, or simulated here on one storey).
 struct Setup {
     stack: Means,
     share: f64,
-    at_prior: Option<(f64, Means)>,
 }
 
 /// A function of the family whose fractions a case takes.
