@@ -29,10 +29,12 @@ impl std::fmt::Display for Method {
 /// sweep stores the goods' own demands, each block's peak absolute acceleration and velocity
 /// and each interface's residual slip; 5: a peak's extremum is refined by Newton's method on
 /// its slope to a certified `ε/8` of its value, not its time to a few ulps of `dt`: every
-/// stored peak moves at round-off, its time by up to about `√ε` of the motion's time scale).
+/// stored peak moves at round-off, its time by up to about `√ε` of the motion's time scale;
+/// 6: the sweep's rule `held_at_lower_friction`, `skip_rule` 3, where a stack repeats an
+/// earlier case's run: no stored number moves, the codes do).
 pub const INTEGRATOR: Method = Method {
     name: "integrator",
-    version: 5,
+    version: 6,
 };
 
 /// Exact response spectra (`spectrum::response`), with the target spectra they are compared to.

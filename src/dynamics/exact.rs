@@ -506,6 +506,7 @@ impl<'s, const YIELDS: bool, const LONG_PERIODS: bool> ExactRun<'s, YIELDS, LONG
             peak_slip_m: vec![0.0; n],
             residual_slip_m: vec![0.0; n],
             slip_time_s: vec![0.0; n],
+            held: vec![true; n],
             ..Response::default()
         };
         Self {
@@ -1420,6 +1421,9 @@ impl<const YIELDS: bool, const LONG_PERIODS: bool> Contacts for ExactRun<'_, YIE
             &mut self.contacts,
             &mut self.force,
         )?;
+        for (held, c) in self.out.held.iter_mut().zip(&self.contacts) {
+            *held &= *c == Contact::Stick;
+        }
         Ok(())
     }
 

@@ -155,6 +155,10 @@ pub struct Response {
     pub residual_slip_m: Vec<f64>,
     /// Total time each interface spent slipping, s.
     pub slip_time_s: Vec<f64>,
+    /// Whether each interface stuck for the whole record: every contact selection left it
+    /// stuck (never slipping, never free). Empty where the integrator does not track it (the
+    /// RK4 reference).
+    pub held: Vec<bool>,
     /// Number of interface state changes.
     pub switches: u64,
     /// Structure displacement relative to the ground at the end of the record, m (a yielding

@@ -13,7 +13,10 @@
 //!   ([`SkipRule::NoSlip`]); likewise the single block when it stays below `μ_s,1·g`;
 //! * when the coefficients never decrease upward and static equals kinetic, no upper interface
 //!   can slip before the one below it, so the stack acts as one block ([`SkipRule::SingleBlock`],
-//!   docs/model.md "Stated special cases").
+//!   docs/model.md "Stated special cases");
+//! * a stack whose coefficients are an earlier simulated case's of the same masses, or higher
+//!   only at interfaces that stuck throughout that run, moves as that run did
+//!   ([`SkipRule::Held`], the same place).
 //!
 //! In a building ([`Frame`]) each rule holds as stated, the rigid system's acceleration being
 //! that of every floor carrying a stack (docs/model.md, "A study over buildings", gives the
@@ -43,13 +46,17 @@ flag_enum! {
         NoSlip = 1 => "no_slip",
         /// Coefficients never decrease upward (static = kinetic): the stack is the single block.
         SingleBlock = 2 => "single_block",
+        /// The run of an earlier case of the same masses whose coefficients differ only where
+        /// this case's are higher, at interfaces that stuck throughout that run.
+        Held = 3 => "held_at_lower_friction",
     }
 }
 
 /// Meaning of the `skip_rule` codes, for the file attribute.
 pub const SKIP_RULE_CODES: &str = "0 simulated; 1 no interface can slip (rigid absolute \
      acceleration never exceeds min μ_s·g): stack = rigid; 2 friction never decreases upward \
-     with static = kinetic: stack = single block";
+     with static = kinetic: stack = single block; 3 only higher friction at interfaces that \
+     stuck throughout an earlier case's run of the same masses: stack = that run";
 
 /// What the sweep keeps of one system's run.
 #[derive(Debug, Clone, PartialEq)]
@@ -100,6 +107,8 @@ struct Peaks {
     residual_slip_m: Vec<f64>,
     /// Whether a stack started to rock (its rocking checked; false otherwise).
     rocks: bool,
+    /// Whether each interface stuck throughout the run, in every stack (empty without blocks).
+    held: Vec<bool>,
 }
 
 impl Peaks {
@@ -154,6 +163,12 @@ impl Peaks {
             block_v_mps: largest(&r.block_peak_abs_velocity_mps),
             residual_slip_m,
             rocks: r.rocking_onset.iter().any(Option::is_some),
+            held: (0..blocks)
+                .map(|i| {
+                    r.held.len() == r.peak_slip_m.len()
+                        && r.held.iter().skip(i).step_by(blocks).all(|&h| h)
+                })
+                .collect(),
         }
     }
 }
@@ -279,6 +294,17 @@ pub struct UnitOptions<'a> {
     pub aspect: Option<&'a [f64]>,
 }
 
+/// Whether a stack of coefficients `mu` moves as the run of `mu_run` did, the same masses given:
+/// each coefficient is the run's, or higher at an interface that stuck throughout the run
+/// (`held`). Such an interface never needed more than its run's `μ_s·N`, so a higher limit
+/// changes no contact selection: the trajectory, every peak with it, is the run's
+/// (docs/model.md, "Stated special cases").
+fn held_at_lower_friction(mu: &[f64], mu_run: &[f64], held: &[bool]) -> bool {
+    mu.len() == held.len()
+        && (mu.iter().zip(mu_run).zip(held))
+            .all(|((m, r), &h)| m.to_bits() == r.to_bits() || (m > r && h))
+}
+
 /// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`, in
 /// `frame` (one storey: [`Frame::one_storey`]).
 pub fn run_unit(
@@ -313,6 +339,8 @@ pub fn run_unit(
     // Keyed by the bits of α (and the index of μ_1): the same floating-point sum, the same system.
     let mut rigid: HashMap<u64, Peaks> = HashMap::new();
     let mut single: HashMap<(u64, u64), Peaks> = HashMap::new();
+    // The stacks simulated so far: `(α, μ, run)`.
+    let mut stacks: Vec<(Vec<f64>, Vec<f64>, Peaks)> = Vec::new();
     for c in 0..cases {
         let (alpha, mu) = grid.stack(c);
         let case = Case {
@@ -346,16 +374,22 @@ pub fn run_unit(
 
         let min_mu_s = mu_s.iter().copied().fold(f64::INFINITY, f64::min);
         let non_decreasing = physics.mu_static_ratio == 1.0 && mu.windows(2).all(|w| w[1] >= w[0]);
+        let held = || {
+            (stacks.iter()).find(|(alpha, mu_run, run)| {
+                *alpha == case.alpha && held_at_lower_friction(mu, mu_run, &run.held)
+            })
+        };
         let (rule, resp) = if opts.skip && holds(min_mu_s) {
             (SkipRule::NoSlip, None)
         } else if opts.skip && non_decreasing {
             (SkipRule::SingleBlock, None)
+        } else if let Some((_, _, run)) = held().filter(|_| opts.skip) {
+            (SkipRule::Held, Some(run.clone()))
         } else {
             out.simulations += 1;
-            (
-                SkipRule::Simulated,
-                Some(simulate(SystemKind::Stack, &case)?),
-            )
+            let run = simulate(SystemKind::Stack, &case)?;
+            stacks.push((case.alpha.clone(), mu.clone(), run.clone()));
+            (SkipRule::Simulated, Some(run))
         };
         out.u_rigid.push(r.u_m);
         out.u_single.push(u_single);

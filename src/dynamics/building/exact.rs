@@ -556,7 +556,10 @@ impl<'b> Integrator<'b> {
                 }
             })
             .collect();
-        let out = BuildingResponse::zeroed(n, nb, b.stacks().len());
+        let out = BuildingResponse {
+            held: vec![true; nb],
+            ..BuildingResponse::zeroed(n, nb, b.stacks().len())
+        };
         Self {
             b,
             dt,
@@ -1676,6 +1679,9 @@ impl Contacts for Integrator<'_> {
                 self.contacts[k] = fc.contacts[l];
                 self.force[k] = fc.force[l];
             }
+        }
+        for (held, c) in self.out.held.iter_mut().zip(&self.contacts) {
+            *held &= *c == Contact::Stick;
         }
         self.mode = None;
         Ok(())

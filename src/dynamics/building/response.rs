@@ -45,6 +45,10 @@ pub struct BuildingResponse {
     pub peak_slip_m: Vec<f64>,
     /// Signed slip at the record's end, m.
     pub residual_slip_m: Vec<f64>,
+    /// Whether each interface stuck for the whole record: every contact selection left it
+    /// stuck (never slipping, never free). Empty where the integrator does not track it (the
+    /// RK4 reference).
+    pub held: Vec<bool>,
     /// Stick/slip switches.
     pub switches: u64,
     /// Yield and unloading events of all storeys.
@@ -102,6 +106,7 @@ impl BuildingResponse {
             block_peak_abs_velocity_mps: r.peak_abs_velocity_mps[1..=blocks].to_vec(),
             peak_slip_m: r.peak_slip_m,
             residual_slip_m: r.residual_slip_m,
+            held: r.held,
             switches: r.switches,
             yield_events: r.yield_events,
             energy: r.energy,
