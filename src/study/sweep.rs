@@ -165,8 +165,7 @@ impl Peaks {
             rocks: r.rocking_onset.iter().any(Option::is_some),
             held: (0..blocks)
                 .map(|i| {
-                    r.held.len() == r.peak_slip_m.len()
-                        && r.held.iter().skip(i).step_by(blocks).all(|&h| h)
+                    r.held.len() == r.peak_slip_m.len() && of_block(&r.held, blocks, i).all(|h| h)
                 })
                 .collect(),
         }
@@ -174,7 +173,7 @@ impl Peaks {
 }
 
 /// Block (or interface) `i` of every stack of `blocks` blocks, stacks in order.
-fn of_block(values: &[f64], blocks: usize, i: usize) -> impl Iterator<Item = f64> + '_ {
+fn of_block<T: Copy>(values: &[T], blocks: usize, i: usize) -> impl Iterator<Item = T> + '_ {
     values.iter().skip(i).step_by(blocks.max(1)).copied()
 }
 
