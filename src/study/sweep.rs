@@ -373,29 +373,27 @@ pub fn run_unit(
 
         let min_mu_s = mu_s.iter().copied().fold(f64::INFINITY, f64::min);
         let non_decreasing = physics.mu_static_ratio == 1.0 && mu.windows(2).all(|w| w[1] >= w[0]);
-        let held = || {
-            (stacks.iter()).find(|(alpha, mu_run, run)| {
-                *alpha == case.alpha && held_at_lower_friction(mu, mu_run, &run.held)
-            })
+        let repeats = |(alpha, mu_run, run): &(Vec<f64>, Vec<f64>, Peaks)| {
+            *alpha == case.alpha && held_at_lower_friction(mu, mu_run, &run.held)
         };
         let (rule, resp) = if opts.skip && holds(min_mu_s) {
             (SkipRule::NoSlip, None)
         } else if opts.skip && non_decreasing {
             (SkipRule::SingleBlock, None)
-        } else if let Some((_, _, run)) = held().filter(|_| opts.skip) {
-            (SkipRule::Held, Some(run.clone()))
+        } else if let Some(i) = opts.skip.then(|| stacks.iter().position(repeats)).flatten() {
+            (SkipRule::Held, Some(&stacks[i].2))
         } else {
             out.simulations += 1;
             let run = simulate(SystemKind::Stack, &case)?;
-            stacks.push((case.alpha.clone(), mu.clone(), run.clone()));
-            (SkipRule::Simulated, Some(run))
+            stacks.push((case.alpha.clone(), mu.clone(), run));
+            (SkipRule::Simulated, stacks.last().map(|(_, _, run)| run))
         };
         out.u_rigid.push(r.u_m);
         out.u_single.push(u_single);
         out.single_rule.push(u8::from(single_holds));
         out.skip_rule.push(rule as u8);
         // The stack's profiles come from the same system as its other peaks.
-        let (profile, held) = match (rule, &resp) {
+        let (profile, held) = match (rule, resp) {
             (_, Some(s)) => (s, false),
             (SkipRule::NoSlip, None) => (r, true),
             (_, None) if single_holds => (r, true),
@@ -412,13 +410,13 @@ pub fn run_unit(
             (profile.block_a_mps2[0], profile.block_v_mps[0])
         };
         if let Some(aspect) = opts.aspect {
-            let rocks = match &resp {
+            let rocks = match resp {
                 Some(s) => s.rocks,
                 None => stuck_rocks(&case, aspect, one_body.0)?,
             };
             out.rocks_stack.push(u8::from(rocks));
         }
-        match (rule, &resp) {
+        match (rule, resp) {
             (_, Some(s)) => {
                 out.u_stack.push(s.u_m);
                 out.a_stack.push(s.a_mps2 / G);
@@ -447,7 +445,7 @@ pub fn run_unit(
             }
         }
         // Every block of a stack a rule stands in for moves with the stand-in's one body.
-        match &resp {
+        match resp {
             Some(s) => {
                 out.block_accel_stack
                     .extend(s.block_a_mps2.iter().map(|a| a / G));
