@@ -36,7 +36,7 @@
 //! side the target lies and the scan point nearest it is taken.
 
 use super::building::Frame;
-use super::physics::{CaseError, Physics, SystemKind};
+use super::physics::{CaseError, Physics, SystemKind, held_at_lower_friction};
 use crate::case::Case;
 use crate::dynamics::building::{
     Building, BuildingResponse, LinearBuilding, LinearOutput, simulate_building,
@@ -210,17 +210,6 @@ fn options() -> ExactOptions {
     }
 }
 
-fn run_all(
-    b: &Building,
-    grounds: &[Ground],
-    fail: impl Fn(crate::dynamics::SimError) -> CaseError,
-) -> Result<Vec<BuildingResponse>, CaseError> {
-    grounds
-        .iter()
-        .map(|g| simulate_building(b, g, &options()).map_err(&fail))
-        .collect()
-}
-
 /// [`Means`] of `B(fraction)` for `case` in `frame` ([`Physics::building`]'s single block, its
 /// stacks then attached by `fraction`), by the linear building's kernel
 /// ([`crate::dynamics::building::LinearBuilding`]: the modal basis once, every motion after it;
@@ -290,70 +279,70 @@ fn family_values(
         .collect())
 }
 
-/// [`Means`] of system `kind` of `case` in `frame` and its stuck mass share's mean over the
-/// motions (NaN for the rigid system), by the building's integrator even on one storey (whose
-/// sweep runs the one-storey integrator, which gives neither the shears nor the share).
-pub fn system_means(
+/// The building of system `kind` of `case` in `frame` ([`Physics::building`]), its error
+/// named with the frame.
+fn building_of(
     physics: &Physics,
     kind: SystemKind,
     case: &Case,
     frame: &Frame,
-    grounds: &[Ground],
-) -> Result<(Means, f64), CaseError> {
-    let in_building = |e| CaseError::InBuilding {
-        frame: frame.to_string(),
-        source: Box::new(e),
-    };
-    let b = physics.building(kind, case, frame).map_err(|source| {
-        in_building(CaseError::BuildingModel {
-            case: case.clone(),
-            kind,
-            source: Box::new(source),
+) -> Result<Building, CaseError> {
+    physics
+        .building(kind, case, frame)
+        .map_err(|source| CaseError::InBuilding {
+            frame: frame.to_string(),
+            source: Box::new(CaseError::BuildingModel {
+                case: case.clone(),
+                kind,
+                source: Box::new(source),
+            }),
         })
-    })?;
-    let responses = run_all(&b, grounds, |source| {
-        in_building(CaseError::Simulation {
+}
+
+/// `case`'s system `kind` in `frame` under one motion, by the building's integrator even on one
+/// storey (whose sweep runs the one-storey integrator, which gives neither the shears nor the
+/// stuck mass share).
+fn run_one(
+    b: &Building,
+    kind: SystemKind,
+    case: &Case,
+    frame: &Frame,
+    ground: &Ground,
+) -> Result<BuildingResponse, CaseError> {
+    simulate_building(b, ground, &options()).map_err(|source| CaseError::InBuilding {
+        frame: frame.to_string(),
+        source: Box::new(CaseError::Simulation {
             case: case.clone(),
             kind,
             source,
-        })
-    })?;
-    let share = responses.iter().map(|r| r.stuck_mass_share).sum::<f64>() / grounds.len() as f64;
-    Ok((Means::of(&responses, frame), share))
+        }),
+    })
 }
 
-/// The peak absolute acceleration, m/s², of the floors carrying `case`'s stack in the rigid
-/// system, the largest over `grounds`: what the sweep's no-slip rule compares with `μ_s·g`.
-pub fn holds_everywhere(
+/// The stuck mass share's mean over the motions' responses.
+fn mean_share(responses: &[BuildingResponse]) -> f64 {
+    responses.iter().map(|r| r.stuck_mass_share).sum::<f64>() / responses.len() as f64
+}
+
+/// Whether `case`'s stack holds under every motion of the rigid system's `rigid` responses in
+/// `frame`: the peak absolute acceleration of every floor carrying it stays below the least
+/// `μ_s·g`, with the sweep's margin (its no-slip rule, whose argument holds whatever the
+/// integrator).
+fn holds_everywhere(
     physics: &Physics,
     case: &Case,
     frame: &Frame,
-    grounds: &[Ground],
-) -> Result<bool, CaseError> {
-    let b = physics
-        .building(SystemKind::Rigid, case, frame)
-        .map_err(|source| CaseError::BuildingModel {
-            case: case.clone(),
-            kind: SystemKind::Rigid,
-            source: Box::new(source),
-        })?;
+    rigid: &[BuildingResponse],
+) -> bool {
     let min_mu_s = (case.mu.iter())
         .map(|m| m * physics.mu_static_ratio)
         .fold(f64::INFINITY, f64::min);
-    for g in grounds {
-        let r = simulate_building(&b, g, &options()).map_err(|source| CaseError::Simulation {
-            case: case.clone(),
-            kind: SystemKind::Rigid,
-            source,
-        })?;
+    rigid.iter().all(|r| {
         let a = (frame.floors().iter())
             .map(|&f| r.floor_peak_abs_accel_mps2[f - 1])
             .fold(0.0, f64::max);
-        if a >= min_mu_s * G * (1.0 - 1e-9) {
-            return Ok(false);
-        }
-    }
-    Ok(true)
+        a < min_mu_s * G * (1.0 - 1e-9)
+    })
 }
 
 /// The fraction whose value matches `target` (module doc): `scan` holds `(f, value)` at the
@@ -705,6 +694,89 @@ mod tests {
     }
 
     #[test]
+    fn one_storey_stacks_take_earlier_runs_only_where_they_repeat_them() {
+        // Oracle: brute force, every case's stack simulated under every motion. A stack that
+        // takes an earlier case's run (the held rule) must give the same means and share to the
+        // bit, a holding one the rigid system's means; and some case must take a run whose
+        // friction was lower at an interface that held, or the rule went untested.
+        use crate::study::config::{GridConfig, Values as Axis};
+        let config = GridConfig {
+            period_s: Axis::List(vec![0.3, 1.0]),
+            alpha: vec![Axis::List(vec![0.5, 1.0]), Axis::List(vec![0.5, 1.0])],
+            mu: vec![
+                Axis::List(vec![0.05, 0.2, 0.9]),
+                Axis::List(vec![0.05, 0.1, 0.3, 0.9]),
+            ],
+            mu_static_ratio: 1.0,
+            damping: 0.05,
+            damping_basis: Default::default(),
+            stack_floor: None,
+            aspect: None,
+        };
+        let (grid, physics) = (config.axes(), config.physics());
+        let frames = [Frame::one_storey()];
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/records/");
+        let records: Vec<_> = ["RSN960_NORTHR_LOS270.AT2", "RSN829_CAPEMEND_RIO360.AT2"]
+            .iter()
+            .map(|n| crate::ground_motion::read_record(format!("{dir}{n}").as_ref()).unwrap())
+            .collect();
+        let accels: Vec<Vec<f64>> = records.iter().map(|r| r.accel_mps2(1.0)).collect();
+        let grounds: Vec<Ground> = (records.iter().zip(&accels))
+            .map(|(r, a)| Ground::new(r.dt_s, a))
+            .collect();
+        let cases = grid.cases();
+        let (swept, slides) = (vec![None; cases], vec![true; cases]);
+        let family = ZoneFamily {
+            physics: &physics,
+            grid: &grid,
+            frames: &frames,
+            grounds: &grounds,
+            swept: &swept,
+            slides: &slides,
+            keep_going: &|| true,
+        };
+        let frame = &frames[0];
+        let mut repeated = 0;
+        for unit in fraction_units(&grid, &frames) {
+            let first = family.case(unit.cases[0]);
+            let b = building_of(&physics, SystemKind::Rigid, &first, frame).unwrap();
+            let rigid = family
+                .under_every_motion(|g| run_one(&b, SystemKind::Rigid, &first, frame, &grounds[g]))
+                .unwrap();
+            let scan = [(1.0, Means::of(&rigid, frame))];
+            let setups = family.one_storey_setups(&unit, &rigid, &scan).unwrap();
+            let mut brute: Vec<(Case, Vec<BuildingResponse>)> = Vec::new();
+            for (&c, setup) in unit.cases.iter().zip(&setups) {
+                let case = family.case(c);
+                let b = building_of(&physics, SystemKind::Stack, &case, frame).unwrap();
+                let runs: Vec<BuildingResponse> = (grounds.iter())
+                    .map(|g| run_one(&b, SystemKind::Stack, &case, frame, g).unwrap())
+                    .collect();
+                let want = match holds_everywhere(&physics, &case, frame, &rigid) {
+                    true => (scan[0].1.clone(), 1.0),
+                    false => (Means::of(&runs, frame), mean_share(&runs)),
+                };
+                assert_eq!((&setup.stack, setup.share), (&want.0, want.1), "{case:?}");
+                for (earlier, earlier_runs) in &brute {
+                    repeated += (0..grounds.len())
+                        .filter(|&g| {
+                            earlier.alpha == case.alpha
+                                && earlier.mu != case.mu
+                                && held_at_lower_friction(
+                                    &case.mu,
+                                    &earlier.mu,
+                                    &earlier_runs[g].held,
+                                )
+                        })
+                        .count();
+                }
+                brute.push((case, runs));
+            }
+        }
+        assert!(repeated > 0, "no stack repeated an earlier run");
+    }
+
+    #[test]
     fn a_units_searches_share_values_and_take_their_own_steps() {
         // One function searched for several targets and priors, as a unit's cases search it:
         // with the values shared, each fraction is the one a search alone finds, to the bit,
@@ -859,10 +931,28 @@ impl ZoneFamily<'_> {
     /// shards, a unit being computed whole).
     pub fn unit(&self, unit: &FractionUnit) -> Result<Vec<CaseFractions>, AttachedError> {
         use rayon::prelude::*;
-        let scan = self.scan(unit.cases[0])?;
-        let setups = (unit.cases.par_iter())
-            .map(|&c| self.setup(c, &scan.0))
-            .collect::<Result<Vec<_>, _>>()?;
+        let first = unit.cases[0];
+        let (scan, setups) = match &self.swept[first] {
+            Some((_, rigid, _)) => {
+                let scan = self.scan(first, rigid.clone())?;
+                let setups = (unit.cases.iter())
+                    .map(|&c| self.swept_setup(c))
+                    .collect::<Result<Vec<_>, _>>()?;
+                (scan, setups)
+            }
+            None => {
+                // One storey: the rigid system is the unit's key's, run once for its means and
+                // every case's no-slip rule.
+                let (case, frame) = (self.case(first), self.frame(first));
+                let b = building_of(self.physics, SystemKind::Rigid, &case, frame)?;
+                let rigid = self.under_every_motion(|g| {
+                    run_one(&b, SystemKind::Rigid, &case, frame, &self.grounds[g])
+                })?;
+                let scan = self.scan(first, Means::of(&rigid, frame))?;
+                let setups = self.one_storey_setups(unit, &rigid, &scan.0)?;
+                (scan, setups)
+            }
+        };
         // Every function's search evaluates its case's prior: one run gives them all, once for
         // cases that share it.
         let (case, frame) = (self.case(unit.cases[0]), self.frame(unit.cases[0]));
@@ -916,21 +1006,73 @@ impl ZoneFamily<'_> {
         &self.frames[c / self.grid.cases()]
     }
 
-    /// Case `c`'s sliding stack.
-    fn setup(&self, c: usize, scan: &[(f64, Means)]) -> Result<Setup, AttachedError> {
-        let (physics, grounds) = (self.physics, self.grounds);
+    /// Case `c`'s sliding stack, as the sweep stored it.
+    fn swept_setup(&self, c: usize) -> Result<Setup, AttachedError> {
         if !(self.keep_going)() {
             return Err(AttachedError::Stopped);
         }
-        let (case, frame) = (self.case(c), self.frame(c));
-        // The stack's means and share: the sweep's, or on one storey simulated here (the
-        // sweep's no-slip rule, whose argument holds whatever the integrator).
-        let (stack, share) = match &self.swept[c] {
-            Some((stack, _, share)) => (stack.clone(), *share),
-            None if holds_everywhere(physics, &case, frame, grounds)? => (rigid_of(scan), 1.0),
-            None => system_means(physics, SystemKind::Stack, &case, frame, grounds)?,
-        };
-        Ok(Setup { stack, share })
+        let (stack, _, share) = self.swept[c]
+            .as_ref()
+            .expect("a building's sweep stores it");
+        Ok(Setup {
+            stack: stack.clone(),
+            share: *share,
+        })
+    }
+
+    /// The sliding stacks of a one-storey `unit`'s cases, simulated here, in its order: a stack
+    /// that holds under the `rigid` responses takes the rigid system's means (`scan`'s last);
+    /// under each motion, a stack that repeats the run of an earlier case of the same masses
+    /// ([`held_at_lower_friction`]: the sweep's rule, applied motion by motion) takes that run,
+    /// the same bits as simulating it; the rest are simulated, the motions in parallel.
+    fn one_storey_setups(
+        &self,
+        unit: &FractionUnit,
+        rigid: &[BuildingResponse],
+        scan: &[(f64, Means)],
+    ) -> Result<Vec<Setup>, AttachedError> {
+        let physics = self.physics;
+        // The runs so far: `(α, μ, response per motion)`.
+        let mut runs: Vec<(Vec<f64>, Vec<f64>, Vec<BuildingResponse>)> = Vec::new();
+        let mut setups = Vec::with_capacity(unit.cases.len());
+        for &c in &unit.cases {
+            if !(self.keep_going)() {
+                return Err(AttachedError::Stopped);
+            }
+            let (case, frame) = (self.case(c), self.frame(c));
+            if holds_everywhere(physics, &case, frame, rigid) {
+                setups.push(Setup {
+                    stack: rigid_of(scan),
+                    share: 1.0,
+                });
+                continue;
+            }
+            let b = building_of(physics, SystemKind::Stack, &case, frame)?;
+            let responses = self.under_every_motion(|g| {
+                let repeated = runs.iter().find(|(alpha, mu, r)| {
+                    *alpha == case.alpha && held_at_lower_friction(&case.mu, mu, &r[g].held)
+                });
+                match repeated {
+                    Some((_, _, r)) => Ok(r[g].clone()),
+                    None => run_one(&b, SystemKind::Stack, &case, frame, &self.grounds[g]),
+                }
+            })?;
+            setups.push(Setup {
+                stack: Means::of(&responses, frame),
+                share: mean_share(&responses),
+            });
+            runs.push((case.alpha, case.mu, responses));
+        }
+        Ok(setups)
+    }
+
+    /// `run(g)` for every motion `g`, in parallel, in the motions' order.
+    fn under_every_motion(
+        &self,
+        run: impl Fn(usize) -> Result<BuildingResponse, CaseError> + Sync + Send,
+    ) -> Result<Vec<BuildingResponse>, CaseError> {
+        use rayon::prelude::*;
+        (0..self.grounds.len()).into_par_iter().map(run).collect()
     }
 
     /// The fraction of `function` for each of `unit`'s cases, in its order: one [`Values`] of
@@ -988,18 +1130,14 @@ impl ZoneFamily<'_> {
             .collect()
     }
 
-    /// The scan of the key of case `c`.
-    fn scan(&self, c: usize) -> Result<Scan, AttachedError> {
+    /// The scan of the key of case `c`, whose rigid system has the means `rigid` (the sweep's,
+    /// or on one storey simulated here).
+    fn scan(&self, c: usize, rigid: Means) -> Result<Scan, AttachedError> {
         let (physics, grounds) = (self.physics, self.grounds);
         if !(self.keep_going)() {
             return Err(AttachedError::Stopped);
         }
         let (case, frame) = (self.case(c), self.frame(c));
-        // The rigid system's means: the sweep's, or on one storey simulated here.
-        let rigid = match &self.swept[c] {
-            Some((_, rigid, _)) => rigid.clone(),
-            None => system_means(physics, SystemKind::Rigid, &case, frame, grounds)?.0,
-        };
         let mut scan = Vec::new();
         for f in scan_fractions(&case) {
             let m = if f == 1.0 {

@@ -27,7 +27,7 @@
 //! tests/sweep.rs).
 
 use super::building::Frame;
-use super::physics::{CaseError, Physics, SystemKind};
+use super::physics::{CaseError, Physics, SystemKind, held_at_lower_friction};
 use crate::case::Case;
 use crate::dynamics::building::BuildingResponse;
 use crate::dynamics::{ExactOptions, G, Ground, Rocking};
@@ -291,17 +291,6 @@ pub struct UnitOptions<'a> {
     /// The blocks' width-to-height ratios, bottom first: check whether each case's stack
     /// rocks (docs/model.md, "Rocking: when a case leaves the model").
     pub aspect: Option<&'a [f64]>,
-}
-
-/// Whether a stack of coefficients `mu` moves as the run of `mu_run` did, the same masses given:
-/// each coefficient is the run's, or higher at an interface that stuck throughout the run
-/// (`held`). Such an interface never needed more than its run's `μ_s·N`, so a higher limit
-/// changes no contact selection: the trajectory, every peak with it, is the run's
-/// (docs/model.md, "Stated special cases").
-fn held_at_lower_friction(mu: &[f64], mu_run: &[f64], held: &[bool]) -> bool {
-    mu.len() == held.len()
-        && (mu.iter().zip(mu_run).zip(held))
-            .all(|((m, r), &h)| m.to_bits() == r.to_bits() || (m > r && h))
 }
 
 /// Every case of the grid at structure period `grid.periods_s[period_index]` under `ground`, in
