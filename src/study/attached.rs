@@ -248,26 +248,24 @@ fn family_values(
     grounds: &[Ground],
     quantities: &[Quantity],
 ) -> Result<Vec<f64>, CaseError> {
-    let in_building = |e| CaseError::InBuilding {
-        frame: frame.to_string(),
-        source: Box::new(e),
-    };
     let b = physics
         .building(SystemKind::SingleBlock, case, frame)
         .map(|b| b.with_stacks_attached_fraction(fraction))
         .map_err(|source| {
-            in_building(CaseError::BuildingModel {
+            CaseError::BuildingModel {
                 case: case.clone(),
                 kind: SystemKind::Rigid,
                 source: Box::new(source),
-            })
+            }
+            .in_frame(frame)
         })?;
     let linear = |source| {
-        in_building(CaseError::Linear {
+        CaseError::Linear {
             case: case.clone(),
             fraction,
             source,
-        })
+        }
+        .in_frame(frame)
     };
     let kernel = LinearBuilding::new(&b).map_err(linear)?;
     let n = frame.storeys();
@@ -287,16 +285,14 @@ fn building_of(
     case: &Case,
     frame: &Frame,
 ) -> Result<Building, CaseError> {
-    physics
-        .building(kind, case, frame)
-        .map_err(|source| CaseError::InBuilding {
-            frame: frame.to_string(),
-            source: Box::new(CaseError::BuildingModel {
-                case: case.clone(),
-                kind,
-                source: Box::new(source),
-            }),
-        })
+    physics.building(kind, case, frame).map_err(|source| {
+        CaseError::BuildingModel {
+            case: case.clone(),
+            kind,
+            source: Box::new(source),
+        }
+        .in_frame(frame)
+    })
 }
 
 /// `case`'s system `kind` in `frame` under one motion, by the building's integrator even on one
@@ -309,13 +305,13 @@ fn run_one(
     frame: &Frame,
     ground: &Ground,
 ) -> Result<BuildingResponse, CaseError> {
-    simulate_building(b, ground, &options()).map_err(|source| CaseError::InBuilding {
-        frame: frame.to_string(),
-        source: Box::new(CaseError::Simulation {
+    simulate_building(b, ground, &options()).map_err(|source| {
+        CaseError::Simulation {
             case: case.clone(),
             kind,
             source,
-        }),
+        }
+        .in_frame(frame)
     })
 }
 

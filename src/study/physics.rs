@@ -95,6 +95,16 @@ pub enum CaseError {
     },
 }
 
+impl CaseError {
+    /// This error, raised in the building `frame`.
+    pub fn in_frame(self, frame: &Frame) -> Self {
+        CaseError::InBuilding {
+            frame: frame.to_string(),
+            source: Box::new(self),
+        }
+    }
+}
+
 /// The settings every case of a study shares.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Physics {
@@ -313,23 +323,21 @@ impl Physics {
                 .simulate(kind, case, ground, opts, aspect)
                 .map(BuildingResponse::from_one_storey);
         }
-        let in_building = |e| CaseError::InBuilding {
-            frame: frame.to_string(),
-            source: Box::new(e),
-        };
         let b = (self.building_checked(kind, case, frame, None, aspect)).map_err(|source| {
-            in_building(CaseError::BuildingModel {
+            CaseError::BuildingModel {
                 case: case.clone(),
                 kind,
                 source: Box::new(source),
-            })
+            }
+            .in_frame(frame)
         })?;
         simulate_building(&b, ground, opts).map_err(|source| {
-            in_building(CaseError::Simulation {
+            CaseError::Simulation {
                 case: case.clone(),
                 kind,
                 source,
-            })
+            }
+            .in_frame(frame)
         })
     }
 }
