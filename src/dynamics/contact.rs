@@ -70,6 +70,14 @@ pub(crate) trait Contacts {
     fn select(&mut self, ga: f64) -> Result<(), super::SimError>;
 }
 
+/// After a contact selection: `held[k]` stays true only while interface `k` is stuck. Over a
+/// run, whether it stuck at every selection (`Response::held`, `BuildingResponse::held`).
+pub(crate) fn keep_held(held: &mut [bool], contacts: &[Contact]) {
+    for (h, c) in held.iter_mut().zip(contacts) {
+        *h &= *c == Contact::Stick;
+    }
+}
+
 /// The stick/slip switch of both exact integrators, at an event that stopped interface
 /// `stopped` or broke the interfaces `broke` loose: every slipping interface whose relative
 /// velocity has reached or crossed zero sticks momentarily (its group merged), and so does every

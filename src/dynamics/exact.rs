@@ -43,7 +43,7 @@
 use super::closed_form::{
     Basis, Osc, PieceIntegrals, Wave, integral_of_square_decay, integral_of_square_with,
 };
-use super::contact::{Contact, ContactSelector, Contacts, switch_contacts};
+use super::contact::{Contact, ContactSelector, Contacts, keep_held, switch_contacts};
 use super::model::{G, System};
 use super::response::{Energy, History, Response};
 use super::rocking::{self, RockingOnset};
@@ -1421,9 +1421,7 @@ impl<const YIELDS: bool, const LONG_PERIODS: bool> Contacts for ExactRun<'_, YIE
             &mut self.contacts,
             &mut self.force,
         )?;
-        for (held, c) in self.out.held.iter_mut().zip(&self.contacts) {
-            *held &= *c == Contact::Stick;
-        }
+        keep_held(&mut self.out.held, &self.contacts);
         Ok(())
     }
 

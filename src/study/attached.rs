@@ -756,13 +756,8 @@ mod tests {
                 for (earlier, earlier_runs) in &brute {
                     repeated += (0..grounds.len())
                         .filter(|&g| {
-                            earlier.alpha == case.alpha
-                                && earlier.mu != case.mu
-                                && held_at_lower_friction(
-                                    &case.mu,
-                                    &earlier.mu,
-                                    &earlier_runs[g].held,
-                                )
+                            earlier.mu != case.mu
+                                && held_at_lower_friction(&case, earlier, &earlier_runs[g].held)
                         })
                         .count();
                 }
@@ -921,13 +916,14 @@ type Scan = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64);
 
 impl ZoneFamily<'_> {
     /// The attached fractions of every case of `unit`, in its order: the scan once, each case's
-    /// targets (the cases in parallel), the family's means at each distinct prior not scanned,
-    /// then each function's searches over the cases in the unit's order, sharing the function's
-    /// [`Values`] (the functions in parallel: the numbers depend on neither the threads nor the
-    /// shards, a unit being computed whole).
+    /// sliding stack (the sweep's, or on one storey [`Self::one_storey_setups`]), the family's
+    /// means at each distinct prior not scanned, then each function's searches over the cases
+    /// in the unit's order, sharing the function's [`Values`] (the functions in parallel: the
+    /// numbers depend on neither the threads nor the shards, a unit being computed whole).
     pub fn unit(&self, unit: &FractionUnit) -> Result<Vec<CaseFractions>, AttachedError> {
         use rayon::prelude::*;
         let first = unit.cases[0];
+        let (case, frame) = (self.case(first), self.frame(first));
         let (scan, setups) = match &self.swept[first] {
             Some((_, rigid, _)) => {
                 let scan = self.scan(first, rigid.clone())?;
@@ -939,7 +935,6 @@ impl ZoneFamily<'_> {
             None => {
                 // One storey: the rigid system is the unit's key's, run once for its means and
                 // every case's no-slip rule.
-                let (case, frame) = (self.case(first), self.frame(first));
                 let b = building_of(self.physics, SystemKind::Rigid, &case, frame)?;
                 let rigid = self.under_every_motion(|g| {
                     run_one(&b, SystemKind::Rigid, &case, frame, &self.grounds[g])
@@ -951,7 +946,6 @@ impl ZoneFamily<'_> {
         };
         // Every function's search evaluates its case's prior: one run gives them all, once for
         // cases that share it.
-        let (case, frame) = (self.case(unit.cases[0]), self.frame(unit.cases[0]));
         let storeys = frame.storeys();
         let mut priors: Vec<f64> = (setups.iter())
             .map(|s| prior_fraction(s.share, &scan.0))
@@ -1028,8 +1022,8 @@ impl ZoneFamily<'_> {
         scan: &[(f64, Means)],
     ) -> Result<Vec<Setup>, AttachedError> {
         let physics = self.physics;
-        // The runs so far: `(α, μ, response per motion)`.
-        let mut runs: Vec<(Vec<f64>, Vec<f64>, Vec<BuildingResponse>)> = Vec::new();
+        // The cases run so far, with their responses per motion.
+        let mut runs: Vec<(Case, Vec<BuildingResponse>)> = Vec::new();
         let mut setups = Vec::with_capacity(unit.cases.len());
         for &c in &unit.cases {
             if !(self.keep_going)() {
@@ -1045,11 +1039,10 @@ impl ZoneFamily<'_> {
             }
             let b = building_of(physics, SystemKind::Stack, &case, frame)?;
             let responses = self.under_every_motion(|g| {
-                let repeated = runs.iter().find(|(alpha, mu, r)| {
-                    *alpha == case.alpha && held_at_lower_friction(&case.mu, mu, &r[g].held)
-                });
+                let repeated =
+                    (runs.iter()).find(|(ran, r)| held_at_lower_friction(&case, ran, &r[g].held));
                 match repeated {
-                    Some((_, _, r)) => Ok(r[g].clone()),
+                    Some((_, r)) => Ok(r[g].clone()),
                     None => run_one(&b, SystemKind::Stack, &case, frame, &self.grounds[g]),
                 }
             })?;
@@ -1057,7 +1050,7 @@ impl ZoneFamily<'_> {
                 stack: Means::of(&responses, frame),
                 share: mean_share(&responses),
             });
-            runs.push((case.alpha, case.mu, responses));
+            runs.push((case, responses));
         }
         Ok(setups)
     }

@@ -342,13 +342,15 @@ impl Physics {
     }
 }
 
-/// Whether a stack of coefficients `mu` moves as the run of `mu_run` did, the same masses given:
-/// each coefficient is the run's, or higher at an interface that stuck throughout the run
-/// (`held`). Such an interface never needed more than its run's `μ_s·N`, so a higher limit
-/// changes no contact selection: the trajectory, every peak with it, is the run's
-/// (docs/model.md, "Stated special cases").
-pub fn held_at_lower_friction(mu: &[f64], mu_run: &[f64], held: &[bool]) -> bool {
-    mu.len() == held.len()
-        && (mu.iter().zip(mu_run).zip(held))
+/// Whether `case`'s stack moves as the run of `run` did under one motion: the same system (the
+/// same period and masses) whose coefficients are the run's, or higher at an interface that
+/// stuck throughout the run (`held`). Such an interface never needed more than its run's
+/// `μ_s·N`, so a higher limit changes no contact selection: the trajectory, every peak with it,
+/// is the run's (docs/model.md, "Stated special cases").
+pub fn held_at_lower_friction(case: &Case, run: &Case, held: &[bool]) -> bool {
+    case.period_s.to_bits() == run.period_s.to_bits()
+        && case.alpha == run.alpha
+        && case.mu.len() == held.len()
+        && (case.mu.iter().zip(&run.mu).zip(held))
             .all(|((m, r), &h)| m.to_bits() == r.to_bits() || (m > r && h))
 }

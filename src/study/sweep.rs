@@ -327,8 +327,8 @@ pub fn run_unit(
     // Keyed by the bits of α (and the index of μ_1): the same floating-point sum, the same system.
     let mut rigid: HashMap<u64, Peaks> = HashMap::new();
     let mut single: HashMap<(u64, u64), Peaks> = HashMap::new();
-    // The stacks simulated so far: `(α, μ, run)`.
-    let mut stacks: Vec<(Vec<f64>, Vec<f64>, Peaks)> = Vec::new();
+    // The stacks simulated so far, with their runs.
+    let mut stacks: Vec<(Case, Peaks)> = Vec::new();
     for c in 0..cases {
         let (alpha, mu) = grid.stack(c);
         let case = Case {
@@ -362,20 +362,18 @@ pub fn run_unit(
 
         let min_mu_s = mu_s.iter().copied().fold(f64::INFINITY, f64::min);
         let non_decreasing = physics.mu_static_ratio == 1.0 && mu.windows(2).all(|w| w[1] >= w[0]);
-        let repeats = |(alpha, mu_run, run): &(Vec<f64>, Vec<f64>, Peaks)| {
-            *alpha == case.alpha && held_at_lower_friction(mu, mu_run, &run.held)
-        };
+        let repeats = |(ran, run): &(Case, Peaks)| held_at_lower_friction(&case, ran, &run.held);
         let (rule, resp) = if opts.skip && holds(min_mu_s) {
             (SkipRule::NoSlip, None)
         } else if opts.skip && non_decreasing {
             (SkipRule::SingleBlock, None)
         } else if let Some(i) = opts.skip.then(|| stacks.iter().position(repeats)).flatten() {
-            (SkipRule::Held, Some(&stacks[i].2))
+            (SkipRule::Held, Some(&stacks[i].1))
         } else {
             out.simulations += 1;
             let run = simulate(SystemKind::Stack, &case)?;
-            stacks.push((case.alpha.clone(), mu.clone(), run));
-            (SkipRule::Simulated, stacks.last().map(|(_, _, run)| run))
+            stacks.push((case.clone(), run));
+            (SkipRule::Simulated, stacks.last().map(|(_, run)| run))
         };
         out.u_rigid.push(r.u_m);
         out.u_single.push(u_single);

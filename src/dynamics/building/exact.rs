@@ -24,7 +24,7 @@
 // Parallel per-body and per-interface arrays read best with index loops.
 #![allow(clippy::needless_range_loop)]
 
-use super::super::contact::{Contact, ContactSelector, Contacts, switch_contacts};
+use super::super::contact::{Contact, ContactSelector, Contacts, keep_held, switch_contacts};
 use super::super::exact::{BREAK_TOLERANCE, ExactOptions};
 use super::super::model::G;
 use super::super::response::{Energy, History};
@@ -1680,9 +1680,7 @@ impl Contacts for Integrator<'_> {
                 self.force[k] = fc.force[l];
             }
         }
-        for (held, c) in self.out.held.iter_mut().zip(&self.contacts) {
-            *held &= *c == Contact::Stick;
-        }
+        keep_held(&mut self.out.held, &self.contacts);
         self.mode = None;
         Ok(())
     }
