@@ -916,10 +916,10 @@ type Scan = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64);
 
 impl ZoneFamily<'_> {
     /// The attached fractions of every case of `unit`, in its order: the scan once, each case's
-    /// sliding stack (the sweep's, or on one storey [`Self::one_storey_setups`]), the family's
-    /// means at each distinct prior not scanned, then each function's searches over the cases
-    /// in the unit's order, sharing the function's [`Values`] (the functions in parallel: the
-    /// numbers depend on neither the threads nor the shards, a unit being computed whole).
+    /// sliding stack (the sweep's, or on one storey simulated here, `one_storey_setups`), the
+    /// family's means at each distinct prior not scanned, then each function's searches over the
+    /// cases in the unit's order, sharing the function's [`Values`] (the functions in parallel:
+    /// the numbers depend on neither the threads nor the shards, a unit being computed whole).
     pub fn unit(&self, unit: &FractionUnit) -> Result<Vec<CaseFractions>, AttachedError> {
         use rayon::prelude::*;
         let first = unit.cases[0];
