@@ -31,10 +31,13 @@ impl std::fmt::Display for Method {
 /// its slope to a certified `ε/8` of its value, not its time to a few ulps of `dt`: every
 /// stored peak moves at round-off, its time by up to about `√ε` of the motion's time scale;
 /// 6: the sweep's rule `held_at_lower_friction`, `skip_rule` 3, where a stack repeats an
-/// earlier case's run: no stored number moves, the codes do).
+/// earlier case's run: no stored number moves, the codes do; 7: within a mode a building's
+/// piece starts from the last piece's modal state, not from the floors' state projected again,
+/// and its constant loads are projected once per mode: a building's stored peaks move at
+/// round-off).
 pub const INTEGRATOR: Method = Method {
     name: "integrator",
-    version: 6,
+    version: 7,
 };
 
 /// Exact response spectra (`spectrum::response`), with the target spectra they are compared to.

@@ -457,7 +457,13 @@ struct Integrator<'b> {
     curvatures: Vec<f64>,
     start_accel: Vec<f64>,
     z: Vec<f64>,
-    p0: Vec<f64>,
+    /// The modal state of `z`, and the modal loads of the mode's constant floor loads
+    /// (`accel_const`).
+    y_floors: Vec<Cx>,
+    mode_load: Vec<Cx>,
+    /// Whether the state is the last piece's at its end (`self.p_end`): set once a piece has
+    /// been advanced over; a switch then leaves the mode unset, so the next piece starts afresh.
+    at_piece_end: bool,
     events: Vec<Event>,
     /// Peak functions: floor displacements, storey drifts, floor accelerations, storey shears,
     /// floor absolute velocities, the overturning moment.
@@ -596,7 +602,9 @@ impl<'b> Integrator<'b> {
             curvatures: vec![0.0; row_count(n)],
             start_accel: vec![0.0; n],
             z: vec![0.0; 2 * n],
-            p0: vec![0.0; n],
+            y_floors: Vec::new(),
+            mode_load: Vec::new(),
+            at_piece_end: false,
             events: Vec::new(),
             peaks: Vec::new(),
             vg: 0.0,
@@ -889,28 +897,47 @@ impl<'b> Integrator<'b> {
     /// The piece from the current state: the mode (set up again after a switch), the floors'
     /// loads and modal coefficients, the free clusters' cubics, and the switching and peak
     /// functions.
+    ///
+    /// Within a mode the modal state is the state: while no switch has come since the last
+    /// piece, which ended here (`self.p_end`), the piece starts from that piece's modal state and
+    /// the floors' accelerations there, with no pass over the floors.
     fn build(&mut self, ga: f64, slope: f64) -> Result<(), SimError> {
+        let carried = self.mode.is_some() && self.at_piece_end;
         if self.mode.is_none() {
             self.set_up_mode()?;
         }
         let mode = self.mode();
         let n = self.n;
-        for j in 0..n {
-            self.p0[j] = -ga + self.accel_const[j];
-            self.z[j] = self.x[j];
-            self.z[n + j] = self.v[j];
+        let accel_rows = mode.index(Row::Accel, 0);
+        if !carried {
+            for j in 0..n {
+                self.z[j] = self.x[j];
+                self.z[n + j] = self.v[j];
+            }
+            mode.modes.modal_state(&self.z, &mut self.y_floors);
         }
-        mode.modes.piece(&self.z, &self.p0, -slope, &mut self.piece);
+        let y0 = if carried {
+            &self.p_end.y
+        } else {
+            &self.y_floors
+        };
+        mode.modes
+            .piece_in_mode(y0, &self.mode_load, ga, -slope, &mut self.piece);
         self.p_start.start(&mode.modes, &self.piece);
+        if carried {
+            self.start_accel
+                .copy_from_slice(&self.end_rows[accel_rows..accel_rows + n]);
+        } else {
+            mode.by_mode.dots(
+                &mode.modes.weight,
+                &self.p_start.y,
+                accel_rows,
+                &mut self.start_accel,
+            );
+        }
         let live = mode.live_rows(self.yielding);
         mode.by_mode
             .curvatures(&self.piece.mag, &mut self.curvatures[..live]);
-        mode.by_mode.dots(
-            &mode.modes.weight,
-            &self.p_start.y,
-            mode.index(Row::Accel, 0),
-            &mut self.start_accel,
-        );
         for c in &mut self.free {
             c.disp = [
                 self.x[c.bottom],
@@ -919,7 +946,7 @@ impl<'b> Integrator<'b> {
                 -slope / 6.0,
             ];
         }
-        self.build_functions(&mode, ga, slope);
+        self.build_functions(&mode, ga, slope, carried);
         Ok(())
     }
 
@@ -1010,6 +1037,8 @@ impl<'b> Integrator<'b> {
                 m
             }
         };
+        mode.modes
+            .modal_loads(&self.accel_const, &mut self.mode_load);
         self.mode = Some(mode);
         Ok(())
     }
@@ -1028,7 +1057,9 @@ impl<'b> Integrator<'b> {
         }
     }
 
-    fn build_functions(&mut self, mode: &Mode, ga: f64, slope: f64) {
+    /// `carried`: the piece continues the last one's modal state ([`Self::build`]), so the rows'
+    /// values at its start are those at the last one's end.
+    fn build_functions(&mut self, mode: &Mode, ga: f64, slope: f64, carried: bool) {
         let (n, b) = (self.n, self.b);
         let mut events = std::mem::take(&mut self.events);
         let mut peaks = std::mem::take(&mut self.peaks);
@@ -1180,12 +1211,16 @@ impl<'b> Integrator<'b> {
         let heights = self.b.storey_heights_m();
         let (mut moment_offset, mut moment) = (0.0, 0.0);
         for j in 0..n {
-            let damper: f64 = (self.damping_above[j * n..(j + 1) * n].iter())
-                .zip(&self.v[..n])
-                .map(|(c, v)| c * v)
-                .sum();
-            let x_prev = if j > 0 { self.x[j - 1] } else { 0.0 };
-            let shear = self.storeys[j].force(self.x[j] - x_prev) + damper;
+            let shear = if carried {
+                self.offsets[j] + self.end_rows[mode.index(Row::Shear, j)]
+            } else {
+                let damper: f64 = (self.damping_above[j * n..(j + 1) * n].iter())
+                    .zip(&self.v[..n])
+                    .map(|(c, v)| c * v)
+                    .sum();
+                let x_prev = if j > 0 { self.x[j - 1] } else { 0.0 };
+                self.storeys[j].force(self.x[j] - x_prev) + damper
+            };
             peaks.push((
                 PeakOf::Shear(j),
                 Func {
@@ -1441,6 +1476,7 @@ impl<'b> Integrator<'b> {
         }
         self.x[..n].copy_from_slice(&x_new);
         self.v[..n].copy_from_slice(&v_new);
+        self.at_piece_end = true;
         self.x_new = x_new;
         self.v_new = v_new;
         for k in 0..nb {
