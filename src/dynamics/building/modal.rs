@@ -1087,6 +1087,40 @@ mod tests {
         }
     }
 
+    /// `z` (three floors' state) moved over `[0, h]` under `ż = A·z + (0, p(t))` by RK4 at `steps`
+    /// steps: the fine-step reference of the tests below (error ~(h/steps)⁴).
+    fn rk4(a: &DMatrix<f64>, z: &mut [f64; 6], p: impl Fn(f64) -> [f64; 3], h: f64, steps: usize) {
+        let rhs = |t: f64, z: &[f64; 6]| {
+            let load = p(t);
+            let mut d = [0.0; 6];
+            for i in 0..6 {
+                d[i] = (0..6).map(|j| a[(i, j)] * z[j]).sum::<f64>();
+                if i >= 3 {
+                    d[i] += load[i - 3];
+                }
+            }
+            d
+        };
+        let add = |z: &[f64; 6], k: &[f64; 6], f: f64| {
+            let mut o = *z;
+            for i in 0..6 {
+                o[i] += f * k[i];
+            }
+            o
+        };
+        let dt = h / steps as f64;
+        for s in 0..steps {
+            let t = s as f64 * dt;
+            let k1 = rhs(t, z);
+            let k2 = rhs(t + 0.5 * dt, &add(z, &k1, 0.5 * dt));
+            let k3 = rhs(t + 0.5 * dt, &add(z, &k2, 0.5 * dt));
+            let k4 = rhs(t + dt, &add(z, &k3, dt));
+            for i in 0..6 {
+                z[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+    }
+
     /// Pieces carried from one sample interval to the next in the modal state (what the
     /// integrator does within a mode: [`StateModes::piece_in_mode`] from the last piece's end,
     /// the constant loads projected once) against an independent integration over forty
@@ -1114,38 +1148,16 @@ mod tests {
             end.at(&sm, &piece, h);
             y.clone_from(&end.y);
         }
-        let steps = 2_000;
-        let dt = h / steps as f64;
         let mut z = z0;
         for k in 0..40 {
             let slope = (accel[k + 1] - accel[k]) / h;
-            let rhs = |t: f64, z: &[f64; 6]| {
-                let mut d = [0.0; 6];
-                for i in 0..6 {
-                    d[i] = (0..6).map(|j| a[(i, j)] * z[j]).sum::<f64>();
-                    if i >= 3 {
-                        d[i] += p_c[i - 3] - accel[k] - slope * t;
-                    }
-                }
-                d
-            };
-            for s in 0..steps {
-                let t = s as f64 * dt;
-                let add = |z: &[f64; 6], k: &[f64; 6], f: f64| {
-                    let mut o = *z;
-                    for i in 0..6 {
-                        o[i] += f * k[i];
-                    }
-                    o
-                };
-                let k1 = rhs(t, &z);
-                let k2 = rhs(t + 0.5 * dt, &add(&z, &k1, 0.5 * dt));
-                let k3 = rhs(t + 0.5 * dt, &add(&z, &k2, 0.5 * dt));
-                let k4 = rhs(t + dt, &add(&z, &k3, dt));
-                for i in 0..6 {
-                    z[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                }
-            }
+            rk4(
+                &a,
+                &mut z,
+                |t| p_c.map(|p| p - accel[k] - slope * t),
+                h,
+                2_000,
+            );
         }
         let size = z.iter().fold(0.0f64, |s, v| s.max(v.abs()));
         for i in 0..6 {
@@ -1172,36 +1184,9 @@ mod tests {
         let p1 = -3.0;
         let mut piece = Piece::default();
         sm.piece(&z0, &p0, p1, &mut piece);
-        let rhs = |t: f64, z: &[f64; 6]| {
-            let mut d = [0.0; 6];
-            for i in 0..6 {
-                d[i] = (0..6).map(|j| a[(i, j)] * z[j]).sum::<f64>();
-                if i >= 3 {
-                    d[i] += p0[i - 3] + p1 * t;
-                }
-            }
-            d
-        };
-        let (h, steps) = (0.02, 20_000);
-        let dt = h / steps as f64;
+        let h = 0.02;
         let mut z = z0;
-        for s in 0..steps {
-            let t = s as f64 * dt;
-            let k1 = rhs(t, &z);
-            let add = |z: &[f64; 6], k: &[f64; 6], f: f64| {
-                let mut o = *z;
-                for i in 0..6 {
-                    o[i] += f * k[i];
-                }
-                o
-            };
-            let k2 = rhs(t + 0.5 * dt, &add(&z, &k1, 0.5 * dt));
-            let k3 = rhs(t + 0.5 * dt, &add(&z, &k2, 0.5 * dt));
-            let k4 = rhs(t + dt, &add(&z, &k3, dt));
-            for i in 0..6 {
-                z[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
-        }
+        rk4(&a, &mut z, |t| p0.map(|p| p + p1 * t), h, 20_000);
         let mut pt = ModalPoint::default();
         pt.at(&sm, &piece, h);
         for i in 0..6 {
