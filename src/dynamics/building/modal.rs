@@ -1087,6 +1087,16 @@ mod tests {
         }
     }
 
+    /// The fine-step tests' building: three floors of masses 1, 3 and 1 (its basis and state
+    /// matrix), a start state and constant floor loads (m/s²).
+    fn three_floors() -> (StateModes, DMatrix<f64>, [f64; 6], [f64; 3]) {
+        let b = building();
+        let m = [1.0, 3.0, 1.0];
+        let sm = StateModes::new(&m, b.stiffness(), b.damping()).unwrap();
+        let a = state_matrix(&m, b.stiffness(), b.damping());
+        (sm, a, [0.01, -0.02, 0.03, 0.4, 0.1, -0.3], [-1.0, 2.0, 0.5])
+    }
+
     /// `z` (three floors' state) moved over `[0, h]` under `ż = A·z + (0, p(t))` by RK4 at `steps`
     /// steps: the fine-step reference of the tests below (error ~(h/steps)⁴).
     fn rk4(a: &DMatrix<f64>, z: &mut [f64; 6], p: impl Fn(f64) -> [f64; 3], h: f64, steps: usize) {
@@ -1128,13 +1138,7 @@ mod tests {
     /// ~h⁴). The tolerance, `1e-11` of the state's size, allows the round-off of forty pieces.
     #[test]
     fn pieces_carried_in_the_modal_state_match_a_fine_step_integration() {
-        let b = building();
-        let m = [1.0, 3.0, 1.0];
-        let k_t = b.stiffness().to_vec();
-        let sm = StateModes::new(&m, &k_t, b.damping()).unwrap();
-        let a = state_matrix(&m, &k_t, b.damping());
-        let z0 = [0.01, -0.02, 0.03, 0.4, 0.1, -0.3];
-        let p_c = [-1.0, 2.0, 0.5];
+        let (sm, a, z0, p_c) = three_floors();
         let accel: Vec<f64> = (0..=40).map(|k| 3.0 * (0.7 * k as f64).sin()).collect();
         let h = 0.01;
         let mut load = Vec::new();
@@ -1174,13 +1178,7 @@ mod tests {
     /// small step (error ~h⁴, far below the tolerance).
     #[test]
     fn a_piece_matches_a_fine_step_integration() {
-        let b = building();
-        let m = [1.0, 3.0, 1.0];
-        let k_t = b.stiffness().to_vec();
-        let sm = StateModes::new(&m, &k_t, b.damping()).unwrap();
-        let a = state_matrix(&m, &k_t, b.damping());
-        let z0 = [0.01, -0.02, 0.03, 0.4, 0.1, -0.3];
-        let p0 = [-1.0, 2.0, 0.5];
+        let (sm, a, z0, p0) = three_floors();
         let p1 = -3.0;
         let mut piece = Piece::default();
         sm.piece(&z0, &p0, p1, &mut piece);
