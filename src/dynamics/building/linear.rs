@@ -1152,7 +1152,8 @@ impl LinearBuilding {
 
     /// The modal coefficients of the interval starting at state `y` under
     /// `a_g(τ) = a0 + slope·τ`: `y₀`, `β₀ = −g·a0`, `β₁ = −g·slope`, `q = λ²y₀ + λβ₀ + β₁` and
-    /// `|q|·|λ|^{k−2}` (as [`StateModes::piece`] from the physical state).
+    /// `|q|·|λ|^{k−2}` (as [`StateModes::piece_in_mode`] under the ground's load alone, `y` the
+    /// modal state in real and imaginary halves).
     fn piece(&self, y: &[f64], a0: f64, slope: f64, out: &mut Piece) {
         let m = self.modes();
         let g = self.modes.load_row();
