@@ -178,6 +178,13 @@ impl Ground<'_> {
         if self.accel_mps2.len() > MAX_SAMPLES {
             return Err(SimError::TooLong(self.accel_mps2.len()));
         }
+        let most = MAX_PEAK_ACCEL_G * G;
+        // One pass without a branch per sample (the compiler vectorises it: kernels validate
+        // their record at every run); the offending sample is looked for only when there is one.
+        let within = (self.accel_mps2.iter()).fold(true, |ok, a| ok & (a.abs() <= most));
+        if within {
+            return Ok(());
+        }
         if let Some((index, &value)) = self
             .accel_mps2
             .iter()
@@ -186,7 +193,6 @@ impl Ground<'_> {
         {
             return Err(SimError::NonFinite { index, value });
         }
-        let most = MAX_PEAK_ACCEL_G * G;
         if let Some((index, &value)) = self
             .accel_mps2
             .iter()
@@ -221,4 +227,43 @@ pub fn accuracy_warnings(sys: &System, ground: &Ground) -> Vec<String> {
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The one-pass check finds what a sample-by-sample search finds: the first sample that is
+    /// not finite before any that is too large, each at its index, and nothing in a record
+    /// within the limit (its largest sample exactly at it).
+    #[test]
+    fn validate_names_the_first_offending_sample() {
+        let most = MAX_PEAK_ACCEL_G * G;
+        let check = |accel: &[f64]| {
+            Ground {
+                dt_s: 0.01,
+                accel_mps2: accel,
+            }
+            .validate()
+        };
+        let mut a = vec![0.5; 37];
+        a[20] = -most;
+        assert_eq!(check(&a), Ok(()));
+        a[30] = f64::NAN;
+        a[25] = 2.0 * most;
+        assert!(matches!(
+            check(&a),
+            Err(SimError::NonFinite { index: 30, .. })
+        ));
+        a[30] = 0.0;
+        assert!(matches!(
+            check(&a),
+            Err(SimError::PeakAccel { index: 25, .. })
+        ));
+        a[3] = f64::NEG_INFINITY;
+        assert!(matches!(
+            check(&a),
+            Err(SimError::NonFinite { index: 3, .. })
+        ));
+    }
 }
