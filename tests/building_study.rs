@@ -43,6 +43,36 @@ fn units(dir: &Path) -> usize {
         .unwrap_or(0)
 }
 
+/// Every variable of `z` (`[motion, storeys, stack_floor, …]`) in its first storey count's
+/// frame `f`, as bits per motion; a per-floor or per-storey variable's first level only (a study
+/// of one storey pads nothing).
+fn frame_bits(z: &ZoneSweep, f: usize) -> Vec<(&'static str, Vec<u64>)> {
+    use ndarray::{Axis, Slice};
+    use slidestack::store::vars::{Data, Trailing};
+    let building = z.building.as_ref().expect("a building study's sweep");
+    (z.vars.data().into_iter())
+        .chain(building.data())
+        .map(|(var, data)| {
+            let bits: Vec<u64> = match data {
+                Data::Values(a) => {
+                    let frame = a.index_axis(Axis(1), 0);
+                    let frame = frame.index_axis(Axis(1), f);
+                    let per_level = matches!(var.trailing, Trailing::Floor | Trailing::Storey);
+                    let first = match per_level {
+                        true => frame.slice_axis(Axis(frame.ndim() - 1), Slice::from(0..1)),
+                        false => frame.view(),
+                    };
+                    first.iter().map(|x| x.to_bits()).collect()
+                }
+                Data::Codes(a) => (a.index_axis(Axis(1), 0).index_axis(Axis(1), f).iter())
+                    .map(|&c| u64::from(c))
+                    .collect(),
+            };
+            (var.name, bits)
+        })
+        .collect()
+}
+
 /// What `script` prints when the tests' Python (scripts/install-deps.sh --test: xarray,
 /// h5netcdf) runs it with `file` as its argument; panics with its stderr if it fails.
 fn python_on(script: &str, file: &Path) -> String {
@@ -64,9 +94,10 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
     let out_s = out.to_str().unwrap();
     ok(slidestack(&["motions", cfg_s, "--out", out_s], "2"));
     let o = ok(slidestack(&["status", cfg_s, "--out", out_s], "2"));
-    // 2 zones × 3 motions × 6 frames × 3 periods.
+    // 2 zones × 3 motions × 4 buildings × 3 periods: on one storey the roof's and every floor's
+    // frames repeat floor 1's building, and have no units of their own.
     assert!(
-        String::from_utf8_lossy(&o.stdout).contains("0 of 108"),
+        String::from_utf8_lossy(&o.stdout).contains("0 of 72"),
         "{}",
         String::from_utf8_lossy(&o.stdout)
     );
@@ -121,6 +152,31 @@ fn the_quick_building_study_sweeps_resumes_and_is_labelled() {
         assert_ne!(frame(m, 4), frame(m, 5));
     }
     assert!(z.vars.u_stack.iter().all(|x| x.is_finite() && *x > 0.0));
+
+    // The repeated frames' stored results are what their own sweep computes: a study of the
+    // one-storey building with the stack on the roof alone, then on every floor alone, stores
+    // every variable the study stored for that frame (floor 1's units), bit for bit.
+    for (f, floor) in [(1, "roof"), (2, "all")] {
+        let text = std::fs::read_to_string(&cfg).unwrap();
+        let text = (text.replace("storeys: [1, 3]", "storeys: [1]")).replace(
+            "stack_floor: [1, roof, all]",
+            &format!("stack_floor: [{floor}]"),
+        );
+        let alone_cfg = dir.path().join(format!("one-{floor}.yaml"));
+        std::fs::write(&alone_cfg, text).unwrap();
+        let alone = dir.path().join(format!("one-{floor}"));
+        common::copy_motions(&out, &alone);
+        ok(slidestack(
+            &["sweep", s(&alone_cfg), "--out", s(&alone)],
+            "2",
+        ));
+        let (_, _, one) = read_zone_sweep(&alone.join("sweep.h5"), "V", 2, true).unwrap();
+        assert_eq!(
+            frame_bits(&one, 0),
+            frame_bits(&z, f),
+            "one storey, the stack on {floor}"
+        );
+    }
 
     // xarray labels every dimension (Python environment made by scripts/install-deps.sh).
     let script = "import sys, xarray as xr\n\

@@ -9,7 +9,8 @@
 //! reads it back and compares it with what was meant, and only then removes the units.
 //!
 //! In a building study a unit is one zone, one motion, one frame (`storeys`, `stack_floor`) and
-//! one `T_p`.
+//! one `T_p`; a frame that repeats an earlier frame's building (on one storey floor 1, the roof
+//! and every floor) has no units of its own, and `sweep.h5` stores its first frame's results.
 //!
 //! Fingerprint: the `zones` and `grid` sections (and `building`, when given), the solver, and
 //! the motions' fingerprint.
@@ -26,6 +27,7 @@ use crate::store::sweep::{
 };
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
 use crate::store::vars;
+use crate::study::building::first_of_building;
 use crate::study::config::StudyConfig;
 use crate::study::physics::{CaseError, SystemKind};
 use crate::study::sweep::{SKIP_RULE_CODES, SKIP_RULE_FLAGS, UnitOptions, UnitResult, run_unit};
@@ -89,7 +91,7 @@ pub fn fingerprint(cfg: &StudyConfig, motions_fingerprint: &str) -> String {
 }
 
 /// One work unit: zone, motion, frame (0 on one storey) and period indices.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 struct Unit {
     zone: usize,
     motion: usize,
@@ -97,12 +99,15 @@ struct Unit {
     period: usize,
 }
 
-/// Every unit in the fixed order shards count in (the order of the stored axes).
+/// Every unit in the fixed order shards count in (the order of the stored axes). A frame that
+/// repeats an earlier frame's building ([`first_of_building`]: on one storey floor 1, the roof
+/// and every floor) has no units: its results are its first frame's, to the bit.
 fn all_units(study: &Study, grid: &Grid, motions: &[Vec<Record>]) -> Vec<Unit> {
+    let first = first_of_building(study.frames());
     let mut v = Vec::new();
     for (zone, ms) in motions.iter().enumerate() {
         for motion in 0..ms.len() {
-            for frame in 0..study.frames().len() {
+            for frame in (0..first.len()).filter(|&f| first[f] == f) {
                 for period in 0..grid.periods_s.len() {
                     v.push(Unit {
                         zone,
@@ -379,13 +384,27 @@ pub fn merge(s: &Session) -> Result<StageOutcome, PipelineError> {
 fn assemble(s: &Session, units: &Units, all: &[Unit]) -> Result<StageOutcome, PipelineError> {
     let study = units.study;
     let read = units.read_all(all)?;
-    let count =
-        |z: usize| units.motions[z].len() * study.frames().len() * units.grid.periods_s.len();
+    let by_unit: std::collections::HashMap<Unit, &Columns> =
+        all.iter().copied().zip(&read).collect();
+    // Every frame's units in stored order, a repeated building's its first frame's.
+    let first = first_of_building(study.frames());
     let mut zones = Vec::new();
-    let mut at = 0;
     for z in 0..study.cfg.zones.len() {
-        zones.push(units.zone_of(z, &read[at..at + count(z)])?);
-        at += count(z);
+        let mut cols = Vec::new();
+        for motion in 0..units.motions[z].len() {
+            for &frame in &first {
+                for period in 0..units.grid.periods_s.len() {
+                    let u = Unit {
+                        zone: z,
+                        motion,
+                        frame,
+                        period,
+                    };
+                    cols.push(by_unit[&u]);
+                }
+            }
+        }
+        zones.push(units.zone_of(z, &cols)?);
     }
     let path = write_verified(study, units.grid, &zones)?;
     remove_units(study)?;
@@ -430,7 +449,7 @@ impl Units<'_> {
 
     /// Zone `z`'s variables from its units' columns `cols` (motion, frame, `T_p` in stored
     /// order; the columns' layout is `column_lengths`').
-    fn zone_of(&self, z: usize, cols: &[Columns]) -> Result<ZoneSweep, PipelineError> {
+    fn zone_of(&self, z: usize, cols: &[&Columns]) -> Result<ZoneSweep, PipelineError> {
         let (study, grid) = (self.study, self.grid);
         let dir = study.path(UNITS_DIR);
         let building = study.building();
@@ -590,7 +609,9 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError
     let grid = study.grid(StageId::Sweep)?;
     if study.state(StageId::Motions)? != super::StageState::UpToDate {
         let motions: usize = study.motions_per_zone().iter().sum();
-        return Ok((motions * study.frames().len() * grid.periods_s.len(), 0, 0));
+        let first = first_of_building(study.frames());
+        let computed = (first.iter().enumerate()).filter(|&(f, &g)| f == g).count();
+        return Ok((motions * computed * grid.periods_s.len(), 0, 0));
     }
     let motions = super::files::motions(study)?;
     let units = Units {
