@@ -27,7 +27,7 @@ use crate::store::sweep::{
 };
 use crate::store::units::{Columns, Stored, UnitId, read_unit, write_unit};
 use crate::store::vars;
-use crate::study::building::first_of_building;
+use crate::study::building::{distinct_frames, first_of_building};
 use crate::study::config::StudyConfig;
 use crate::study::physics::{CaseError, SystemKind};
 use crate::study::sweep::{SKIP_RULE_CODES, SKIP_RULE_FLAGS, UnitOptions, UnitResult, run_unit};
@@ -100,14 +100,14 @@ struct Unit {
 }
 
 /// Every unit in the fixed order shards count in (the order of the stored axes). A frame that
-/// repeats an earlier frame's building ([`first_of_building`]: on one storey floor 1, the roof
-/// and every floor) has no units: its results are its first frame's, to the bit.
+/// repeats an earlier frame's building (not in [`distinct_frames`]: on one storey the roof and
+/// every floor repeat floor 1) has no units: its results are its first frame's, to the bit.
 fn all_units(study: &Study, grid: &Grid, motions: &[Vec<Record>]) -> Vec<Unit> {
-    let first = first_of_building(study.frames());
+    let frames = distinct_frames(study.frames());
     let mut v = Vec::new();
     for (zone, ms) in motions.iter().enumerate() {
         for motion in 0..ms.len() {
-            for frame in (0..first.len()).filter(|&f| first[f] == f) {
+            for &frame in &frames {
                 for period in 0..grid.periods_s.len() {
                     v.push(Unit {
                         zone,
@@ -609,9 +609,8 @@ pub fn unit_status(study: &Study) -> Result<(usize, usize, usize), PipelineError
     let grid = study.grid(StageId::Sweep)?;
     if study.state(StageId::Motions)? != super::StageState::UpToDate {
         let motions: usize = study.motions_per_zone().iter().sum();
-        let first = first_of_building(study.frames());
-        let computed = (first.iter().enumerate()).filter(|&(f, &g)| f == g).count();
-        return Ok((motions * computed * grid.periods_s.len(), 0, 0));
+        let frames = distinct_frames(study.frames()).len();
+        return Ok((motions * frames * grid.periods_s.len(), 0, 0));
     }
     let motions = super::files::motions(study)?;
     let units = Units {

@@ -325,6 +325,15 @@ pub fn first_of_building(frames: &[Frame]) -> Vec<usize> {
         .collect()
 }
 
+/// The frames that are the first of their building ([`first_of_building`]), in order: those the
+/// sweep runs.
+pub fn distinct_frames(frames: &[Frame]) -> Vec<usize> {
+    (first_of_building(frames).into_iter().enumerate())
+        .filter(|&(f, first)| f == first)
+        .map(|(f, _)| f)
+        .collect()
+}
+
 /// Which of a study's frames repeat an earlier one's building ([`first_of_building`]): the fit
 /// and the report count such a frame's cases once.
 pub fn repeats(frames: &[Frame]) -> Vec<bool> {

@@ -12,7 +12,7 @@
 //! save less than the research grid's costs more than it says. The job scripts' time limit is
 //! twice the estimate plus 5 minutes.
 
-use super::building::first_of_building;
+use super::building::distinct_frames;
 use super::shape::StudyShape;
 
 /// A one-storey study: ns per simulated record sample per thread (a bound on the sweep's cost
@@ -52,18 +52,18 @@ pub fn building_ns_per_sample(storeys: usize) -> f64 {
 }
 
 /// A study's ns per work-bound sample: [`ONE_STOREY_NS_PER_SAMPLE`] on one storey, else the mean
-/// of [`building_ns_per_sample`] over the frames the sweep computes (the first of each building,
-/// [`first_of_building`]: each has as many units of as many cases).
+/// of [`building_ns_per_sample`] over the frames the sweep computes ([`distinct_frames`]: each
+/// has as many units of as many cases).
 pub fn ns_per_sample(shape: &StudyShape) -> f64 {
     if !shape.is_building() {
         return ONE_STOREY_NS_PER_SAMPLE;
     }
     let frames = shape.frames();
-    let computed: Vec<f64> = (first_of_building(frames).into_iter().enumerate())
-        .filter(|&(f, first)| f == first)
-        .map(|(f, _)| building_ns_per_sample(frames[f].storeys()))
-        .collect();
-    computed.iter().sum::<f64>() / computed.len() as f64
+    let computed = distinct_frames(frames);
+    let sum: f64 = (computed.iter())
+        .map(|&f| building_ns_per_sample(frames[f].storeys()))
+        .sum();
+    sum / computed.len() as f64
 }
 
 #[cfg(test)]

@@ -30,7 +30,7 @@ use crate::fit::{
 use crate::grid::Grid;
 use crate::store::fit::{FormFit, FrameFit, NotFitted, ZoneFit};
 use crate::store::tnew::ZoneTnew;
-use crate::study::building::{Frame, fit_features, repeats};
+use crate::study::building::{Frame, distinct_frames, fit_features, repeats};
 use crate::study::tnew::{building_samples, samples};
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -82,7 +82,7 @@ pub fn cases_needed(features: usize) -> usize {
 pub fn case_count(grid: &Grid, frames: &[Frame]) -> (usize, usize) {
     let n = grid.blocks();
     let features = fit_features(n, frames).map_or_else(|| feature_names(n), |b| b.names());
-    let distinct = repeats(frames).iter().filter(|r| !**r).count().max(1);
+    let distinct = distinct_frames(frames).len().max(1);
     (grid.cases() * distinct, cases_needed(features.len()))
 }
 
