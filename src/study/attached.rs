@@ -878,9 +878,10 @@ pub struct FractionUnit {
 /// ([`super::building::first_of_building`]) give units for the first only.
 pub fn fraction_units(grid: &crate::grid::Grid, frames: &[Frame]) -> Vec<FractionUnit> {
     let per_frame = grid.cases();
-    let first = super::building::first_of_building(frames);
     let mut units: BTreeMap<(usize, u64, u64), FractionUnit> = BTreeMap::new();
-    for c in (0..frames.len() * per_frame).filter(|&c| first[c / per_frame] == c / per_frame) {
+    let cases = (super::building::distinct_frames(frames).into_iter())
+        .flat_map(|f| f * per_frame..(f + 1) * per_frame);
+    for c in cases {
         let case = grid.case(c % per_frame);
         let (period_s, alpha_total) = (case.period_s, case.alpha_total());
         let key = (c / per_frame, period_s.to_bits(), alpha_total.to_bits());
