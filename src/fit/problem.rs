@@ -223,65 +223,6 @@ impl Problem {
         p
     }
 
-    /// The variable-projection cost of the paper form (Golub & Pereyra 1973): its `k`
-    /// exponent weights `c` given, the linear parameters `(a, B, e)` that minimise the sum of
-    /// squares are a linear least-squares problem; this is the sum of squares they leave
-    /// (`+∞` when not finite). The linear solve is by the normal equations and Cholesky, a
-    /// `(k + 2)²` system: its error in `(a, B, e)` is of the order of the squared condition
-    /// number times round-off (about 1e-7 relative at the paper grid's 3e4), which moves a sum
-    /// of squares at its minimum by the square of that, 1e-14; [`Problem::complete_start`]
-    /// gives the SVD's solution for the result.
-    pub fn projected_sse(&self, c: &[f64]) -> f64 {
-        debug_assert_eq!(self.form, Form::Paper);
-        let (k, n, q) = (self.k, self.n(), self.k + 2);
-        let ex: Vec<f64> = (0..n)
-            .map(|i| {
-                self.row(i)
-                    .iter()
-                    .zip(c)
-                    .map(|(x, w)| x * w)
-                    .sum::<f64>()
-                    .exp()
-            })
-            .collect();
-        let column = |i: usize, j: usize| -> f64 {
-            let v = if j < k {
-                self.row(i)[j]
-            } else if j == k {
-                ex[i]
-            } else {
-                1.0
-            };
-            v * self.w[i]
-        };
-        let (mut gram, mut rhs) = (vec![0.0; q * q], vec![0.0; q]);
-        let mut v = vec![0.0; q];
-        for i in 0..n {
-            for (j, vj) in v.iter_mut().enumerate() {
-                *vj = column(i, j);
-            }
-            let wy = self.w[i] * self.y[i];
-            for a in 0..q {
-                rhs[a] += v[a] * wy;
-                for b in 0..=a {
-                    gram[a * q + b] += v[a] * v[b];
-                }
-            }
-        }
-        let largest = (0..q).map(|j| gram[j * q + j]).fold(0.0, f64::max);
-        if !largest.is_finite() {
-            return f64::INFINITY;
-        }
-        crate::numeric::linalg::cholesky_solve(&mut gram, &mut rhs, q, 1e-14 * largest);
-        let s: f64 = (0..n)
-            .map(|i| {
-                let fit: f64 = (0..q).map(|j| rhs[j] * column(i, j)).sum();
-                (fit - self.w[i] * self.y[i]).powi(2)
-            })
-            .sum();
-        if s.is_finite() { s } else { f64::INFINITY }
-    }
-
     /// Root mean square of each Jacobian column at `p` (1 where a column is zero or not
     /// finite): the scales `d` of [`Scaled`].
     pub fn column_scales(&self, p: &[f64]) -> Vec<f64> {
@@ -412,16 +353,97 @@ impl Hessian for Scaled<'_> {
     }
 }
 
-/// The paper form's variable-projection problem for argmin ([`Problem::projected_sse`]): cost
+/// The paper form's variable-projection problem for argmin ([`Projected::sse`]): cost
 /// `½·SSE` over the exponent weights alone, scaled as in [`Scaled`] (`q_j = d_j·c_j`).
+///
+/// Of the linear problem's `k + 2` weighted columns `(w·z_1 … w·z_k, w·e^{c·z}, w)` only the
+/// exponential one depends on `c`: the others, and their entries of the normal equations, are
+/// computed once here, each summed over the cases in their order as at every point.
 pub(crate) struct Projected<'a> {
     pub problem: &'a Problem,
     pub d: Vec<f64>,
+    /// The weighted columns per case, `n × (k + 2)` row-major, the exponential one (`k`) zero.
+    columns: Vec<f64>,
+    /// `w_i·y_i`.
+    wy: Vec<f64>,
+    /// The normal equations' lower triangle (`(k + 2)²`, row-major) and right-hand side without
+    /// the exponential column's entries.
+    gram: Vec<f64>,
+    rhs: Vec<f64>,
 }
 
-impl Projected<'_> {
+impl<'a> Projected<'a> {
+    /// The projected problem of the paper form's `problem`, its exponent weights scaled by `d`.
+    pub fn new(problem: &'a Problem, d: Vec<f64>) -> Self {
+        debug_assert_eq!(problem.form, Form::Paper);
+        let (k, n, q) = (problem.k, problem.n(), problem.k + 2);
+        let mut columns = vec![0.0; n * q];
+        for (i, v) in columns.chunks_exact_mut(q).enumerate() {
+            let w = problem.w[i];
+            for (vj, z) in v.iter_mut().zip(&problem.row(i)[..k]) {
+                *vj = z * w;
+            }
+            v[k + 1] = w;
+        }
+        let wy: Vec<f64> = (0..n).map(|i| problem.w[i] * problem.y[i]).collect();
+        let (mut gram, mut rhs) = (vec![0.0; q * q], vec![0.0; q]);
+        for (v, wy) in columns.chunks_exact(q).zip(&wy) {
+            for a in (0..q).filter(|&a| a != k) {
+                rhs[a] += v[a] * wy;
+                for b in (0..=a).filter(|&b| b != k) {
+                    gram[a * q + b] += v[a] * v[b];
+                }
+            }
+        }
+        Self {
+            problem,
+            d,
+            columns,
+            wy,
+            gram,
+            rhs,
+        }
+    }
+
     pub fn to_c(&self, q: &[f64]) -> Vec<f64> {
         q.iter().zip(&self.d).map(|(q, d)| q / d).collect()
+    }
+
+    /// The variable-projection cost of the paper form (Golub & Pereyra 1973): its `k`
+    /// exponent weights `c` given, the linear parameters `(a, B, e)` that minimise the sum of
+    /// squares are a linear least-squares problem; this is the sum of squares they leave
+    /// (`+∞` when not finite). The linear solve is by the normal equations and Cholesky, a
+    /// `(k + 2)²` system: its error in `(a, B, e)` is of the order of the squared condition
+    /// number times round-off (about 1e-7 relative at the paper grid's 3e4), which moves a sum
+    /// of squares at its minimum by the square of that, 1e-14; [`Problem::complete_start`]
+    /// gives the SVD's solution for the result.
+    pub fn sse(&self, c: &[f64]) -> f64 {
+        let (p, k) = (self.problem, self.problem.k);
+        let q = k + 2;
+        let ex: Vec<f64> = (0..p.n())
+            .map(|i| (p.row(i).iter().zip(c).map(|(x, w)| x * w).sum::<f64>()).exp() * p.w[i])
+            .collect();
+        let (mut gram, mut rhs) = (self.gram.clone(), self.rhs.clone());
+        for ((v, wy), &e) in self.columns.chunks_exact(q).zip(&self.wy).zip(&ex) {
+            rhs[k] += e * wy;
+            for b in 0..k {
+                gram[k * q + b] += e * v[b];
+            }
+            gram[k * q + k] += e * e;
+            gram[(k + 1) * q + k] += v[k + 1] * e;
+        }
+        let largest = (0..q).map(|j| gram[j * q + j]).fold(0.0, f64::max);
+        if !largest.is_finite() {
+            return f64::INFINITY;
+        }
+        crate::numeric::linalg::cholesky_solve(&mut gram, &mut rhs, q, 1e-14 * largest);
+        let s: f64 = (self.columns.chunks_exact(q).zip(&self.wy).zip(&ex))
+            .map(|((v, wy), &e)| {
+                let fit: f64 = (0..q).map(|j| rhs[j] * if j == k { e } else { v[j] }).sum();
+                (fit - wy).powi(2)
+            })
+            .sum();
+        if s.is_finite() { s } else { f64::INFINITY }
     }
 }
 
@@ -430,7 +452,7 @@ impl CostFunction for Projected<'_> {
     type Output = f64;
 
     fn cost(&self, q: &Vec<f64>) -> Result<f64, ArgminError> {
-        Ok(0.5 * self.problem.projected_sse(&self.to_c(q)))
+        Ok(0.5 * self.sse(&self.to_c(q)))
     }
 }
 
@@ -517,7 +539,8 @@ mod tests {
         let mut start = vec![0.0; problem.m];
         start[3..6].copy_from_slice(&c);
         let p = problem.complete_start(&start);
-        let (projected, sse) = (problem.projected_sse(&c), problem.sse(&p));
+        let projected = Projected::new(&problem, vec![1.0; 3]).sse(&c);
+        let sse = problem.sse(&p);
         assert!(
             (projected - sse).abs() <= 1e-10 * sse,
             "{projected} vs {sse}"

@@ -230,7 +230,7 @@ fn nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), F
 fn projected_nelder_mead(problem: &Problem, p0: &[f64]) -> Result<(Vec<f64>, u64, bool), FitError> {
     let k = problem.k;
     let d = problem.column_scales(p0)[k..2 * k].to_vec();
-    let projected = Projected { problem, d };
+    let projected = Projected::new(problem, d);
     let q0: Vec<f64> = p0[k..2 * k]
         .iter()
         .zip(&projected.d)
