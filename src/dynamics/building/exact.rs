@@ -34,7 +34,7 @@ use super::super::{Ground, SimError, Unwatched, Watch, watched};
 use super::modal::{
     ModalError, ModalFn, ModalPoint, Piece, RowsByMode, StateModes, cubic, cubic_slope, mode_terms,
 };
-use super::model::{Building, StoreySpring};
+use super::model::{Building, Stack, StoreySpring};
 use super::response::BuildingResponse;
 use crate::numeric::{Cx, GAUSS8};
 use std::cell::RefCell;
@@ -396,6 +396,16 @@ enum Holder {
     Free(usize),
 }
 
+/// The blocks riding on a floor (`Holder::Floor`) whose stacks are `on_floor`, `stuck[s]` the
+/// stuck blocks of stack `s`: each stack's stuck part, in block order.
+fn riders<'a>(
+    stacks: &'a [Stack],
+    on_floor: &'a [usize],
+    stuck: &'a [usize],
+) -> impl Iterator<Item = usize> + 'a {
+    (on_floor.iter()).flat_map(|&s| stacks[s].first..stacks[s].first + stuck[s])
+}
+
 /// A floor's part of the contact problem: its stacks' interfaces (global, in order) and for each
 /// the local index of the body below (0 the floor).
 struct FloorContacts {
@@ -432,6 +442,8 @@ struct Integrator<'b> {
     mode: Option<Rc<Mode>>,
     /// Blocks stuck to their floor, per stack.
     stuck: Vec<usize>,
+    /// The stacks standing on each floor, in their order.
+    stacks_on: Vec<Vec<usize>>,
     /// Per floor: mass with its stuck blocks (kg) and the constant part of its absolute
     /// acceleration, `−(d_j + f_top,j)/M_j` (m/s²).
     floor_mass: Vec<f64>,
@@ -585,6 +597,13 @@ impl<'b> Integrator<'b> {
             key: Vec::new(),
             mode: None,
             stuck: vec![0; b.stacks().len()],
+            stacks_on: (0..n)
+                .map(|f| {
+                    (0..b.stacks().len())
+                        .filter(|&si| b.stacks()[si].floor == f)
+                        .collect()
+                })
+                .collect(),
             floor_mass: vec![0.0; n],
             accel_const: vec![0.0; n],
             f_top: vec![0.0; n],
@@ -1369,10 +1388,8 @@ impl<'b> Integrator<'b> {
                     let (floor_peaks, block_peaks) =
                         self.out.riders(matches!(of, PeakOf::Velocity(_)));
                     let mut floor = floor_peaks[f];
-                    for q in 0..nb {
-                        if self.holder[q] == Holder::Floor(f) {
-                            floor = floor.min(block_peaks[q]);
-                        }
+                    for q in riders(self.b.stacks(), &self.stacks_on[f], &self.stuck) {
+                        floor = floor.min(block_peaks[q]);
                     }
                     floor
                 }
@@ -1391,14 +1408,12 @@ impl<'b> Integrator<'b> {
                     PeakOf::Shear(j) => self.out.storey_peak_shear_n[j] = peak,
                     PeakOf::Overturning => self.out.peak_overturning_n_m = peak,
                     PeakOf::Accel(f) | PeakOf::Velocity(f) => {
-                        let holder = &self.holder;
+                        let riders = riders(self.b.stacks(), &self.stacks_on[f], &self.stuck);
                         let (floor_peaks, block_peaks) =
                             self.out.riders_mut(matches!(of, PeakOf::Velocity(_)));
                         floor_peaks[f] = floor_peaks[f].max(peak);
-                        for q in 0..nb {
-                            if holder[q] == Holder::Floor(f) {
-                                block_peaks[q] = block_peaks[q].max(peak);
-                            }
+                        for q in riders {
+                            block_peaks[q] = block_peaks[q].max(peak);
                         }
                     }
                 }
