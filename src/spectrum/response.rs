@@ -210,37 +210,76 @@ pub fn peaks_of_records(
         validate_record(accel_mps2, dt_s)?;
         validate_oscillator(period_s, damping)?;
     }
-    let reaches: Vec<Reach> = (records.iter())
-        .map(|&(accel_mps2, dt_s)| Reach::new(accel_mps2, dt_s))
-        .collect();
-    let mut groups: Vec<((u64, usize), Vec<usize>)> = Vec::new();
-    for (i, &(accel_mps2, dt_s)) in records.iter().enumerate() {
-        let key = (dt_s.to_bits(), accel_mps2.len());
-        match groups.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, members)) => members.push(i),
-            None => groups.push((key, vec![i])),
+    Ok(RecordSet::checked(records).peaks_in_lanes(period_s, damping))
+}
+
+/// Records whose peaks are taken at many periods one period at a time ([`Self::peaks`]): each
+/// checked, and what its every spectrum needs of it computed, once.
+pub struct RecordSet<'a> {
+    records: Vec<(&'a [f64], f64)>,
+    reaches: Vec<Reach>,
+    /// The records of each step and length, in their order.
+    groups: Vec<Vec<usize>>,
+}
+
+impl<'a> RecordSet<'a> {
+    /// `records` (`(accel_mps2, dt_s)`), each checked in their order.
+    pub fn new(records: &[(&'a [f64], f64)]) -> Result<Self, SpectrumError> {
+        for &(accel_mps2, dt_s) in records {
+            validate_record(accel_mps2, dt_s)?;
         }
+        Ok(Self::checked(records))
     }
-    let mut peaks: Vec<Option<Peak>> = vec![None; records.len()];
-    for (_, members) in &groups {
-        for batch in members.chunks(LANES) {
-            // Fewer records than lanes: the first fills the rest, its copies' peaks dropped.
-            let pick = |l: usize| *batch.get(l).unwrap_or(&batch[0]);
-            let lanes = PerLane {
-                accel: std::array::from_fn(|l| records[pick(l)].0),
-                reach: std::array::from_fn(|l| &reaches[pick(l)]),
-            };
-            let dt_s = records[batch[0]].1;
-            let got = peaks_in_lanes(&lanes, dt_s, &[period_s; LANES], damping);
-            for (&i, p) in batch.iter().zip(got) {
-                peaks[i] = Some(p);
+
+    /// `records`, already checked.
+    fn checked(records: &[(&'a [f64], f64)]) -> Self {
+        let reaches = (records.iter())
+            .map(|&(accel_mps2, dt_s)| Reach::new(accel_mps2, dt_s))
+            .collect();
+        let mut groups: Vec<((u64, usize), Vec<usize>)> = Vec::new();
+        for (i, &(accel_mps2, dt_s)) in records.iter().enumerate() {
+            let key = (dt_s.to_bits(), accel_mps2.len());
+            match groups.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, members)) => members.push(i),
+                None => groups.push((key, vec![i])),
             }
         }
+        Self {
+            records: records.to_vec(),
+            reaches,
+            groups: groups.into_iter().map(|(_, members)| members).collect(),
+        }
     }
-    Ok(peaks
-        .into_iter()
-        .map(|p| p.expect("every record is in a batch"))
-        .collect())
+
+    /// [`peaks_of_records`] of these records, to the bit.
+    pub fn peaks(&self, period_s: f64, damping: f64) -> Result<Vec<Peak>, SpectrumError> {
+        validate_oscillator(period_s, damping)?;
+        Ok(self.peaks_in_lanes(period_s, damping))
+    }
+
+    fn peaks_in_lanes(&self, period_s: f64, damping: f64) -> Vec<Peak> {
+        let records = &self.records;
+        let mut peaks: Vec<Option<Peak>> = vec![None; records.len()];
+        for members in &self.groups {
+            for batch in members.chunks(LANES) {
+                // Fewer records than lanes: the first fills the rest, its copies' peaks dropped.
+                let pick = |l: usize| *batch.get(l).unwrap_or(&batch[0]);
+                let lanes = PerLane {
+                    accel: std::array::from_fn(|l| records[pick(l)].0),
+                    reach: std::array::from_fn(|l| &self.reaches[pick(l)]),
+                };
+                let dt_s = records[batch[0]].1;
+                let got = peaks_in_lanes(&lanes, dt_s, &[period_s; LANES], damping);
+                for (&i, p) in batch.iter().zip(got) {
+                    peaks[i] = Some(p);
+                }
+            }
+        }
+        peaks
+            .into_iter()
+            .map(|p| p.expect("every record is in a batch"))
+            .collect()
+    }
 }
 
 /// Peak response of one oscillator.
@@ -874,16 +913,28 @@ mod tests {
             .map(|(i, (dt, len))| (record(i as u64, len), dt))
             .collect();
         let records: Vec<(&[f64], f64)> = owned.iter().map(|(a, dt)| (&a[..], *dt)).collect();
+        // One `RecordSet` serves every period with the same bits.
+        let set = RecordSet::new(&records).unwrap();
         for period in [0.03, 0.3, 1.0, 6.0] {
             for zeta in [0.0, 0.05] {
                 let got = peaks_of_records(&records, period, zeta).unwrap();
+                let from_set = set.peaks(period, zeta).unwrap();
+                let bits = |p: &Peak| [p.sd_m, p.u_m, p.time_s].map(f64::to_bits);
                 for (i, (&(a, dt), p)) in records.iter().zip(&got).enumerate() {
                     let own = response_spectrum(a, dt, &[period], zeta).unwrap().peaks[0];
-                    let bits = |p: &Peak| [p.sd_m, p.u_m, p.time_s].map(f64::to_bits);
                     assert_eq!(bits(p), bits(&own), "record {i}, T = {period}, ζ = {zeta}");
+                    assert_eq!(
+                        bits(&from_set[i]),
+                        bits(&own),
+                        "set: record {i}, T = {period}"
+                    );
                 }
             }
         }
+        assert_eq!(
+            set.peaks(0.0, 0.05).unwrap_err().to_string(),
+            "period 0.0 s must be within 0.001 … 10000 s"
+        );
         let mut bad = owned.clone();
         bad[9].0[3] = f64::NAN;
         let records: Vec<(&[f64], f64)> = bad.iter().map(|(a, dt)| (&a[..], *dt)).collect();
@@ -898,6 +949,10 @@ mod tests {
                 .unwrap_err()
                 .to_string(),
             "period 0.0 s must be within 0.001 … 10000 s"
+        );
+        assert_eq!(
+            RecordSet::new(&records).err().unwrap().to_string(),
+            "ground acceleration sample 3 is not finite (NaN)"
         );
     }
 }

@@ -42,7 +42,7 @@ use crate::dynamics::building::{
     Building, BuildingResponse, LinearBuilding, LinearOutput, simulate_building,
 };
 use crate::dynamics::{ExactOptions, G, Ground};
-use crate::spectrum::response::peaks_of_records;
+use crate::spectrum::response::RecordSet;
 use crate::spectrum::{SpectrumError, TARGET_DAMPING};
 use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::brent::BrentRoot;
@@ -578,28 +578,27 @@ pub fn load_ratio(case: &Case, frame: &Frame) -> f64 {
     case.alpha_total() * loaded / frame.floor_masses.iter().sum::<f64>()
 }
 
-/// The mean over the motions of their 5 %-damped pseudo-spectral acceleration at `period_s`
-/// exactly (each summed in motion order, then divided), g; the motions in the spectrum's lanes
-/// ([`peaks_of_records`]).
-pub fn mean_psa_g(grounds: &[Ground], period_s: f64) -> Result<f64, SpectrumError> {
-    let records: Vec<(&[f64], f64)> = grounds.iter().map(|g| (g.accel_mps2, g.dt_s)).collect();
-    let peaks = peaks_of_records(&records, period_s, TARGET_DAMPING)?;
+/// The mean over the motions `records` of their 5 %-damped pseudo-spectral acceleration at
+/// `period_s` exactly (each summed in motion order, then divided), g; the motions in the
+/// spectrum's lanes ([`RecordSet::peaks`]).
+pub fn mean_psa_g(records: &RecordSet, period_s: f64) -> Result<f64, SpectrumError> {
+    let peaks = records.peaks(period_s, TARGET_DAMPING)?;
     let sum = (peaks.iter()).fold(0.0, |sum, p| sum + p.psa_g(period_s));
-    Ok(sum / grounds.len() as f64)
+    Ok(sum / peaks.len() as f64)
 }
 
 /// The code-format base shear of `B(f)` over the rigid system's, as a design code would estimate
-/// it from the zone's mean spectrum: `(W + f·W_L)·S̄a(T_1(f)) / ((W + W_L)·S̄a(T_1,rigid))`;
-/// exactly 1 at `f = 1`.
+/// it from the mean spectrum of the zone's motions `records`:
+/// `(W + f·W_L)·S̄a(T_1(f)) / ((W + W_L)·S̄a(T_1,rigid))`; exactly 1 at `f = 1`.
 pub fn code_shear_ratio(
     case: &Case,
     frame: &Frame,
-    grounds: &[Ground],
+    records: &RecordSet,
     fraction: f64,
     psa_rigid_g: f64,
 ) -> Result<f64, SpectrumError> {
     let r = load_ratio(case, frame);
-    let psa = mean_psa_g(grounds, frame.t1_attached_s(case, fraction))?;
+    let psa = mean_psa_g(records, frame.t1_attached_s(case, fraction))?;
     Ok((1.0 + fraction * r) * psa / ((1.0 + r) * psa_rigid_g))
 }
 
@@ -911,11 +910,12 @@ pub struct ZoneFamily<'a> {
     pub keep_going: &'a (dyn Fn() -> bool + Sync),
 }
 
-/// A unit's scan: the family's means at the scan's fractions, the code-format ratio at each and
-/// the rigid system's mean spectral acceleration at `T_1`, g.
-type Scan = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64);
+/// A unit's scan: the family's means at the scan's fractions, the code-format ratio at each, the
+/// rigid system's mean spectral acceleration at `T_1` (g), and the motions prepared for the
+/// code-format ratio's other spectra.
+type Scan<'a> = (Vec<(f64, Means)>, Vec<(f64, f64)>, f64, RecordSet<'a>);
 
-impl ZoneFamily<'_> {
+impl<'a> ZoneFamily<'a> {
     /// The attached fractions of every case of `unit`, in its order: the scan once, each case's
     /// sliding stack (the sweep's, or on one storey simulated here, `one_storey_setups`), the
     /// family's means at each distinct prior not scanned, then each function's searches over the
@@ -1072,7 +1072,7 @@ impl ZoneFamily<'_> {
         &self,
         unit: &FractionUnit,
         function: Function,
-        (scan, code_scan, psa_rigid): &Scan,
+        (scan, code_scan, psa_rigid, spectra): &Scan,
         // The family's means at the cases' priors the scan does not hold.
         at_priors: &[(f64, Means)],
         setups: &[Setup],
@@ -1091,7 +1091,7 @@ impl ZoneFamily<'_> {
             }
             Function::Code => {
                 let values = Values::new(code_scan.iter().copied(), move |f| {
-                    code_shear_ratio(&case, frame, grounds, f, psa_rigid).map_err(|source| {
+                    code_shear_ratio(&case, frame, spectra, f, psa_rigid).map_err(|source| {
                         AttachedError::Spectrum {
                             period_s: frame.t1_attached_s(&case, f),
                             source,
@@ -1122,7 +1122,7 @@ impl ZoneFamily<'_> {
 
     /// The scan of the key of case `c`, whose rigid system has the means `rigid` (the sweep's,
     /// or on one storey simulated here).
-    fn scan(&self, c: usize, rigid: Means) -> Result<Scan, AttachedError> {
+    fn scan(&self, c: usize, rigid: Means) -> Result<Scan<'a>, AttachedError> {
         let (physics, grounds) = (self.physics, self.grounds);
         if !(self.keep_going)() {
             return Err(AttachedError::Stopped);
@@ -1138,13 +1138,17 @@ impl ZoneFamily<'_> {
             scan.push((f, m));
         }
         let t_rigid = frame.t1_attached_s(&case, 1.0);
-        let psa_rigid = mean_psa_g(grounds, t_rigid).map_err(|source| AttachedError::Spectrum {
+        let spectrum = |source| AttachedError::Spectrum {
             period_s: t_rigid,
             source,
-        })?;
+        };
+        let records: Vec<(&'a [f64], f64)> =
+            (grounds.iter()).map(|g| (g.accel_mps2, g.dt_s)).collect();
+        let spectra = RecordSet::new(&records).map_err(spectrum)?;
+        let psa_rigid = mean_psa_g(&spectra, t_rigid).map_err(spectrum)?;
         let code = (scan.iter().map(|(f, _)| *f))
             .map(|f| {
-                code_shear_ratio(&case, frame, grounds, f, psa_rigid)
+                code_shear_ratio(&case, frame, &spectra, f, psa_rigid)
                     .map(|g| (f, g))
                     .map_err(|source| AttachedError::Spectrum {
                         period_s: frame.t1_attached_s(&case, f),
@@ -1152,7 +1156,7 @@ impl ZoneFamily<'_> {
                     })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok((scan, code, psa_rigid))
+        Ok((scan, code, psa_rigid, spectra))
     }
 }
 
