@@ -100,9 +100,11 @@ pub struct LinearBuilding {
     n: usize,
     modes: StateModes,
     heights_m: Vec<f64>,
-    /// Every output: floor displacements, floor absolute accelerations, storey drifts, storey
-    /// shears, the overturning moment (`4N + 1`).
-    all: Outputs,
+    /// Every output's coefficient `c_r` of every kept mode (`(4N + 1) × modes`): floor
+    /// displacements, floor absolute accelerations, storey drifts, storey shears, the
+    /// overturning moment. Tabled for the samples' products by [`Self::run`] and
+    /// [`Self::select`] (a search of `λ` takes one of them).
+    rows: Vec<Cx>,
 }
 
 /// One peak response of a linear building ([`LinearBuilding::select`]).
@@ -447,12 +449,11 @@ impl LinearBuilding {
         for r in 0..m {
             rows[Self::moment(n) * m + r] = combine(&mu, &mv, r);
         }
-        let all = Outputs::new(&modes, rows);
         Ok(Self {
             n,
             modes,
             heights_m: storey_heights_m.to_vec(),
-            all,
+            rows,
         })
     }
 
@@ -476,7 +477,7 @@ impl LinearBuilding {
                     | LinearOutput::StoreyShear(j) => j,
                 };
                 assert!(within < n, "{o:?} of a building of {n} storeys");
-                self.all.rows[at * m..(at + 1) * m].iter().copied()
+                self.rows[at * m..(at + 1) * m].iter().copied()
             })
             .collect();
         Selection(Outputs::new(&self.modes, rows))
@@ -985,7 +986,7 @@ impl LinearBuilding {
     /// The peaks of every output over `ground` (from rest at its first sample, over its
     /// duration), exact for a ground acceleration linear between samples.
     pub fn run(&self, ground: &Ground) -> Result<LinearPeaks, LinearBuildingError> {
-        let best = self.peaks(&self.all, ground)?;
+        let best = self.peaks(&Outputs::new(&self.modes, self.rows.clone()), ground)?;
         let n = self.n;
         let take = |at: fn(usize, usize) -> usize| (0..n).map(|j| best[at(n, j)]).collect();
         Ok(LinearPeaks {
