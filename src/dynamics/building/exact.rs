@@ -1287,11 +1287,11 @@ impl<'b> Integrator<'b> {
     /// within which its static limit carries the blocks above it, in the current mode.
     fn break_bounds(&self, f: usize, mut each: impl FnMut(usize, usize, f64, f64)) {
         let (n, b) = (self.n, self.b);
-        for (si, s) in b.stacks().iter().enumerate() {
-            if s.floor != f || self.stuck[si] == 0 {
+        for &si in &self.stacks_on[f] {
+            let (s, e) = (&b.stacks()[si], self.stuck[si]);
+            if e == 0 {
                 continue;
             }
-            let e = self.stuck[si];
             let f_top = if e < s.blocks {
                 self.force[s.first + e]
             } else {
