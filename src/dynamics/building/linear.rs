@@ -17,7 +17,7 @@
 //! the absolute acceleration, per storey the drift and the storey shear, the overturning moment at
 //! the base), so one pass over the samples costs `O(modes × outputs)` multiply-adds per sample,
 //! with no allocation, division or square root: a matrix–vector product over outputs grouped by
-//! eight (compiled for AVX2 where the processor has it, the same bits either way).
+//! eight (compiled for AVX-512 and AVX2 where the processor has them, the same bits either way).
 //!
 //! Peaks are exact between samples. The first pass takes every output's largest sampled `|f|`
 //! and keeps, per block of `BLOCK` (32) intervals, the modal state at its start, each output's
@@ -260,15 +260,32 @@ impl Carry {
     }
 }
 
-/// Whether the processor runs the first pass's AVX2 copies.
-fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
+/// The copies of the first pass, each compiled for an instruction set: the same operations in
+/// the same order (no multiply–add contracted), so the same bits. AVX-512 (with VL) runs the
+/// AVX2 copy's 256-bit operations with 32 vector registers instead of 16, so that more of the
+/// modes' coefficients stay in registers (`tnew` of `configs/mdof.yaml`, two pairs: 40.4 → 38.8 s
+/// and 40.4 → 39.1 s; docs/performance.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Simd {
+    Baseline,
+    Avx2,
+    Avx512,
+}
+
+impl Simd {
+    /// The most this processor runs.
+    fn available() -> Simd {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::is_x86_feature_detected as has;
+            if has!("avx2") && has!("avx512f") && has!("avx512vl") {
+                return Simd::Avx512;
+            }
+            if has!("avx2") {
+                return Simd::Avx2;
+            }
+        }
+        Simd::Baseline
     }
 }
 
@@ -583,28 +600,28 @@ impl LinearBuilding {
     /// shorter record's lane runs on over zeros, its pass and state kept as they stood at its
     /// own last whole block), then each record's partial last block alone (one record: alone
     /// throughout). Every lane does the scalar pass's operations in its order, so each record's
-    /// pass has the same bits as its own. Compiled twice: for AVX2 (chosen at run time where the
-    /// processor has it) and for the baseline; neither contracts a multiply and an add, so both
-    /// give the same bits.
+    /// pass has the same bits as its own. Compiled for AVX-512, AVX2 (each chosen at run time
+    /// where the processor has it) and the baseline ([`Simd`]); none contracts a multiply and
+    /// an add, so all give the same bits.
     fn first_passes(
         out: &Outputs,
         steps: &[ModeStep],
         accels: &[&[f64]],
         inv_h: f64,
     ) -> Vec<FirstPass> {
-        Self::first_passes_in(true, out, steps, accels, inv_h)
+        Self::first_passes_in(Simd::Avx512, out, steps, accels, inv_h)
     }
 
-    /// [`Self::first_passes`] by its AVX2 copies where `avx2` and the processor has AVX2, else
-    /// by the baseline's.
+    /// [`Self::first_passes`] by the copies of `simd`, or of the most below it that the
+    /// processor runs.
     fn first_passes_in(
-        avx2: bool,
+        simd: Simd,
         out: &Outputs,
         steps: &[ModeStep],
         accels: &[&[f64]],
         inv_h: f64,
     ) -> Vec<FirstPass> {
-        let avx2 = avx2 && has_avx2();
+        let simd = simd.min(Simd::available());
         let m = steps.len();
         let mut passes: Vec<FirstPass> = (accels.iter())
             .map(|a| FirstPass::new(out, m, a.len() - 1))
@@ -634,31 +651,19 @@ impl LinearBuilding {
                 passes.push(FirstPass::new(out, m, accels[0].len() - 1));
                 carries.push(Carry::new(out, m));
             }
-            #[cfg(target_arch = "x86_64")]
-            if avx2 {
-                // SAFETY: `avx2` only where the processor has AVX2.
-                unsafe {
-                    Self::lane_blocks_avx2(
-                        out,
-                        steps,
-                        &lanes,
-                        inv_h,
-                        &mut passes,
-                        &mut carries,
-                        ends,
-                    )
-                };
-            }
-            if !avx2 {
-                Self::lane_blocks::<false>(
-                    out,
-                    steps,
-                    &lanes,
-                    inv_h,
-                    &mut passes,
-                    &mut carries,
-                    ends,
-                );
+            let (p, c) = (&mut passes, &mut carries);
+            match simd {
+                // SAFETY: `simd` only as far as the processor runs it (`Simd::available`).
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx512 => unsafe {
+                    Self::lane_blocks_avx512(out, steps, &lanes, inv_h, p, c, ends)
+                },
+                // SAFETY: as above.
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 => unsafe {
+                    Self::lane_blocks_avx2(out, steps, &lanes, inv_h, p, c, ends)
+                },
+                _ => Self::lane_blocks::<false>(out, steps, &lanes, inv_h, p, c, ends),
             }
             from = whole;
         }
@@ -666,13 +671,19 @@ impl LinearBuilding {
         for (((pass, carry), accel), from) in
             passes.iter_mut().zip(&mut carries).zip(accels).zip(from)
         {
-            #[cfg(target_arch = "x86_64")]
-            if avx2 {
-                // SAFETY: `avx2` only where the processor has AVX2.
-                unsafe { Self::blocks_avx2(out, steps, accel, inv_h, pass, carry, from) };
-                continue;
+            match simd {
+                // SAFETY: `simd` only as far as the processor runs it (`Simd::available`).
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx512 => unsafe {
+                    Self::blocks_avx512(out, steps, accel, inv_h, pass, carry, from)
+                },
+                // SAFETY: as above.
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 => unsafe {
+                    Self::blocks_avx2(out, steps, accel, inv_h, pass, carry, from)
+                },
+                _ => Self::blocks(out, steps, accel, inv_h, pass, carry, from),
             }
-            Self::blocks(out, steps, accel, inv_h, pass, carry, from);
         }
         passes
     }
@@ -680,6 +691,20 @@ impl LinearBuilding {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn blocks_avx2(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accel: &[f64],
+        inv_h: f64,
+        pass: &mut FirstPass,
+        carry: &mut Carry,
+        from: usize,
+    ) {
+        Self::blocks(out, steps, accel, inv_h, pass, carry, from)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    unsafe fn blocks_avx512(
         out: &Outputs,
         steps: &[ModeStep],
         accel: &[f64],
@@ -751,11 +776,26 @@ impl LinearBuilding {
         Self::lane_blocks::<true>(out, steps, accels, inv_h, passes, carries, ends)
     }
 
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    unsafe fn lane_blocks_avx512(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]; MOTIONS],
+        inv_h: f64,
+        passes: &mut [FirstPass],
+        carries: &mut [Carry],
+        ends: [usize; MOTIONS],
+    ) {
+        Self::lane_blocks::<true>(out, steps, accels, inv_h, passes, carries, ends)
+    }
+
     /// [`Self::blocks`] over [`MOTIONS`] records at once, one per lane (each lane the scalar
     /// operations in their order), lane `l` kept for its first `ends[l]` blocks: its pass
     /// written over them and its state after them left in its `carries`. The lanes run the
     /// most blocks of any (`accels[l]` holds at least `BLOCK·max(ends) + 1` samples). `AVX2`:
-    /// called from [`Self::lane_blocks_avx2`] alone, its steps by [`lane_step_avx2`].
+    /// called from [`Self::lane_blocks_avx2`] and [`Self::lane_blocks_avx512`] alone, its steps
+    /// by [`lane_step_avx2`] (inlined there, so compiled for each).
     #[inline(always)]
     fn lane_blocks<const AVX2: bool>(
         out: &Outputs,
@@ -925,8 +965,8 @@ impl LinearBuilding {
     ) {
         #[cfg(target_arch = "x86_64")]
         if AVX2 {
-            // SAFETY: `AVX2` is true only in `lane_blocks_avx2`'s calls, made where the
-            // processor has AVX2.
+            // SAFETY: `AVX2` is true only in `lane_blocks_avx2`'s and `lane_blocks_avx512`'s
+            // calls, made where the processor has AVX2.
             return unsafe { lane_step_avx2::<SUM>(steps, y, q_max, a, inv_h, row, f) };
         }
         Self::lane_step::<MOTIONS, SUM>(steps, y, q_max, a, inv_h, row, f)
@@ -1263,12 +1303,12 @@ mod tests {
         assert_eq!(e, LinearBuildingError::Ground(SimError::TooShort(1)));
     }
 
-    /// The first passes of records side by side, by the AVX2 copies (where the processor has
-    /// them) and by the baseline's, against each record's pass alone (no lanes): every stored
-    /// number the same bits, for one output (its sum spread over two steps) and several, with
-    /// records shorter than the longest's whole blocks, one shorter than a block and a batch
-    /// short of lanes. `tests/building_linear.rs` checks the peaks; this reaches the baseline's
-    /// copy, which a processor with AVX2 never runs there.
+    /// The first passes of records side by side and each alone, by the AVX-512 and AVX2 copies
+    /// (where the processor has them) and by the baseline's, against each record's pass alone by
+    /// the baseline's: every stored number the same bits, for one output (its sum spread over
+    /// two steps) and several, with records shorter than the longest's whole blocks, one shorter
+    /// than a block and a batch short of lanes. `tests/building_linear.rs` checks the peaks;
+    /// this reaches the copies a processor with more never runs there.
     #[test]
     fn lanes_give_each_records_first_pass_on_either_instruction_set() {
         let lin = LinearBuilding::new(&Building::new(&spec()).unwrap()).unwrap();
@@ -1301,20 +1341,33 @@ mod tests {
                 let accels: Vec<&[f64]> = batch.iter().map(|a| &a[..]).collect();
                 let alone: Vec<Vec<u64>> = (accels.iter())
                     .map(|a| {
-                        bits(&LinearBuilding::first_passes_in(false, out, &steps, &[a], 100.0)[0])
+                        let pass = LinearBuilding::first_passes_in(
+                            Simd::Baseline,
+                            out,
+                            &steps,
+                            &[a],
+                            100.0,
+                        );
+                        bits(&pass[0])
                     })
                     .collect();
-                // Without AVX2 on the processor, `true` runs the baseline's copy again.
-                for avx2 in [false, true] {
-                    let lanes = LinearBuilding::first_passes_in(avx2, out, &steps, &accels, 100.0);
+                // A copy the processor does not run gives way to the most below it that it
+                // runs (`Simd::available`).
+                for simd in [Simd::Baseline, Simd::Avx2, Simd::Avx512] {
+                    let lanes = LinearBuilding::first_passes_in(simd, out, &steps, &accels, 100.0);
                     let got: Vec<Vec<u64>> = lanes.iter().map(bits).collect();
                     assert_eq!(
                         got,
                         alone,
-                        "avx2 {avx2}, {} outputs, {} records",
+                        "{simd:?}, {} outputs, {} records",
                         out.count,
                         batch.len()
                     );
+                    // Each record alone by this copy too (its partial last block).
+                    for (a, want) in accels.iter().zip(&alone) {
+                        let pass = LinearBuilding::first_passes_in(simd, out, &steps, &[a], 100.0);
+                        assert_eq!(&bits(&pass[0]), want, "{simd:?} alone");
+                    }
                 }
             }
         }
