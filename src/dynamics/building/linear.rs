@@ -621,7 +621,49 @@ impl LinearBuilding {
         accels: &[&[f64]],
         inv_h: f64,
     ) -> Vec<FirstPass> {
-        let simd = simd.min(Simd::available());
+        match simd.min(Simd::available()) {
+            // SAFETY: a copy only as far as the processor runs it (`Simd::available`).
+            #[cfg(target_arch = "x86_64")]
+            Simd::Avx512 => unsafe { Self::first_passes_avx512(out, steps, accels, inv_h) },
+            // SAFETY: as above.
+            #[cfg(target_arch = "x86_64")]
+            Simd::Avx2 => unsafe { Self::first_passes_avx2(out, steps, accels, inv_h) },
+            _ => Self::first_passes_with::<false>(out, steps, accels, inv_h),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn first_passes_avx2(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]],
+        inv_h: f64,
+    ) -> Vec<FirstPass> {
+        Self::first_passes_with::<true>(out, steps, accels, inv_h)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    unsafe fn first_passes_avx512(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]],
+        inv_h: f64,
+    ) -> Vec<FirstPass> {
+        Self::first_passes_with::<true>(out, steps, accels, inv_h)
+    }
+
+    /// [`Self::first_passes`], compiled into each copy: `AVX2` only in
+    /// [`Self::first_passes_avx2`] and [`Self::first_passes_avx512`], whose lane steps are then
+    /// [`lane_step_avx2`]'s.
+    #[inline(always)]
+    fn first_passes_with<const AVX2: bool>(
+        out: &Outputs,
+        steps: &[ModeStep],
+        accels: &[&[f64]],
+        inv_h: f64,
+    ) -> Vec<FirstPass> {
         let m = steps.len();
         let mut passes: Vec<FirstPass> = (accels.iter())
             .map(|a| FirstPass::new(out, m, a.len() - 1))
@@ -652,68 +694,16 @@ impl LinearBuilding {
                 carries.push(Carry::new(out, m));
             }
             let (p, c) = (&mut passes, &mut carries);
-            match simd {
-                // SAFETY: `simd` only as far as the processor runs it (`Simd::available`).
-                #[cfg(target_arch = "x86_64")]
-                Simd::Avx512 => unsafe {
-                    Self::lane_blocks_avx512(out, steps, &lanes, inv_h, p, c, ends)
-                },
-                // SAFETY: as above.
-                #[cfg(target_arch = "x86_64")]
-                Simd::Avx2 => unsafe {
-                    Self::lane_blocks_avx2(out, steps, &lanes, inv_h, p, c, ends)
-                },
-                _ => Self::lane_blocks::<false>(out, steps, &lanes, inv_h, p, c, ends),
-            }
+            Self::lane_blocks::<AVX2>(out, steps, &lanes, inv_h, p, c, ends);
             from = whole;
         }
         passes.truncate(accels.len());
         for (((pass, carry), accel), from) in
             passes.iter_mut().zip(&mut carries).zip(accels).zip(from)
         {
-            match simd {
-                // SAFETY: `simd` only as far as the processor runs it (`Simd::available`).
-                #[cfg(target_arch = "x86_64")]
-                Simd::Avx512 => unsafe {
-                    Self::blocks_avx512(out, steps, accel, inv_h, pass, carry, from)
-                },
-                // SAFETY: as above.
-                #[cfg(target_arch = "x86_64")]
-                Simd::Avx2 => unsafe {
-                    Self::blocks_avx2(out, steps, accel, inv_h, pass, carry, from)
-                },
-                _ => Self::blocks(out, steps, accel, inv_h, pass, carry, from),
-            }
+            Self::blocks(out, steps, accel, inv_h, pass, carry, from);
         }
         passes
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn blocks_avx2(
-        out: &Outputs,
-        steps: &[ModeStep],
-        accel: &[f64],
-        inv_h: f64,
-        pass: &mut FirstPass,
-        carry: &mut Carry,
-        from: usize,
-    ) {
-        Self::blocks(out, steps, accel, inv_h, pass, carry, from)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,avx512f,avx512vl")]
-    unsafe fn blocks_avx512(
-        out: &Outputs,
-        steps: &[ModeStep],
-        accel: &[f64],
-        inv_h: f64,
-        pass: &mut FirstPass,
-        carry: &mut Carry,
-        from: usize,
-    ) {
-        Self::blocks(out, steps, accel, inv_h, pass, carry, from)
     }
 
     /// The first pass's blocks from `from` to the record's end, from the state `carry` holds
@@ -762,40 +752,12 @@ impl LinearBuilding {
         }
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn lane_blocks_avx2(
-        out: &Outputs,
-        steps: &[ModeStep],
-        accels: &[&[f64]; MOTIONS],
-        inv_h: f64,
-        passes: &mut [FirstPass],
-        carries: &mut [Carry],
-        ends: [usize; MOTIONS],
-    ) {
-        Self::lane_blocks::<true>(out, steps, accels, inv_h, passes, carries, ends)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,avx512f,avx512vl")]
-    unsafe fn lane_blocks_avx512(
-        out: &Outputs,
-        steps: &[ModeStep],
-        accels: &[&[f64]; MOTIONS],
-        inv_h: f64,
-        passes: &mut [FirstPass],
-        carries: &mut [Carry],
-        ends: [usize; MOTIONS],
-    ) {
-        Self::lane_blocks::<true>(out, steps, accels, inv_h, passes, carries, ends)
-    }
-
     /// [`Self::blocks`] over [`MOTIONS`] records at once, one per lane (each lane the scalar
     /// operations in their order), lane `l` kept for its first `ends[l]` blocks: its pass
     /// written over them and its state after them left in its `carries`. The lanes run the
     /// most blocks of any (`accels[l]` holds at least `BLOCK·max(ends) + 1` samples). `AVX2`:
-    /// called from [`Self::lane_blocks_avx2`] and [`Self::lane_blocks_avx512`] alone, its steps
-    /// by [`lane_step_avx2`] (inlined there, so compiled for each).
+    /// compiled into [`Self::first_passes_avx2`] and [`Self::first_passes_avx512`] alone, its
+    /// steps by [`lane_step_avx2`] (inlined there, so compiled for each).
     #[inline(always)]
     fn lane_blocks<const AVX2: bool>(
         out: &Outputs,
@@ -965,8 +927,8 @@ impl LinearBuilding {
     ) {
         #[cfg(target_arch = "x86_64")]
         if AVX2 {
-            // SAFETY: `AVX2` is true only in `lane_blocks_avx2`'s and `lane_blocks_avx512`'s
-            // calls, made where the processor has AVX2.
+            // SAFETY: `AVX2` is true only inside `first_passes_avx2` and
+            // `first_passes_avx512`, called where the processor has AVX2.
             return unsafe { lane_step_avx2::<SUM>(steps, y, q_max, a, inv_h, row, f) };
         }
         Self::lane_step::<MOTIONS, SUM>(steps, y, q_max, a, inv_h, row, f)
