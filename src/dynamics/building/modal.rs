@@ -626,6 +626,54 @@ pub fn value_terms(lambda: Cx, tau: f64) -> [Cx; 3] {
     [e, p1.scale(tau), p2.scale(tau * tau)]
 }
 
+/// Modes whose [`value_terms`] [`value_terms_in_lanes`] computes side by side.
+const TERM_LANES: usize = 4;
+
+/// [`value_terms`] of up to [`TERM_LANES`] modes at one `τ` (`lambda.len()` of them): each
+/// mode's bits, the same operations in the same order, but where every mode takes the Taylor
+/// series the lanes' Horner steps are interleaved, so that their chains of dependent
+/// multiply–adds overlap instead of following one another (a refinement's evaluation waits on
+/// them). The lanes past `lambda.len()` repeat its first mode and are not read.
+#[inline(always)]
+fn value_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 3]; TERM_LANES] {
+    let x: [Cx; TERM_LANES] =
+        std::array::from_fn(|l| lambda.get(l).unwrap_or(&lambda[0]).scale(tau));
+    if !x.iter().all(|x| x.norm_sqr() < 0.25) {
+        return std::array::from_fn(|l| value_terms(*lambda.get(l).unwrap_or(&lambda[0]), tau));
+    }
+    // `horner(x, &INV_FACTORIAL[2..15])` in each lane.
+    let (mut re, mut im) = ([0.0; TERM_LANES], [0.0; TERM_LANES]);
+    for &ck in INV_FACTORIAL[2..15].iter().rev() {
+        for l in 0..TERM_LANES {
+            let (r, i) = (
+                re[l] * x[l].0 - im[l] * x[l].1,
+                re[l] * x[l].1 + im[l] * x[l].0,
+            );
+            re[l] = r + ck;
+            im[l] = i + 0.0;
+        }
+    }
+    let t2 = tau * tau;
+    std::array::from_fn(|l| {
+        let p2 = Cx(re[l], im[l]);
+        let p1 = Cx(1.0, 0.0).add(x[l].mul(p2));
+        let e = Cx(1.0, 0.0).add(x[l].mul(p1));
+        [e, p1.scale(tau), p2.scale(t2)]
+    })
+}
+
+/// `visit(r, value_terms(lambda[r], tau))` for every mode `r` in order, the terms computed
+/// [`TERM_LANES`] modes at a time ([`value_terms_in_lanes`], the same bits).
+#[inline(always)]
+fn each_value_terms(lambda: &[Cx], tau: f64, mut visit: impl FnMut(usize, [Cx; 3])) {
+    for (first, lanes) in (0..).step_by(TERM_LANES).zip(lambda.chunks(TERM_LANES)) {
+        let terms = value_terms_in_lanes(lanes, tau);
+        for (r, terms) in (first..first + lanes.len()).zip(terms) {
+            visit(r, terms);
+        }
+    }
+}
+
 /// `[e^{λτ}, τφ₁(λτ)]`, what a slope needs: [`value_terms`]' first two, the same bits, without
 /// `φ₂`'s division where the closed form does not need it.
 #[inline]
@@ -724,12 +772,17 @@ impl super::super::search::Smooth for ModalFn<'_> {
             return (f, df);
         }
         let lambda = &self.modes.lambda;
-        let terms = |r: usize| value_terms(lambda[r], t);
-        (self.piece.terms).each(self.modes, (t, 0.0), terms, |r, &[e, p1, p2]| {
+        let mut add = |r: usize, [e, p1, p2]: [Cx; 3]| {
             let (c, w) = (self.c[r], self.scale * self.modes.weight[r]);
             f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
             df += w * c.mul(self.piece.dy(r, lambda[r], e, p1)).0;
-        });
+        };
+        if self.modes.modes() <= FEW_MODES {
+            each_value_terms(lambda, t, add);
+        } else {
+            let terms = |r: usize| value_terms(lambda[r], t);
+            (self.piece.terms).each(self.modes, (t, 0.0), terms, |r, &t| add(r, t));
+        }
         (f, df)
     }
 
@@ -738,25 +791,23 @@ impl super::super::search::Smooth for ModalFn<'_> {
     /// not kept (`Kept` holds the searches' points).
     fn eval_second(&self, &t: &f64) -> (f64, f64, f64) {
         let (mut f, mut df, mut d2) = self.poly_eval(t);
-        for (r, c) in self.c.iter().enumerate() {
-            let l = self.modes.lambda[r];
-            let [e, p1, p2] = value_terms(l, t);
-            let w = self.scale * self.modes.weight[r];
+        let lambda = &self.modes.lambda[..self.c.len()];
+        each_value_terms(lambda, t, |r, [e, p1, p2]| {
+            let (c, w) = (self.c[r], self.scale * self.modes.weight[r]);
             f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
-            df += w * c.mul(self.piece.dy(r, l, e, p1)).0;
+            df += w * c.mul(self.piece.dy(r, lambda[r], e, p1)).0;
             d2 += w * c.mul(e.mul(self.piece.q2[r])).0;
-        }
+        });
         (f, df, d2)
     }
 
     /// `eval`'s value alone, the same bits (a root's refinement needs no slope).
     fn value(&self, &t: &f64) -> f64 {
         let (mut f, _, _) = self.poly_eval(t);
-        for (r, c) in self.c.iter().enumerate() {
-            let [e, p1, p2] = value_terms(self.modes.lambda[r], t);
+        each_value_terms(&self.modes.lambda[..self.c.len()], t, |r, [e, p1, p2]| {
             let w = self.scale * self.modes.weight[r];
-            f += w * c.mul(self.piece.y(r, e, p1, p2)).0;
-        }
+            f += w * self.c[r].mul(self.piece.y(r, e, p1, p2)).0;
+        });
         f
     }
 
@@ -852,6 +903,60 @@ mod tests {
                     err <= 8.0 * f64::EPSILON * want.abs().max(1e-300),
                     "{x:?}: value terms {got:?} vs {want:?}"
                 );
+            }
+        }
+    }
+
+    /// The modes' terms side by side are each mode's own, bit for bit: every mode on the
+    /// series (the lanes' interleaved Horner steps), one mode past it (every lane by its own
+    /// `value_terms`), fewer modes than lanes, more than one group of lanes, signed zeros; and
+    /// `each_value_terms` visits every mode once, in order, with those bits.
+    #[test]
+    fn value_terms_in_lanes_are_each_modes_own_bits() {
+        let bits = |t: &[Cx; 3]| t.map(|c| (c.0.to_bits(), c.1.to_bits()));
+        let sets: [&[Cx]; 6] = [
+            &[
+                Cx(-0.3, 40.0),
+                Cx(-1.0, 15.0),
+                Cx(-0.01, 2.0),
+                Cx(-5.0, 0.0),
+            ],
+            &[
+                Cx(-0.3, 40.0),
+                Cx(-1.0, 15.0),
+                Cx(-9.0, 70.0),
+                Cx(-5.0, 0.0),
+            ],
+            &[Cx(-0.3, 40.0), Cx(-1.0, -15.0)],
+            &[Cx(0.0, -0.0), Cx(-0.0, 3.0), Cx(-2.0, 0.0)],
+            &[Cx(-49.0, 0.0)],
+            &[
+                Cx(-0.2, 5.0),
+                Cx(-0.4, 9.0),
+                Cx(-0.6, 13.0),
+                Cx(-0.8, 17.0),
+                Cx(-1.0, 21.0),
+            ],
+        ];
+        for lambda in sets {
+            for tau in [0.0, 1e-9, 3.7e-3, 0.01, -0.004] {
+                for (first, lanes) in (0..).step_by(TERM_LANES).zip(lambda.chunks(TERM_LANES)) {
+                    let got = value_terms_in_lanes(lanes, tau);
+                    for (l, &x) in lanes.iter().enumerate() {
+                        assert_eq!(
+                            bits(&got[l]),
+                            bits(&value_terms(x, tau)),
+                            "mode {} of {lambda:?} at {tau}",
+                            first + l
+                        );
+                    }
+                }
+                let mut seen = Vec::new();
+                each_value_terms(lambda, tau, |r, t| seen.push((r, bits(&t))));
+                let want: Vec<_> = (lambda.iter().enumerate())
+                    .map(|(r, &x)| (r, bits(&value_terms(x, tau))))
+                    .collect();
+                assert_eq!(seen, want, "{lambda:?} at {tau}");
             }
         }
     }
