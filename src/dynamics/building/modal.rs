@@ -425,6 +425,23 @@ impl<T> Kept<T> {
             }
             return;
         }
+        self.kept(
+            modes,
+            key,
+            |v| v.extend((0..modes.modes()).map(value)),
+            visit,
+        );
+    }
+
+    /// [`Self::each`] in a basis of more than [`FEW_MODES`] modes, the numbers at times `key`
+    /// kept, or appended by `fill` in the modes' order (and kept).
+    fn kept(
+        &self,
+        modes: &StateModes,
+        key: (f64, f64),
+        fill: impl FnOnce(&mut Vec<T>),
+        mut visit: impl FnMut(usize, &T),
+    ) {
         let key = Some([modes.id, key.0.to_bits(), key.1.to_bits()]);
         let mut slots = self.slots.borrow_mut();
         let at = match slots.iter().position(|(k, _)| *k == key) {
@@ -434,7 +451,7 @@ impl<T> Kept<T> {
                 self.oldest.set((at + 1) % KEPT);
                 let (k, values) = &mut slots[at];
                 values.clear();
-                values.extend((0..modes.modes()).map(value));
+                fill(values);
                 *k = key;
                 at
             }
@@ -481,9 +498,16 @@ pub struct ModalPoint {
 }
 
 impl ModalPoint {
-    /// The point at `tau`.
+    /// The point at `tau` (the modes' terms [`TERM_LANES`] at a time, each mode's bits).
     pub fn at(&mut self, modes: &StateModes, piece: &Piece, tau: f64) {
-        self.fill(modes, piece, tau, |r| mode_terms(modes.lambda[r], tau));
+        self.resize(modes.modes(), tau);
+        let lambda = &modes.lambda[..modes.modes()];
+        for (first, lanes) in (0..).step_by(TERM_LANES).zip(lambda.chunks(TERM_LANES)) {
+            let terms = mode_terms_in_lanes(lanes, tau);
+            for (r, terms) in (first..first + lanes.len()).zip(terms) {
+                self.set(modes, piece, r, terms);
+            }
+        }
     }
 
     /// The point at `tau` with the mode terms given (cached for a whole sample interval).
@@ -504,20 +528,28 @@ impl ModalPoint {
         tau: f64,
         terms: impl Fn(usize) -> [Cx; 4],
     ) {
-        let m = modes.modes();
+        self.resize(modes.modes(), tau);
+        for r in 0..modes.modes() {
+            self.set(modes, piece, r, terms(r));
+        }
+    }
+
+    fn resize(&mut self, m: usize, tau: f64) {
         self.tau = tau;
         self.y.resize(m, Cx(0.0, 0.0));
         self.dy.resize(m, Cx(0.0, 0.0));
         self.iy.resize(m, Cx(0.0, 0.0));
-        for r in 0..m {
-            let [e, p1, p2, p3] = terms(r);
-            self.y[r] = piece.y(r, e, p1, p2);
-            self.dy[r] = piece.dy(r, modes.lambda[r], e, p1);
-            self.iy[r] = p1
-                .mul(piece.y0[r])
-                .add(p2.mul(piece.b0[r]))
-                .add(p3.mul(piece.b1[r]));
-        }
+    }
+
+    /// Mode `r` of the point from its terms `[e^{λτ}, τφ₁, τ²φ₂, τ³φ₃]`.
+    #[inline]
+    fn set(&mut self, modes: &StateModes, piece: &Piece, r: usize, [e, p1, p2, p3]: [Cx; 4]) {
+        self.y[r] = piece.y(r, e, p1, p2);
+        self.dy[r] = piece.dy(r, modes.lambda[r], e, p1);
+        self.iy[r] = p1
+            .mul(piece.y0[r])
+            .add(p2.mul(piece.b0[r]))
+            .add(p3.mul(piece.b1[r]));
     }
 
     /// `Σ_r w_r·Re(c_r·x_r)` of a row `c` over one of this point's vectors.
@@ -626,24 +658,15 @@ pub fn value_terms(lambda: Cx, tau: f64) -> [Cx; 3] {
     [e, p1.scale(tau), p2.scale(tau * tau)]
 }
 
-/// Modes whose [`value_terms`] [`value_terms_in_lanes`] computes side by side.
+/// Modes whose terms ([`value_terms`], [`mode_terms`]) are computed side by side.
 const TERM_LANES: usize = 4;
 
-/// [`value_terms`] of up to [`TERM_LANES`] modes at one `τ` (`lambda.len()` of them): each
-/// mode's bits, the same operations in the same order, but where every mode takes the Taylor
-/// series the lanes' Horner steps are interleaved, so that their chains of dependent
-/// multiply–adds overlap instead of following one another (a refinement's evaluation waits on
-/// them). The lanes past `lambda.len()` repeat its first mode and are not read.
+/// [`horner`] in each lane, the lanes' steps interleaved: each lane's bits, its chain of
+/// dependent multiply–adds overlapping the others' instead of following them.
 #[inline(always)]
-fn value_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 3]; TERM_LANES] {
-    let x: [Cx; TERM_LANES] =
-        std::array::from_fn(|l| lambda.get(l).unwrap_or(&lambda[0]).scale(tau));
-    if !x.iter().all(|x| x.norm_sqr() < 0.25) {
-        return std::array::from_fn(|l| value_terms(*lambda.get(l).unwrap_or(&lambda[0]), tau));
-    }
-    // `horner(x, &INV_FACTORIAL[2..15])` in each lane.
+fn horner_in_lanes(x: &[Cx; TERM_LANES], c: &[f64]) -> [Cx; TERM_LANES] {
     let (mut re, mut im) = ([0.0; TERM_LANES], [0.0; TERM_LANES]);
-    for &ck in INV_FACTORIAL[2..15].iter().rev() {
+    for &ck in c.iter().rev() {
         for l in 0..TERM_LANES {
             let (r, i) = (
                 re[l] * x[l].0 - im[l] * x[l].1,
@@ -653,12 +676,51 @@ fn value_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 3]; TERM_LANES] {
             im[l] = i + 0.0;
         }
     }
+    std::array::from_fn(|l| Cx(re[l], im[l]))
+}
+
+/// `λτ` of up to [`TERM_LANES`] modes (`lambda.len()`), the lanes past them repeating the
+/// first, and whether every `|λτ|²` is below `limit` (every lane takes the Taylor series).
+#[inline(always)]
+fn lanes_of(lambda: &[Cx], tau: f64, limit: f64) -> ([Cx; TERM_LANES], bool) {
+    let x: [Cx; TERM_LANES] =
+        std::array::from_fn(|l| lambda.get(l).unwrap_or(&lambda[0]).scale(tau));
+    (x, x.iter().all(|x| x.norm_sqr() < limit))
+}
+
+/// [`value_terms`] of up to [`TERM_LANES`] modes at one `τ` (`lambda.len()` of them): each
+/// mode's bits, the same operations in the same order, their Taylor series side by side where
+/// every mode takes it ([`horner_in_lanes`]; a refinement's evaluation waits on them). The
+/// lanes past `lambda.len()` are not to be read.
+#[inline(always)]
+fn value_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 3]; TERM_LANES] {
+    let (x, series) = lanes_of(lambda, tau, 0.25);
+    if !series {
+        return std::array::from_fn(|l| value_terms(*lambda.get(l).unwrap_or(&lambda[0]), tau));
+    }
+    let p2 = horner_in_lanes(&x, &INV_FACTORIAL[2..15]);
     let t2 = tau * tau;
     std::array::from_fn(|l| {
-        let p2 = Cx(re[l], im[l]);
+        let p1 = Cx(1.0, 0.0).add(x[l].mul(p2[l]));
+        let e = Cx(1.0, 0.0).add(x[l].mul(p1));
+        [e, p1.scale(tau), p2[l].scale(t2)]
+    })
+}
+
+/// [`mode_terms`] of up to [`TERM_LANES`] modes at one `τ`, as [`value_terms_in_lanes`].
+#[inline(always)]
+fn mode_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 4]; TERM_LANES] {
+    let (x, series) = lanes_of(lambda, tau, 1.0);
+    if !series {
+        return std::array::from_fn(|l| mode_terms(*lambda.get(l).unwrap_or(&lambda[0]), tau));
+    }
+    let p3 = horner_in_lanes(&x, &INV_FACTORIAL[3..20]);
+    let (t2, t3) = (tau * tau, tau * tau * tau);
+    std::array::from_fn(|l| {
+        let p2 = Cx(0.5, 0.0).add(x[l].mul(p3[l]));
         let p1 = Cx(1.0, 0.0).add(x[l].mul(p2));
         let e = Cx(1.0, 0.0).add(x[l].mul(p1));
-        [e, p1.scale(tau), p2.scale(t2)]
+        [e, p1.scale(tau), p2.scale(t2), p3[l].scale(t3)]
     })
 }
 
@@ -780,8 +842,8 @@ impl super::super::search::Smooth for ModalFn<'_> {
         if self.modes.modes() <= FEW_MODES {
             each_value_terms(lambda, t, add);
         } else {
-            let terms = |r: usize| value_terms(lambda[r], t);
-            (self.piece.terms).each(self.modes, (t, 0.0), terms, |r, &t| add(r, t));
+            let fill = |v: &mut Vec<[Cx; 3]>| each_value_terms(lambda, t, |_, terms| v.push(terms));
+            (self.piece.terms).kept(self.modes, (t, 0.0), fill, |r, &t| add(r, t));
         }
         (f, df)
     }
@@ -907,14 +969,16 @@ mod tests {
         }
     }
 
-    /// The modes' terms side by side are each mode's own, bit for bit: every mode on the
-    /// series (the lanes' interleaved Horner steps), one mode past it (every lane by its own
-    /// `value_terms`), fewer modes than lanes, more than one group of lanes, signed zeros; and
-    /// `each_value_terms` visits every mode once, in order, with those bits.
+    /// The modes' terms side by side (`value_terms_in_lanes`, `mode_terms_in_lanes`) are each
+    /// mode's own, bit for bit: every mode on the series (the lanes' interleaved Horner
+    /// steps), one mode past it (every lane by its own terms), fewer modes than lanes, more
+    /// than one group of lanes, signed zeros; and `each_value_terms` visits every mode once, in
+    /// order, with those bits.
     #[test]
     fn value_terms_in_lanes_are_each_modes_own_bits() {
         let bits = |t: &[Cx; 3]| t.map(|c| (c.0.to_bits(), c.1.to_bits()));
-        let sets: [&[Cx]; 6] = [
+        let sets: [&[Cx]; 7] = [
+            &[Cx(-0.3, 40.0), Cx(-3.0, 150.0), Cx(-1.0, 15.0)],
             &[
                 Cx(-0.3, 40.0),
                 Cx(-1.0, 15.0),
@@ -942,12 +1006,20 @@ mod tests {
             for tau in [0.0, 1e-9, 3.7e-3, 0.01, -0.004] {
                 for (first, lanes) in (0..).step_by(TERM_LANES).zip(lambda.chunks(TERM_LANES)) {
                     let got = value_terms_in_lanes(lanes, tau);
+                    let got4 = mode_terms_in_lanes(lanes, tau);
                     for (l, &x) in lanes.iter().enumerate() {
+                        let r = first + l;
+                        let want = value_terms(x, tau);
                         assert_eq!(
                             bits(&got[l]),
-                            bits(&value_terms(x, tau)),
-                            "mode {} of {lambda:?} at {tau}",
-                            first + l
+                            bits(&want),
+                            "mode {r} of {lambda:?} at {tau}"
+                        );
+                        let (got4, want4) = (got4[l], mode_terms(x, tau));
+                        assert_eq!(
+                            got4.map(|c| (c.0.to_bits(), c.1.to_bits())),
+                            want4.map(|c| (c.0.to_bits(), c.1.to_bits())),
+                            "mode terms of mode {r} of {lambda:?} at {tau}"
                         );
                     }
                 }
