@@ -690,10 +690,13 @@ fn lanes_of(lambda: &[Cx], tau: f64, limit: f64) -> ([Cx; TERM_LANES], bool) {
 
 /// [`value_terms`] of up to [`TERM_LANES`] modes at one `τ` (`lambda.len()` of them): each
 /// mode's bits, the same operations in the same order, their Taylor series side by side where
-/// every mode takes it ([`horner_in_lanes`]; a refinement's evaluation waits on them). The
-/// lanes past `lambda.len()` are not to be read.
+/// every mode takes it ([`horner_in_lanes`]; a refinement's evaluation waits on them), a mode
+/// alone by itself. The lanes past `lambda.len()` are not to be read.
 #[inline(always)]
 fn value_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 3]; TERM_LANES] {
+    if lambda.len() == 1 {
+        return [value_terms(lambda[0], tau); TERM_LANES];
+    }
     let (x, series) = lanes_of(lambda, tau, 0.25);
     if !series {
         return std::array::from_fn(|l| value_terms(*lambda.get(l).unwrap_or(&lambda[0]), tau));
@@ -710,6 +713,9 @@ fn value_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 3]; TERM_LANES] {
 /// [`mode_terms`] of up to [`TERM_LANES`] modes at one `τ`, as [`value_terms_in_lanes`].
 #[inline(always)]
 fn mode_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 4]; TERM_LANES] {
+    if lambda.len() == 1 {
+        return [mode_terms(lambda[0], tau); TERM_LANES];
+    }
     let (x, series) = lanes_of(lambda, tau, 1.0);
     if !series {
         return std::array::from_fn(|l| mode_terms(*lambda.get(l).unwrap_or(&lambda[0]), tau));
