@@ -502,12 +502,9 @@ impl ModalPoint {
     pub fn at(&mut self, modes: &StateModes, piece: &Piece, tau: f64) {
         self.resize(modes.modes(), tau);
         let lambda = &modes.lambda[..modes.modes()];
-        for (first, lanes) in (0..).step_by(TERM_LANES).zip(lambda.chunks(TERM_LANES)) {
-            let terms = mode_terms_in_lanes(lanes, tau);
-            for (r, terms) in (first..first + lanes.len()).zip(terms) {
-                self.set(modes, piece, r, terms);
-            }
-        }
+        each_in_lanes(lambda, tau, mode_terms_in_lanes, |r, terms| {
+            self.set(modes, piece, r, terms)
+        });
     }
 
     /// The point at `tau` with the mode terms given (cached for a whole sample interval).
@@ -679,67 +676,80 @@ fn horner_in_lanes(x: &[Cx; TERM_LANES], c: &[f64]) -> [Cx; TERM_LANES] {
     std::array::from_fn(|l| Cx(re[l], im[l]))
 }
 
-/// `λτ` of up to [`TERM_LANES`] modes (`lambda.len()`), the lanes past them repeating the
-/// first, and whether every `|λτ|²` is below `limit` (every lane takes the Taylor series).
+/// Terms of up to [`TERM_LANES`] modes at one `τ` (`lambda.len()` of them): `series` of the
+/// lanes' `λτ` where every `|λτ|²` is below `limit` (every mode takes the Taylor series; the
+/// lanes past `lambda.len()` repeat its first mode and are not to be read), else `one` of each
+/// mode, as for a mode alone.
 #[inline(always)]
-fn lanes_of(lambda: &[Cx], tau: f64, limit: f64) -> ([Cx; TERM_LANES], bool) {
-    let x: [Cx; TERM_LANES] =
-        std::array::from_fn(|l| lambda.get(l).unwrap_or(&lambda[0]).scale(tau));
-    (x, x.iter().all(|x| x.norm_sqr() < limit))
+fn terms_in_lanes<T: Copy>(
+    lambda: &[Cx],
+    tau: f64,
+    limit: f64,
+    one: impl Fn(Cx, f64) -> T,
+    series: impl FnOnce(&[Cx; TERM_LANES]) -> [T; TERM_LANES],
+) -> [T; TERM_LANES] {
+    if lambda.len() == 1 {
+        return [one(lambda[0], tau); TERM_LANES];
+    }
+    let mode = |l: usize| *lambda.get(l).unwrap_or(&lambda[0]);
+    let x: [Cx; TERM_LANES] = std::array::from_fn(|l| mode(l).scale(tau));
+    if !x.iter().all(|x| x.norm_sqr() < limit) {
+        return std::array::from_fn(|l| one(mode(l), tau));
+    }
+    series(&x)
 }
 
-/// [`value_terms`] of up to [`TERM_LANES`] modes at one `τ` (`lambda.len()` of them): each
-/// mode's bits, the same operations in the same order, their Taylor series side by side where
-/// every mode takes it ([`horner_in_lanes`]; a refinement's evaluation waits on them), a mode
-/// alone by itself. The lanes past `lambda.len()` are not to be read.
+/// [`value_terms`] of up to [`TERM_LANES`] modes at one `τ`: each mode's bits, the same
+/// operations in the same order, their Taylor series side by side where every mode takes it
+/// ([`horner_in_lanes`]; a refinement's evaluation waits on them).
 #[inline(always)]
 fn value_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 3]; TERM_LANES] {
-    if lambda.len() == 1 {
-        return [value_terms(lambda[0], tau); TERM_LANES];
-    }
-    let (x, series) = lanes_of(lambda, tau, 0.25);
-    if !series {
-        return std::array::from_fn(|l| value_terms(*lambda.get(l).unwrap_or(&lambda[0]), tau));
-    }
-    let p2 = horner_in_lanes(&x, &INV_FACTORIAL[2..15]);
-    let t2 = tau * tau;
-    std::array::from_fn(|l| {
-        let p1 = Cx(1.0, 0.0).add(x[l].mul(p2[l]));
-        let e = Cx(1.0, 0.0).add(x[l].mul(p1));
-        [e, p1.scale(tau), p2[l].scale(t2)]
+    terms_in_lanes(lambda, tau, 0.25, value_terms, |x| {
+        let p2 = horner_in_lanes(x, &INV_FACTORIAL[2..15]);
+        let t2 = tau * tau;
+        std::array::from_fn(|l| {
+            let p1 = Cx(1.0, 0.0).add(x[l].mul(p2[l]));
+            let e = Cx(1.0, 0.0).add(x[l].mul(p1));
+            [e, p1.scale(tau), p2[l].scale(t2)]
+        })
     })
 }
 
 /// [`mode_terms`] of up to [`TERM_LANES`] modes at one `τ`, as [`value_terms_in_lanes`].
 #[inline(always)]
 fn mode_terms_in_lanes(lambda: &[Cx], tau: f64) -> [[Cx; 4]; TERM_LANES] {
-    if lambda.len() == 1 {
-        return [mode_terms(lambda[0], tau); TERM_LANES];
-    }
-    let (x, series) = lanes_of(lambda, tau, 1.0);
-    if !series {
-        return std::array::from_fn(|l| mode_terms(*lambda.get(l).unwrap_or(&lambda[0]), tau));
-    }
-    let p3 = horner_in_lanes(&x, &INV_FACTORIAL[3..20]);
-    let (t2, t3) = (tau * tau, tau * tau * tau);
-    std::array::from_fn(|l| {
-        let p2 = Cx(0.5, 0.0).add(x[l].mul(p3[l]));
-        let p1 = Cx(1.0, 0.0).add(x[l].mul(p2));
-        let e = Cx(1.0, 0.0).add(x[l].mul(p1));
-        [e, p1.scale(tau), p2.scale(t2), p3[l].scale(t3)]
+    terms_in_lanes(lambda, tau, 1.0, mode_terms, |x| {
+        let p3 = horner_in_lanes(x, &INV_FACTORIAL[3..20]);
+        let (t2, t3) = (tau * tau, tau * tau * tau);
+        std::array::from_fn(|l| {
+            let p2 = Cx(0.5, 0.0).add(x[l].mul(p3[l]));
+            let p1 = Cx(1.0, 0.0).add(x[l].mul(p2));
+            let e = Cx(1.0, 0.0).add(x[l].mul(p1));
+            [e, p1.scale(tau), p2.scale(t2), p3[l].scale(t3)]
+        })
     })
 }
 
-/// `visit(r, value_terms(lambda[r], tau))` for every mode `r` in order, the terms computed
-/// [`TERM_LANES`] modes at a time ([`value_terms_in_lanes`], the same bits).
+/// `visit(r, terms)` for every mode `r` of `lambda` in order, the terms computed by `lanes`
+/// ([`value_terms_in_lanes`], [`mode_terms_in_lanes`]) [`TERM_LANES`] modes at a time.
 #[inline(always)]
-fn each_value_terms(lambda: &[Cx], tau: f64, mut visit: impl FnMut(usize, [Cx; 3])) {
-    for (first, lanes) in (0..).step_by(TERM_LANES).zip(lambda.chunks(TERM_LANES)) {
-        let terms = value_terms_in_lanes(lanes, tau);
-        for (r, terms) in (first..first + lanes.len()).zip(terms) {
+fn each_in_lanes<T>(
+    lambda: &[Cx],
+    tau: f64,
+    lanes: impl Fn(&[Cx], f64) -> [T; TERM_LANES],
+    mut visit: impl FnMut(usize, T),
+) {
+    for (first, modes) in (0..).step_by(TERM_LANES).zip(lambda.chunks(TERM_LANES)) {
+        for (r, terms) in (first..first + modes.len()).zip(lanes(modes, tau)) {
             visit(r, terms);
         }
     }
+}
+
+/// `visit(r, value_terms(lambda[r], tau))` for every mode `r` in order ([`each_in_lanes`]).
+#[inline(always)]
+fn each_value_terms(lambda: &[Cx], tau: f64, visit: impl FnMut(usize, [Cx; 3])) {
+    each_in_lanes(lambda, tau, value_terms_in_lanes, visit);
 }
 
 /// `[e^{λτ}, τφ₁(λτ)]`, what a slope needs: [`value_terms`]' first two, the same bits, without
