@@ -501,8 +501,7 @@ impl ModalPoint {
     /// The point at `tau` (the modes' terms [`TERM_LANES`] at a time, each mode's bits).
     pub fn at(&mut self, modes: &StateModes, piece: &Piece, tau: f64) {
         self.resize(modes.modes(), tau);
-        let lambda = &modes.lambda[..modes.modes()];
-        each_in_lanes(lambda, tau, mode_terms_in_lanes, |r, terms| {
+        each_in_lanes(&modes.lambda, tau, mode_terms_in_lanes, |r, terms| {
             self.set(modes, piece, r, terms)
         });
     }
