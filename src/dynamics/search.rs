@@ -345,7 +345,10 @@ fn peak_rec<S: Smooth>(
     depth: u32,
     budget: &mut Budget,
 ) -> Result<(), SearchError> {
-    if range_within(s, lo, hi, -best.0, best.0) || monotone(s, lo, hi) {
+    // Both tests are pure, so their order changes only the cost: the monotone test is the
+    // cheaper (one bound, after a sign test) and the one that ends most stretches, where the
+    // function grows to a new record at an end and no range can be certified.
+    if monotone(s, lo, hi) || range_within(s, lo, hi, -best.0, best.0) {
         return Ok(());
     }
     let (t_lo, t_hi) = (S::tau(&lo.at), S::tau(&hi.at));

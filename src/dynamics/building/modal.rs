@@ -558,6 +558,10 @@ impl ModalPoint {
     }
 }
 
+/// Rows from which [`RowsByMode`]'s passes take their AVX2 copy: below it the call costs more
+/// than the wider operations save (`cargo bench --bench integrator`, one storey).
+const WIDE_ROWS: usize = 16;
+
 /// A table of rows stored mode by mode: row `i`'s coefficient of mode `r` at `r·stride + i`,
 /// real and imaginary parts apart, and `w_r·|c|` of each.
 #[derive(Debug, Clone, Default)]
@@ -595,7 +599,29 @@ impl RowsByMode {
     /// `out[i] = Σ_r w_r·Re(c_{r,first+i}·x_r)` for the rows `first …` (as many as `out`
     /// holds), in one pass over the modes: [`ModalPoint::dot`] of each row, the same terms
     /// added in the same order (from the same start as `f64`'s `Sum`), so the same bits.
+    ///
+    /// Compiled twice, as [`Self::curvatures`]: for AVX2 (chosen at run time where the
+    /// processor has it: four rows per operation instead of two) and for the baseline. Neither
+    /// contracts a multiply and an add, so both give the same bits.
     pub fn dots(&self, weight: &[f64], x: &[Cx], first: usize, out: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if out.len() >= WIDE_ROWS && std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor has AVX2 (checked just above).
+                return unsafe { self.dots_avx2(weight, x, first, out) };
+            }
+        }
+        self.dots_generic(weight, x, first, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn dots_avx2(&self, weight: &[f64], x: &[Cx], first: usize, out: &mut [f64]) {
+        self.dots_generic(weight, x, first, out)
+    }
+
+    #[inline(always)]
+    fn dots_generic(&self, weight: &[f64], x: &[Cx], first: usize, out: &mut [f64]) {
         let rows = out.len();
         out.fill(std::iter::empty::<f64>().sum());
         for (r, (&w, xr)) in weight.iter().zip(x).enumerate() {
@@ -610,7 +636,28 @@ impl RowsByMode {
     /// `out[i] = Σ_r w_r·|c_{r,i}|·mag_r[0]` for the first rows (as many as `out` holds): each
     /// row's modal curvature bound over a piece (what [`ModalFn`]'s bound of `k = 2` sums from
     /// a decaying start), the terms in mode order.
+    ///
+    /// Compiled twice: for AVX2 (chosen at run time where the processor has it) and for the
+    /// baseline, the same bits.
     pub fn curvatures(&self, mag: &[[f64; 3]], out: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if out.len() >= WIDE_ROWS && std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor has AVX2 (checked just above).
+                return unsafe { self.curvatures_avx2(mag, out) };
+            }
+        }
+        self.curvatures_generic(mag, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn curvatures_avx2(&self, mag: &[[f64; 3]], out: &mut [f64]) {
+        self.curvatures_generic(mag, out)
+    }
+
+    #[inline(always)]
+    fn curvatures_generic(&self, mag: &[[f64; 3]], out: &mut [f64]) {
         out.fill(std::iter::empty::<f64>().sum());
         for (r, m) in mag.iter().enumerate() {
             let a = &self.abs[r * self.stride..r * self.stride + out.len()];
@@ -1251,31 +1298,44 @@ mod tests {
     }
 
     /// Every row at once mode by mode has the bits of each row's [`ModalPoint::dot`], for a
-    /// range of rows starting anywhere; the curvatures those of the sum over the modes.
+    /// range of rows starting anywhere, as many as [`WIDE_ROWS`] or more (the AVX2 copy where
+    /// the processor has it) and fewer (the baseline); the curvatures those of the sum over the
+    /// modes.
     #[test]
     fn rows_by_mode_have_each_rows_bits() {
         let (sm, piece) = a_piece();
         let m = sm.modes();
-        let rows: Vec<Cx> = (0..6).flat_map(|i| sm.row(i).to_vec()).collect();
+        let count = WIDE_ROWS + 11;
+        // The basis' six rows over and over, each copy scaled apart.
+        let rows: Vec<Cx> = (0..count)
+            .flat_map(|i| {
+                sm.row(i % 6)
+                    .iter()
+                    .map(move |c| c.scale(1.0 + 0.37 * i as f64))
+            })
+            .collect();
         let rows_abs: Vec<f64> = (0..rows.len())
             .map(|i| sm.weight[i % m] * rows[i].abs())
             .collect();
         let table = RowsByMode::new(&rows, &rows_abs, m);
         let mut pt = ModalPoint::default();
         pt.at(&sm, &piece, 0.7 / sm.fastest());
-        for first in [0, 2, 5] {
-            let mut out = vec![f64::NAN; 6 - first];
+        for first in [0, 2, 5, 11, 20] {
+            let mut out = vec![f64::NAN; count - first];
             table.dots(&sm.weight, &pt.y, first, &mut out);
             for (k, got) in out.iter().enumerate() {
-                let want = ModalPoint::dot(&sm, sm.row(first + k), &pt.y);
-                assert_eq!(got.to_bits(), want.to_bits(), "row {}", first + k);
+                let i = first + k;
+                let want = ModalPoint::dot(&sm, &rows[i * m..(i + 1) * m], &pt.y);
+                assert_eq!(got.to_bits(), want.to_bits(), "row {i} from {first}");
             }
         }
-        let mut curv = vec![f64::NAN; 6];
-        table.curvatures(&piece.mag, &mut curv);
-        for (i, got) in curv.iter().enumerate() {
-            let want: f64 = (0..m).map(|r| rows_abs[i * m + r] * piece.mag[r][0]).sum();
-            assert_eq!(got.to_bits(), want.to_bits(), "row {i}");
+        for len in [6, count] {
+            let mut curv = vec![f64::NAN; len];
+            table.curvatures(&piece.mag, &mut curv);
+            for (i, got) in curv.iter().enumerate() {
+                let want: f64 = (0..m).map(|r| rows_abs[i * m + r] * piece.mag[r][0]).sum();
+                assert_eq!(got.to_bits(), want.to_bits(), "row {i} of {len}");
+            }
         }
     }
 
