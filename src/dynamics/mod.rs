@@ -42,6 +42,7 @@
 pub mod building;
 pub mod closed_form;
 pub mod contact;
+pub(crate) mod deferred;
 pub mod exact;
 pub mod model;
 pub mod response;

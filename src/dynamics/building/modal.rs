@@ -480,6 +480,16 @@ impl Piece {
             .add(p1.mul(self.b1[r]))
     }
 
+    /// `from`'s coefficients, in this piece's buffers (its kept numbers depend on the basis and
+    /// times alone, so they stay).
+    pub fn copy_coefficients(&mut self, from: &Piece) {
+        self.y0.clone_from(&from.y0);
+        self.b0.clone_from(&from.b0);
+        self.b1.clone_from(&from.b1);
+        self.q2.clone_from(&from.q2);
+        self.mag.clone_from(&from.mag);
+    }
+
     fn resize(&mut self, m: usize) {
         for v in [&mut self.y0, &mut self.b0, &mut self.b1, &mut self.q2] {
             v.resize(m, Cx(0.0, 0.0));
@@ -528,6 +538,13 @@ impl ModalPoint {
         for r in 0..modes.modes() {
             self.set(modes, piece, r, terms(r));
         }
+    }
+
+    /// `from`'s time, values and slopes (not its integrals), in this point's buffers.
+    pub fn copy_values(&mut self, from: &ModalPoint) {
+        self.tau = from.tau;
+        self.y.clone_from(&from.y);
+        self.dy.clone_from(&from.dy);
     }
 
     fn resize(&mut self, m: usize, tau: f64) {
