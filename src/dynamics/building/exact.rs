@@ -498,13 +498,12 @@ struct Integrator<'b> {
     /// floor absolute velocities, the overturning moment.
     peaks: Vec<(PeakOf, Func)>,
     /// Every stored peak ([`Integrator::deferred_slot`]) with its searches deferred, and the
-    /// copies of the pieces waiting in them (the current piece's, once one waits); without
-    /// `defer_peaks` every piece whose certificate fails is searched in turn (the reference the
-    /// tests compare with).
+    /// copies of the pieces waiting in them (the current piece's, once one waits).
     deferred: Vec<DeferredPeak<Waiting>>,
     copies: Vec<Rc<PieceCopy>>,
     copy: Option<Rc<PieceCopy>>,
-    defer_peaks: bool,
+    /// Scratch: the bodies sharing a floor's acceleration or velocity.
+    sharing: Vec<usize>,
     /// The ground's velocity at the piece's start, m/s: the record integrated exactly (it is
     /// linear between samples).
     vg: f64,
@@ -656,7 +655,7 @@ impl<'b> Integrator<'b> {
                 .collect(),
             copies: Vec::new(),
             copy: None,
-            defer_peaks: true,
+            sharing: Vec::new(),
             vg: 0.0,
             damping_above: (0..n * n)
                 .map(|jl| {
@@ -1421,8 +1420,6 @@ impl<'b> Integrator<'b> {
         end: f64,
     ) -> Result<(), SimError> {
         let (n, nb) = (self.n, self.b.blocks());
-        let dt = self.dt;
-        let search_error = |source| SimError::Search { time_s: t0, source };
         self.loose_mass_time += self.loose_mass_kg * end;
         // Peaks: floor displacements, storey drifts, floor accelerations (with the blocks that
         // ride on each floor), storey shears, floor velocities (with their riders), the
@@ -1431,78 +1428,33 @@ impl<'b> Integrator<'b> {
         for idx in 0..self.peaks.len() {
             // Borrowed, not copied: a copy of the function stalls the loads that follow it.
             let (of, g) = (self.peaks[idx].0, &self.peaks[idx].1);
-            if self.defer_peaks {
-                let (f0, f1, slack) = self.ends_and_reach(mode, g, end);
-                let ends = f0.abs().max(f1.abs());
-                let bound = (f0.max(f1) + slack).max(slack - f0.min(f1));
-                let (PeakOf::Accel(f) | PeakOf::Velocity(f)) = of else {
-                    let d = self.deferred_slot(of, 0);
-                    if bound > self.deferred[d].known() {
-                        let g = *g;
-                        self.defer_peak(d, ends, bound, &g, t0)?;
-                    }
-                    continue;
-                };
-                // The blocks riding on the floor share its value: the smallest of their peaks
-                // known clears them all.
-                let b = self.b;
-                let riding = riders(b.stacks(), &self.stacks_on[f], &self.stuck);
-                let known = riding
-                    .fold(self.deferred[self.deferred_slot(of, f)].known(), |k, q| {
-                        k.min(self.deferred[self.deferred_slot(of, n + q)].known())
-                    });
-                if bound <= known {
-                    continue;
-                }
-                let g = *g;
-                self.defer_peak(self.deferred_slot(of, f), ends, bound, &g, t0)?;
-                for at in 0..self.stacks_on[f].len() {
-                    let s = self.stacks_on[f][at];
-                    for q in b.stacks()[s].first..b.stacks()[s].first + self.stuck[s] {
-                        self.defer_peak(self.deferred_slot(of, n + q), ends, bound, &g, t0)?;
-                    }
+            let (f0, f1, slack) = self.ends_and_reach(mode, g, end);
+            let ends = f0.abs().max(f1.abs());
+            let bound = (f0.max(f1) + slack).max(slack - f0.min(f1));
+            let (PeakOf::Accel(f) | PeakOf::Velocity(f)) = of else {
+                let d = self.deferred_slot(of, 0);
+                if bound > self.deferred[d].known() {
+                    let g = *g;
+                    self.defer_peak(d, ends, bound, &g, t0)?;
                 }
                 continue;
-            }
-            let best = match of {
-                PeakOf::Disp(j) => self.out.floor_peak_displacement_m[j],
-                PeakOf::Drift(i) => self.out.storey_peak_drift_m[i],
-                PeakOf::Shear(j) => self.out.storey_peak_shear_n[j],
-                PeakOf::Overturning => self.out.peak_overturning_n_m,
-                PeakOf::Accel(f) | PeakOf::Velocity(f) => {
-                    let (floor_peaks, block_peaks) =
-                        self.out.riders(matches!(of, PeakOf::Velocity(_)));
-                    let mut floor = floor_peaks[f];
-                    for q in riders(self.b.stacks(), &self.stacks_on[f], &self.stuck) {
-                        floor = floor.min(block_peaks[q]);
-                    }
-                    floor
-                }
             };
-            if self.clear(mode, g, end, -best, best) {
-                continue;
-            }
-            let f = self.func(mode, g);
-            let n0 = self.node0(mode, g);
-            let n1 = Self::node_at(mode, g, &self.p_end);
-            let (peak, _) = search::peak_abs(&f, &n0, &n1, best, dt).map_err(search_error)?;
-            if peak > best {
-                match of {
-                    PeakOf::Disp(j) => self.out.floor_peak_displacement_m[j] = peak,
-                    PeakOf::Drift(i) => self.out.storey_peak_drift_m[i] = peak,
-                    PeakOf::Shear(j) => self.out.storey_peak_shear_n[j] = peak,
-                    PeakOf::Overturning => self.out.peak_overturning_n_m = peak,
-                    PeakOf::Accel(f) | PeakOf::Velocity(f) => {
-                        let riders = riders(self.b.stacks(), &self.stacks_on[f], &self.stuck);
-                        let (floor_peaks, block_peaks) =
-                            self.out.riders_mut(matches!(of, PeakOf::Velocity(_)));
-                        floor_peaks[f] = floor_peaks[f].max(peak);
-                        for q in riders {
-                            block_peaks[q] = block_peaks[q].max(peak);
-                        }
-                    }
+            // The floor and the blocks riding on it share the value: the smallest of their
+            // peaks known clears them all.
+            let mut bodies = std::mem::take(&mut self.sharing);
+            bodies.clear();
+            bodies.push(f);
+            bodies.extend(riders(self.b.stacks(), &self.stacks_on[f], &self.stuck).map(|q| n + q));
+            let known = (bodies.iter())
+                .map(|&body| self.deferred[self.deferred_slot(of, body)].known())
+                .fold(f64::INFINITY, f64::min);
+            if bound > known {
+                let g = *g;
+                for &body in &bodies {
+                    self.defer_peak(self.deferred_slot(of, body), ends, bound, &g, t0)?;
                 }
             }
+            self.sharing = bodies;
         }
         // A free cluster's absolute acceleration is constant, so its absolute velocity is linear
         // over the piece: its ends bound it.
@@ -1510,19 +1462,10 @@ impl<'b> Integrator<'b> {
             let v0 = self.v[c.bottom] + self.vg;
             let v1 = v0 + c.accel * end;
             for body in c.bottom..=c.top {
-                if self.defer_peaks {
-                    let accel = self.deferred_slot(PeakOf::Accel(0), body);
-                    self.deferred[accel].cleared(c.accel.abs());
-                    let velocity = self.deferred_slot(PeakOf::Velocity(0), body);
-                    self.deferred[velocity].cleared(v0.abs().max(v1.abs()));
-                    continue;
-                }
-                let p = &mut self.out.block_peak_abs_accel_mps2[body - n];
-                *p = p.max(c.accel.abs());
-                if self.opts.abs_velocity {
-                    let p = &mut self.out.block_peak_abs_velocity_mps[body - n];
-                    *p = p.max(v0.abs()).max(v1.abs());
-                }
+                let accel = self.deferred_slot(PeakOf::Accel(0), body);
+                self.deferred[accel].met(c.accel.abs());
+                let velocity = self.deferred_slot(PeakOf::Velocity(0), body);
+                self.deferred[velocity].met(v0.abs().max(v1.abs()));
             }
         }
         // New floor state.
@@ -1682,9 +1625,6 @@ impl<'b> Integrator<'b> {
             while let Some(((copy, g), best)) = self.deferred[d].next() {
                 let peak = Self::search_copy(&copy, &g, best, self.dt)?;
                 self.deferred[d].searched(peak);
-            }
-            if !self.defer_peaks {
-                continue;
             }
             let peak = self.deferred[d].peak();
             let body = |first: usize| d - first;
@@ -2009,16 +1949,18 @@ mod tests {
 
     fn run(b: &Building, accel: &[f64], opts: ExactOptions, defer: bool) -> BuildingResponse {
         let mut it = Integrator::new(b, 0.01, opts);
-        it.defer_peaks = defer;
+        if !defer {
+            it.deferred = (it.deferred.iter()).map(|_| DeferredPeak::new(0)).collect();
+        }
         it.run(accel, &Unwatched).unwrap()
     }
 
-    /// Deferred peak searches ([`DeferredPeak`]) against every failing piece searched in turn:
+    /// Deferred peak searches ([`DeferredPeak`]) against each failing piece searched at once:
     /// the same peaks to round-off (each piece's maximum is certified to `ε/8` of its value,
     /// from a start that differs between the two), every other output bit for bit (the peaks
     /// steer nothing).
     #[test]
-    fn deferred_peaks_are_every_pieces_searched_in_turn() {
+    fn deferred_peaks_are_each_failing_piece_searched_at_once() {
         let mut three = BuildingSpec::uniform(3, 0.6);
         three.stacks = vec![
             StackSpec::new(3, &[0.5, 0.5], &[0.2, 0.1]),

@@ -120,37 +120,6 @@ impl BuildingResponse {
         }
     }
 
-    /// The floors' and the blocks' peak absolute velocities (`velocity`) or accelerations: a
-    /// block stuck to its floor shares the floor's.
-    pub(super) fn riders(&self, velocity: bool) -> (&[f64], &[f64]) {
-        if velocity {
-            (
-                &self.floor_peak_abs_velocity_mps,
-                &self.block_peak_abs_velocity_mps,
-            )
-        } else {
-            (
-                &self.floor_peak_abs_accel_mps2,
-                &self.block_peak_abs_accel_mps2,
-            )
-        }
-    }
-
-    /// [`Self::riders`], to raise them.
-    pub(super) fn riders_mut(&mut self, velocity: bool) -> (&mut [f64], &mut [f64]) {
-        if velocity {
-            (
-                &mut self.floor_peak_abs_velocity_mps,
-                &mut self.block_peak_abs_velocity_mps,
-            )
-        } else {
-            (
-                &mut self.floor_peak_abs_accel_mps2,
-                &mut self.block_peak_abs_accel_mps2,
-            )
-        }
-    }
-
     /// Refuses a response with a non-finite number.
     pub fn check_finite(&self) -> Result<(), super::super::SimError> {
         let lists = [
