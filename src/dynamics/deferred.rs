@@ -3,7 +3,7 @@
 //!
 //! An integrator certifies each piece of a peak function against the peak so far and searches
 //! the piece exactly where the certificate fails ([`super::search::peak_abs`]). While a response
-//! grows nearly every piece fails it: on the integrator bench's twenty storeys 90 % of those
+//! grows nearly every piece fails it: on the integrator bench's twenty storeys 88 % of those
 //! searches raised the peak (docs/model.md, "A multi-storey building"), each refined to
 //! round-off, although only the piece that holds the run's peak decides the stored number. The
 //! building integrator keeps its peaks here; the one-storey integrator still searches each

@@ -639,7 +639,10 @@ impl<'b> Integrator<'b> {
             free: Vec::with_capacity(nb),
             piece: Piece::default(),
             p_start: ModalPoint::default(),
-            p_end: ModalPoint::default(),
+            p_end: ModalPoint {
+                integrals: opts.energy_balance,
+                ..ModalPoint::default()
+            },
             p_quad: ModalPoint::default(),
             end_rows: vec![0.0; row_count(n)],
             curvatures: vec![0.0; row_count(n)],

@@ -498,13 +498,15 @@ impl Piece {
     }
 }
 
-/// The modal state at one instant of a piece: `y(τ)`, `y'(τ)`, `∫₀^τ y` per kept mode.
+/// The modal state at one instant of a piece: `y(τ)`, `y'(τ)`, and `∫₀^τ y` per kept mode
+/// where `integrals` asks for it (the energy balance alone reads it).
 #[derive(Debug, Clone, Default)]
 pub struct ModalPoint {
     pub tau: f64,
     pub y: Vec<Cx>,
     pub dy: Vec<Cx>,
     pub iy: Vec<Cx>,
+    pub integrals: bool,
 }
 
 impl ModalPoint {
@@ -559,10 +561,12 @@ impl ModalPoint {
     fn set(&mut self, modes: &StateModes, piece: &Piece, r: usize, [e, p1, p2, p3]: [Cx; 4]) {
         self.y[r] = piece.y(r, e, p1, p2);
         self.dy[r] = piece.dy(r, modes.lambda[r], e, p1);
-        self.iy[r] = p1
-            .mul(piece.y0[r])
-            .add(p2.mul(piece.b0[r]))
-            .add(p3.mul(piece.b1[r]));
+        if self.integrals {
+            self.iy[r] = p1
+                .mul(piece.y0[r])
+                .add(p2.mul(piece.b0[r]))
+                .add(p3.mul(piece.b1[r]));
+        }
     }
 
     /// `Σ_r w_r·Re(c_r·x_r)` of a row `c` over one of this point's vectors.
