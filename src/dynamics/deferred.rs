@@ -70,8 +70,12 @@ impl<C> DeferredPeak<C> {
     /// A piece whose certificate failed: `bound ≥ max |f|` over it, `ends` the larger `|f|` of
     /// its end values. It waits; where more wait than the limit ([`PENDING`] by default), the one
     /// with the largest bound is returned with the peak to search it from, its result to go to
-    /// [`Self::searched`].
+    /// [`Self::searched`]. A piece whose bound is not a number is returned at once: its search
+    /// reports the value that is not finite, as the search of each piece in turn would.
     pub fn defer(&mut self, ends: f64, bound: f64, piece: C) -> Option<(C, f64)> {
+        if bound.is_nan() {
+            return Some((piece, self.known));
+        }
         self.raise(ends);
         if bound > self.known {
             self.pending.push(Pending { bound, piece });
@@ -228,6 +232,13 @@ mod tests {
             deferred_searches * 4 < eager_searches,
             "{deferred_searches} searches against {eager_searches}"
         );
+    }
+
+    #[test]
+    fn a_piece_that_is_not_a_number_is_searched_at_once() {
+        let mut d = DeferredPeak::default();
+        assert!(d.defer(1.0, 2.0, 0).is_none());
+        assert_eq!(d.defer(f64::NAN, f64::NAN, 1), Some((1, 1.0)));
     }
 
     #[test]

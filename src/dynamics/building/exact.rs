@@ -1434,12 +1434,14 @@ impl<'b> Integrator<'b> {
             let (f0, f1, slack) = self.ends_and_reach(mode, g, end);
             let ends = f0.abs().max(f1.abs());
             let bound = (f0.max(f1) + slack).max(slack - f0.min(f1));
+            // A bound not below the peak known (or not a number: its search reports it) waits.
             let (PeakOf::Accel(f) | PeakOf::Velocity(f)) = of else {
                 let d = self.deferred_slot(of, 0);
-                if bound > self.deferred[d].known() {
-                    let g = *g;
-                    self.defer_peak(d, ends, bound, &g, t0)?;
+                if bound <= self.deferred[d].known() {
+                    continue;
                 }
+                let g = *g;
+                self.defer_peak(d, ends, bound, &g, t0)?;
                 continue;
             };
             // The floor and the blocks riding on it share the value: the smallest of their
@@ -1451,11 +1453,13 @@ impl<'b> Integrator<'b> {
             let known = (bodies.iter())
                 .map(|&body| self.deferred[self.deferred_slot(of, body)].known())
                 .fold(f64::INFINITY, f64::min);
-            if bound > known {
-                let g = *g;
-                for &body in &bodies {
-                    self.defer_peak(self.deferred_slot(of, body), ends, bound, &g, t0)?;
-                }
+            if bound <= known {
+                self.sharing = bodies;
+                continue;
+            }
+            let g = *g;
+            for &body in &bodies {
+                self.defer_peak(self.deferred_slot(of, body), ends, bound, &g, t0)?;
             }
             self.sharing = bodies;
         }
@@ -1623,29 +1627,27 @@ impl<'b> Integrator<'b> {
 
     /// Searches the deferred peaks' waiting pieces that can still raise them, and stores them.
     fn settle_deferred_peaks(&mut self) -> Result<(), SimError> {
-        let n = self.n;
         for d in 0..self.deferred.len() {
             while let Some(((copy, g), best)) = self.deferred[d].next() {
                 let peak = Self::search_copy(&copy, &g, best, self.dt)?;
                 self.deferred[d].searched(peak);
             }
-            let peak = self.deferred[d].peak();
-            let body = |first: usize| d - first;
-            let (accel, velocity) = (3 * n + 1, 3 * n + 1 + self.bodies);
-            let out = &mut self.out;
-            match d {
-                _ if d < n => out.floor_peak_displacement_m[d] = peak,
-                _ if d < 2 * n => out.storey_peak_drift_m[d - n] = peak,
-                _ if d < 3 * n => out.storey_peak_shear_n[d - 2 * n] = peak,
-                _ if d < accel => out.peak_overturning_n_m = peak,
-                _ if d < accel + n => out.floor_peak_abs_accel_mps2[body(accel)] = peak,
-                _ if d < velocity => out.block_peak_abs_accel_mps2[body(accel + n)] = peak,
-                _ if d < velocity + n => out.floor_peak_abs_velocity_mps[body(velocity)] = peak,
-                _ => out.block_peak_abs_velocity_mps[body(velocity + n)] = peak,
-            }
         }
-        self.copy = None;
-        self.copies.clear();
+        let mut out = std::mem::take(&mut self.out);
+        let peak = |of: PeakOf, body: usize| self.deferred[self.deferred_slot(of, body)].peak();
+        for j in 0..self.n {
+            out.floor_peak_displacement_m[j] = peak(PeakOf::Disp(j), 0);
+            out.storey_peak_drift_m[j] = peak(PeakOf::Drift(j), 0);
+            out.storey_peak_shear_n[j] = peak(PeakOf::Shear(j), 0);
+            out.floor_peak_abs_accel_mps2[j] = peak(PeakOf::Accel(j), j);
+            out.floor_peak_abs_velocity_mps[j] = peak(PeakOf::Velocity(j), j);
+        }
+        for q in 0..self.b.blocks() {
+            out.block_peak_abs_accel_mps2[q] = peak(PeakOf::Accel(0), self.n + q);
+            out.block_peak_abs_velocity_mps[q] = peak(PeakOf::Velocity(0), self.n + q);
+        }
+        out.peak_overturning_n_m = peak(PeakOf::Overturning, 0);
+        self.out = out;
         Ok(())
     }
 
